@@ -1,0 +1,262 @@
+"""Triangle meshes with per-face labels, and the primitives assets are built from.
+
+A :class:`Mesh` is the unit every asset builder returns and the SceneModel stores
+as a prototype. It carries, per triangle, the native class id (a tree has trunk and
+crown faces) and the material id (from ``generator/materials.yaml``), plus named
+anchor points (lamp positions, headlights) the renderer uses to place lights.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import trimesh
+
+from generator.labels import class_table
+from generator.materials import material_table
+
+
+@dataclass
+class Mesh:
+    """A labelled triangle mesh in a local frame.
+
+    Attributes
+    ----------
+    vertices : (n, 3) float64
+        Local frame, metres, z up.
+    faces : (m, 3) int64
+        Vertex indices, counter-clockwise seen from outside (outward normals).
+    face_class : (m,) uint8
+        Native class id per triangle (``generator/labels/classes.yaml``).
+    face_material : (m,) uint16
+        Material id per triangle (``generator/materials.yaml``).
+    anchors : dict of str to (k, 3) float64
+        Named points in the local frame (e.g. ``"lamp"``, ``"headlight"``).
+    """
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    face_class: np.ndarray
+    face_material: np.ndarray
+    anchors: dict[str, np.ndarray] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        self.vertices = np.asarray(self.vertices, np.float64).reshape(-1, 3)
+        self.faces = np.asarray(self.faces, np.int64).reshape(-1, 3)
+        m = len(self.faces)
+        self.face_class = np.broadcast_to(np.asarray(self.face_class, np.uint8), (m,)).copy()
+        self.face_material = np.broadcast_to(np.asarray(self.face_material, np.uint16), (m,)).copy()
+        self.anchors = {k: np.asarray(v, np.float64).reshape(-1, 3) for k, v in self.anchors.items()}
+
+    @property
+    def n_faces(self) -> int:
+        return len(self.faces)
+
+    def bounds(self) -> np.ndarray:
+        """(2, 3) float64: min and max corner of the vertices."""
+        if len(self.vertices) == 0:
+            return np.zeros((2, 3))
+        return np.stack([self.vertices.min(0), self.vertices.max(0)])
+
+    def transformed(self, matrix: np.ndarray) -> "Mesh":
+        """A copy with vertices and anchors mapped by the 4x4 ``matrix``."""
+        return Mesh(
+            apply(matrix, self.vertices), self.faces, self.face_class, self.face_material,
+            {k: apply(matrix, v) for k, v in self.anchors.items()},
+        )
+
+    def select(self, face_mask: np.ndarray) -> "Mesh":
+        """The sub-mesh of the faces where ``face_mask`` is True (unused vertices dropped)."""
+        faces = self.faces[face_mask]
+        used, inverse = np.unique(faces, return_inverse=True)
+        return Mesh(self.vertices[used], inverse.reshape(-1, 3), self.face_class[face_mask],
+                    self.face_material[face_mask], dict(self.anchors))
+
+    def to_trimesh(self) -> trimesh.Trimesh:
+        """A :class:`trimesh.Trimesh` of the geometry (labels not carried)."""
+        return trimesh.Trimesh(self.vertices, self.faces, process=False)
+
+
+def empty() -> Mesh:
+    """A mesh with no faces."""
+    return Mesh(np.zeros((0, 3)), np.zeros((0, 3), np.int64), np.zeros(0, np.uint8), np.zeros(0, np.uint16))
+
+
+def merge(meshes: list[Mesh]) -> Mesh:
+    """Concatenate meshes (anchors with the same name are stacked)."""
+    meshes = [m for m in meshes if m.n_faces or m.anchors]
+    if not meshes:
+        return empty()
+    offsets = np.cumsum([0] + [len(m.vertices) for m in meshes[:-1]])
+    anchors: dict[str, list[np.ndarray]] = {}
+    for m in meshes:
+        for k, v in m.anchors.items():
+            anchors.setdefault(k, []).append(v)
+    return Mesh(
+        np.concatenate([m.vertices for m in meshes]),
+        np.concatenate([m.faces + o for m, o in zip(meshes, offsets)]),
+        np.concatenate([m.face_class for m in meshes]),
+        np.concatenate([m.face_material for m in meshes]),
+        {k: np.concatenate(v) for k, v in anchors.items()},
+    )
+
+
+def apply(matrix: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Map (n, 3) points by a 4x4 homogeneous ``matrix``."""
+    points = np.asarray(points, np.float64).reshape(-1, 3)
+    return points @ matrix[:3, :3].T + matrix[:3, 3]
+
+
+def pose(x: float = 0.0, y: float = 0.0, z: float = 0.0, yaw: float = 0.0,
+         pitch: float = 0.0, roll: float = 0.0) -> np.ndarray:
+    """4x4 float64 transform: rotate by roll (x), pitch (y), yaw (z), in that order, then translate.
+
+    Angles in radians; yaw counter-clockwise seen from above.
+    """
+    cr, sr, cp, sp, cy, sy = np.cos(roll), np.sin(roll), np.cos(pitch), np.sin(pitch), np.cos(yaw), np.sin(yaw)
+    rz = np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]])
+    ry = np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
+    rx = np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]])
+    m = np.eye(4)
+    m[:3, :3] = rz @ ry @ rx
+    m[:3, 3] = (x, y, z)
+    return m
+
+
+def _ids(cls: str | int, material: str | int) -> tuple[int, int]:
+    c = class_table().id(cls) if isinstance(cls, str) else int(cls)
+    m = material_table().id(material) if isinstance(material, str) else int(material)
+    return c, m
+
+
+def box(size: tuple[float, float, float], cls: str | int, material: str | int,
+        center: tuple[float, float, float] = (0.0, 0.0, 0.0), bottom: bool = True) -> Mesh:
+    """An axis-aligned box of ``size`` (x, y, z) metres centred on ``center``.
+
+    ``bottom=False`` leaves out the two bottom triangles (boxes resting on the ground
+    need no hidden floor).
+    """
+    tm = trimesh.creation.box(extents=size)
+    faces = tm.faces
+    if not bottom:
+        centroids_z = tm.vertices[faces].mean(1)[:, 2]
+        faces = faces[centroids_z > -size[2] / 2 + 1e-9]
+    c, m = _ids(cls, material)
+    return Mesh(tm.vertices + np.asarray(center, float), faces, c, m)
+
+
+def slab(x0: float, y0: float, x1: float, y1: float, z0: float, z1: float, cls: str | int,
+         material: str | int, bottom: bool = False) -> Mesh:
+    """A box spanning [x0, x1] x [y0, y1] x [z0, z1] (ground slabs, curbs)."""
+    return box((x1 - x0, y1 - y0, z1 - z0), cls, material, ((x0 + x1) / 2, (y0 + y1) / 2, (z0 + z1) / 2), bottom)
+
+
+def rect(x0: float, y0: float, x1: float, y1: float, z: float, cls: str | int, material: str | int) -> Mesh:
+    """A flat upward-facing rectangle at height ``z`` (markings, ground patches)."""
+    v = np.array([[x0, y0, z], [x1, y0, z], [x1, y1, z], [x0, y1, z]], float)
+    c, m = _ids(cls, material)
+    return Mesh(v, [[0, 1, 2], [0, 2, 3]], c, m)
+
+
+def quad(corners: np.ndarray, cls: str | int, material: str | int) -> Mesh:
+    """A planar quad from four (x, y, z) corners in counter-clockwise order (seen from its front)."""
+    c, m = _ids(cls, material)
+    return Mesh(np.asarray(corners, float), [[0, 1, 2], [0, 2, 3]], c, m)
+
+
+def cylinder(radius: float, height: float, cls: str | int, material: str | int, sections: int = 8,
+             z0: float = 0.0, radius_top: float | None = None, caps: bool = True) -> Mesh:
+    """A vertical (optionally tapered) cylinder from ``z0`` to ``z0 + height`` around the z axis."""
+    rt = radius if radius_top is None else radius_top
+    a = np.linspace(0, 2 * np.pi, sections, endpoint=False)
+    ring = np.stack([np.cos(a), np.sin(a)], 1)
+    v = np.concatenate([np.c_[ring * radius, np.full(sections, z0)], np.c_[ring * rt, np.full(sections, z0 + height)]])
+    i = np.arange(sections)
+    j = (i + 1) % sections
+    faces = [np.stack([i, j, j + sections], 1), np.stack([i, j + sections, i + sections], 1)]
+    if caps:
+        v = np.concatenate([v, [[0, 0, z0], [0, 0, z0 + height]]])
+        cb, ct = 2 * sections, 2 * sections + 1
+        faces += [np.stack([np.full(sections, cb), j, i], 1), np.stack([np.full(sections, ct), i + sections, j + sections], 1)]
+    c, m = _ids(cls, material)
+    return Mesh(v, np.concatenate(faces), c, m)
+
+
+def icosphere(radius: float, cls: str | int, material: str | int, subdivisions: int = 1,
+              center: tuple[float, float, float] = (0.0, 0.0, 0.0),
+              scale: tuple[float, float, float] = (1.0, 1.0, 1.0)) -> Mesh:
+    """An icosphere (20 * 4**subdivisions triangles), optionally scaled per axis into an ellipsoid."""
+    tm = trimesh.creation.icosphere(subdivisions=subdivisions, radius=radius)
+    c, m = _ids(cls, material)
+    return Mesh(tm.vertices * np.asarray(scale, float) + np.asarray(center, float), tm.faces, c, m)
+
+
+def prism(polygon: np.ndarray, z0: float, z1: float, cls: str | int, material: str | int,
+          top_material: str | int | None = None, bottom: bool = False) -> Mesh:
+    """Extrude a simple counter-clockwise polygon ((k, 2) metres) from ``z0`` to ``z1``.
+
+    Sides get ``material``; the top cap ``top_material`` (default ``material``).
+    """
+    poly = np.asarray(polygon, float)
+    k = len(poly)
+    tris = _triangulate(poly)
+    v = np.concatenate([np.c_[poly, np.full(k, z0)], np.c_[poly, np.full(k, z1)]])
+    i = np.arange(k)
+    j = (i + 1) % k
+    sides = np.concatenate([np.stack([i, j, j + k], 1), np.stack([i, j + k, i + k], 1)])
+    c, m = _ids(cls, material)
+    mt = m if top_material is None else _ids(cls, top_material)[1]
+    faces = [sides, tris + k]
+    mats = [np.full(len(sides), m), np.full(len(tris), mt)]
+    if bottom:
+        faces.append(tris[:, ::-1])
+        mats.append(np.full(len(tris), m))
+    return Mesh(v, np.concatenate(faces), c, np.concatenate(mats))
+
+
+def _triangulate(poly: np.ndarray) -> np.ndarray:
+    """Ear-clipping triangulation of a simple counter-clockwise polygon: (k-2, 3) int indices."""
+    idx = list(range(len(poly)))
+    out = []
+    guard = 0
+    while len(idx) > 3 and guard < 10000:
+        guard += 1
+        n = len(idx)
+        for t in range(n):
+            a, b, c = idx[(t - 1) % n], idx[t], idx[(t + 1) % n]
+            pa, pb, pc = poly[a], poly[b], poly[c]
+            cross = (pb[0] - pa[0]) * (pc[1] - pa[1]) - (pb[1] - pa[1]) * (pc[0] - pa[0])
+            if cross <= 1e-12:
+                continue
+            others = [poly[o] for o in idx if o not in (a, b, c)]
+            if any(_in_triangle(p, pa, pb, pc) for p in others):
+                continue
+            out.append((a, b, c))
+            idx.pop(t)
+            break
+        else:
+            raise ValueError("polygon is not simple or not counter-clockwise")
+    out.append(tuple(idx))
+    return np.array(out, np.int64)
+
+
+def _in_triangle(p, a, b, c) -> bool:
+    d1 = (p[0] - b[0]) * (a[1] - b[1]) - (a[0] - b[0]) * (p[1] - b[1])
+    d2 = (p[0] - c[0]) * (b[1] - c[1]) - (b[0] - c[0]) * (p[1] - c[1])
+    d3 = (p[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (p[1] - a[1])
+    neg = (d1 < 0) or (d2 < 0) or (d3 < 0)
+    pos = (d1 > 0) or (d2 > 0) or (d3 > 0)
+    return not (neg and pos)
+
+
+def convex_hull(mesh: Mesh, cls: str | int, inflate: float = 0.02) -> Mesh:
+    """Convex hull of ``mesh``'s vertices pushed out by ``inflate`` metres (a label proxy).
+
+    The hull is inflated so that it contains every vertex of the object strictly and
+    wins the depth test against the object's own surface in the label pass.
+    """
+    hull = trimesh.convex.convex_hull(mesh.vertices)
+    normals = hull.vertex_normals
+    c, _ = _ids(cls, "default")
+    return Mesh(hull.vertices + normals * inflate, hull.faces, c, 0)

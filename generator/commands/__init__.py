@@ -1,0 +1,1 @@
+"""One module per ``urbangen`` sub-command (see :mod:`generator.cli`)."""

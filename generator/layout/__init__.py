@@ -1,0 +1,1 @@
+"""Procedural town layout (pure numpy): streets, lots, placements, routes and frames."""

@@ -1,0 +1,75 @@
+"""The surface material table (``materials.yaml``), shared by assets, Blender and LiDAR."""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+
+@dataclass(frozen=True)
+class MaterialInfo:
+    """One row of the material table."""
+
+    id: int
+    name: str
+    reflectivity: float
+    retro: bool
+    color: tuple[int, int, int]
+    emissive: str | None
+
+
+class MaterialTable:
+    """Material rows with name lookup and per-id arrays."""
+
+    def __init__(self, rows: list[MaterialInfo]):
+        if [r.id for r in rows] != list(range(len(rows))):
+            raise ValueError("materials.yaml: ids must be 0..N-1 in order")
+        self.rows = rows
+        self.names = [r.name for r in rows]
+        self._by_name = {r.name: r for r in rows}
+
+    def __len__(self) -> int:
+        return len(self.rows)
+
+    def __getitem__(self, key: int | str) -> MaterialInfo:
+        return self._by_name[key] if isinstance(key, str) else self.rows[key]
+
+    def id(self, name: str) -> int:
+        """Material id of ``name``."""
+        try:
+            return self._by_name[name].id
+        except KeyError:
+            raise KeyError(f"unknown material {name!r}; known: {', '.join(self.names)}") from None
+
+    @functools.cached_property
+    def reflectivity(self) -> np.ndarray:
+        """(n_materials,) float32 diffuse reflectivity at 905 nm."""
+        return np.array([r.reflectivity for r in self.rows], np.float32)
+
+    @functools.cached_property
+    def retro(self) -> np.ndarray:
+        """(n_materials,) bool: retroreflective surfaces."""
+        return np.array([r.retro for r in self.rows], bool)
+
+    @functools.cached_property
+    def colors(self) -> np.ndarray:
+        """(n_materials, 3) uint8 preview colour."""
+        return np.array([r.color for r in self.rows], np.uint8)
+
+
+@functools.cache
+def material_table() -> MaterialTable:
+    """The package's material table (read once)."""
+    with open(Path(__file__).with_name("materials.yaml"), "r", encoding="utf-8") as f:
+        raw = yaml.safe_load(f)["materials"]
+    return MaterialTable(
+        [
+            MaterialInfo(int(r["id"]), str(r["name"]), float(r["reflectivity"]), bool(r["retro"]),
+                         tuple(int(c) for c in r["color"]), r["emissive"])
+            for r in raw
+        ]
+    )

@@ -1,0 +1,46 @@
+"""Read and validate scene specs and render configs.
+
+Each loader reads the file safely (``json`` / ``yaml.safe_load``), validates it against
+its packaged JSON Schema, checks cross-field rules, fills defaults and returns frozen
+dataclasses. Any problem is one :class:`generator.errors.SpecError`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+from pathlib import Path
+
+from generator.errors import SpecError
+from generator.spec.model import SceneSpec, build
+from generator.spec.validate import check_ranges, load_schema, read_document, validate, with_defaults
+
+
+def canonical_hash(data: dict) -> str:
+    """SHA-256 hex digest of the canonical JSON of ``data`` (sorted keys, no spaces)."""
+    return hashlib.sha256(json.dumps(data, sort_keys=True, separators=(",", ":")).encode()).hexdigest()
+
+
+def parse_spec(document: object, source: str) -> SceneSpec:
+    """Validate an already parsed spec document and build the :class:`SceneSpec`."""
+    schema = load_schema("scene")
+    if not isinstance(document, dict):
+        raise SpecError(source, "(top level)", f"must be a JSON object, got {type(document).__name__}")
+    validate(document, schema, source)
+    full = with_defaults(document, schema)
+    check_ranges(full, source)
+    spec = build(SceneSpec, full)
+    return dataclasses.replace(spec, source=source, spec_hash=canonical_hash(spec.to_dict()))
+
+
+def load_spec(path: str | Path) -> SceneSpec:
+    """Load a scene spec JSON file.
+
+    Raises
+    ------
+    SpecError
+        ``<file>: <field>: <reason>`` for a missing file, malformed JSON, unknown key,
+        wrong type, out-of-range value or inverted range.
+    """
+    return parse_spec(read_document(path), str(path))

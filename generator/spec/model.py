@@ -1,0 +1,180 @@
+"""Typed scene spec: frozen dataclasses mirroring ``schemas/scene.schema.json``.
+
+Defaults live in the schema only; :func:`generator.spec.load.load_spec` fills them in
+before these classes are built, so every field here is always present.
+Lengths in metres, angles in degrees (as written in the spec).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import typing
+from dataclasses import dataclass
+
+Range = tuple[float, float]
+Vec3 = tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class Town:
+    blocks_x: int
+    blocks_y: int
+    block_size_m: float
+    block_size_jitter_m: float
+    lanes_per_direction: int
+    lane_width_m: float
+    parking_strip_width_m: float
+    sidewalk_width_m: float
+    curb_height_m: float
+    margin_m: float
+
+    @property
+    def road_width_m(self) -> float:
+        """Kerb-to-kerb width of a street: lanes both ways plus both parking strips."""
+        return 2 * self.lanes_per_direction * self.lane_width_m + 2 * self.parking_strip_width_m
+
+
+@dataclass(frozen=True)
+class Density:
+    buildings: float
+    trees_per_100m: float
+    bushes_per_100m: float
+    hedges: float
+    fences: float
+    parked_cars_per_100m: float
+    truck_fraction: float
+    moving_cars_per_100m: float
+    people_per_100m: float
+    signs_per_block: float
+    lamp_spacing_m: float
+    parks: float
+
+
+@dataclass(frozen=True)
+class Heights:
+    building_m: Range
+    floor_m: float
+    tree_m: Range
+    person_m: Range
+
+
+@dataclass(frozen=True)
+class Paths:
+    spacing_m: float
+    yaw_jitter_deg: float
+    pitch_jitter_deg: float
+    roll_jitter_deg: float
+    speed_mps: float
+    clearance_m: float
+
+
+@dataclass(frozen=True)
+class Camera:
+    hfov_deg: float
+    xyz_m: Vec3
+    rpy_deg: Vec3
+
+
+@dataclass(frozen=True)
+class Lidar:
+    preset: str
+    sensor_file: str | None
+    xyz_m: Vec3
+    rpy_deg: Vec3
+    motion_skew: bool
+
+
+@dataclass(frozen=True)
+class Sensors:
+    camera: Camera
+    lidar: Lidar
+
+
+@dataclass(frozen=True)
+class Weather:
+    fog_visibility_m: Range
+    rain_rate_mmh: Range
+    wetness: Range
+    sun_elevation_deg: Range
+    sun_azimuth_deg: Range
+    lit_windows: Range
+
+
+@dataclass(frozen=True)
+class DomainGap:
+    enabled: bool
+    dropout: float
+    jitter_m: float
+    constant_intensity: float | None
+
+
+@dataclass(frozen=True)
+class LidarProcessing:
+    intensity_model: str
+    intensity_profile: str | None
+    constant_intensity: float
+    domain_gap: DomainGap
+
+
+@dataclass(frozen=True)
+class Labels:
+    openlabel_min_points: int
+
+
+@dataclass(frozen=True)
+class SceneSpec:
+    """A validated scene spec (see ``schemas/scene.schema.json`` for every field's meaning).
+
+    Attributes
+    ----------
+    source : str
+        The file it was read from (for messages; relative paths in the spec resolve against it).
+    spec_hash : str
+        SHA-256 of the canonical JSON of the spec with defaults filled in.
+    """
+
+    name: str
+    seed: int
+    town: Town
+    density: Density
+    heights: Heights
+    paths: Paths
+    sensors: Sensors
+    weather: Weather
+    lidar: LidarProcessing
+    labels: Labels
+    source: str = ""
+    spec_hash: str = ""
+
+    def to_dict(self) -> dict:
+        """The spec as plain JSON-able data (without ``source`` and ``spec_hash``)."""
+        d = dataclasses.asdict(self)
+        d.pop("source")
+        d.pop("spec_hash")
+        return _lists(d)
+
+
+def _lists(x):
+    if isinstance(x, dict):
+        return {k: _lists(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_lists(v) for v in x]
+    return x
+
+
+def build(cls, data: dict):
+    """Construct dataclass ``cls`` from validated, default-filled ``data`` (recursively)."""
+    hints = typing.get_type_hints(cls)
+    kwargs = {}
+    for f in dataclasses.fields(cls):
+        if f.name not in data:
+            continue
+        t, v = hints[f.name], data[f.name]
+        if dataclasses.is_dataclass(t):
+            v = build(t, v)
+        elif typing.get_origin(t) is tuple:
+            v = tuple(float(x) for x in v)
+        elif t is float and isinstance(v, int):
+            v = float(v)
+        kwargs[f.name] = v
+    return cls(**kwargs)
