@@ -1,0 +1,1 @@
+"""Dataset file formats: SemanticKITTI, KITTI calib, PLY, label configs."""

@@ -1,0 +1,1 @@
+"""Image outputs: previews, post effects, EXR and metadata."""
