@@ -1,0 +1,1 @@
+"""Virtual spinning LiDAR: sensor tables, Embree ray casting against the SceneModel, labelled points."""
