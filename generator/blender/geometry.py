@@ -1,0 +1,124 @@
+"""SceneModel -> Blender objects.
+
+One mesh datablock per prototype (repeated assets are linked duplicates: instancing),
+built with ``foreach_set`` from the very arrays the LiDAR casts against. Every mesh
+carries the per-face ``class_id`` (INT) and ``face_rand`` (FLOAT in [0, 1)) attributes;
+every object carries its instance id as ``pass_index`` and its colour in ``color``.
+Label proxies live in their own collection, hidden in the RGB pass.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from assets_procedural.mesh import Mesh
+from generator.blender.bpy_guard import bpy, mathutils
+from generator.materials import material_table
+from generator.rng import stream
+from generator.scene import SceneModel
+
+#: Materials shaded smooth (organic shapes); everything else is flat (hard surfaces).
+SMOOTH_MATERIALS = frozenset({"leaves", "hedge_leaves", "bark", "skin", "hair", "clothing", "rubber"})
+
+
+@dataclass
+class BlenderScene:
+    """Handles to what :func:`build` created."""
+
+    real: "bpy.types.Collection"
+    proxies: "bpy.types.Collection"
+    objects: list
+    proxy_objects: list
+    meshes: dict
+
+
+def _mesh(name: str, m: Mesh, materials: list, seed: int) -> "bpy.types.Mesh":
+    me = bpy.data.meshes.new(name)
+    n_v, n_f = len(m.vertices), m.n_faces
+    me.vertices.add(n_v)
+    me.vertices.foreach_set("co", m.vertices.astype(np.float32).ravel())
+    me.loops.add(3 * n_f)
+    me.loops.foreach_set("vertex_index", m.faces.astype(np.int32).ravel())
+    me.polygons.add(n_f)
+    me.polygons.foreach_set("loop_start", np.arange(0, 3 * n_f, 3, dtype=np.int32))
+    used = np.unique(m.face_material)
+    for mid in used:
+        me.materials.append(materials[int(mid)])
+    slot = np.searchsorted(used, m.face_material).astype(np.int32)
+    me.polygons.foreach_set("material_index", slot)
+    table = material_table()
+    smooth = np.isin(m.face_material, [table.id(n) for n in SMOOTH_MATERIALS])
+    me.attributes.new("sharp_face", "BOOLEAN", "FACE").data.foreach_set("value", ~smooth)
+    me.attributes.new("class_id", "INT", "FACE").data.foreach_set("value", m.face_class.astype(np.int32))
+    rand = stream(seed, "blender", "face_rand", name).random(n_f).astype(np.float32)
+    me.attributes.new("face_rand", "FLOAT", "FACE").data.foreach_set("value", rand)
+    me.update()
+    return me
+
+
+def build(scene: SceneModel, materials: list, parent: "bpy.types.Collection") -> BlenderScene:
+    """Create every object of ``scene`` under ``parent``.
+
+    Parameters
+    ----------
+    scene : SceneModel
+    materials : list of bpy.types.Material
+        Indexed by material id (see :func:`generator.blender.materials.build_materials`).
+    parent : bpy.types.Collection
+        Usually the scene's master collection.
+    """
+    real = bpy.data.collections.new("urbangen_real")
+    proxies = bpy.data.collections.new("urbangen_proxies")
+    parent.children.link(real)
+    parent.children.link(proxies)
+    meshes = {key: _mesh(key, m, materials, scene.seed) for key, m in scene.prototypes.items()}
+    proxy_meshes = {key: _mesh("hull:" + key, m, materials, scene.seed) for key, m in scene.proxies.items()}
+    objs, hulls = [], []
+    for o in scene.objects:
+        ob = bpy.data.objects.new(o.name, meshes[o.prototype])
+        ob.matrix_world = _matrix(o.transform)
+        ob.pass_index = int(o.instance_id)
+        color = o.attrs.get("color", (1.0, 1.0, 1.0))
+        ob.color = (float(color[0]), float(color[1]), float(color[2]), 1.0)
+        ob["ug_class"] = o.cls
+        real.objects.link(ob)
+        objs.append(ob)
+        if o.proxy is not None:
+            hb = bpy.data.objects.new(o.name + "_hull", proxy_meshes[o.proxy])
+            hb.matrix_world = _matrix(o.transform)
+            hb.pass_index = int(o.instance_id)
+            proxies.objects.link(hb)
+            hulls.append(hb)
+    return BlenderScene(real, proxies, objs, hulls, meshes)
+
+
+def _matrix(t: np.ndarray) -> "mathutils.Matrix":
+    return mathutils.Matrix([list(map(float, row)) for row in t])
+
+
+def set_proxies_visible(bs: BlenderScene, visible: bool) -> None:
+    """Show the label proxies (label pass) or hide them completely (RGB pass: no shading, no shadow)."""
+    bs.proxies.hide_render = not visible
+
+
+def evaluated_triangles(depsgraph, collection: "bpy.types.Collection") -> tuple[int, np.ndarray]:
+    """Triangle count and (2, 3) world bounds of the evaluated objects of ``collection``.
+
+    Used by tests to hold Blender's geometry equal to the SceneModel.
+    """
+    n = 0
+    lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
+    for ob in collection.objects:
+        ev = ob.evaluated_get(depsgraph)
+        me = ev.to_mesh()
+        me.calc_loop_triangles()
+        n += len(me.loop_triangles)
+        co = np.empty(len(me.vertices) * 3, np.float32)
+        me.vertices.foreach_get("co", co)
+        co = co.reshape(-1, 3) @ np.array(ev.matrix_world)[:3, :3].T + np.array(ev.matrix_world)[:3, 3]
+        if len(co):
+            lo, hi = np.minimum(lo, co.min(0)), np.maximum(hi, co.max(0))
+        ev.to_mesh_clear()
+    return n, np.stack([lo, hi])

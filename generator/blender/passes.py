@@ -1,0 +1,114 @@
+"""Render passes as numpy arrays.
+
+* RGB pass: the config's Cycles settings, label proxies hidden -> linear RGB.
+* Real pass: label material, 1 sample, proxies hidden -> class and instance of the real
+  surface at each pixel centre and its planar depth.
+* Label pass: the same with the proxies shown -> the mask class and instance.
+
+Depth is converted from Cycles' planar Z to the distance along the pixel's ray
+(range, metres) so it compares directly with LiDAR range; sky pixels get +inf.
+Background mode has no pixels in "Render Result", so each render is saved with
+``save_render`` to an uncompressed float EXR in a scratch folder and read back.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import OpenEXR
+
+from generator import rig
+from generator.blender import geometry, session
+from generator.blender.bpy_guard import bpy
+from generator.blender.materials import label_material, label_world
+
+SKY_Z = 1e9
+
+
+@dataclass
+class LabelPasses:
+    """Per-pixel labels of one camera pose.
+
+    Attributes
+    ----------
+    class_id : (H, W) uint8
+        Native class with label proxies (what the masks hold).
+    instance : (H, W) uint16
+        Instance id with label proxies (0 for stuff and sky).
+    real_class : (H, W) uint8
+        Native class of the real geometry (proxies hidden): what a ray from the camera hits.
+    real_instance : (H, W) uint16
+    depth : (H, W) float32
+        Distance along the pixel's ray to the real geometry, metres; +inf for sky.
+    seconds : dict
+    """
+
+    class_id: np.ndarray
+    instance: np.ndarray
+    real_class: np.ndarray
+    real_instance: np.ndarray
+    depth: np.ndarray
+    seconds: dict = field(default_factory=dict)
+
+
+def _render(scene, path: Path) -> dict[str, np.ndarray]:
+    bpy.ops.render.render(write_still=False)
+    bpy.data.images["Render Result"].save_render(str(path), scene=scene)
+    with OpenEXR.File(str(path)) as f:
+        chans = {}
+        for part in f.parts:
+            for name, ch in part.channels.items():
+                chans[name.split(".", 1)[-1]] = np.array(ch.pixels)
+    path.unlink()
+    return chans
+
+
+def render_rgb(scene, bs: geometry.BlenderScene, cfg, seed: int, scratch: Path) -> tuple[np.ndarray, float]:
+    """Render the RGB pass; return ((H, W, 3) float32 linear RGB, seconds)."""
+    session.rgb_state(scene, cfg, seed)
+    geometry.set_proxies_visible(bs, False)
+    t = time.perf_counter()
+    chans = _render(scene, scratch / "rgb.exr")
+    combined = chans["Combined"]
+    return np.ascontiguousarray(combined[..., :3], np.float32), time.perf_counter() - t
+
+
+def _integers(rgba: np.ndarray, what: str) -> tuple[np.ndarray, np.ndarray]:
+    vals = rgba[..., :2]
+    ints = np.rint(vals)
+    bad = np.abs(vals - ints) > 1e-3
+    if bad.any():
+        raise RuntimeError(f"{what}: {int(bad.sum())} pixel values are not integers: labels would be blended")
+    return ints[..., 0].astype(np.uint8), ints[..., 1].astype(np.uint16)
+
+
+def render_labels(scene, bs: geometry.BlenderScene, k: np.ndarray, scratch: Path) -> LabelPasses:
+    """Render the real and label passes for the current camera.
+
+    Parameters
+    ----------
+    k : (3, 3) float64
+        Camera intrinsics, used to turn planar depth into range along each pixel ray.
+    """
+    session.label_state(scene, label_material(), label_world())
+    secs = {}
+    geometry.set_proxies_visible(bs, False)
+    t = time.perf_counter()
+    real = _render(scene, scratch / "real.exr")
+    secs["real_pass"] = time.perf_counter() - t
+    geometry.set_proxies_visible(bs, True)
+    t = time.perf_counter()
+    lab = _render(scene, scratch / "label.exr")
+    secs["label_pass"] = time.perf_counter() - t
+    geometry.set_proxies_visible(bs, False)
+    real_class, real_instance = _integers(real["Combined"], "real pass")
+    class_id, instance = _integers(lab["Combined"], "label pass")
+    h, w = class_id.shape
+    z = real["Depth.Z"] if "Depth.Z" in real else real["Z"]
+    cos = rig.pixel_rays(k, w, h)[..., 2]
+    depth = (z / cos).astype(np.float32)
+    depth[z >= SKY_Z] = np.inf
+    return LabelPasses(class_id, instance, real_class, real_instance, depth, secs)

@@ -1,0 +1,313 @@
+"""Procedural material recipes, one function per name in ``generator/materials.yaml``.
+
+Each recipe receives a :class:`Nodes` builder, a parameter generator (seeded per
+material, so every seed gives a slightly different town) and returns the surface
+shader socket. Scene-wide switches are scene custom properties read with
+``VIEW_LAYER`` attributes (see :mod:`generator.blender.controls`); per-object colour
+is ``Object.color`` (Object Info > Color); ``face_rand`` is a per-face random in [0, 1).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from generator.blender.controls import CONTROL
+from generator.blender.nodes import Nodes
+
+
+def _jit(rng: np.random.Generator, base, spread: float):
+    base = np.asarray(base, float)
+    return tuple(np.clip(base * (1 + rng.uniform(-spread, spread, base.shape)), 0, 1))
+
+
+def _wet(g: Nodes, color, roughness, normal=None, puddles: bool = True):
+    """Wet-surface modifier: darker, glossier, puddles with ripples where the noise is low."""
+    wet = g.attr(CONTROL["wetness"], "VIEW_LAYER")
+    seed = g.attr(CONTROL["puddle_seed"], "VIEW_LAYER")
+    mask = wet
+    if puddles:
+        pud = g.noise(g.coords("Object"), scale=0.08, detail=3, roughness=0.6, w=seed)
+        pud = g.math("MULTIPLY", g.smooth(pud, 0.56, 0.6), wet)
+        ripple = g.math("SUBTRACT", g.voronoi(scale=6.0, w=g.mul(seed, 7.0)), g.voronoi(scale=6.5, w=g.mul(seed, 7.0)))
+        normal = g.bump(g.mul(ripple, pud), strength=0.15, distance=0.01, normal=normal)
+        mask = g.math("MAXIMUM", wet, pud)
+        roughness = g.lerp(pud, roughness, 0.02)
+    color = g.mix(g.mul(mask, 0.55), color, g.mix(0.5, color, (0, 0, 0), "MULTIPLY"))
+    roughness = g.lerp(g.mul(wet, 0.8), roughness, 0.08)
+    return color, roughness, normal
+
+
+def _emit(g: Nodes, shader, color, strength: float, group: str, factor=1.0):
+    on = g.mul(g.attr(CONTROL["light_" + group], "VIEW_LAYER"), factor)
+    return g.add_shader(shader, g.emission(color, g.mul(on, strength)))
+
+
+def asphalt(g: Nodes, rng, tone=0.055, wear=0.5):
+    co = g.coords("Object")
+    tone = tone * rng.uniform(0.85, 1.2)
+    grain = g.noise(co, scale=80, detail=4)
+    patches = g.noise(co, scale=0.06, detail=3)
+    crack_zone = g.smooth(g.noise(co, scale=0.12, detail=2), 0.58, 0.66)
+    edges = g.smooth(g.voronoi(g.mapping(co, scale=(1, 1, 1)), scale=0.25, feature="DISTANCE_TO_EDGE"), 0.0, 0.01)
+    cracks = g.lerp(crack_zone, 1.0, edges)
+    base = g.ramp(grain, [(0.3, (tone * 0.7,) * 3), (0.7, (tone * 1.4,) * 3)])
+    base = g.mix(g.mul(g.smooth(patches, 0.45, 0.6), wear), base, (tone * 1.8, tone * 1.75, tone * 1.7))
+    base = g.mix(0.5, base, g.mix(cracks, (0.02, 0.02, 0.02), (1, 1, 1)), "MULTIPLY")
+    color, rough, normal = _wet(g, base, 0.85, g.bump(grain, 0.25, 0.01))
+    return g.principled(base_color=color, roughness=rough, normal=normal)
+
+
+def parking_asphalt(g, rng):
+    return asphalt(g, rng, tone=0.075, wear=0.8)
+
+
+def _paint(g, rng, color):
+    co = g.coords("Object")
+    dirt = g.noise(co, scale=3, detail=4)
+    base = g.mix(g.mul(g.smooth(dirt, 0.5, 0.8), 0.5), _jit(rng, color, 0.05), (0.35, 0.35, 0.33))
+    col, rough, normal = _wet(g, base, 0.55, None, puddles=False)
+    return g.principled(base_color=col, roughness=rough)
+
+
+def lane_paint(g, rng):
+    return _paint(g, rng, (0.75, 0.75, 0.72))
+
+
+def crosswalk_paint(g, rng):
+    return _paint(g, rng, (0.8, 0.8, 0.78))
+
+
+def _concrete(g, rng, tone, slabs: bool):
+    co = g.coords("Object")
+    n = g.noise(co, scale=25, detail=5)
+    base = g.ramp(n, [(0.35, _jit(rng, (tone * 0.85,) * 3, 0.05)), (0.65, _jit(rng, (tone * 1.1,) * 3, 0.05))])
+    if slabs:
+        xy = g.mapping(co, scale=(1, 1, 0))
+        joints = g.brick(xy, color1=(1, 1, 1), color2=(0.92, 0.92, 0.92), mortar=(0.45, 0.45, 0.45), scale=1.0,
+                         mortar_size=0.008, brick_width=1.0, row_height=1.0, offset=0.0)
+        base = g.mix(1.0, base, joints, "MULTIPLY")
+    col, rough, normal = _wet(g, base, 0.8, g.bump(n, 0.1, 0.01))
+    return g.principled(base_color=col, roughness=rough, normal=normal)
+
+
+def sidewalk_concrete(g, rng):
+    return _concrete(g, rng, 0.42, slabs=True)
+
+
+def curb_concrete(g, rng):
+    return _concrete(g, rng, 0.5, slabs=False)
+
+
+def grass(g, rng):
+    co = g.coords("Object")
+    n = g.noise(co, scale=1.5, detail=6)
+    fine = g.noise(co, scale=60, detail=2)
+    base = g.ramp(n, [(0.3, _jit(rng, (0.06, 0.11, 0.025), 0.1)), (0.7, _jit(rng, (0.13, 0.17, 0.04), 0.1))])
+    base = g.mix(g.mul(fine, 0.3), base, (0.2, 0.18, 0.08))
+    col, rough, normal = _wet(g, base, 0.95, g.bump(fine, 0.4, 0.02), puddles=False)
+    return g.principled(base_color=col, roughness=rough, normal=normal)
+
+
+def soil(g, rng):
+    n = g.noise(g.coords("Object"), scale=8, detail=6)
+    base = g.ramp(n, [(0.3, (0.10, 0.07, 0.045)), (0.7, (0.16, 0.12, 0.08))])
+    col, rough, normal = _wet(g, base, 0.95, g.bump(n, 0.3, 0.02), puddles=False)
+    return g.principled(base_color=col, roughness=rough, normal=normal)
+
+
+def _wall_coords(g):
+    """(x + y, z) so axis-aligned walls map metres along the wall and up."""
+    co = g.coords("Object")
+    sep = g.node("ShaderNodeSeparateXYZ")
+    g.set(sep.inputs[0], co)
+    comb = g.node("ShaderNodeCombineXYZ")
+    g.set(comb.inputs[0], g.add(sep.outputs["X"], sep.outputs["Y"]))
+    g.set(comb.inputs[1], sep.outputs["Z"])
+    return comb.outputs[0], co
+
+
+def _tint(g, base):
+    """Multiply a colour by the object's colour (``attrs['color']`` on the object)."""
+    return g.mix(1.0, base, g.object_info("Color"), "MULTIPLY")
+
+
+def facade_plaster(g, rng):
+    uv, co = _wall_coords(g)
+    n = g.noise(co, scale=4, detail=6)
+    stains = g.smooth(g.noise(g.mapping(co, scale=(1, 1, 0.3)), scale=0.8, detail=4), 0.55, 0.75)
+    base = g.mix(g.mul(stains, 0.35), g.ramp(n, [(0.4, (0.92,) * 3), (0.6, (1.0,) * 3)]), (0.45, 0.42, 0.38), "MULTIPLY")
+    return g.principled(base_color=_tint(g, base), roughness=0.9, normal=g.bump(n, 0.15, 0.02))
+
+
+def facade_brick(g, rng):
+    uv, co = _wall_coords(g)
+    c1 = _jit(rng, (0.30, 0.085, 0.045), 0.15)
+    c2 = _jit(rng, (0.22, 0.065, 0.035), 0.15)
+    bricks = g.brick(uv, color1=c1, color2=c2, mortar=(0.45, 0.43, 0.4), scale=1.0, mortar_size=0.012,
+                     brick_width=0.25, row_height=0.075)
+    mortar = g.brick(uv, color1=(1, 1, 1), color2=(1, 1, 1), mortar=(0, 0, 0), scale=1.0, mortar_size=0.012,
+                     brick_width=0.25, row_height=0.075, out="Factor")
+    n = g.noise(co, scale=30, detail=3)
+    base = g.mix(g.mul(n, 0.25), bricks, (0.1, 0.05, 0.03))
+    return g.principled(base_color=_tint(g, base), roughness=0.85, normal=g.bump(mortar, 0.3, 0.01))
+
+
+def facade_concrete(g, rng):
+    uv, co = _wall_coords(g)
+    panels = g.brick(uv, color1=(0.95, 0.95, 0.95), color2=(0.85, 0.85, 0.85), mortar=(0.3, 0.3, 0.3), scale=1.0,
+                     mortar_size=0.01, brick_width=3.0, row_height=1.6, offset=0.0)
+    n = g.noise(co, scale=6, detail=8)
+    base = g.mix(1.0, panels, g.ramp(n, [(0.3, (0.5,) * 3), (0.7, (0.62,) * 3)]), "MULTIPLY")
+    return g.principled(base_color=_tint(g, base), roughness=0.8, normal=g.bump(n, 0.1, 0.01))
+
+
+def window_glass(g, rng):
+    lit_fraction = g.attr(CONTROL["lit_windows"], "VIEW_LAYER")
+    lit = g.math("LESS_THAN", g.attr("face_rand"), lit_fraction)
+    warm = g.mix(g.object_info("Random"), (1.0, 0.75, 0.45), (0.9, 0.9, 1.0))
+    glass = g.principled(base_color=(0.02, 0.025, 0.03), roughness=0.03, metallic=0.0, ior=1.5, specular=1.0)
+    return _emit(g, glass, warm, 6.0, "windows", lit)
+
+
+def window_frame(g, rng):
+    return g.principled(base_color=_jit(rng, (0.75, 0.75, 0.72), 0.05), roughness=0.5)
+
+
+def roof(g, rng):
+    uv, co = _wall_coords(g)
+    tiles = g.brick(uv, color1=_jit(rng, (0.22, 0.08, 0.06), 0.2), color2=_jit(rng, (0.16, 0.06, 0.05), 0.2),
+                    mortar=(0.05, 0.05, 0.05), scale=1.0, mortar_size=0.01, brick_width=0.3, row_height=0.22)
+    n = g.noise(co, scale=10, detail=4)
+    return g.principled(base_color=_tint(g, tiles), roughness=0.75, normal=g.bump(n, 0.2, 0.01))
+
+
+def door(g, rng):
+    uv, co = _wall_coords(g)
+    grain = g.wave(co, scale=2, distortion=6, detail=4, direction="Z")
+    base = g.ramp(grain, [(0.2, (0.12, 0.06, 0.03)), (0.8, (0.2, 0.11, 0.06))])
+    return g.principled(base_color=base, roughness=0.6)
+
+
+def bark(g, rng):
+    co = g.coords("Object")
+    stripes = g.wave(g.mapping(co, scale=(4, 4, 0.5)), scale=3, distortion=8, detail=6, direction="X")
+    base = g.ramp(stripes, [(0.2, (0.05, 0.035, 0.025)), (0.8, (0.16, 0.12, 0.09))])
+    return g.principled(base_color=base, roughness=0.9, normal=g.bump(stripes, 0.6, 0.02))
+
+
+def _foliage(g, rng, color):
+    n = g.noise(g.coords("Object"), scale=3, detail=4)
+    hue = g.add(0.46, g.mul(g.object_info("Random"), 0.08))
+    base = g.hsv(g.ramp(n, [(0.3, _jit(rng, color, 0.1)), (0.7, _jit(rng, np.asarray(color) * 1.6, 0.1))]),
+                 hue=hue, value=g.add(0.8, g.mul(g.attr("face_rand"), 0.4)))
+    leaf = g.principled(base_color=base, roughness=0.7, specular=0.3, normal=g.bump(g.noise(scale=40), 0.5, 0.02))
+    return g.mix_shader(0.25, leaf, g.translucent(base))
+
+
+def leaves(g, rng):
+    return _foliage(g, rng, (0.045, 0.09, 0.02))
+
+
+def hedge_leaves(g, rng):
+    return _foliage(g, rng, (0.03, 0.07, 0.018))
+
+
+def car_paint(g, rng):
+    return g.principled(base_color=g.object_info("Color"), metallic=0.4, roughness=0.3, coat=1.0, coat_roughness=0.05)
+
+
+def truck_paint(g, rng):
+    return g.principled(base_color=g.object_info("Color"), metallic=0.1, roughness=0.45)
+
+
+def car_glass(g, rng):
+    return g.principled(base_color=(0.01, 0.012, 0.015), roughness=0.02, ior=1.5, specular=1.0)
+
+
+def rubber(g, rng):
+    return g.principled(base_color=(0.015, 0.015, 0.015), roughness=0.9)
+
+
+def chrome(g, rng):
+    return g.principled(base_color=(0.8, 0.8, 0.82), metallic=1.0, roughness=0.15)
+
+
+def headlight(g, rng):
+    lens = g.principled(base_color=(0.8, 0.8, 0.8), roughness=0.1, metallic=0.6)
+    return _emit(g, lens, (1.0, 0.95, 0.85), 40.0, "vehicle_lights")
+
+
+def taillight(g, rng):
+    lens = g.principled(base_color=(0.4, 0.02, 0.02), roughness=0.15)
+    return _emit(g, lens, (1.0, 0.05, 0.02), 15.0, "vehicle_lights")
+
+
+def pole_metal(g, rng):
+    n = g.noise(g.coords("Object"), scale=20, detail=3)
+    base = g.ramp(n, [(0.3, _jit(rng, (0.18, 0.19, 0.2), 0.1)), (0.7, (0.26, 0.27, 0.28))])
+    return g.principled(base_color=base, metallic=0.7, roughness=0.45)
+
+
+def lamp_glass(g, rng):
+    glass = g.principled(base_color=(0.8, 0.78, 0.7), roughness=0.2)
+    return _emit(g, glass, (1.0, 0.8, 0.55), 60.0, "street_lamps")
+
+
+def sign_face(g, rng):
+    return g.principled(base_color=g.object_info("Color"), roughness=0.35, specular=0.8)
+
+
+def sign_back(g, rng):
+    return g.principled(base_color=(0.35, 0.36, 0.37), metallic=0.8, roughness=0.4)
+
+
+def tl_housing(g, rng):
+    return g.principled(base_color=(0.02, 0.02, 0.02), roughness=0.5)
+
+
+def _signal(g, color, which: int):
+    """A signal lamp, lit when the object's state (Object Info > Random in thirds) selects it."""
+    state = g.math("FLOOR", g.mul(g.object_info("Random"), 3.0))
+    lit = g.math("COMPARE", state, float(which))
+    lens = g.principled(base_color=tuple(c * 0.25 for c in color), roughness=0.1)
+    on = g.add(g.mul(lit, 0.8), 0.2)
+    return _emit(g, lens, color, 30.0, "traffic_lights", on)
+
+
+def tl_red(g, rng):
+    return _signal(g, (1.0, 0.05, 0.02), 0)
+
+
+def tl_amber(g, rng):
+    return _signal(g, (1.0, 0.55, 0.02), 1)
+
+
+def tl_green(g, rng):
+    return _signal(g, (0.1, 1.0, 0.4), 2)
+
+
+def fence_metal(g, rng):
+    return g.principled(base_color=_jit(rng, (0.05, 0.07, 0.05), 0.2), metallic=0.6, roughness=0.5)
+
+
+def fence_wood(g, rng):
+    grain = g.wave(g.coords("Object"), scale=3, distortion=5, detail=4, direction="Z")
+    base = g.ramp(grain, [(0.2, (0.2, 0.13, 0.07)), (0.8, (0.32, 0.22, 0.13))])
+    return g.principled(base_color=base, roughness=0.8)
+
+
+def skin(g, rng):
+    tone = g.mix(g.object_info("Random"), (0.45, 0.28, 0.2), (0.12, 0.07, 0.045))
+    return g.principled(base_color=tone, roughness=0.5, subsurface=0.1)
+
+
+def clothing(g, rng):
+    return g.principled(base_color=g.object_info("Color"), roughness=0.85, sheen=0.3)
+
+
+def hair(g, rng):
+    return g.principled(base_color=g.mix(g.object_info("Random"), (0.02, 0.015, 0.01), (0.25, 0.17, 0.08)), roughness=0.6)
+
+
+def default(g, rng):
+    return g.principled(base_color=(0.3, 0.3, 0.3), roughness=0.7)

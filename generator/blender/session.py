@@ -1,0 +1,110 @@
+"""Blender session: an empty scene configured for Cycles from a RenderConfig.
+
+Two render states share one scene: the RGB pass (the config's samples, bounces,
+filter, denoiser) and the label pass (1 sample, no bounces, a box filter of minimal
+width, no denoising, the label material and world as view-layer overrides).
+"""
+
+from __future__ import annotations
+
+import logging
+
+from generator.blender.bpy_guard import bpy
+from generator.spec.render import RenderConfig
+
+log = logging.getLogger(__name__)
+
+
+def reset() -> "bpy.types.Scene":
+    """Start from an empty factory scene and return it."""
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    return bpy.context.scene
+
+
+def _gpu_available() -> bool:
+    prefs = bpy.context.preferences.addons["cycles"].preferences
+    for backend in ("OPTIX", "CUDA", "HIP", "ONEAPI", "METAL"):
+        try:
+            prefs.compute_device_type = backend
+        except TypeError:
+            continue
+        prefs.get_devices()
+        gpus = [d for d in prefs.devices if d.type != "CPU"]
+        if gpus:
+            for d in prefs.devices:
+                d.use = d.type != "CPU"
+            return True
+    return False
+
+
+def configure(scene: "bpy.types.Scene", cfg: RenderConfig) -> str:
+    """Apply ``cfg`` to ``scene``; return the device actually used ("CPU" or "GPU")."""
+    scene.render.engine = "CYCLES"
+    device = "CPU"
+    if cfg.device == "gpu":
+        if _gpu_available():
+            device = "GPU"
+        else:
+            log.warning("render config %s asks for a GPU but none was found (no OptiX/CUDA/HIP/oneAPI/Metal "
+                        "device); rendering on the CPU instead", cfg.name)
+    scene.cycles.device = device
+    r = scene.render
+    r.resolution_x, r.resolution_y = cfg.width, cfg.height
+    r.resolution_percentage = 100
+    r.use_persistent_data = cfg.persistent_data
+    r.threads_mode = "FIXED" if cfg.threads > 0 else "AUTO"
+    if cfg.threads > 0:
+        r.threads = cfg.threads
+    r.dither_intensity = 0.0
+    r.use_compositing = False
+    r.use_sequencer = False
+    r.film_transparent = False
+    s = r.image_settings
+    s.media_type = "MULTI_LAYER_IMAGE"
+    s.color_depth = "32"
+    s.exr_codec = "NONE"
+    scene.view_layers[0].use_pass_z = True
+    return device
+
+
+def rgb_state(scene: "bpy.types.Scene", cfg: RenderConfig, seed: int) -> None:
+    """Settings of the RGB pass."""
+    c = scene.cycles
+    c.samples = cfg.samples
+    c.use_adaptive_sampling = cfg.adaptive_threshold > 0
+    if cfg.adaptive_threshold > 0:
+        c.adaptive_threshold = cfg.adaptive_threshold
+    c.max_bounces = cfg.max_bounces
+    c.diffuse_bounces = min(cfg.max_bounces, 4)
+    c.glossy_bounces = min(cfg.max_bounces, 4)
+    c.transmission_bounces = min(cfg.max_bounces, 8)
+    c.transparent_max_bounces = 8
+    c.caustics_reflective = False
+    c.caustics_refractive = False
+    c.sample_clamp_indirect = 10.0
+    c.pixel_filter_type = "BLACKMAN_HARRIS"
+    c.filter_width = 1.5
+    c.use_denoising = cfg.denoiser != "none"
+    if c.use_denoising:
+        c.denoiser = "OPENIMAGEDENOISE"
+        c.denoising_quality = cfg.denoiser_quality.upper()
+    c.seed = seed % (2**31 - 1)
+    vl = scene.view_layers[0]
+    vl.material_override = None
+    vl.world_override = None
+
+
+def label_state(scene: "bpy.types.Scene", material, world) -> None:
+    """Settings of the label pass: exact integers per pixel."""
+    c = scene.cycles
+    c.samples = 1
+    c.use_adaptive_sampling = False
+    c.max_bounces = 0
+    c.transparent_max_bounces = 0
+    c.use_denoising = False
+    c.pixel_filter_type = "BOX"
+    c.filter_width = 0.01
+    c.seed = 0
+    vl = scene.view_layers[0]
+    vl.material_override = material
+    vl.world_override = world

@@ -1,0 +1,66 @@
+"""Entry point of a spawned render worker process.
+
+The parent (pure Python, no bpy) starts workers with the ``spawn`` start method and
+hands each one a job: the spec, render config, output folder and the list of frames.
+The worker builds the SceneModel and the Blender scene once, renders its frames, writes
+each image's files atomically and reports progress on a queue:
+``("frame", index, seconds_dict)``, ``("error", message)`` and ``("done", stats)``.
+Blender's own per-tile chatter on stdout is sent to ``blender.log`` in the scratch folder.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+import resource
+import time
+import traceback
+from pathlib import Path
+
+log = logging.getLogger(__name__)
+
+
+@contextlib.contextmanager
+def _stdout_to(path: Path):
+    """Redirect the process's C-level stdout (Blender prints render progress there)."""
+    fd = os.open(str(path), os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o644)
+    saved = os.dup(1)
+    try:
+        os.dup2(fd, 1)
+        yield
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
+        os.close(fd)
+
+
+def run(job: dict, queue) -> None:
+    """Render ``job["frames"]`` and report on ``queue`` (a multiprocessing queue)."""
+    try:
+        scratch = Path(job["scratch"])
+        scratch.mkdir(parents=True, exist_ok=True)
+        with _stdout_to(scratch / "blender.log"):
+            _run(job, queue, scratch)
+    except BaseException as e:  # report everything; the parent decides
+        queue.put(("error", f"{type(e).__name__}: {e}\n{traceback.format_exc()}"))
+        raise SystemExit(1)
+
+
+def _run(job: dict, queue, scratch: Path) -> None:
+    from generator.blender.renderer import Renderer  # imports bpy (after the sys.path clean-up)
+    from generator.jobs.images import render_and_write
+    from generator.layout.assemble import build_scene
+    from generator.layout.frames import plan_frames
+
+    spec, cfg = job["spec"], job["config"]
+    t = time.perf_counter()
+    scene = build_scene(spec)
+    layout_s = time.perf_counter() - t
+    renderer = Renderer(scene, spec, cfg, scratch)
+    queue.put(("ready", {"layout_s": layout_s, "blender_build_s": renderer.build_seconds, "pid": os.getpid()}))
+    for index in job["frames"]:
+        frame = plan_frames(scene, spec, 1, first=index)[0]
+        secs = render_and_write(renderer, scene, spec, cfg, frame, Path(job["out"]))
+        queue.put(("frame", index, secs))
+    queue.put(("done", {"max_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))

@@ -1,0 +1,71 @@
+"""Preview PNGs: tone-mapped RGB beside the colourised labels (and optional extra panels)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from PIL import Image, ImageDraw
+
+from generator.atomic import atomic_path
+from generator.labels import class_table
+
+EXPOSURE = 1.6
+
+
+def tonemap(rgb: np.ndarray, exposure: float = EXPOSURE) -> np.ndarray:
+    """(H, W, 3) float linear RGB -> uint8 sRGB with a Reinhard curve at a fixed exposure.
+
+    A fixed exposure keeps night images dark and day images bright, as they were rendered.
+    """
+    x = np.clip(np.nan_to_num(rgb) * exposure, 0, None)
+    x = x / (1.0 + x)
+    srgb = np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1 / 2.4) - 0.055)
+    return (np.clip(srgb, 0, 1) * 255 + 0.5).astype(np.uint8)
+
+
+def colorize(class_id: np.ndarray) -> np.ndarray:
+    """(H, W) native class ids -> (H, W, 3) uint8 class colours."""
+    return class_table().colors[class_id]
+
+
+def depth_panel(depth: np.ndarray, far: float = 120.0) -> np.ndarray:
+    """(H, W) metres -> (H, W, 3) uint8 grey (near bright, far and sky dark)."""
+    d = np.clip(1.0 - np.nan_to_num(depth, posinf=far) / far, 0, 1)
+    return np.repeat((d * 255).astype(np.uint8)[..., None], 3, -1)
+
+
+def side_by_side(panels: list[np.ndarray], gap: int = 4) -> np.ndarray:
+    """Concatenate (H, W, 3) uint8 panels horizontally with a white gap."""
+    h = panels[0].shape[0]
+    sep = np.full((h, gap, 3), 255, np.uint8)
+    out = [panels[0]]
+    for p in panels[1:]:
+        out += [sep, p]
+    return np.concatenate(out, 1)
+
+
+def legend(class_ids: np.ndarray, width: int) -> np.ndarray:
+    """A strip naming the classes present, in their colours."""
+    table = class_table()
+    present = [int(c) for c in np.unique(class_ids)]
+    row_h, cols = 14, max(1, width // 120)
+    rows = (len(present) + cols - 1) // cols
+    img = Image.new("RGB", (width, rows * row_h + 4), (255, 255, 255))
+    d = ImageDraw.Draw(img)
+    for i, c in enumerate(present):
+        x, y = (i % cols) * 120 + 4, (i // cols) * row_h + 2
+        d.rectangle([x, y + 2, x + 10, y + 12], fill=tuple(int(v) for v in table.colors[c]), outline=(0, 0, 0))
+        d.text((x + 14, y + 1), table.names[c], fill=(0, 0, 0))
+    return np.asarray(img)
+
+
+def write_preview(path: str | Path, rgb: np.ndarray, class_id: np.ndarray, depth: np.ndarray | None = None) -> None:
+    """Write RGB | labels (| depth) with a class legend below, atomically, as PNG."""
+    panels = [tonemap(rgb), colorize(class_id)]
+    if depth is not None:
+        panels.append(depth_panel(depth))
+    top = side_by_side(panels)
+    img = np.concatenate([top, legend(class_id, top.shape[1])], 0)
+    with atomic_path(path, suffix=".png") as tmp:
+        Image.fromarray(img).save(tmp, format="PNG", optimize=False)

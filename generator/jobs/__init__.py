@@ -1,0 +1,1 @@
+"""Dataset jobs: planning, worker orchestration, per-image output."""

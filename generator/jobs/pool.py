@@ -1,0 +1,97 @@
+"""Run render workers in spawned processes and follow their progress.
+
+Each worker is one process with one Blender and one scene build; frames are dealt
+round-robin. The parent never imports bpy, so spawning is always safe.
+"""
+
+from __future__ import annotations
+
+import logging
+import multiprocessing as mp
+import queue as queue_mod
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from tqdm import tqdm
+
+log = logging.getLogger(__name__)
+
+
+@dataclass
+class PoolResult:
+    """What the workers reported."""
+
+    frame_seconds: dict[int, dict] = field(default_factory=dict)
+    ready: list[dict] = field(default_factory=list)
+    done: list[dict] = field(default_factory=list)
+    wall_s: float = 0.0
+
+
+def run_workers(target: str, jobs: list[dict], total: int, desc: str = "render") -> PoolResult:
+    """Start one spawned process per job running ``target`` (``"module:function"``) and wait.
+
+    Parameters
+    ----------
+    target : str
+        Worker entry, called as ``function(job, queue)``.
+    jobs : list of dict
+        One job per worker (picklable).
+    total : int
+        Number of ``("frame", ...)`` reports expected, for the progress bar.
+
+    Raises
+    ------
+    RuntimeError
+        With the worker's traceback when a worker fails.
+    """
+    module, func = target.split(":")
+    ctx = mp.get_context("spawn")
+    q = ctx.Queue()
+    import importlib
+
+    fn = getattr(importlib.import_module(module), func)
+    procs = [ctx.Process(target=fn, args=(job, q), daemon=False) for job in jobs]
+    t0 = time.perf_counter()
+    for p in procs:
+        p.start()
+    res = PoolResult()
+    try:
+        with tqdm(total=total, desc=desc, unit="img", disable=None, smoothing=0.1) as bar:
+            while len(res.done) < len(procs):
+                try:
+                    msg = q.get(timeout=1.0)
+                except queue_mod.Empty:
+                    dead = [p for p in procs if p.exitcode not in (None, 0)]
+                    if dead:
+                        raise RuntimeError(f"render worker {dead[0].pid} exited with code {dead[0].exitcode}")
+                    continue
+                kind = msg[0]
+                if kind == "frame":
+                    res.frame_seconds[msg[1]] = msg[2]
+                    bar.update(1)
+                elif kind == "ready":
+                    res.ready.append(msg[1])
+                elif kind == "done":
+                    res.done.append(msg[1])
+                elif kind == "error":
+                    raise RuntimeError("render worker failed:\n" + msg[1])
+    finally:
+        for p in procs:
+            if p.is_alive() and len(res.done) < len(procs):
+                p.terminate()
+        for p in procs:
+            p.join(timeout=30)
+    res.wall_s = time.perf_counter() - t0
+    return res
+
+
+def deal(items: list, workers: int) -> list[list]:
+    """Split ``items`` round-robin into ``workers`` non-empty lists."""
+    workers = max(1, min(workers, len(items)))
+    return [items[i::workers] for i in range(workers)]
+
+
+def scratch_dir(out: Path, worker: int) -> Path:
+    """Per-worker scratch folder inside the output folder (removed at the end of a run)."""
+    return Path(out) / ".scratch" / f"worker{worker}"
