@@ -1,0 +1,137 @@
+"""KITTI odometry ``calib.txt`` and ``poses.txt`` conventions, from the urbangen rig.
+
+``calib.txt`` (one ``KEY: 12 numbers`` line each, row-major 3x4):
+
+* ``P0`` .. ``P3``: projection matrices ``K [I | 0]`` of the rig camera, with ``K`` from
+  :func:`generator.rig.intrinsics` (hfov of the spec, resolution of the render config).
+  urbangen renders ONE camera, which plays KITTI's cam0 and cam2 at once, so all four
+  matrices are equal with zero baselines: a KITTI tool projecting with ``P2 @ Tr`` lands
+  on urbangen's image. (Stereo tools dividing by the P1 baseline do not apply.) Pixel
+  convention of the rig: the origin is the top-left CORNER of the top-left pixel, so
+  ``floor(u), floor(v)`` is the pixel hit; for OpenCV's integer-centre convention
+  subtract 0.5 from ``cx, cy``.
+* ``Tr``: velodyne -> cam0 (``T_cam0_velo``), from the rig mounts WITHOUT the per-frame
+  camera jitter (``rig.camera_extrinsics(xyz, rpy)`` and ``rig.mount`` of the LiDAR).
+  With the default KITTI-like mounts it is about ``R = [[0,-1,0],[0,0,-1],[1,0,0]]``,
+  ``t = (0, -0.08, -0.27)`` m, like KITTI's own.
+
+``poses.txt``: line ``i`` is the pose of cam0 at scan ``i`` in the cam0 frame of scan 0
+(``T_cam0(0)_cam0(i)``), 3x4 row-major, as in KITTI odometry. The LiDAR pose in the first
+LiDAR frame is then ``inv(Tr) @ pose_i @ Tr`` (what the SemanticKITTI API computes);
+urbangen files each scan under the LiDAR pose at its sweep start.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from generator import rig
+from generator.atomic import write_text
+from generator.errors import UserError
+
+CALIB_KEYS = ("P0", "P1", "P2", "P3", "Tr")
+
+
+def homogeneous(m: np.ndarray) -> np.ndarray:
+    """(4, 4) float64 from a (3, 4) matrix (bottom row 0 0 0 1)."""
+    out = np.eye(4)
+    out[:3] = np.asarray(m, np.float64).reshape(3, 4)
+    return out
+
+
+def velo_to_cam(spec) -> np.ndarray:
+    """``Tr`` = ``T_cam0_velo`` (4, 4) float64 from the spec's camera and LiDAR mounts (no jitter)."""
+    cam, lidar = spec.sensors.camera, spec.sensors.lidar
+    t_ego_cam = rig.camera_extrinsics(cam.xyz_m, cam.rpy_deg)
+    return rig.invert(t_ego_cam) @ rig.mount(lidar.xyz_m, lidar.rpy_deg)
+
+
+def kitti_calib(spec, width: int, height: int) -> dict[str, np.ndarray]:
+    """``P0``..``P3`` and ``Tr`` as (3, 4) float64 for a render of ``width`` x ``height`` pixels."""
+    k = rig.intrinsics(spec.sensors.camera.hfov_deg, width, height)
+    p = np.hstack([k, np.zeros((3, 1))])
+    out = {f"P{i}": p.copy() for i in range(4)}
+    out["Tr"] = velo_to_cam(spec)[:3]
+    return out
+
+
+def format_calib(calib: dict[str, np.ndarray]) -> str:
+    """``KEY: v v v ...`` lines (``%.12e``, KITTI's own precision)."""
+    lines = []
+    for key, m in calib.items():
+        vals = np.asarray(m, np.float64).reshape(-1)
+        lines.append(f"{key}: " + " ".join(f"{v:.12e}" for v in vals))
+    return "\n".join(lines) + "\n"
+
+
+def write_calib(path: str | Path, calib: dict[str, np.ndarray]) -> None:
+    """Write ``calib.txt`` atomically."""
+    write_text(path, format_calib(calib))
+
+
+def read_calib(path: str | Path) -> dict[str, np.ndarray]:
+    """Read a KITTI ``calib.txt``.
+
+    Returns
+    -------
+    dict of str to ndarray
+        Each key's numbers as a (3, 4) float64 matrix when it has 12 values (P0..P3, Tr,
+        Tr_velo_to_cam...), (3, 3) for 9 (R0_rect), else flat.
+
+    Raises
+    ------
+    UserError
+        Missing file, a line without ``KEY:``, or non-numeric values (naming file and line).
+    """
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as e:
+        raise UserError(f"{p}: cannot read calibration: {e}") from None
+    out: dict[str, np.ndarray] = {}
+    for n, line in enumerate(text.splitlines(), 1):
+        if not line.strip():
+            continue
+        key, sep, rest = line.partition(":")
+        if not sep:
+            raise UserError(f"{p}: line {n}: expected 'KEY: numbers', got {line[:40]!r}")
+        try:
+            vals = np.array([float(v) for v in rest.split()], np.float64)
+        except ValueError:
+            raise UserError(f"{p}: line {n}: {key.strip()}: values must be numbers") from None
+        out[key.strip()] = vals.reshape(3, 4) if vals.size == 12 else (vals.reshape(3, 3) if vals.size == 9 else vals)
+    return out
+
+
+def tr_matrix(calib: dict[str, np.ndarray], source: str = "calib.txt") -> np.ndarray:
+    """(4, 4) ``Tr`` (velodyne -> cam0) from a parsed calib (``Tr`` or ``Tr_velo_to_cam``)."""
+    for key in ("Tr", "Tr_velo_to_cam"):
+        if key in calib and np.size(calib[key]) == 12:
+            return homogeneous(calib[key])
+    raise UserError(f"{source}: no 'Tr' (velodyne to camera) entry with 12 numbers")
+
+
+def camera_poses(T_world_velo: np.ndarray, tr: np.ndarray) -> np.ndarray:
+    """KITTI ``poses.txt`` content from LiDAR world poses.
+
+    Parameters
+    ----------
+    T_world_velo : (n, 4, 4) float64
+        LiDAR pose (sweep start) of each scan, world frame.
+    tr : (4, 4) float64
+        ``T_cam0_velo``.
+
+    Returns
+    -------
+    (n, 4, 4) float64
+        ``T_cam0(0)_cam0(i)``.
+    """
+    t_world_cam = np.asarray(T_world_velo, np.float64) @ rig.invert(tr)
+    return rig.invert(t_world_cam[0]) @ t_world_cam
+
+
+def lidar_poses(cam_poses: np.ndarray, tr: np.ndarray) -> np.ndarray:
+    """(n, 4, 4) LiDAR poses in the first LiDAR frame: ``inv(Tr) @ pose @ Tr`` (SemanticKITTI API)."""
+    return rig.invert(tr) @ np.asarray(cam_poses, np.float64) @ tr

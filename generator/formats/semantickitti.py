@@ -1,0 +1,255 @@
+"""SemanticKITTI sequences: writer and a robust reader for any dataset in that layout.
+
+Layout (``root/sequences/NN/``)::
+
+    velodyne/NNNNNN.bin   float32 little-endian rows (x, y, z, remission), sensor frame, metres
+    labels/NNNNNN.label   uint32 little-endian per point: SemanticKITTI raw id in the low
+                          16 bits, instance id in the high 16 bits
+    poses.txt             cam0 pose of each scan in the first cam0 frame, 3x4 row-major
+                          (see :mod:`generator.formats.kitti_calib`)
+    calib.txt             P0..P3 and Tr (velodyne -> cam0)
+    times.txt             seconds since the sequence start, one line per scan
+
+Every write is atomic (:mod:`generator.atomic`). Every read problem is a
+:class:`generator.errors.UserError` naming the file.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Iterator
+
+import numpy as np
+
+from generator.atomic import write_bytes, write_text
+from generator.errors import UserError
+from generator.formats.kitti_calib import lidar_poses, read_calib, tr_matrix
+
+__all__ = [
+    "encode_labels", "decode_labels", "write_scan", "write_labels", "write_poses", "write_times",
+    "read_scan", "read_labels", "read_poses", "read_times", "read_calib", "sequence_name", "sequence_dir",
+    "list_sequences", "Sequence", "ScanRecord", "iter_sequence",
+]
+
+
+def encode_labels(semantic: np.ndarray, instance: np.ndarray) -> np.ndarray:
+    """(n,) uint32 ``instance << 16 | semantic`` from (n,) uint16 raw ids and instance ids."""
+    sem = np.asarray(semantic)
+    inst = np.asarray(instance)
+    if sem.max(initial=0) > 0xFFFF or inst.max(initial=0) > 0xFFFF or sem.min(initial=0) < 0 or inst.min(initial=0) < 0:
+        raise ValueError("semantic and instance ids must fit in 16 bits")
+    return (inst.astype(np.uint32) << np.uint32(16)) | sem.astype(np.uint32)
+
+
+def decode_labels(label: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(semantic uint16, instance uint16) from (n,) uint32 labels."""
+    label = np.asarray(label, np.uint32)
+    return (label & np.uint32(0xFFFF)).astype(np.uint16), (label >> np.uint32(16)).astype(np.uint16)
+
+
+def scan_array(xyz: np.ndarray, remission: np.ndarray) -> np.ndarray:
+    """(n, 4) float32 ``.bin`` rows from (n, 3) coordinates and (n,) remission."""
+    out = np.empty((len(xyz), 4), "<f4")
+    out[:, :3] = xyz
+    out[:, 3] = remission
+    return out
+
+
+def write_scan(path: str | Path, xyz: np.ndarray, remission: np.ndarray) -> None:
+    """Write a ``.bin`` scan: (n, 3) float coordinates (sensor frame, metres) + (n,) remission in [0, 1]."""
+    if len(xyz) != len(remission):
+        raise ValueError(f"{len(xyz)} points but {len(remission)} remission values")
+    write_bytes(path, scan_array(xyz, remission).tobytes())
+
+
+def write_labels(path: str | Path, semantic: np.ndarray, instance: np.ndarray) -> None:
+    """Write a ``.label`` file from (n,) SemanticKITTI raw ids and (n,) instance ids."""
+    if len(semantic) != len(instance):
+        raise ValueError(f"{len(semantic)} semantic ids but {len(instance)} instance ids")
+    write_bytes(path, encode_labels(semantic, instance).astype("<u4").tobytes())
+
+
+def _matrix_lines(m: np.ndarray) -> str:
+    rows = np.asarray(m, np.float64)[:, :3, :4].reshape(len(m), 12)
+    return "".join(" ".join(f"{v:.9e}" for v in r) + "\n" for r in rows)
+
+
+def write_poses(path: str | Path, poses: np.ndarray) -> None:
+    """Write ``poses.txt`` from (n, 4, 4) cam0 poses (``kitti_calib.camera_poses``)."""
+    write_text(path, _matrix_lines(poses))
+
+
+def write_times(path: str | Path, times: np.ndarray) -> None:
+    """Write ``times.txt`` from (n,) seconds."""
+    write_text(path, "".join(f"{t:e}\n" for t in np.asarray(times, np.float64)))
+
+
+# -- reading ----------------------------------------------------------------------------------
+def _read_raw(path: Path, dtype: str, row: int, what: str) -> np.ndarray:
+    try:
+        size = os.path.getsize(path)
+    except OSError:
+        raise UserError(f"{path}: {what} file not found") from None
+    itemsize = np.dtype(dtype).itemsize * row
+    if size % itemsize:
+        raise UserError(f"{path}: size {size} bytes is not a multiple of {itemsize} ({what}); truncated or not a {what} file")
+    return np.fromfile(path, dtype=dtype)
+
+
+def read_scan(path: str | Path) -> np.ndarray:
+    """(n, 4) float32 (x, y, z, remission) of a ``.bin`` file."""
+    return _read_raw(Path(path), "<f4", 4, "scan").reshape(-1, 4).astype(np.float32, copy=False)
+
+
+def read_labels(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
+    """(semantic uint16, instance uint16) of a ``.label`` file."""
+    return decode_labels(_read_raw(Path(path), "<u4", 1, "label"))
+
+
+def _read_rows(path: Path, width: int, what: str) -> np.ndarray:
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as e:
+        raise UserError(f"{path}: cannot read {what}: {e}") from None
+    rows = []
+    for n, line in enumerate(text.splitlines(), 1):
+        if not line.strip():
+            continue
+        try:
+            vals = [float(v) for v in line.split()]
+        except ValueError:
+            raise UserError(f"{path}: line {n}: values must be numbers") from None
+        if len(vals) != width:
+            raise UserError(f"{path}: line {n}: expected {width} numbers, got {len(vals)}")
+        rows.append(vals)
+    return np.array(rows, np.float64).reshape(-1, width)
+
+
+def read_poses(path: str | Path) -> np.ndarray:
+    """(n, 4, 4) float64 poses of a KITTI ``poses.txt``."""
+    rows = _read_rows(Path(path), 12, "poses")
+    out = np.repeat(np.eye(4)[None], len(rows), 0)
+    out[:, :3, :4] = rows.reshape(-1, 3, 4)
+    return out
+
+
+def read_times(path: str | Path) -> np.ndarray:
+    """(n,) float64 seconds of a KITTI ``times.txt``."""
+    return _read_rows(Path(path), 1, "times")[:, 0]
+
+
+# -- sequences ---------------------------------------------------------------------------------
+def sequence_name(sequence: int | str) -> str:
+    """Two-digit (or longer, zero-padded) sequence folder name; rejects anything but digits."""
+    s = str(sequence)
+    if not s.isdigit() or len(s) > 4:
+        raise UserError(f"sequence must be a number like 00..99, got {sequence!r}")
+    return f"{int(s):02d}"
+
+
+def sequence_dir(root: str | Path, sequence: int | str) -> Path:
+    """``root/sequences/NN``."""
+    return Path(root) / "sequences" / sequence_name(sequence)
+
+
+def list_sequences(root: str | Path) -> list[str]:
+    """Sequence folder names under ``root/sequences`` (digits only), sorted."""
+    base = Path(root) / "sequences"
+    if not base.is_dir():
+        raise UserError(f"{base}: not a SemanticKITTI dataset (no sequences/ folder)")
+    return sorted(p.name for p in base.iterdir() if p.is_dir() and p.name.isdigit())
+
+
+@dataclass
+class ScanRecord:
+    """One scan of a sequence.
+
+    Attributes
+    ----------
+    index : int
+        Frame number (file stem).
+    points : (n, 4) float32
+        x, y, z, remission; sensor frame, metres.
+    semantic, instance : (n,) uint16 or None
+        Labels (None when the sequence has no ``labels/`` folder, e.g. a test split).
+    pose : (4, 4) float64 or None
+        LiDAR pose in the first LiDAR frame (``inv(Tr) @ poses[i] @ Tr``), when poses and calib exist.
+    time : float or None
+        Seconds from ``times.txt``.
+    """
+
+    index: int
+    points: np.ndarray
+    semantic: np.ndarray | None
+    instance: np.ndarray | None
+    pose: np.ndarray | None
+    time: float | None
+
+
+class Sequence:
+    """Read access to ``root/sequences/NN`` of any SemanticKITTI-layout dataset."""
+
+    def __init__(self, root: str | Path, sequence: int | str):
+        self.dir = sequence_dir(root, sequence)
+        self.velodyne = self.dir / "velodyne"
+        self.labels_dir = self.dir / "labels"
+        if not self.velodyne.is_dir():
+            raise UserError(f"{self.velodyne}: missing (not a SemanticKITTI sequence)")
+        stems = [p.stem for p in self.velodyne.glob("*.bin")]
+        bad = [s for s in stems if not s.isdigit()]
+        if bad:
+            raise UserError(f"{self.velodyne / (bad[0] + '.bin')}: scan names must be frame numbers like 000000.bin")
+        self.frames: list[int] = sorted(int(s) for s in stems)
+        self._stem = {int(s): s for s in stems}
+        self.has_labels = self.labels_dir.is_dir()
+        self.times = read_times(self.dir / "times.txt") if (self.dir / "times.txt").is_file() else None
+        self.calib = read_calib(self.dir / "calib.txt") if (self.dir / "calib.txt").is_file() else None
+        self.cam_poses = read_poses(self.dir / "poses.txt") if (self.dir / "poses.txt").is_file() else None
+        for name, arr in (("times.txt", self.times), ("poses.txt", self.cam_poses)):
+            if arr is not None and self.frames and len(arr) <= max(self.frames):
+                raise UserError(f"{self.dir / name}: {len(arr)} lines but scans go up to frame {max(self.frames)}")
+
+    def __len__(self) -> int:
+        return len(self.frames)
+
+    def _name(self, index: int) -> str:
+        try:
+            return self._stem[index]
+        except KeyError:
+            raise UserError(f"{self.velodyne}: no scan {index:06d}.bin") from None
+
+    def scan_path(self, index: int) -> Path:
+        return self.velodyne / f"{self._name(index)}.bin"
+
+    def label_path(self, index: int) -> Path:
+        return self.labels_dir / f"{self._name(index)}.label"
+
+    def lidar_poses(self) -> np.ndarray | None:
+        """(n, 4, 4) LiDAR poses in the first LiDAR frame, or None without poses/calib."""
+        if self.cam_poses is None or self.calib is None:
+            return None
+        return lidar_poses(self.cam_poses, tr_matrix(self.calib, str(self.dir / "calib.txt")))
+
+    def read(self, index: int, labels: bool = True, _poses: np.ndarray | None = None) -> ScanRecord:
+        """The scan, labels (unless ``labels=False``), pose and time of frame ``index``."""
+        pts = read_scan(self.scan_path(index))
+        sem = inst = None
+        if labels and self.has_labels:
+            sem, inst = read_labels(self.label_path(index))
+            if len(sem) != len(pts):
+                raise UserError(f"{self.label_path(index)}: {len(sem)} labels but {self.scan_path(index)} has {len(pts)} points")
+        poses = self.lidar_poses() if _poses is None else _poses
+        return ScanRecord(index, pts, sem, inst, None if poses is None else poses[index],
+                          None if self.times is None else float(self.times[index]))
+
+    def __iter__(self) -> Iterator[ScanRecord]:
+        poses = self.lidar_poses()  # parsed once for the whole sequence
+        for i in self.frames:
+            yield self.read(i, True, poses)
+
+
+def iter_sequence(root: str | Path, sequence: int | str) -> Iterator[ScanRecord]:
+    """Iterate the scans of ``root/sequences/NN`` in frame order (see :class:`Sequence`)."""
+    yield from Sequence(root, sequence)

@@ -1,0 +1,133 @@
+"""Ray casting against the SceneModel's real triangles, behind one small interface.
+
+The only backend is Embree through ``embreex`` (used directly, not through trimesh). A
+caster is built ONCE per scene and reused for every frame.
+
+Precision: Embree works in float32. The vertices are re-centred once, in float64, on the
+centre of the scene's bounding box before the cast to float32, and every ray origin is
+translated into that frame (float64 subtraction, then float32). Coordinates therefore
+stay within half the town's extent (about +-150 m for a 4x4 town, float32 spacing
+1.5e-5 m there), and the hit distance is measured from the ray origin, so ranges keep
+sub-millimetre precision anywhere in the town. Re-centring on each sensor position would
+need a BVH rebuild per frame, which costs more than a whole scan (``bench/lidar_throughput.py``
+prints both), for no gain at these extents.
+
+Threads: ``embreex`` releases the GIL inside ``run``, so callers split rays across a
+``ThreadPoolExecutor`` (see :mod:`generator.lidar.scan`).
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Protocol
+
+import numpy as np
+
+
+class RayCaster(Protocol):
+    """What the scanner needs from a backend."""
+
+    def intersect(self, origins: np.ndarray, directions: np.ndarray, max_distance: float) -> tuple[np.ndarray, np.ndarray]:
+        """First hits of rays; see :meth:`EmbreeCaster.intersect`."""
+
+    @property
+    def face_normals(self) -> np.ndarray:
+        """(F, 3) float32 unit face normals, world frame."""
+
+
+def _unit_normals(tri: np.ndarray) -> np.ndarray:
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    norm = np.linalg.norm(n, axis=1, keepdims=True)
+    return np.divide(n, norm, out=np.zeros_like(n), where=norm > 0).astype(np.float32)
+
+
+class EmbreeCaster:
+    """An Embree BVH over one triangle soup, re-centred for float32.
+
+    Parameters
+    ----------
+    vertices : (V, 3) float32 or float64
+        World frame, metres.
+    faces : (F, 3) integer
+        Vertex indices; the primitive id of a hit is the row in ``faces``.
+    center : (3,) float64, optional
+        Re-centring point (default: centre of the vertices' bounding box).
+
+    Attributes
+    ----------
+    center : (3,) float64
+    build_seconds : float
+        Wall time of the BVH build.
+    """
+
+    def __init__(self, vertices: np.ndarray, faces: np.ndarray, center: np.ndarray | None = None):
+        from embreex import rtcore_scene
+        from embreex.mesh_construction import TriangleMesh
+
+        v64 = np.asarray(vertices, np.float64).reshape(-1, 3)
+        f = np.ascontiguousarray(np.asarray(faces).reshape(-1, 3), np.int32)
+        if len(f) == 0:
+            raise ValueError("cannot build a caster over a scene without triangles")
+        self.center = (v64.min(0) + v64.max(0)) / 2.0 if center is None else np.asarray(center, np.float64)
+        local = np.ascontiguousarray(v64 - self.center, np.float32)
+        self.n_faces = len(f)
+        self._normals = _unit_normals(v64[f])
+        t0 = time.perf_counter()
+        self._scene = rtcore_scene.EmbreeScene()
+        TriangleMesh(self._scene, local, f)
+        if hasattr(self._scene, "commit"):
+            self._scene.commit()
+        self.build_seconds = time.perf_counter() - t0
+
+    @classmethod
+    def from_scene(cls, scene) -> "EmbreeCaster":
+        """A caster over ``scene.vertices`` / ``scene.faces`` (the real geometry, never the label proxies)."""
+        return cls(scene.vertices, scene.faces)
+
+    @property
+    def face_normals(self) -> np.ndarray:
+        """(F, 3) float32 unit normals per face, world frame (zero for degenerate faces)."""
+        return self._normals
+
+    def intersect(self, origins: np.ndarray, directions: np.ndarray, max_distance: float) -> tuple[np.ndarray, np.ndarray]:
+        """First hit of every ray.
+
+        Parameters
+        ----------
+        origins : (n, 3) float64
+            World frame, metres.
+        directions : (n, 3) float
+            Unit directions, world frame.
+        max_distance : float
+            Hits farther than this are misses, metres.
+
+        Returns
+        -------
+        distance : (n,) float32
+            Distance along the ray to the hit, metres (``inf`` on a miss).
+        prim : (n,) int32
+            Row of the hit face in ``faces`` (-1 on a miss).
+        """
+        o = np.ascontiguousarray(np.asarray(origins, np.float64) - self.center, np.float32)
+        d = np.ascontiguousarray(directions, np.float32)
+        tmax = np.full(len(o), max_distance, np.float32)
+        out = self._scene.run(o, d, dists=tmax, output=1)
+        prim = out["primID"]
+        dist = np.where(prim >= 0, out["tfar"], np.float32(np.inf)).astype(np.float32, copy=False)
+        return dist, prim
+
+    def run_raw(self, origins_local: np.ndarray, directions: np.ndarray) -> dict:
+        """Plain ``EmbreeScene.run(..., output=1)`` on float32 rays already in the re-centred frame (benchmarks)."""
+        return self._scene.run(origins_local, directions, output=1)
+
+
+#: Backends by name (dispatch by table; Embree is the only one shipped).
+BACKENDS = {"embree": EmbreeCaster.from_scene}
+
+
+def make_caster(scene, backend: str = "embree") -> RayCaster:
+    """A caster over ``scene``'s real triangles with the named backend."""
+    try:
+        return BACKENDS[backend](scene)
+    except KeyError:
+        raise ValueError(f"unknown ray-casting backend {backend!r}; known: {', '.join(BACKENDS)}") from None

@@ -1,0 +1,216 @@
+"""One LiDAR sweep: sensor rays + sensor motion -> labelled points.
+
+Motion convention (KITTI-like, NOT de-skewed)
+---------------------------------------------
+A sweep of frame ``k`` starts at ``t_k`` (``generator.layout.frames``) and lasts one
+rotation. With motion skew on, column ``c`` is fired at ``t_k + c / (steps * rotation_hz)``
+from the sensor pose at that instant, and its points keep the raw coordinates the sensor
+measures: the emission point plus range times beam direction, in the sensor frame AT
+FIRING TIME. The whole sweep is then filed under the pose at the sweep START
+(``T_world_sensor`` of column 0, which is what ``poses.txt`` records), exactly as KITTI
+stores its scans: a static wall seen late in the sweep appears shifted by the ego motion
+since ``t_k`` (up to speed x 0.1 s at 10 Hz). Each point's ``time`` field gives its
+firing offset, so a consumer can de-skew. With motion skew off every column is fired
+from the pose at ``t_k`` and ``time`` is 0.
+
+Point record (:data:`POINT_DTYPE`, one structured row per return; no-return rays and
+rays blocked nearer than the sensor's minimum range are not points):
+
+=============== ======= ==========================================================
+field           dtype   meaning
+=============== ======= ==========================================================
+x, y, z         float32 sensor frame at firing time, metres (x fwd, y left, z up)
+range           float32 distance from the laser's emission point along the beam, metres
+                        (what the device measures; differs from |xyz| by the offsets)
+azimuth         float32 beam azimuth, radians CCW from +x, in [-pi, pi)
+time            float32 firing offset after the sweep start, seconds (0 with skew off)
+cos_incidence   float32 |dot(beam direction, face normal)|
+ring            uint8   beam row by elevation, 0 = highest
+column          uint16  firing column, 0 .. azimuth_steps - 1
+laser           uint8   device laser id
+class           uint8   native class id (``scene.face_class``)
+instance        uint16  instance id (``scene.face_instance``, 0 for stuff)
+material        uint16  material id (``scene.face_material``)
+=============== ======= ==========================================================
+
+Points are ordered by column (firing time), then ring.
+"""
+
+from __future__ import annotations
+
+import os
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+
+import numpy as np
+
+from generator import rig
+from generator.layout.frames import ego_pose_at
+from generator.lidar.caster import RayCaster, make_caster
+from generator.lidar.sensors import Sensor
+
+POINT_DTYPE = np.dtype([
+    ("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("range", "<f4"), ("azimuth", "<f4"), ("time", "<f4"),
+    ("cos_incidence", "<f4"), ("ring", "u1"), ("column", "<u2"), ("laser", "u1"), ("class", "u1"),
+    ("instance", "<u2"), ("material", "<u2"),
+])
+
+
+@dataclass
+class Scan:
+    """The points of one sweep.
+
+    Attributes
+    ----------
+    points : (n,) POINT_DTYPE
+    T_world_sensor : (4, 4) float64
+        Sensor pose at the sweep start (the pose the points are filed under).
+    n_rays : int
+        Rays fired (``rings * columns``).
+    rings, columns : int
+        Range-image shape.
+    """
+
+    points: np.ndarray
+    T_world_sensor: np.ndarray
+    n_rays: int
+    rings: int
+    columns: int
+
+    @property
+    def xyz(self) -> np.ndarray:
+        """(n, 3) float32 sensor-frame coordinates."""
+        p = self.points
+        return np.stack([p["x"], p["y"], p["z"]], -1)
+
+    def range_image(self) -> np.ndarray:
+        """(rings, columns) float32 range per beam and column, metres; 0 where no return."""
+        img = np.zeros((self.rings, self.columns), np.float32)
+        img[self.points["ring"], self.points["column"]] = self.points["range"]
+        return img
+
+
+class Scanner:
+    """Casts a sensor's sweeps against one scene, reusing the BVH for every frame.
+
+    Parameters
+    ----------
+    scene : generator.scene.SceneModel
+        Cast against ``scene.vertices`` / ``scene.faces`` (real geometry, not label proxies).
+    sensor : Sensor
+    threads : int, optional
+        Worker threads (default: ``os.cpu_count()``).
+    caster : RayCaster, optional
+        A prebuilt caster over the same scene (default: Embree over ``scene``).
+    chunks_per_thread : int
+        Work items per thread (small items balance load across threads).
+    """
+
+    def __init__(self, scene, sensor: Sensor, threads: int | None = None, caster: RayCaster | None = None,
+                 chunks_per_thread: int = 4):
+        self.sensor = sensor
+        self.threads = max(1, int(threads or os.cpu_count() or 1))
+        self.caster = caster if caster is not None else make_caster(scene)
+        self._face_class = np.asarray(scene.face_class, np.uint8)
+        self._face_instance = np.asarray(scene.face_instance, np.uint16)
+        self._face_material = np.asarray(scene.face_material, np.uint16)
+        origins, dirs, azimuth = sensor.local_rays()
+        steps, n_l = azimuth.shape
+        self._origins, self._dirs = origins, dirs
+        self._azimuth = azimuth.astype(np.float32).reshape(-1)
+        order = sensor.by_ring
+        self._ring = np.tile(sensor.ring[order].astype(np.uint8), steps)
+        self._laser = np.tile(sensor.laser_id[order].astype(np.uint8), steps)
+        self._column = np.repeat(np.arange(steps, dtype=np.uint16), n_l)
+        self._col_time = np.repeat(sensor.column_time().astype(np.float32), n_l)
+        n_chunks = min(steps, self.threads * max(1, chunks_per_thread))
+        edges = np.linspace(0, steps, n_chunks + 1).round().astype(int)
+        self._chunks = [slice(a, b) for a, b in zip(edges[:-1], edges[1:]) if b > a]
+        self._pool = ThreadPoolExecutor(self.threads, thread_name_prefix="lidar") if self.threads > 1 else None
+
+    def close(self) -> None:
+        """Stop the worker threads."""
+        if self._pool is not None:
+            self._pool.shutdown()
+            self._pool = None
+
+    def __enter__(self) -> "Scanner":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def scan(self, T_world_sensor: np.ndarray) -> Scan:
+        """Cast one sweep.
+
+        Parameters
+        ----------
+        T_world_sensor : (4, 4) or (steps, 4, 4) float64
+            One pose for the whole sweep (motion skew off) or one pose per firing column
+            (motion skew on; column 0 is the sweep start), world frame.
+
+        Returns
+        -------
+        Scan
+        """
+        poses = np.asarray(T_world_sensor, np.float64)
+        skew = poses.ndim == 3
+        if skew and len(poses) != self.sensor.azimuth_steps:
+            raise ValueError(f"need one pose per column ({self.sensor.azimuth_steps}), got {len(poses)}")
+        work = [(c, poses, skew) for c in self._chunks]
+        parts = list(self._pool.map(self._cast_chunk, *zip(*work))) if self._pool else [self._cast_chunk(*w) for w in work]
+        points = np.concatenate(parts) if parts else np.zeros(0, POINT_DTYPE)
+        return Scan(points, poses[0] if skew else poses, self.sensor.rays_per_sweep, self.sensor.n_lasers,
+                    self.sensor.azimuth_steps)
+
+    def _cast_chunk(self, cols: slice, poses: np.ndarray, skew: bool) -> np.ndarray:
+        o_loc, d_loc = self._origins[cols], self._dirs[cols]  # (k, L, 3)
+        if skew:
+            rot, trans = poses[cols, :3, :3], poses[cols, :3, 3]
+            d_w = np.einsum("kij,klj->kli", rot, d_loc)
+            o_w = np.einsum("kij,klj->kli", rot, o_loc) + trans[:, None, :]
+        else:
+            rot, trans = poses[:3, :3], poses[:3, 3]
+            d_w, o_w = d_loc @ rot.T, o_loc @ rot.T + trans
+        d_w, o_w = d_w.reshape(-1, 3), o_w.reshape(-1, 3)
+        dist, prim = self.caster.intersect(o_w, d_w, self.sensor.max_range_m)
+        idx = np.flatnonzero((prim >= 0) & (dist >= self.sensor.min_range_m))
+        face = prim[idx]
+        r = dist[idx].astype(np.float64)[:, None]
+        xyz = o_loc.reshape(-1, 3)[idx] + r * d_loc.reshape(-1, 3)[idx]
+        ray = idx + cols.start * self.sensor.n_lasers
+        out = np.empty(len(idx), POINT_DTYPE)
+        out["x"], out["y"], out["z"] = xyz[:, 0], xyz[:, 1], xyz[:, 2]
+        out["range"] = dist[idx]
+        out["azimuth"] = self._azimuth[ray]
+        out["time"] = self._col_time[ray] if skew else 0.0
+        out["cos_incidence"] = np.abs(np.einsum("ij,ij->i", d_w[idx], self.caster.face_normals[face]))
+        out["ring"], out["column"], out["laser"] = self._ring[ray], self._column[ray], self._laser[ray]
+        out["class"] = self._face_class[face]
+        out["instance"] = self._face_instance[face]
+        out["material"] = self._face_material[face]
+        return out
+
+
+def sensor_mount(spec) -> np.ndarray:
+    """``T_ego_sensor`` (4, 4) float64 of the spec's LiDAR (``sensors.lidar.xyz_m`` / ``rpy_deg``)."""
+    lidar = spec.sensors.lidar
+    return rig.mount(lidar.xyz_m, lidar.rpy_deg)
+
+
+def sweep_poses(scene, spec, sensor: Sensor, t0: float, motion_skew: bool | None = None, route: int = 0) -> np.ndarray:
+    """Sensor poses for a sweep starting at ``t0`` seconds along route ``route``.
+
+    Parameters
+    ----------
+    motion_skew : bool, optional
+        Default: ``spec.sensors.lidar.motion_skew``.
+
+    Returns
+    -------
+    (steps, 4, 4) float64 with skew (one ``T_world_sensor`` per firing column), else (4, 4) at ``t0``.
+    """
+    skew = spec.sensors.lidar.motion_skew if motion_skew is None else motion_skew
+    t = t0 + sensor.column_time() if skew else np.array([t0], np.float64)
+    poses = ego_pose_at(scene, spec, t, route) @ sensor_mount(spec)
+    return poses if skew else poses[0]

@@ -1,0 +1,213 @@
+"""Cast a whole SemanticKITTI sequence along a route: scans, labels, poses, calib, previews.
+
+Per frame ``k`` of :func:`generator.layout.frames.plan_frames` one sweep starting at
+``t_k``; files under ``out/sequences/NN/`` (see :mod:`generator.formats.semantickitti`)
+plus ``bev/NNNNNN.png`` (bird's-eye view), optionally ``range/NNNNNN.npy`` (range image,
+rings x columns float32, 0 = no return) and ``ply/NNNNNN.ply``; ``lidar_meta.json`` says
+how the data was made (sensor, conventions, remission placeholder, point counts); the
+dataset's ``semantic-kitti.yaml`` label config sits in ``out/``.
+
+Write order: calib first, then scans; ``poses.txt``, ``times.txt`` and the metadata last,
+so a sequence with ``poses.txt`` is complete. Re-running into the same folder overwrites
+(each file atomically) and removes frames beyond the new frame count.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from generator import __version__
+from generator.atomic import atomic_path, inside, write_json
+from generator.errors import UserError
+from generator.formats import kitti_calib, semantickitti as sk
+from generator.formats.label_config import count_raw_ids, merge_counts, write_label_config
+from generator.formats.ply import write_ply
+from generator.imaging.bev import write_bev
+from generator.labels import class_table
+from generator.layout.frames import max_frames, plan_frames
+from generator.lidar.remission import IntensityFn, intensity_fn_for_spec
+from generator.lidar.scan import Scanner, sensor_mount, sweep_poses
+from generator.lidar.sensors import Sensor, sensor_for_spec
+from generator.rng import stream
+
+log = logging.getLogger(__name__)
+
+META_NAME = "lidar_meta.json"
+LABEL_CONFIG_NAME = "semantic-kitti.yaml"
+
+MOTION_CONVENTION = (
+    "Column c of a sweep is fired at t_k + c/(steps*rotation_hz) from the sensor pose at that instant "
+    "(motion skew on) or at t_k (off); points keep the raw sensor-frame coordinates of their firing "
+    "instant and the scan is filed under the LiDAR pose at the sweep start t_k, as KITTI does (not de-skewed)."
+)
+
+
+@dataclass(frozen=True)
+class SequenceOptions:
+    """How to write a sequence.
+
+    Attributes
+    ----------
+    frames : int
+        Number of scans (frames 0 .. frames-1 of route 0).
+    sequence : str
+        Folder name ``NN``.
+    threads : int or None
+        Casting threads (None = all cores).
+    range_image, ply, bev : bool
+        Extra outputs per scan.
+    resolution : (int, int)
+        Camera width, height for ``calib.txt`` (from the render config).
+    render_config : str
+        Name of that render config (recorded in the metadata).
+    route : int
+        Route index of the scene.
+    """
+
+    frames: int
+    sequence: str = "00"
+    threads: int | None = None
+    range_image: bool = False
+    ply: bool = False
+    bev: bool = True
+    resolution: tuple[int, int] = (640, 360)
+    render_config: str = "preview"
+    route: int = 0
+
+
+def check_frames(scene, spec, n: int, route: int = 0) -> None:
+    """Refuse more frames than fit on an open route (a loop wraps)."""
+    if n < 1:
+        raise UserError(f"--frames must be >= 1, got {n}")
+    if route >= len(scene.paths):
+        raise UserError(f"{spec.source}: the scene has no route {route}")
+    if not scene.paths[route].closed and n > max_frames(scene, spec, route):
+        raise UserError(f"{spec.source}: route {route} fits {max_frames(scene, spec, route)} frames at "
+                        f"paths.spacing_m = {spec.paths.spacing_m}, asked for {n}")
+
+
+def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, sensor: Sensor | None = None,
+                   intensity_fn: IntensityFn | None = None, progress: bool = True) -> dict:
+    """Cast and write one sequence; returns the metadata written to ``lidar_meta.json``.
+
+    Parameters
+    ----------
+    scene : generator.scene.SceneModel
+    spec : generator.spec.SceneSpec
+    out : path-like
+        Dataset root (``out/sequences/NN`` is created).
+    sensor : Sensor, optional
+        Default: :func:`generator.lidar.sensors.sensor_for_spec`.
+    intensity_fn : IntensityFn, optional
+        Default: the spec's ``lidar.intensity_model``.
+    """
+    sensor = sensor_for_spec(spec) if sensor is None else sensor
+    intensity_fn = intensity_fn_for_spec(spec) if intensity_fn is None else intensity_fn
+    check_frames(scene, spec, options.frames, options.route)
+    name = sk.sequence_name(options.sequence)
+    seq = inside(out, "sequences", name)
+    frames = plan_frames(scene, spec, options.frames, route=options.route)
+    calib = kitti_calib.kitti_calib(spec, *options.resolution)
+    tr = kitti_calib.homogeneous(calib["Tr"])
+    kitti_calib.write_calib(seq / "calib.txt", calib)
+    to_sk = class_table().to_semantickitti
+    t_ego_sensor = sensor_mount(spec)
+    starts, n_points, counts = [], [], {}
+    with Scanner(scene, sensor, threads=options.threads) as scanner:
+        for f in tqdm(frames, desc=f"lidar {name}", unit="scan", disable=None if progress else True):
+            scan = scanner.scan(sweep_poses(scene, spec, sensor, f.t, route=options.route))
+            pts = scan.points
+            stem = f"{f.index:06d}"
+            remission = np.asarray(intensity_fn(pts, stream(spec.seed, "lidar", "intensity", f.index)), np.float32)
+            semantic = to_sk[pts["class"]]
+            sk.write_scan(seq / "velodyne" / f"{stem}.bin", scan.xyz, remission)
+            sk.write_labels(seq / "labels" / f"{stem}.label", semantic, pts["instance"])
+            if options.bev:
+                write_bev(seq / "bev" / f"{stem}.png", scan.xyz, pts["class"], title=f"{spec.name} {name}/{stem}")
+            if options.range_image:
+                with atomic_path(seq / "range" / f"{stem}.npy") as tmp:
+                    np.save(tmp, scan.range_image())
+            if options.ply:
+                write_ply(seq / "ply" / f"{stem}.ply", scan.xyz, remission, semantic, pts["instance"],
+                          class_table().colors[pts["class"]])
+            starts.append(f.T_world_ego @ t_ego_sensor)
+            n_points.append(int(len(pts)))
+            counts = merge_counts(counts, count_raw_ids(semantic))
+    _remove_stale(seq, options.frames)
+    sk.write_poses(seq / "poses.txt", kitti_calib.camera_poses(np.array(starts), tr))
+    sk.write_times(seq / "times.txt", np.array([f.t for f in frames]))
+    meta = _metadata(scene, spec, sensor, options, intensity_fn, n_points, counts)
+    write_json(seq / META_NAME, meta)
+    write_dataset_label_config(out)
+    return meta
+
+
+def _remove_stale(seq: Path, n: int) -> None:
+    for sub, ext in (("velodyne", ".bin"), ("labels", ".label"), ("bev", ".png"), ("range", ".npy"), ("ply", ".ply")):
+        for p in sorted((seq / sub).glob(f"*{ext}")):
+            if p.stem.isdigit() and int(p.stem) >= n:
+                log.warning("removing %s left by an earlier, longer run", p)
+                p.unlink()
+
+
+def write_dataset_label_config(out: str | Path) -> dict:
+    """(Re)write ``out/semantic-kitti.yaml`` with ``content`` summed over every sequence's metadata."""
+    total: dict[int, int] = {}
+    seqs = []
+    for name in sk.list_sequences(out):
+        meta_path = Path(out) / "sequences" / name / META_NAME
+        if meta_path.is_file():
+            meta = json.loads(meta_path.read_text(encoding="utf-8"))
+            counts = {int(k): int(v) for k, v in meta["raw_id_counts"].items()}
+        else:  # a sequence from elsewhere: count its labels
+            counts = {}
+            for rec in sk.Sequence(out, name):
+                if rec.semantic is not None:
+                    counts = merge_counts(counts, count_raw_ids(rec.semantic))
+        total = merge_counts(total, counts)
+        seqs.append(int(name))
+    return write_label_config(Path(out) / LABEL_CONFIG_NAME, total, seqs)
+
+
+def _metadata(scene, spec, sensor: Sensor, options: SequenceOptions, intensity_fn, n_points, counts) -> dict:
+    import embreex
+
+    remission = dict(getattr(intensity_fn, "description", {"model": getattr(intensity_fn, "__name__", "custom")}))
+    if remission.get("placeholder"):
+        remission["note"] = ("placeholder: every point has the same remission until an intensity model "
+                             "is selected; do not train on it")
+    return {
+        "generator": f"urbangen {__version__} lidar",
+        "format": "SemanticKITTI",
+        "sequence": sk.sequence_name(options.sequence),
+        "frames": options.frames,
+        "scene": {"name": spec.name, "seed": spec.seed, "spec_hash": spec.spec_hash, "scene_digest": scene.digest(),
+                  "route": options.route, "triangles": int(len(scene.faces))},
+        "sensor": {"name": sensor.name, "model": sensor.model, "file": sensor.source, "lasers": sensor.n_lasers,
+                   "azimuth_steps": sensor.azimuth_steps, "rotation_hz": sensor.rotation_hz,
+                   "range_m": [sensor.min_range_m, sensor.max_range_m],
+                   "rings": "ring 0 = highest beam (range-image row 0)",
+                   "corrections": "vert/rot/vert_offset/horiz_offset applied as the Velodyne driver does; "
+                                  "dist_correction (device range bias) not applied"},
+        "mount": {"lidar_xyz_m": list(spec.sensors.lidar.xyz_m), "lidar_rpy_deg": list(spec.sensors.lidar.rpy_deg),
+                  "camera_xyz_m": list(spec.sensors.camera.xyz_m), "camera_rpy_deg": list(spec.sensors.camera.rpy_deg),
+                  "camera_hfov_deg": spec.sensors.camera.hfov_deg},
+        "calib": {"render_config": options.render_config, "resolution": list(options.resolution),
+                  "P0..P3": "K [I|0] of the one rig camera (zero baselines)",
+                  "Tr": "velodyne -> cam0 from the rig mounts, without per-frame camera jitter"},
+        "poses": "poses.txt: cam0 pose of each scan in the first cam0 frame (KITTI); LiDAR pose = inv(Tr) @ pose @ Tr",
+        "motion_skew": bool(spec.sensors.lidar.motion_skew),
+        "motion_convention": MOTION_CONVENTION,
+        "remission": remission,
+        "labels": "uint32: SemanticKITTI raw id (low 16 bits) | instance id (high 16 bits)",
+        "points_per_scan": n_points,
+        "rays_per_scan": sensor.rays_per_sweep,
+        "raw_id_counts": {str(k): v for k, v in sorted(counts.items())},
+        "software": {"numpy": np.__version__, "embreex": getattr(embreex, "__version__", "unknown")},
+    }
