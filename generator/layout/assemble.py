@@ -1,0 +1,181 @@
+"""``build_scene(spec) -> SceneModel``: the whole procedural town, deterministic in the spec.
+
+Order of work (each feature draws from its own named stream, so adding one does not
+shift the others): grid -> routes -> lots -> buildings -> hedges/fences -> traffic lights
+-> lamps -> street trees -> signs -> lot greenery -> parked vehicles -> lane cars ->
+people -> ground objects. Objects accepted earlier win space; everything keeps clear of
+the routes (see :mod:`generator.layout.placement_core`). Finally the routes are verified
+against every object box, and an internal error is raised if any sample is too close.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections import defaultdict
+
+import numpy as np
+
+from assets_procedural.mesh import Mesh, pose
+from generator.labels import class_table
+from generator.layout import placement_lots as pl
+from generator.layout import placement_street as ps
+from generator.layout.lots import Lot, lot_ground_mesh, make_lots
+from generator.layout.placement_core import EGO_HALF_WIDTH_M, Keepout, Library, Placed, Placer, point_box_distance
+from generator.layout.routes import densify, make_routes
+from generator.layout.streets import (Grid, intersection_road_mesh, intersection_walk_mesh, make_grid, margin_mesh,
+                                      segment_road_mesh, segment_walk_mesh)
+from generator.scene import OrientedBox, Path, SceneModel, SceneObject
+from generator.spec.model import SceneSpec
+
+log = logging.getLogger(__name__)
+
+MAX_INSTANCES = 65535
+
+#: Placement steps in the order they claim space.
+STEPS = (
+    ("buildings", lambda p, s, g, lots, st: pl.place_buildings(p, s, lots, g.curb_h)),
+    ("hedges and fences", lambda p, s, g, lots, st: pl.place_fronts(p, s, lots, g.curb_h)),
+    ("traffic lights", lambda p, s, g, lots, st: ps.place_traffic_lights(p, s, st)),
+    ("lamp posts", lambda p, s, g, lots, st: ps.place_lamps(p, s, st)),
+    ("street trees", lambda p, s, g, lots, st: ps.place_street_trees(p, s, st)),
+    ("traffic signs", lambda p, s, g, lots, st: ps.place_signs(p, s, st)),
+    ("lot greenery", lambda p, s, g, lots, st: pl.place_lot_greenery(p, s, lots, g.curb_h)),
+    ("parked vehicles", lambda p, s, g, lots, st: ps.place_parked(p, s, st)),
+    ("lane cars", lambda p, s, g, lots, st: ps.place_lane_cars(p, s, st)),
+    ("people", lambda p, s, g, lots, st: ps.place_people(p, s, st)),
+)
+
+
+class LayoutError(RuntimeError):
+    """An internal invariant of the layout is broken (a bug, not a user error)."""
+
+
+def box_of(lo: np.ndarray, hi: np.ndarray, transform: np.ndarray) -> OrientedBox:
+    """OrientedBox of the local AABB ``lo``..``hi`` ((3,) metres) under a yaw-only ``transform``."""
+    c = (np.asarray(lo) + hi) / 2 @ transform[:3, :3].T + transform[:3, 3]
+    yaw = float(np.arctan2(transform[1, 0], transform[0, 0]))
+    return OrientedBox(tuple(float(v) for v in c), tuple(float(v) for v in np.subtract(hi, lo)), yaw)
+
+
+def ground_pieces(grid: Grid, lots: list[Lot]) -> list[tuple[str, str, str, Mesh, np.ndarray]]:
+    """Stuff objects: ``(kind, class, prototype key or "", mesh, transform)``.
+
+    One road and one sidewalk object per street segment, one asphalt square (shared
+    prototype) and one corner-sidewalk object per intersection, one ground per lot, and
+    the terrain margin.
+    """
+    out = []
+    for seg in grid.segments:
+        T = seg.transform()
+        out.append(("street", "road", "", segment_road_mesh(grid, seg), T))
+        out.append(("sidewalk", "sidewalk", "", segment_walk_mesh(grid, seg), T))
+    square = intersection_road_mesh(grid)
+    for node in grid.nodes:
+        T = pose(*grid.node_xy(node))
+        out.append(("intersection", "road", "intersection_road", square, T))
+        out.append(("corner", "sidewalk", "", intersection_walk_mesh(grid, node), T))
+    for lot in lots:
+        out.append(("lot_ground", "terrain" if lot.ground == "grass" else "sidewalk", "",
+                    lot_ground_mesh(lot, grid.curb_h), lot.transform()))
+    if grid.margin > 0:
+        out.append(("terrain", "terrain", "", margin_mesh(grid), np.eye(4)))
+    return out
+
+
+def _objects(grid: Grid, lots: list[Lot], placed: list[Placed], lib: Library):
+    from assets_procedural.proxy import label_proxy
+
+    prototypes: dict[str, Mesh] = {}
+    proxies: dict[str, Mesh] = {}
+    objects: list[SceneObject] = []
+    counters: dict[str, int] = defaultdict(int)
+
+    def name(kind: str) -> str:
+        counters[kind] += 1
+        return f"{kind}_{counters[kind] - 1:04d}"
+
+    for kind, cls, key, mesh, T in ground_pieces(grid, lots):
+        nm = name(kind)
+        key = key or nm
+        prototypes.setdefault(key, mesh)
+        lo, hi = mesh.bounds()
+        objects.append(SceneObject(len(objects), nm, kind, cls, 0, key, T, box_of(lo, hi, T)))
+    if len(placed) > MAX_INSTANCES:
+        raise LayoutError(f"{len(placed)} things exceed the {MAX_INSTANCES} instance ids of a uint16 label")
+    for k, p in enumerate(placed):
+        if p.proto not in prototypes:
+            mesh = lib.protos[p.proto].mesh
+            prototypes[p.proto] = mesh
+            hull = label_proxy(mesh)
+            if hull is not None:
+                proxies[p.proto] = hull
+        objects.append(SceneObject(len(objects), name(p.kind), p.kind, p.cls, k + 1, p.proto, p.transform, p.box,
+                                   p.proto if p.proto in proxies else None, p.attrs))
+    return prototypes, proxies, objects
+
+
+def verify_routes(paths: list[Path], grid: Grid, objects: list[SceneObject], limit: float) -> None:
+    """Raise :class:`LayoutError` unless every route sample lies on driving-lane asphalt and keeps
+    ``limit`` metres (2D) from every thing's box."""
+    drive = grid.drivable_rects()
+    things = [o for o in objects if o.instance_id > 0]
+    keep = Keepout(np.zeros((0, 2)), limit)
+    for path in paths:
+        xy = path.points[:, :2]
+        inside = ((xy[:, None, 0] >= drive[None, :, 0] - 1e-6) & (xy[:, None, 0] <= drive[None, :, 2] + 1e-6)
+                  & (xy[:, None, 1] >= drive[None, :, 1] - 1e-6) & (xy[:, None, 1] <= drive[None, :, 3] + 1e-6)).any(1)
+        if not inside.all():
+            raise LayoutError(f"{path.name}: {int((~inside).sum())} samples off the driving lanes, e.g. {xy[~inside][0]}")
+        keep = Keepout(xy, limit)
+        for o in things:
+            d = keep.distance(o.box)
+            if d < limit:
+                raise LayoutError(f"{path.name}: {o.name} is {d:.2f} m from the route (< {limit:.2f} m)")
+
+
+def build_scene(spec: SceneSpec) -> SceneModel:
+    """Build the town described by ``spec``.
+
+    Returns
+    -------
+    SceneModel
+        Stuff objects first (instance id 0), then things with instance ids 1..N in placement
+        order; route 0 is the comb loop :mod:`generator.layout.frames` follows.
+
+    Raises
+    ------
+    LayoutError
+        If a route ends up off the lanes or too close to an object (a bug).
+    """
+    t0 = time.perf_counter()
+    grid = make_grid(spec)
+    routes = make_routes(grid)
+    lots = make_lots(spec, grid)
+    limit = spec.paths.clearance_m + EGO_HALF_WIDTH_M
+    keepout = Keepout(np.concatenate([densify(r) for r in routes]), limit)
+    lib = Library(spec.seed)
+    placer = Placer(lib, keepout)
+    street = ps.Street(grid)
+    log.info("layout %s: %d x %d blocks, %d segments, %d lots", spec.name, len(grid.xs) - 1, len(grid.ys) - 1,
+             len(grid.segments), len(lots))
+    for label, step in STEPS:
+        n0, t1 = len(placer.placed), time.perf_counter()
+        step(placer, spec, grid, lots, street)
+        log.info("placed %d %s (%.2f s)", len(placer.placed) - n0, label, time.perf_counter() - t1)
+    prototypes, proxies, objects = _objects(grid, lots, placer.placed, lib)
+    verify_routes(routes, grid, objects, limit - 1e-6)
+    scene = SceneModel(spec.seed, spec.spec_hash, grid.bounds, prototypes, proxies, objects, routes)
+    log.info("scene %s: %d objects, %d prototypes, %d proxies, built in %.2f s", spec.name, len(objects),
+             len(prototypes), len(proxies), time.perf_counter() - t0)
+    return scene
+
+
+def class_counts(scene: SceneModel) -> dict[str, dict[str, int]]:
+    """Objects (by main class) and triangles (by face class) per class name."""
+    names = class_table().names
+    tri = np.bincount(scene.face_class, minlength=len(names))
+    objs: dict[str, int] = defaultdict(int)
+    for o in scene.objects:
+        objs[o.cls] += 1
+    return {n: {"objects": int(objs.get(n, 0)), "triangles": int(tri[i])} for i, n in enumerate(names)}

@@ -1,0 +1,212 @@
+"""Blocks split into lots: building plans, parks, yards, hedges and fences along the fronts.
+
+Each block (inside its sidewalks) is cut into one or two rows of lots; each row faces one
+street and is cut along its frontage into 2-6 lots of varied width (corner lots face the
+row's street). A lot has its own frame: ``a`` along the frontage, ``b`` into the lot (b = 0 at
+the sidewalk's outer edge), z up; its yaw is chosen so that this frame is exactly the local
+frame of a building asset (front towards -y = towards the street).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from assets_procedural.mesh import Mesh, merge, pose
+from generator.layout.streets import Grid, rects
+from generator.rng import stream
+from generator.spec.model import SceneSpec
+
+MIN_LOT_W = 9.0        #: narrowest lot along the frontage, metres
+MIN_ROW_DEPTH = 14.0   #: a block is split into two rows only if each gets at least this depth
+SIDE_GAP = (1.2, 3.0)  #: building to lot side, metres
+BACK_GAP = 2.0         #: building to lot back, metres
+FRONT_GAP_M = 2.0      #: gap left in a hedge or fence for the entrance
+FRONT_B = 0.6          #: centre line of hedges/fences, metres behind the lot front
+FACADES = ("plaster", "brick", "concrete")
+ROOFS = ("flat", "gable", "hip")
+
+
+@dataclass
+class BuildingPlan:
+    """A building on a lot, in the lot frame.
+
+    Attributes
+    ----------
+    footprint : (k, 2) float64
+        Counter-clockwise polygon in the building's local frame (bounding box centred on 0).
+    center : (2,) float
+        Footprint bounding-box centre in the lot frame (a, b), metres.
+    height, floor_height : float
+        Metres; the height is a whole number of floors.
+    facade, roof : str
+        Asset parameters (``plaster|brick|concrete``, ``flat|gable|hip``).
+    attrs : dict
+        Render tints: ``facade_color``, ``roof_color`` (3 floats in 0..1).
+    """
+
+    footprint: np.ndarray
+    center: tuple[float, float]
+    height: float
+    floor_height: float
+    facade: str
+    roof: str
+    attrs: dict
+
+
+@dataclass
+class FrontLine:
+    """A hedge or fence piece along the lot front: ``a0..a1`` at ``b`` (lot frame, metres)."""
+
+    kind: str        # "hedge" | "fence"
+    a0: float
+    a1: float
+    b: float
+
+
+@dataclass
+class Lot:
+    """One lot of a block (see the module docstring for its frame)."""
+
+    index: int
+    block: tuple[int, int]
+    origin: tuple[float, float]       #: world xy of the front centre, metres
+    yaw: float                        #: radians; lot (a, b) axes = building local (x, y)
+    width: float
+    depth: float
+    use: str                          #: "building" | "park" | "yard"
+    ground: str                       #: "grass" | "paving"
+    building: BuildingPlan | None = None
+    front: list[FrontLine] = field(default_factory=list)
+    entrance_a: float = 0.0           #: a of the door / gate (lot frame)
+
+    def transform(self, z: float = 0.0) -> np.ndarray:
+        """(4, 4) world-from-lot transform."""
+        return pose(self.origin[0], self.origin[1], z, self.yaw)
+
+    def to_world(self, ab: np.ndarray) -> np.ndarray:
+        """(n, 2) world xy of lot-frame points ``ab`` ((n, 2) metres)."""
+        ab = np.asarray(ab, np.float64).reshape(-1, 2)
+        c, s = np.cos(self.yaw), np.sin(self.yaw)
+        return np.stack([ab[:, 0] * c - ab[:, 1] * s, ab[:, 0] * s + ab[:, 1] * c], 1) + np.asarray(self.origin)
+
+    def corners_world(self) -> np.ndarray:
+        """(4, 2) world corners of the lot."""
+        w = self.width / 2
+        return self.to_world([(-w, 0), (w, 0), (w, self.depth), (-w, self.depth)])
+
+
+def _rows(rect: tuple[float, float, float, float], g: np.random.Generator):
+    """Rows of a block: (origin of the row's front-left corner, unit a, unit b (into lot), frontage, depth)."""
+    x0, y0, x1, y1 = rect
+    w, d = x1 - x0, y1 - y0
+    along_x = w >= d if abs(w - d) > 4 else bool(g.random() < 0.5)
+    depth = d if along_x else w
+    # faces: (front-left corner, a axis, b axis); a x b = +z so the lot frame is right-handed
+    if along_x:
+        faces = [((x0, y0), (1, 0), (0, 1), w), ((x1, y1), (-1, 0), (0, -1), w)]
+    else:
+        faces = [((x0, y1), (0, -1), (1, 0), d), ((x1, y0), (0, 1), (-1, 0), d)]
+    if depth >= 2 * MIN_ROW_DEPTH:
+        split = depth / 2 + g.uniform(-0.1, 0.1) * depth
+        return [(faces[0], split), (faces[1], depth - split)]
+    return [(faces[int(g.integers(2))], depth)]
+
+
+def _widths(frontage: float, g: np.random.Generator) -> np.ndarray:
+    n = int(min(g.integers(2, 7), max(1, frontage // MIN_LOT_W)))
+    w = g.uniform(0.65, 1.35, n)
+    w = w / w.sum() * frontage
+    # keep every lot at least MIN_LOT_W wide when the frontage allows it
+    while n > 1 and w.min() < MIN_LOT_W:
+        n -= 1
+        w = np.full(n, frontage / n)
+    return w
+
+
+def _footprint(w: float, d: float, g: np.random.Generator) -> np.ndarray:
+    hw, hd = w / 2, d / 2
+    if w >= 10 and d >= 10 and g.random() < 0.35:
+        nx, ny = w * g.uniform(0.35, 0.6), d * g.uniform(0.35, 0.55)
+        p = np.array([(-hw, -hd), (hw, -hd), (hw, hd - ny), (hw - nx, hd - ny), (hw - nx, hd), (-hw, hd)])
+        if g.random() < 0.5:       # notch at the back-left instead: mirror x and keep CCW
+            p = (p * [-1, 1])[::-1]
+        return p
+    return np.array([(-hw, -hd), (hw, -hd), (hw, hd), (-hw, hd)])
+
+
+def _building(spec: SceneSpec, width: float, depth: float, setback: float, g: np.random.Generator) -> BuildingPlan | None:
+    side = g.uniform(*SIDE_GAP, 2)
+    bw = width - side.sum()
+    bd = min(g.uniform(10.0, 22.0), depth - setback - BACK_GAP)
+    if bw < 6.0 or bd < 6.0:
+        return None
+    hf = spec.heights.floor_m
+    lo, hi = spec.heights.building_m
+    floors = max(1, int(round(g.uniform(lo, hi) / hf)))
+    facade = FACADES[int(g.integers(len(FACADES)))]
+    roof = "flat" if floors > 4 or g.random() < 0.35 else ROOFS[1 + int(g.integers(2))]
+    base = {"plaster": (0.85, 0.8, 0.7), "brick": (0.6, 0.32, 0.24), "concrete": (0.65, 0.65, 0.63)}[facade]
+    tint = np.clip(np.asarray(base) * g.uniform(0.85, 1.15, 3), 0, 1)
+    roof_tint = np.clip(np.array((0.35, 0.28, 0.26) if roof != "flat" else (0.4, 0.4, 0.42)) * g.uniform(0.8, 1.2, 3), 0, 1)
+    attrs = {"facade_color": [round(float(c), 4) for c in tint], "roof_color": [round(float(c), 4) for c in roof_tint]}
+    center = (float(-width / 2 + side[0] + bw / 2), float(setback + bd / 2))
+    return BuildingPlan(_footprint(bw, bd, g), center, floors * hf, hf, facade, roof, attrs)
+
+
+def _front(kind: str, width: float, gap_at: float) -> list[FrontLine]:
+    a0, a1 = -width / 2 + 0.4, width / 2 - 0.4
+    g0, g1 = gap_at - FRONT_GAP_M / 2, gap_at + FRONT_GAP_M / 2
+    return [FrontLine(kind, float(s), float(e), FRONT_B) for s, e in ((a0, g0), (g1, a1)) if e - s >= 1.0]
+
+
+def make_lots(spec: SceneSpec, grid: Grid) -> list[Lot]:
+    """Split every block into lots and plan what stands on each (stream ``("layout", "lots")``)."""
+    g = stream(spec.seed, "layout", "lots")
+    d = spec.density
+    lots: list[Lot] = []
+    for j in range(len(grid.ys) - 1):
+        for i in range(len(grid.xs) - 1):
+            for (corner, ua, ub, frontage), depth in _rows(grid.block_rect(i, j), g):
+                yaw = float(np.arctan2(ub[1], ub[0]) - np.pi / 2)
+                a = 0.0
+                for w in _widths(frontage, g):
+                    origin = np.asarray(corner) + np.asarray(ua) * (a + w / 2)
+                    a += w
+                    lots.append(_plan_lot(spec, len(lots), (i, j), origin, yaw, float(w), float(depth), d, g))
+    return lots
+
+
+def _plan_lot(spec, index, block, origin, yaw, width, depth, d, g) -> Lot:
+    r = g.random()
+    front = "hedge" if r < d.hedges else ("fence" if r < d.hedges + d.fences else None)
+    lot = Lot(index, block, (float(origin[0]), float(origin[1])), yaw, width, depth, "yard", "grass")
+    if g.random() < d.buildings:
+        setback = g.uniform(2.5, 4.0) if front else g.uniform(0.0, 4.0)
+        lot.building = _building(spec, width, depth, float(setback), g)
+    if lot.building is not None:
+        lot.use = "building"
+        lot.ground = "grass" if g.random() < 0.6 else "paving"
+        lot.entrance_a = lot.building.center[0]
+    else:
+        lot.use = "park" if g.random() < d.parks else "yard"
+        lot.entrance_a = float(g.uniform(-0.25, 0.25) * width)
+        if lot.use == "park":
+            front = None if g.random() < 0.5 else front
+    if front:
+        lot.front = _front(front, width, lot.entrance_a)
+    return lot
+
+
+def lot_ground_mesh(lot: Lot, curb_h: float) -> Mesh:
+    """Ground of ``lot`` at sidewalk height (lot frame), with a paved path to the entrance."""
+    w = lot.width / 2
+    cls, mat = ("terrain", "grass") if lot.ground == "grass" else ("sidewalk", "sidewalk_concrete")
+    parts = [rects([(-w, 0, w, lot.depth)], curb_h, cls, mat)]
+    if lot.building is not None and lot.ground == "grass":
+        setback = lot.building.center[1] - np.ptp(lot.building.footprint[:, 1]) / 2
+        if setback > 0.3:
+            a = lot.entrance_a
+            parts.append(rects([(a - 0.75, 0, a + 0.75, setback)], curb_h + 0.003, "sidewalk", "sidewalk_concrete"))
+    return merge(parts)

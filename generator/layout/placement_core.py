@@ -1,0 +1,265 @@
+"""Placement machinery: asset prototypes, 3D occupancy, the route keep-out, and the placer.
+
+Every thing in the town is a prototype mesh under a yaw-only transform. Before an object
+is accepted the :class:`Placer` checks
+
+* the route keep-out: its oriented box (2D) stays ``clearance + EGO_HALF_WIDTH_M`` away from
+  every route sample (:class:`Keepout`);
+* the occupancy: its collision boxes (the prototype cut into height bands, so a lamp arm
+  or a tree crown does not block the pavement under it) overlap no accepted box
+  (:class:`Occupancy`, a uniform grid hash with a vectorised separating-axis test).
+"""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from assets_procedural.mesh import Mesh, pose
+from generator.rng import stream
+from generator.scene import OrientedBox
+
+EGO_HALF_WIDTH_M = 1.2   #: half the width of the ego vehicle that drives the routes
+BAND_M = 0.5             #: height of a collision band
+WHOLE_BOX_KINDS = frozenset({"building", "hedge", "fence"})
+
+
+def collision_boxes(mesh: Mesh, whole: bool = False, band: float = BAND_M, tol: float = 0.15) -> np.ndarray:
+    """Conservative local AABBs of ``mesh`` cut into height bands.
+
+    Every triangle whose z-range meets a band contributes its full xy extent to that band;
+    consecutive bands with nearly equal extents are merged.
+
+    Returns
+    -------
+    (b, 6) float64
+        ``(x0, y0, z0, x1, y1, z1)`` per box, local frame, metres.
+    """
+    lo, hi = mesh.bounds()
+    if whole or mesh.n_faces == 0:
+        return np.array([[*lo, *hi]])
+    tri = mesh.vertices[mesh.faces]
+    tmin, tmax = tri.min(1), tri.max(1)
+    edges = np.arange(lo[2], hi[2] + band, band)
+    out: list[list[float]] = []
+    for z0, z1 in zip(edges[:-1], np.minimum(edges[1:], hi[2])):
+        m = (tmin[:, 2] <= z1) & (tmax[:, 2] >= z0)
+        if not m.any():
+            continue
+        xy = [*tmin[m, :2].min(0), *tmax[m, :2].max(0)]
+        if out and np.all(np.abs(np.subtract(xy, [out[-1][k] for k in (0, 1, 3, 4)])) < tol):
+            prev = out[-1]
+            out[-1] = [min(prev[0], xy[0]), min(prev[1], xy[1]), prev[2], max(prev[3], xy[2]), max(prev[4], xy[3]), z1]
+        else:
+            out.append([xy[0], xy[1], z0, xy[2], xy[3], z1])
+    return np.array(out, np.float64)
+
+
+@dataclass
+class Proto:
+    """A prototype mesh and what placement needs to know about it."""
+
+    key: str
+    kind: str
+    mesh: Mesh
+    lo: np.ndarray           #: (3,) local AABB min
+    hi: np.ndarray           #: (3,) local AABB max
+    bands: np.ndarray        #: (b, 6) collision boxes (local)
+    params: dict = field(default_factory=dict)
+
+
+class Library:
+    """Builds prototypes through :func:`assets_procedural.catalog.build` and caches them.
+
+    Instanced kinds get a handful of variants (``key = "<kind>_v<i>"``) built from the
+    stream ``("assets", kind, i)``; unique kinds (buildings, fences, hedges) get one
+    prototype per object from ``("assets", kind, n)``.
+    """
+
+    def __init__(self, seed: int):
+        from assets_procedural import catalog  # imported lazily: the layout math does not need it
+
+        self.seed = seed
+        self._catalog = catalog
+        self.protos: dict[str, Proto] = {}
+        self._unique: dict[str, int] = defaultdict(int)
+
+    def main_class(self, kind: str) -> str:
+        return self._catalog.MAIN_CLASS[kind]
+
+    def _make(self, key: str, kind: str, g: np.random.Generator, params: dict) -> Proto:
+        mesh = self._catalog.build(kind, g, **params)
+        lo, hi = mesh.bounds()
+        p = Proto(key, kind, mesh, lo, hi, collision_boxes(mesh, whole=kind in WHOLE_BOX_KINDS), dict(params))
+        self.protos[key] = p
+        return p
+
+    def variant(self, kind: str, i: int, params_fn=None, tag: str = "") -> Proto:
+        """Variant ``i`` of an instanced kind; ``params_fn(g) -> dict`` draws its parameters first.
+
+        ``tag`` names a separate family of variants of the same kind (e.g. street trees),
+        keyed ``"<kind>_<tag>_v<i>"`` and built from the stream ``("assets", kind, tag, i)``.
+        """
+        key = f"{kind}_{tag}_v{i}" if tag else f"{kind}_v{i}"
+        if key not in self.protos:
+            g = stream(self.seed, "assets", kind, tag, i) if tag else stream(self.seed, "assets", kind, i)
+            self._make(key, kind, g, params_fn(g) if params_fn else {})
+        return self.protos[key]
+
+    def unique(self, kind: str, **params) -> Proto:
+        """A new prototype of ``kind`` used by one object only."""
+        n = self._unique[kind]
+        self._unique[kind] += 1
+        return self._make(f"{kind}_{n:04d}", kind, stream(self.seed, "assets", kind, n), params)
+
+    def discard(self, proto: Proto) -> None:
+        """Forget a unique prototype whose object was rejected."""
+        self.protos.pop(proto.key, None)
+
+
+def world_boxes(local: np.ndarray, transform: np.ndarray, pad: float = 0.0) -> np.ndarray:
+    """Local (b, 6) AABBs under a yaw-only ``transform`` -> (b, 7) ``(cx, cy, hx, hy, yaw, z0, z1)``."""
+    yaw = float(np.arctan2(transform[1, 0], transform[0, 0]))
+    c = (local[:, :3] + local[:, 3:]) / 2
+    cw = c @ transform[:3, :3].T + transform[:3, 3]
+    h = (local[:, 3:] - local[:, :3]) / 2
+    z = transform[2, 3]
+    return np.stack([cw[:, 0], cw[:, 1], h[:, 0] + pad, h[:, 1] + pad, np.full(len(c), yaw),
+                     local[:, 2] + z, local[:, 5] + z], 1)
+
+
+def oriented_box(proto: Proto, transform: np.ndarray) -> OrientedBox:
+    """The object's :class:`OrientedBox`: the prototype's local AABB under ``transform``."""
+    c = (proto.lo + proto.hi) / 2 @ transform[:3, :3].T + transform[:3, 3]
+    size = proto.hi - proto.lo
+    yaw = float(np.arctan2(transform[1, 0], transform[0, 0]))
+    return OrientedBox(tuple(float(v) for v in c), tuple(float(v) for v in size), yaw)
+
+
+def _axes(b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    c, s = np.cos(b[..., 4]), np.sin(b[..., 4])
+    return np.stack([c, s], -1), np.stack([-s, c], -1)
+
+
+def overlaps(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(k, m) bool: do boxes ``a`` (k, 7) and ``b`` (m, 7) overlap (2D separating axes + z interval)?"""
+    A, B = a[:, None, :], b[None, :, :]
+    ax, ay = _axes(A)
+    bx, by = _axes(B)
+    d = B[..., :2] - A[..., :2]
+    ok = (A[..., 5] < B[..., 6]) & (B[..., 5] < A[..., 6])
+    for n in (ax, ay, bx, by):
+        ra = A[..., 2] * np.abs((n * ax).sum(-1)) + A[..., 3] * np.abs((n * ay).sum(-1))
+        rb = B[..., 2] * np.abs((n * bx).sum(-1)) + B[..., 3] * np.abs((n * by).sum(-1))
+        ok &= np.abs((n * d).sum(-1)) < ra + rb
+    return ok
+
+
+class Occupancy:
+    """Accepted collision boxes in a uniform grid hash (cells of ``cell`` metres)."""
+
+    def __init__(self, cell: float = 8.0):
+        self.cell = cell
+        self._buf = np.zeros((256, 7))
+        self._n = 0
+        self._cells: dict[tuple[int, int], list[int]] = defaultdict(list)
+
+    def _keys(self, b: np.ndarray) -> set[tuple[int, int]]:
+        r = np.hypot(b[:, 2], b[:, 3])
+        lo = np.floor((b[:, :2] - r[:, None]) / self.cell).astype(int)
+        hi = np.floor((b[:, :2] + r[:, None]) / self.cell).astype(int)
+        return {(i, j) for l, h in zip(lo, hi) for i in range(l[0], h[0] + 1) for j in range(l[1], h[1] + 1)}
+
+    @property
+    def boxes(self) -> np.ndarray:
+        """(n, 7) accepted boxes ``(cx, cy, hx, hy, yaw, z0, z1)``."""
+        return self._buf[: self._n]
+
+    def hits(self, boxes: np.ndarray) -> bool:
+        """True if any of ``boxes`` (k, 7) overlaps an accepted box."""
+        idx = sorted({i for key in self._keys(boxes) for i in self._cells.get(key, ())})
+        return bool(idx) and bool(overlaps(boxes, self.boxes[idx]).any())
+
+    def add(self, boxes: np.ndarray) -> None:
+        start = self._n
+        while start + len(boxes) > len(self._buf):
+            self._buf = np.concatenate([self._buf, np.zeros_like(self._buf)])
+        self._buf[start:start + len(boxes)] = boxes
+        self._n += len(boxes)
+        for k in range(len(boxes)):
+            for key in self._keys(boxes[k:k + 1]):
+                self._cells[key].append(start + k)
+
+
+class Keepout:
+    """Route samples every 25 cm; objects must keep ``limit`` metres (2D) away from all of them."""
+
+    def __init__(self, samples_xy: np.ndarray, limit: float):
+        self.points = np.asarray(samples_xy, np.float64).reshape(-1, 2)
+        self.limit = float(limit)
+        self.tree = cKDTree(self.points) if len(self.points) else None
+
+    def distance(self, box: OrientedBox) -> float:
+        """2D distance from the box footprint to the nearest route sample within reach (inf if none)."""
+        if self.tree is None:
+            return np.inf
+        r = float(np.hypot(box.size[0], box.size[1]) / 2 + self.limit + 0.5)
+        idx = self.tree.query_ball_point(box.center[:2], r)
+        if not idx:
+            return np.inf
+        return float(point_box_distance(self.points[idx], box).min())
+
+    def violated(self, box: OrientedBox) -> bool:
+        return self.distance(box) < self.limit
+
+
+def point_box_distance(points: np.ndarray, box: OrientedBox) -> np.ndarray:
+    """(n,) float64 2D distance from (n, 2) world points to the footprint of ``box`` (0 inside)."""
+    p = np.asarray(points, np.float64).reshape(-1, 2) - np.asarray(box.center[:2])
+    c, s = np.cos(box.yaw), np.sin(box.yaw)
+    lx, ly = np.abs(p[:, 0] * c + p[:, 1] * s), np.abs(-p[:, 0] * s + p[:, 1] * c)
+    dx = np.maximum(lx - box.size[0] / 2, 0)
+    dy = np.maximum(ly - box.size[1] / 2, 0)
+    return np.hypot(dx, dy)
+
+
+@dataclass
+class Placed:
+    """An accepted object, before instance ids and names are assigned."""
+
+    kind: str
+    cls: str
+    proto: str
+    transform: np.ndarray
+    box: OrientedBox
+    attrs: dict
+
+
+class Placer:
+    """Accepts objects that clear the route keep-out and the occupancy."""
+
+    def __init__(self, library: Library, keepout: Keepout, occupancy: Occupancy | None = None):
+        self.lib = library
+        self.keepout = keepout
+        self.occ = occupancy or Occupancy()
+        self.placed: list[Placed] = []
+
+    def try_place(self, proto: Proto, x: float, y: float, z: float, yaw: float, attrs: dict | None = None,
+                  pad: float = 0.0) -> bool:
+        """Place ``proto`` at (x, y, z) turned by ``yaw`` if it fits; return whether it was placed."""
+        T = pose(x, y, z, yaw)
+        box = oriented_box(proto, T)
+        if self.keepout.violated(box):
+            return False
+        boxes = world_boxes(proto.bands, T, pad)
+        if self.occ.hits(boxes):
+            return False
+        self.occ.add(boxes)
+        self.placed.append(Placed(proto.kind, self.lib.main_class(proto.kind), proto.key, T, box, dict(attrs or {})))
+        return True
+
+    def count(self, kind: str) -> int:
+        return sum(1 for p in self.placed if p.kind == kind)

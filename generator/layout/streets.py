@@ -1,0 +1,379 @@
+"""The street grid: block sizes, street cross-sections, ground meshes of streets and intersections.
+
+The town is a grid of ``blocks_x x blocks_y`` blocks separated (and surrounded) by two-way
+streets. Street centre lines run at ``Grid.xs`` (north-south streets) and ``Grid.ys``
+(east-west streets); they meet at intersections ("nodes") ``(i, j)`` at ``(xs[i], ys[j])``.
+
+Cross-section of every street, from its centre line outwards (metres)::
+
+    |<- lanes_per_direction * lane_width ->|<- parking ->|<- curb ->|<- sidewalk ->|
+    0                                      lane_half     road_half  walk_inner     corridor_half
+
+Road and parking surfaces are at z = 0 (the world's road plane); curbs and sidewalks rise to
+``curb_height_m``, as do lot grounds and the terrain margin. A *segment* is the stretch of one
+street between two adjacent intersections; its local frame has ``u`` along the street (from
+the start intersection's edge, metres) and ``v`` to the left, so right-hand traffic driving
+towards +u uses the lanes at ``v < 0``.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+
+from assets_procedural.mesh import Mesh, merge, pose, slab
+from generator.labels import class_table
+from generator.materials import material_table
+from generator.rng import stream
+from generator.spec.model import SceneSpec
+
+log = logging.getLogger(__name__)
+
+CURB_WIDTH_M = 0.18
+MARK_Z_M = 0.005           #: markings float this far above the asphalt (no z-fighting)
+CROSSWALK_U = (0.6, 3.6)   #: crosswalk band, metres from the intersection edge
+STOP_U = (4.6, 5.0)        #: stop line band, metres from the intersection edge
+PARKING_START_U = 7.0      #: parking strips start this far from the intersection edge
+BAY_M = 6.0                #: parking bay length
+DASH_M, GAP_M = 3.0, 6.0   #: centre-line dash pattern
+MIN_BLOCK_M = 15.0         #: blocks never shrink below this (jitter can be large)
+
+
+@dataclass(frozen=True)
+class Segment:
+    """One street between two adjacent intersections.
+
+    Attributes
+    ----------
+    index : int
+        Position in :attr:`Grid.segments`.
+    axis : int
+        0 for an east-west street (u = +x), 1 for a north-south street (u = +y).
+    a, b : tuple of int
+        Start and end node ``(i, j)``.
+    origin : (2,) float
+        World xy of the street centre at the start intersection's edge.
+    length : float
+        Metres between the two intersection squares (the road surface of the segment).
+    """
+
+    index: int
+    axis: int
+    a: tuple[int, int]
+    b: tuple[int, int]
+    origin: tuple[float, float]
+    length: float
+
+    @property
+    def yaw(self) -> float:
+        """Direction of +u, radians."""
+        return 0.0 if self.axis == 0 else np.pi / 2
+
+    def transform(self, z: float = 0.0) -> np.ndarray:
+        """(4, 4) world-from-segment transform (u, v, z) -> world."""
+        return pose(self.origin[0], self.origin[1], z, self.yaw)
+
+    def to_world(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """(n, 2) float64 world xy of segment coordinates ``u``, ``v`` (metres)."""
+        u, v = np.broadcast_arrays(np.asarray(u, float), np.asarray(v, float))
+        if self.axis == 0:
+            return np.stack([self.origin[0] + u, self.origin[1] + v], -1).reshape(-1, 2)
+        return np.stack([self.origin[0] - v, self.origin[1] + u], -1).reshape(-1, 2)
+
+    def rect_world(self, u0: float, u1: float, v0: float, v1: float) -> tuple[float, float, float, float]:
+        """The segment-frame rectangle ``[u0, u1] x [v0, v1]`` as a world AABB (x0, y0, x1, y1)."""
+        p = self.to_world([u0, u1], [v0, v1])
+        return (float(p[:, 0].min()), float(p[:, 1].min()), float(p[:, 0].max()), float(p[:, 1].max()))
+
+
+@dataclass(frozen=True)
+class Grid:
+    """The street grid and its cross-section (all lengths in metres, world frame)."""
+
+    xs: np.ndarray                   #: (blocks_x + 1,) float64 x of north-south street centres
+    ys: np.ndarray                   #: (blocks_y + 1,) float64 y of east-west street centres
+    lanes: int                       #: lanes per direction
+    lane_w: float
+    parking_w: float
+    curb_w: float
+    sidewalk_w: float
+    curb_h: float
+    margin: float
+    segments: tuple[Segment, ...]
+
+    @property
+    def lane_half(self) -> float:
+        """Centre line to the outer edge of the driving lanes."""
+        return self.lanes * self.lane_w
+
+    @property
+    def road_half(self) -> float:
+        """Centre line to the curb face (kerb-to-kerb half width)."""
+        return self.lane_half + self.parking_w
+
+    @property
+    def walk_inner(self) -> float:
+        """Centre line to the inner edge of the sidewalk (behind the curb)."""
+        return self.road_half + self.curb_w
+
+    @property
+    def corridor_half(self) -> float:
+        """Centre line to the outer edge of the sidewalk (where lots begin)."""
+        return self.walk_inner + self.sidewalk_w
+
+    @property
+    def nodes(self) -> list[tuple[int, int]]:
+        """Every intersection ``(i, j)``, row-major in j then i."""
+        return [(i, j) for j in range(len(self.ys)) for i in range(len(self.xs))]
+
+    @property
+    def bounds(self) -> np.ndarray:
+        """(2, 2) float64 [[xmin, ymin], [xmax, ymax]] of the whole town including the margin."""
+        e = self.corridor_half + self.margin
+        return np.array([[self.xs[0] - e, self.ys[0] - e], [self.xs[-1] + e, self.ys[-1] + e]])
+
+    def node_xy(self, node: tuple[int, int]) -> np.ndarray:
+        return np.array([self.xs[node[0]], self.ys[node[1]]])
+
+    def block_rect(self, i: int, j: int) -> tuple[float, float, float, float]:
+        """Block ``(i, j)`` inside its sidewalks: (x0, y0, x1, y1)."""
+        c = self.corridor_half
+        return (self.xs[i] + c, self.ys[j] + c, self.xs[i + 1] - c, self.ys[j + 1] - c)
+
+    def segment_between(self, a: tuple[int, int], b: tuple[int, int]) -> tuple[Segment, int]:
+        """The segment joining adjacent nodes ``a`` and ``b`` and the direction (+1: a->b is +u)."""
+        for s in self.segments:
+            if (s.a, s.b) == (a, b):
+                return s, 1
+            if (s.a, s.b) == (b, a):
+                return s, -1
+        raise KeyError(f"nodes {a} and {b} are not adjacent")
+
+    def arms(self, node: tuple[int, int]) -> list[int]:
+        """Directions (0 = east, 1 = north, 2 = west, 3 = south) in which streets leave ``node``."""
+        i, j = node
+        out = []
+        if i < len(self.xs) - 1:
+            out.append(0)
+        if j < len(self.ys) - 1:
+            out.append(1)
+        if i > 0:
+            out.append(2)
+        if j > 0:
+            out.append(3)
+        return out
+
+    # -- areas used by placement and tests ---------------------------------------------------
+    def road_rects(self) -> np.ndarray:
+        """(k, 4) float64 world AABBs (x0, y0, x1, y1) of kerb-to-kerb road (streets + intersections)."""
+        r = self.road_half
+        rows = [(self.xs[0] - r, y - r, self.xs[-1] + r, y + r) for y in self.ys]
+        cols = [(x - r, self.ys[0] - r, x + r, self.ys[-1] + r) for x in self.xs]
+        return np.array(rows + cols, np.float64)
+
+    def lane_rects(self) -> list[tuple[Segment, int, int, tuple[float, float, float, float]]]:
+        """Driving lanes of every segment: ``(segment, direction, lane, (x0, y0, x1, y1))``.
+
+        ``direction`` is +1 for traffic towards +u (lanes at v < 0), -1 otherwise; ``lane`` 0
+        is next to the centre line.
+        """
+        out = []
+        for s in self.segments:
+            for d in (1, -1):
+                for k in range(self.lanes):
+                    v0, v1 = sorted((-d * k * self.lane_w, -d * (k + 1) * self.lane_w))
+                    out.append((s, d, k, s.rect_world(0.0, s.length, v0, v1)))
+        return out
+
+    def drivable_rects(self) -> np.ndarray:
+        """(k, 4) world AABBs of driving-lane asphalt: every lane band plus the intersection squares
+        and the parking-free segment ends (where turning arcs run)."""
+        r, lh = self.road_half, self.lane_half
+        out = [s.rect_world(0.0, s.length, -lh, lh) for s in self.segments]
+        for s in self.segments:
+            out.append(s.rect_world(0.0, min(PARKING_START_U, s.length), -r, r))
+            out.append(s.rect_world(max(0.0, s.length - PARKING_START_U), s.length, -r, r))
+        for n in self.nodes:
+            x, y = self.node_xy(n)
+            out.append((x - r, y - r, x + r, y + r))
+        return np.array(out, np.float64)
+
+    def parking_rects(self) -> list[tuple[Segment, int, tuple[float, float, float, float]]]:
+        """Parking strips: ``(segment, side, (x0, y0, x1, y1))``; side -1 is the v < 0 strip."""
+        if self.parking_w <= 0:
+            return []
+        out = []
+        for s in self.segments:
+            u0, u1 = PARKING_START_U, s.length - PARKING_START_U
+            if u1 - u0 < BAY_M:
+                continue
+            for side in (-1, 1):
+                v0, v1 = sorted((side * self.lane_half, side * self.road_half))
+                out.append((s, side, s.rect_world(u0, u1, v0, v1)))
+        return out
+
+    def ground_height(self, xy: np.ndarray) -> np.ndarray:
+        """(n,) float64 height of the ground surface at world points ``xy`` ((n, 2) metres).
+
+        0 on the road (kerb to kerb, intersections included), ``curb_h`` elsewhere
+        (curbs, sidewalks, lots, terrain).
+        """
+        xy = np.asarray(xy, np.float64).reshape(-1, 2)
+        on_road = np.zeros(len(xy), bool)
+        for x0, y0, x1, y1 in self.road_rects():
+            on_road |= (xy[:, 0] > x0) & (xy[:, 0] < x1) & (xy[:, 1] > y0) & (xy[:, 1] < y1)
+        return np.where(on_road, 0.0, self.curb_h)
+
+
+def make_grid(spec: SceneSpec) -> Grid:
+    """Draw the block sizes (stream ``("layout", "grid")``) and build the :class:`Grid`.
+
+    The town is centred on the world origin.
+    """
+    t = spec.town
+    g = stream(spec.seed, "layout", "grid")
+    half_j = t.block_size_jitter_m / 2
+    bx = t.block_size_m + g.uniform(-half_j, half_j, t.blocks_x)
+    by = t.block_size_m + g.uniform(-half_j, half_j, t.blocks_y)
+    if min(bx.min(), by.min()) < MIN_BLOCK_M:
+        log.warning("block size jitter would make blocks smaller than %.0f m; clipped", MIN_BLOCK_M)
+    bx, by = np.maximum(bx, MIN_BLOCK_M), np.maximum(by, MIN_BLOCK_M)
+    road_half = t.lanes_per_direction * t.lane_width_m + t.parking_strip_width_m
+    corridor = 2 * (road_half + CURB_WIDTH_M + t.sidewalk_width_m)
+    xs = np.concatenate([[0.0], np.cumsum(bx + corridor)])
+    ys = np.concatenate([[0.0], np.cumsum(by + corridor)])
+    xs, ys = xs - xs[-1] / 2, ys - ys[-1] / 2
+    segs = []
+    for j in range(len(ys)):
+        for i in range(len(xs) - 1):
+            segs.append(((i, j), (i + 1, j), 0, (xs[i] + road_half, ys[j]), xs[i + 1] - xs[i] - 2 * road_half))
+    for i in range(len(xs)):
+        for j in range(len(ys) - 1):
+            segs.append(((i, j), (i, j + 1), 1, (xs[i], ys[j] + road_half), ys[j + 1] - ys[j] - 2 * road_half))
+    segments = tuple(Segment(k, ax, a, b, (float(o[0]), float(o[1])), float(n)) for k, (a, b, ax, o, n) in enumerate(segs))
+    return Grid(xs, ys, t.lanes_per_direction, t.lane_width_m, t.parking_strip_width_m, CURB_WIDTH_M,
+                t.sidewalk_width_m, t.curb_height_m, t.margin_m, segments)
+
+
+# -- meshes -------------------------------------------------------------------------------------
+def rects(boxes: np.ndarray, z: float, cls: str, material: str) -> Mesh:
+    """Many flat upward-facing rectangles at height ``z`` in one mesh.
+
+    Parameters
+    ----------
+    boxes : (k, 4) float
+        ``(x0, y0, x1, y1)`` per rectangle (any corner order), metres.
+    """
+    b = np.asarray(boxes, np.float64).reshape(-1, 4)
+    x0, x1 = np.minimum(b[:, 0], b[:, 2]), np.maximum(b[:, 0], b[:, 2])
+    y0, y1 = np.minimum(b[:, 1], b[:, 3]), np.maximum(b[:, 1], b[:, 3])
+    keep = (x1 - x0 > 1e-6) & (y1 - y0 > 1e-6)
+    x0, x1, y0, y1 = x0[keep], x1[keep], y0[keep], y1[keep]
+    k = len(x0)
+    zz = np.full(k, z)
+    v = np.stack([np.stack([x0, y0, zz], 1), np.stack([x1, y0, zz], 1),
+                  np.stack([x1, y1, zz], 1), np.stack([x0, y1, zz], 1)], 1).reshape(-1, 3)
+    base = (np.arange(k) * 4)[:, None]
+    f = np.concatenate([base + [0, 1, 2], base + [0, 2, 3]], 1).reshape(-1, 3)
+    return Mesh(v, f, class_table().id(cls), material_table().id(material))
+
+
+def _dashes(a0: float, a1: float, v0: float, v1: float, dash: float = DASH_M, gap: float = GAP_M) -> np.ndarray:
+    starts = np.arange(a0, a1, dash + gap)
+    return np.stack([starts, np.full_like(starts, v0), np.minimum(starts + dash, a1), np.full_like(starts, v1)], 1)
+
+
+def segment_road_mesh(grid: Grid, seg: Segment) -> Mesh:
+    """Road surface, parking strips, lane markings, stop lines and crosswalks of ``seg`` (segment frame)."""
+    L, lh, rh, p = seg.length, grid.lane_half, grid.road_half, grid.parking_w
+    parts = [rects([(0, -lh, L, lh)], 0.0, "road", "asphalt")]
+    pk0, pk1 = PARKING_START_U, L - PARKING_START_U
+    has_parking = p > 0 and pk1 - pk0 >= BAY_M
+    if p > 0:
+        sides = [(lh, rh), (-rh, -lh)]
+        if has_parking:
+            road = [(0, a, pk0, b) for a, b in sides] + [(pk1, a, L, b) for a, b in sides]
+            parts.append(rects(road, 0.0, "road", "asphalt"))
+            parts.append(rects([(pk0, a, pk1, b) for a, b in sides], 0.0, "parking", "parking_asphalt"))
+        else:
+            parts.append(rects([(0, a, L, b) for a, b in sides], 0.0, "road", "asphalt"))
+    z = MARK_Z_M
+    m0, m1 = STOP_U[1], L - STOP_U[1]       # markings run between the stop lines
+    marks = []
+    if grid.lanes == 1:
+        marks.append(_dashes(m0, m1, -0.06, 0.06))
+    else:
+        marks += [np.array([(m0, -0.18, m1, -0.06), (m0, 0.06, m1, 0.18)])]
+        for k in range(1, grid.lanes):
+            for sgn in (-1, 1):
+                marks.append(_dashes(m0, m1, sgn * k * grid.lane_w - 0.06, sgn * k * grid.lane_w + 0.06))
+    edge = lh if p > 0 else rh - 0.3
+    marks.append(np.array([(m0, edge - 0.075, m1, edge + 0.075), (m0, -edge - 0.075, m1, -edge + 0.075)]))
+    marks.append(np.array([(STOP_U[0], 0.06, STOP_U[1], lh), (L - STOP_U[1], -lh, L - STOP_U[0], -0.06)]))
+    if has_parking:
+        bays = np.arange(pk0, pk1 + 1e-6, BAY_M)
+        for a, b in ((lh + 0.075, rh), (-rh, -lh - 0.075)):
+            marks.append(np.stack([bays - 0.05, np.full_like(bays, a), bays + 0.05, np.full_like(bays, b)], 1))
+    parts.append(rects(np.concatenate(marks), z, "road_marking", "lane_paint"))
+    span = 2 * (rh - 0.25)
+    n = int((span + 0.5) // 1.0)
+    v = -(n * 1.0 - 0.5) / 2 + np.arange(n) * 1.0
+    bars = []
+    for u0, u1 in (CROSSWALK_U, (L - CROSSWALK_U[1], L - CROSSWALK_U[0])):
+        bars.append(np.stack([np.full(n, u0), v, np.full(n, u1), v + 0.5], 1))
+    parts.append(rects(np.concatenate(bars), z, "crosswalk", "crosswalk_paint"))
+    return merge(parts)
+
+
+def _curb(x0: float, y0: float, x1: float, y1: float, h: float) -> Mesh:
+    return slab(min(x0, x1), min(y0, y1), max(x0, x1), max(y0, y1), 0.0, h, "curb", "curb_concrete")
+
+
+def segment_walk_mesh(grid: Grid, seg: Segment) -> Mesh:
+    """Curbs and sidewalks along both sides of ``seg`` between the corner squares (segment frame)."""
+    rh, wi, ch, h = grid.road_half, grid.walk_inner, grid.corridor_half, grid.curb_h
+    u0, u1 = ch - rh, seg.length - (ch - rh)
+    parts = [_curb(u0, rh, u1, wi, h), _curb(u0, -wi, u1, -rh, h),
+             rects([(u0, wi, u1, ch), (u0, -ch, u1, -wi)], h, "sidewalk", "sidewalk_concrete")]
+    return merge(parts)
+
+
+def intersection_road_mesh(grid: Grid) -> Mesh:
+    """The asphalt square of an intersection (node frame: origin at the node, axes = world axes)."""
+    r = grid.road_half
+    return rects([(-r, -r, r, r)], 0.0, "road", "asphalt")
+
+
+def intersection_walk_mesh(grid: Grid, node: tuple[int, int]) -> Mesh:
+    """Corner squares (L-shaped curb + sidewalk) and, where an arm is missing, a curb closing it (node frame)."""
+    rh, wi, ch, h = grid.road_half, grid.walk_inner, grid.corridor_half, grid.curb_h
+    parts = []
+    arms = grid.arms(node)
+    for sx in (-1, 1):
+        for sy in (-1, 1):
+            x_arm, y_arm = (0 if sx > 0 else 2) in arms, (1 if sy > 0 else 3) in arms
+            # curbs only along the road edges that exist; the rest of the square is sidewalk
+            if x_arm:
+                parts.append(_curb(sx * rh, sy * rh, sx * ch, sy * wi, h))
+            if y_arm:
+                parts.append(_curb(sx * rh, sy * (wi if x_arm else rh), sx * wi, sy * ch, h))
+            x_in = wi if y_arm else rh
+            y_in = wi if x_arm else rh
+            parts.append(rects([(sx * x_in, sy * y_in, sx * ch, sy * ch)], h, "sidewalk", "sidewalk_concrete"))
+    for d in range(4):
+        if d in arms:
+            continue
+        cap = merge([_curb(rh, -rh, wi, rh, h), rects([(wi, -rh, ch, rh)], h, "sidewalk", "sidewalk_concrete")])
+        parts.append(cap.transformed(pose(yaw=d * np.pi / 2)))
+    return merge(parts)
+
+
+def margin_mesh(grid: Grid) -> Mesh:
+    """The terrain ring between the outer sidewalks and the town bounds (world frame)."""
+    (bx0, by0), (bx1, by1) = grid.bounds
+    c = grid.corridor_half
+    ix0, iy0, ix1, iy1 = grid.xs[0] - c, grid.ys[0] - c, grid.xs[-1] + c, grid.ys[-1] + c
+    ring = [(bx0, by0, bx1, iy0), (bx0, iy1, bx1, by1), (bx0, iy0, ix0, iy1), (ix1, iy0, bx1, iy1)]
+    return rects(ring, grid.curb_h, "terrain", "grass")
