@@ -260,3 +260,131 @@ def convex_hull(mesh: Mesh, cls: str | int, inflate: float = 0.02) -> Mesh:
     normals = hull.vertex_normals
     c, _ = _ids(cls, "default")
     return Mesh(hull.vertices + normals * inflate, hull.faces, c, 0)
+
+
+# -- primitives added for the asset families (additive; nothing above changed) ---------------
+
+def _frame(axis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Two unit vectors (u, v) with (u, v, axis) a right-handed orthonormal frame."""
+    axis = np.asarray(axis, float) / np.linalg.norm(axis)
+    helper = np.array([0.0, 0.0, 1.0]) if abs(axis[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
+    u = np.cross(helper, axis)
+    u /= np.linalg.norm(u)
+    return u, np.cross(axis, u)
+
+
+def tube(p0: tuple[float, float, float], p1: tuple[float, float, float], radius: float, cls: str | int,
+         material: str | int, radius1: float | None = None, sections: int = 8, caps: bool = True) -> Mesh:
+    """A (tapered) cylinder from point ``p0`` (radius ``radius``) to ``p1`` (radius ``radius1``).
+
+    Parameters
+    ----------
+    p0, p1 : (3,) float
+        End centres, metres, local frame.
+    radius, radius1 : float
+        End radii, metres (``radius1`` defaults to ``radius``); both must be > 0.
+    sections : int
+        Number of sides.
+    caps : bool
+        Close both ends with a fan.
+    """
+    p0, p1 = np.asarray(p0, float), np.asarray(p1, float)
+    axis = p1 - p0
+    length = float(np.linalg.norm(axis))
+    u, v = _frame(axis)
+    w = axis / length
+    base = cylinder(radius, length, cls, material, sections, 0.0, radius1, caps)
+    rot = np.stack([u, v, w], 1)
+    return Mesh(base.vertices @ rot.T + p0, base.faces, base.face_class, base.face_material)
+
+
+def loft(rings: np.ndarray, cls: str | int, material: str | int, caps: bool = True) -> Mesh:
+    """Skin a sequence of closed rings with quads (car bodies, torsos, trunks).
+
+    Parameters
+    ----------
+    rings : (s, k, 3) float
+        ``s`` rings of ``k`` points each, metres; point ``i`` of one ring joins point ``i`` of
+        the next. Each ring must be star-shaped around its centroid (convex is enough).
+    caps : bool
+        Close the first and last ring with a fan around the ring centroid.
+
+    Returns
+    -------
+    Mesh
+        Faces oriented outward (away from the local ring centroid), whatever the ring order.
+    """
+    rings = np.asarray(rings, float)
+    s, k, _ = rings.shape
+    v = rings.reshape(-1, 3)
+    i = np.arange(k)
+    j = (i + 1) % k
+    faces = []
+    for r in range(s - 1):
+        a, b = r * k + i, (r + 1) * k + i
+        an, bn = r * k + j, (r + 1) * k + j
+        faces += [np.stack([a, an, bn], 1), np.stack([a, bn, b], 1)]
+    faces = np.concatenate(faces)
+    centres = rings.mean(1)
+    tri = v[faces]
+    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    ring_of_face = faces[:, 0] // k
+    out = tri.mean(1) - 0.5 * (centres[ring_of_face] + centres[np.minimum(ring_of_face + 1, s - 1)])
+    if np.sum(np.einsum("ij,ij->i", normal, out)) < 0:
+        faces = faces[:, ::-1]
+    if caps:
+        c0, c1 = len(v), len(v) + 1
+        v = np.concatenate([v, centres[[0, -1]]])
+        # orient each cap away from the neighbouring ring
+        cap0 = np.stack([np.full(k, c0), j, i], 1)
+        cap1 = np.stack([np.full(k, c1), (s - 1) * k + i, (s - 1) * k + j], 1)
+        for cap, inward in ((cap0, centres[min(1, s - 1)] - centres[0]), (cap1, centres[max(s - 2, 0)] - centres[-1])):
+            t = v[cap]
+            n = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]).sum(0)
+            if np.dot(n, inward) > 0:
+                cap[:] = cap[:, ::-1]
+        faces = np.concatenate([faces, cap0, cap1])
+    c, m = _ids(cls, material)
+    return Mesh(v, faces, c, m)
+
+
+def polygon(points: np.ndarray, cls: str | int, material: str | int,
+            normal: tuple[float, float, float] | None = None) -> Mesh:
+    """A planar convex polygon from (k, 3) points, fan-triangulated.
+
+    If ``normal`` is given the faces are oriented to face it; otherwise the point order
+    (counter-clockwise seen from the front) decides.
+    """
+    p = np.asarray(points, float)
+    k = len(p)
+    faces = np.stack([np.zeros(k - 2, np.int64), np.arange(1, k - 1), np.arange(2, k)], 1)
+    if normal is not None:
+        n = np.cross(p[faces[:, 1]] - p[faces[:, 0]], p[faces[:, 2]] - p[faces[:, 0]]).sum(0)
+        if np.dot(n, normal) < 0:
+            faces = faces[:, ::-1]
+    c, m = _ids(cls, material)
+    return Mesh(p, faces, c, m)
+
+
+def disc(center: tuple[float, float, float], normal: tuple[float, float, float], radius: float,
+         cls: str | int, material: str | int, sections: int = 12) -> Mesh:
+    """A flat regular ``sections``-gon of circumradius ``radius`` facing ``normal``."""
+    n = np.asarray(normal, float) / np.linalg.norm(normal)
+    u, v = _frame(n)
+    a = np.linspace(0, 2 * np.pi, sections, endpoint=False)
+    pts = np.asarray(center, float) + radius * (np.cos(a)[:, None] * u + np.sin(a)[:, None] * v)
+    return polygon(pts, cls, material, normal=n)
+
+
+def on_ground(mesh: Mesh) -> Mesh:
+    """The mesh shifted along z so that its lowest vertex is at z = 0 (anchors move with it)."""
+    if len(mesh.vertices) == 0:
+        return mesh
+    return mesh.transformed(pose(z=-float(mesh.vertices[:, 2].min())))
+
+
+def face_normals(mesh: Mesh) -> np.ndarray:
+    """(m, 3) float64 unit normals of the faces (right-hand rule on the vertex order)."""
+    tri = mesh.vertices[mesh.faces]
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    return n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)

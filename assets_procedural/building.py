@@ -1,0 +1,292 @@
+"""Buildings: extruded footprints with recessed, framed windows, a front door and a roof.
+
+Local frame: metres, z up, origin on the ground near the footprint centre (the footprint
+is used as given), the front (the door) on the edge(s) facing -y. Every face is class
+``building``. Windows are holes in the wall with reveals, a frame ring and one separate
+glass quad per window (material ``window_glass``) 12-18 cm behind the wall plane, so no
+face is closer than 2 cm to a parallel face of another material.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+
+from assets_procedural.mesh import Mesh, box, merge, polygon
+from assets_procedural.building_roof import flat_roof, pitched_roof, rectangle_of
+
+log = logging.getLogger(__name__)
+
+CLS = "building"
+FACADES = {"plaster": "facade_plaster", "brick": "facade_brick", "concrete": "facade_concrete"}
+ROOFS = ("flat", "gable", "hip")
+FRAME_W = 0.06          # width of the frame ring, metres
+FRAME_FROM_GLASS = 0.03  # frame ring sits this far in front of the glass
+
+
+@dataclass(frozen=True)
+class Style:
+    """Per-building window rhythm drawn once from the rng (metres)."""
+
+    pitch: float        # distance between window columns
+    win_w: float
+    win_h: float
+    sill: float         # window bottom above the floor level
+    recess: float       # glass depth behind the wall plane
+    pattern: str        # "single" | "mullion" | "cross"
+    shop: bool          # ground floor of the front with shop windows
+
+
+@dataclass(frozen=True)
+class Hole:
+    """A rectangular opening in facade coordinates (u along the edge, v = z)."""
+
+    u0: float
+    u1: float
+    v0: float
+    v1: float
+    kind: str  # "window" | "shop" | "door"
+
+
+def _clean(footprint: np.ndarray) -> np.ndarray:
+    """Drop repeated and collinear vertices; return the polygon counter-clockwise."""
+    p = np.asarray(footprint, float).reshape(-1, 2)
+    if len(p) < 3 or not np.all(np.isfinite(p)):
+        raise ValueError(f"footprint must be a (k>=3, 2) finite polygon, got shape {p.shape}")
+    area = 0.5 * np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1])
+    if area < 0:
+        p = p[::-1]
+    keep = []
+    for i in range(len(p)):
+        a, b, c = p[i - 1], p[i], p[(i + 1) % len(p)]
+        cross = (b[0] - a[0]) * (c[1] - b[1]) - (b[1] - a[1]) * (c[0] - b[0])
+        if np.linalg.norm(b - a) > 1e-6 and abs(cross) > 1e-9:
+            keep.append(b)
+    p = np.array(keep)
+    if len(p) < 3 or abs(area) < 1.0:
+        raise ValueError("footprint is degenerate (area < 1 m^2)")
+    return p
+
+
+def _style(rng: np.random.Generator, height: float) -> Style:
+    win_w = float(rng.uniform(0.9, 1.5))
+    return Style(
+        pitch=float(win_w + rng.uniform(1.0, 2.0)),
+        win_w=win_w,
+        win_h=float(rng.uniform(1.3, 1.7)),
+        sill=float(rng.uniform(0.8, 0.95)),
+        recess=float(rng.uniform(0.12, 0.18)),
+        pattern=str(rng.choice(["single", "mullion", "cross"])),
+        shop=bool(height >= 9.0 and rng.random() < 0.35),
+    )
+
+
+def _columns(length: float, st: Style) -> np.ndarray:
+    """(nc,) float: window column centres along an edge of ``length`` metres."""
+    usable = length - 1.2
+    if usable < st.win_w:
+        return np.zeros(0)
+    nc = int((usable - st.win_w) // st.pitch) + 1
+    return length / 2 + (np.arange(nc) - (nc - 1) / 2) * st.pitch
+
+
+def _holes(length: float, n_floors: float, fh: float, st: Style, door: dict | None) -> list[Hole]:
+    """Window, shop-window and door openings of one facade."""
+    cols = _columns(length, st)
+    win_h = min(st.win_h, fh - st.sill - 0.35)
+    holes: list[Hole] = []
+    door_col = None
+    if door is not None:
+        if len(cols):
+            door_col = int(np.argmin(np.abs(cols - length / 2)))
+            uc = float(cols[door_col])
+            room = 2 * st.pitch - st.win_w - 0.5 if len(cols) > 1 else length - 0.6
+        else:
+            uc, room = length / 2, length - 0.6
+        w = min(door["width"], room, length - 0.6)
+        holes.append(Hole(uc - w / 2, uc + w / 2, 0.0, min(door["height"], fh - 0.3), "door"))
+        door["u"] = uc
+    for f in range(n_floors):
+        for k, uc in enumerate(cols):
+            if f == 0 and k == door_col:
+                continue
+            if f == 0 and door is not None and st.shop:
+                half = (st.pitch - 0.6) / 2
+                holes.append(Hole(uc - half, uc + half, 0.45, min(fh - 0.35, 2.9), "shop"))
+                continue
+            v0 = f * fh + st.sill
+            holes.append(Hole(uc - st.win_w / 2, uc + st.win_w / 2, v0, v0 + win_h, "window"))
+    return [h for h in holes if h.u0 > 0.05 and h.u1 < length - 0.05]
+
+
+def _wall_rects(length: float, height: float, holes: list[Hole]) -> list[tuple[float, float, float, float]]:
+    """Rectangles (u0, u1, v0, v1) covering [0, length] x [0, height] minus the holes."""
+    vs = sorted({0.0, height, *[h.v0 for h in holes], *[h.v1 for h in holes]})
+    rects = []
+    for va, vb in zip(vs[:-1], vs[1:]):
+        if vb - va < 1e-6:
+            continue
+        cuts = sorted((h.u0, h.u1) for h in holes if h.v0 <= va + 1e-9 and h.v1 >= vb - 1e-9)
+        u = 0.0
+        for u0, u1 in cuts + [(length, length)]:
+            if u0 - u > 1e-6:
+                rects.append((u, u0, va, vb))
+            u = max(u, u1)
+    return rects
+
+
+class _Facade:
+    """Maps facade coordinates (u along the edge, v up, w outward) to the local frame."""
+
+    def __init__(self, p0: np.ndarray, p1: np.ndarray):
+        d = p1 - p0
+        self.length = float(np.linalg.norm(d))
+        self.d = np.array([d[0], d[1], 0.0]) / self.length
+        self.n = np.array([self.d[1], -self.d[0], 0.0])  # outward for a CCW footprint
+        self.o = np.array([p0[0], p0[1], 0.0])
+
+    def pts(self, uvw: list[tuple[float, float, float]]) -> np.ndarray:
+        a = np.asarray(uvw, float)
+        return self.o + a[:, :1] * self.d + a[:, 1:2] * np.array([0, 0, 1.0]) + a[:, 2:3] * self.n
+
+    def rect(self, u0, u1, v0, v1, w, material, facing=None) -> Mesh:
+        """Quad in the plane at offset ``w``, facing ``facing`` (default outward)."""
+        p = self.pts([(u0, v0, w), (u1, v0, w), (u1, v1, w), (u0, v1, w)])
+        return polygon(p, CLS, material, normal=self.n if facing is None else facing)
+
+    def ring(self, u0, u1, v0, v1, w, width, material) -> list[Mesh]:
+        """A flat frame ring of ``width`` inside the rectangle, facing outward."""
+        return [self.rect(u0, u1, v0, v0 + width, w, material), self.rect(u0, u1, v1 - width, v1, w, material),
+                self.rect(u0, u0 + width, v0 + width, v1 - width, w, material),
+                self.rect(u1 - width, u1, v0 + width, v1 - width, w, material)]
+
+    def reveals(self, h: Hole, depth: float, material: str) -> list[Mesh]:
+        """The four (three for a door) inner faces of the opening, facing into it."""
+        up = np.array([0, 0, 1.0])
+        out = [
+            polygon(self.pts([(h.u0, h.v1, 0), (h.u1, h.v1, 0), (h.u1, h.v1, -depth), (h.u0, h.v1, -depth)]), CLS, material, -up),
+            polygon(self.pts([(h.u0, h.v0, 0), (h.u0, h.v1, 0), (h.u0, h.v1, -depth), (h.u0, h.v0, -depth)]), CLS, material, self.d),
+            polygon(self.pts([(h.u1, h.v0, 0), (h.u1, h.v1, 0), (h.u1, h.v1, -depth), (h.u1, h.v0, -depth)]), CLS, material, -self.d),
+        ]
+        if h.v0 > 0:
+            out.append(polygon(self.pts([(h.u0, h.v0, 0), (h.u1, h.v0, 0), (h.u1, h.v0, -depth), (h.u0, h.v0, -depth)]), CLS, material, up))
+        return out
+
+    def sill(self, h: Hole, material: str) -> Mesh:
+        """A stone sill under a window, proud of the wall (top, front, bottom, ends)."""
+        s = box((h.u1 - h.u0 + 0.1, 0.07, 0.06), CLS, material, center=(0, 0, 0))
+        keep = s.vertices[s.faces].mean(1)[:, 1] < 0.035 - 1e-9  # drop the face against the wall
+        s = Mesh(s.vertices, s.faces[keep], s.face_class[keep], s.face_material[keep])
+        # box frame (x along u, -y outward, z up) -> local frame (right-handed: d x -n = z)
+        uc = (h.u0 + h.u1) / 2
+        m = np.eye(4)
+        m[:3, 0], m[:3, 1], m[:3, 2] = self.d, -self.n, (0, 0, 1.0)
+        m[:3, 3] = self.o + uc * self.d + 0.035 * self.n + (h.v0 - 0.03) * np.array([0, 0, 1.0])
+        return s.transformed(m)
+
+
+def _opening(fc: _Facade, h: Hole, st: Style, facade_mat: str) -> tuple[list[Mesh], np.ndarray]:
+    """Reveals, frame, glass (or door leaf) of one hole; returns meshes and the pane centre."""
+    depth = st.recess
+    parts = fc.reveals(h, depth, facade_mat)
+    centre = fc.pts([((h.u0 + h.u1) / 2, (h.v0 + h.v1) / 2, -depth)])[0]
+    wf = -depth + FRAME_FROM_GLASS
+    if h.kind == "door":
+        parts.append(fc.rect(h.u0, h.u1, h.v0, h.v1, -depth, "door"))
+        parts += [fc.rect(h.u0, h.u1, h.v1 - FRAME_W, h.v1, wf, "window_frame"),
+                  fc.rect(h.u0, h.u0 + FRAME_W, h.v0, h.v1 - FRAME_W, wf, "window_frame"),
+                  fc.rect(h.u1 - FRAME_W, h.u1, h.v0, h.v1 - FRAME_W, wf, "window_frame")]
+        return parts, centre
+    parts.append(fc.rect(h.u0, h.u1, h.v0, h.v1, -depth, "window_glass"))
+    parts += fc.ring(h.u0, h.u1, h.v0, h.v1, wf, FRAME_W, "window_frame")
+    a, b, c, e = h.u0 + FRAME_W, h.u1 - FRAME_W, h.v0 + FRAME_W, h.v1 - FRAME_W
+    um = (h.u0 + h.u1) / 2
+    if st.pattern in ("mullion", "cross") or h.kind == "shop":
+        parts.append(fc.rect(um - 0.03, um + 0.03, c, e, wf, "window_frame"))
+    if st.pattern == "cross" and h.kind == "window":
+        vt = h.v0 + 0.68 * (h.v1 - h.v0)
+        parts += [fc.rect(a, um - 0.03, vt - 0.03, vt + 0.03, wf, "window_frame"),
+                  fc.rect(um + 0.03, b, vt - 0.03, vt + 0.03, wf, "window_frame")]
+    if h.kind == "window":
+        parts.append(fc.sill(h, "facade_concrete"))
+    return parts, centre
+
+
+def building(rng: np.random.Generator, footprint: np.ndarray, height: float, floor_height: float = 3.2,
+             facade: str = "plaster", roof: str = "flat") -> Mesh:
+    """A building on ``footprint``: walls with windows on every floor, a door on the front, a roof.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        Source of every random choice (window rhythm, parapet, roof pitch, chimney).
+    footprint : (k, 2) float
+        Simple polygon, local metres, counter-clockwise (a clockwise one is reversed).
+    height : float
+        Wall height in metres (top of the parapet for flat roofs; the eaves for gable and
+        hip roofs, whose ridge rises above it).
+    floor_height : float
+        Storey height in metres; one row of windows per storey.
+    facade : {"plaster", "brick", "concrete"}
+        Wall material.
+    roof : {"flat", "gable", "hip"}
+        Pitched roofs need a rectangular footprint; other footprints get a flat roof.
+
+    Returns
+    -------
+    Mesh
+        Class ``building``; anchors ``"door"`` (1, 3): bottom centre of the door in the wall
+        plane, and ``"windows"`` (n, 3): centres of the glass panes.
+    """
+    if facade not in FACADES:
+        raise ValueError(f"facade must be one of {sorted(FACADES)}, got {facade!r}")
+    if roof not in ROOFS:
+        raise ValueError(f"roof must be one of {ROOFS}, got {roof!r}")
+    if not (height >= 3.0 and floor_height >= 2.2):
+        raise ValueError(f"height {height} m / floor_height {floor_height} m too small")
+    poly = _clean(footprint)
+    facade_mat = FACADES[facade]
+    st = _style(rng, height)
+    rect = rectangle_of(poly)
+    if roof != "flat" and rect is None:
+        log.debug("roof %r needs a rectangular footprint; using a flat roof", roof)
+        roof = "flat"
+    parapet = float(rng.uniform(0.6, 1.1)) if roof == "flat" else 0.0
+    # a storey gets windows when its window top stays 0.25 m under the roof line
+    win_top = st.sill + min(st.win_h, floor_height - st.sill - 0.35)
+    n_floors = max(1, int((height - parapet - 0.25 - win_top) // floor_height) + 1)
+
+    k = len(poly)
+    lengths = [float(np.linalg.norm(poly[(i + 1) % k] - poly[i])) for i in range(k)]
+    # outward normal of edge i is (d_y, -d_x): the front edge has the most negative n_y = -d_x
+    n_y = [round(-(poly[(i + 1) % k][0] - poly[i][0]) / lengths[i], 6) for i in range(k)]
+    front = min(range(k), key=lambda i: (n_y[i], -lengths[i]))
+    door = {"width": float(rng.choice([1.1, 1.2, 1.8])), "height": float(rng.uniform(2.1, 2.4))}
+
+    parts: list[Mesh] = []
+    panes = []
+    door_point = None
+    for i in range(k):
+        fc = _Facade(poly[i], poly[(i + 1) % k])
+        d = dict(door) if i == front and fc.length >= 1.4 else None
+        holes = _holes(fc.length, n_floors, floor_height, st, d)
+        for u0, u1, v0, v1 in _wall_rects(fc.length, height, holes):
+            parts.append(fc.rect(u0, u1, v0, v1, 0.0, facade_mat))
+        for h in holes:
+            meshes, centre = _opening(fc, h, st, facade_mat)
+            parts += meshes
+            if h.kind == "door":
+                door_point = fc.pts([((h.u0 + h.u1) / 2, 0.0, 0.0)])
+            else:
+                panes.append(centre)
+    if roof == "flat":
+        parts.append(flat_roof(rng, poly, height, parapet, facade_mat))
+    else:
+        parts.append(pitched_roof(rng, rect, height, roof, facade_mat))
+    out = merge(parts)
+    out.anchors = {"windows": np.array(panes).reshape(-1, 3)}
+    if door_point is not None:
+        out.anchors["door"] = door_point
+    return out

@@ -1,0 +1,124 @@
+"""Fences along x: posts, rails and bars, pickets or wire-mesh panels with real gaps.
+
+Every face is class ``fence``. The gaps are open space in the geometry: LiDAR beams pass
+between bars as they do in the real world, while the label pass covers the whole fence
+with its convex-hull proxy.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from assets_procedural.mesh import Mesh, box, merge, prism, pose
+
+CLS = "fence"
+
+
+def _bar(x0: float, x1: float, y0: float, y1: float, z0: float, z1: float, material: str,
+         ends: bool = True) -> Mesh:
+    """An axis-aligned box spanning the given ranges.
+
+    No bottom face when it stands on the ground; ``ends=False`` also drops the two faces
+    across its longest axis (hidden ends of thin wires and of rails buried in posts).
+    """
+    size = np.array([x1 - x0, y1 - y0, z1 - z0])
+    b = box(tuple(size), CLS, material, ((x0 + x1) / 2, (y0 + y1) / 2, (z0 + z1) / 2), bottom=z0 > 0)
+    if ends:
+        return b
+    axis = int(np.argmax(size))
+    rel = b.vertices[b.faces].mean(1)[:, axis] - (x0 + x1, y0 + y1, z0 + z1)[axis] / 2
+    keep = np.abs(rel) < size[axis] / 2 - 1e-9
+    return Mesh(b.vertices, b.faces[keep], b.face_class[keep], b.face_material[keep])
+
+
+def _bars_between(xa: float, xb: float, pitch: float, width: float) -> np.ndarray:
+    """(n,) float: centres of bars of ``width`` filling (xa, xb) at about ``pitch`` spacing."""
+    span = xb - xa
+    n = max(1, int(round(span / pitch)) - 1)
+    return xa + span * (np.arange(1, n + 1) / (n + 1))
+
+
+def _posts(rng: np.random.Generator, length: float, spacing: tuple[float, float], post_w: float) -> np.ndarray:
+    """(k,) float: post centres from -length/2 to +length/2, the end posts flush with the ends."""
+    half = length / 2 - post_w / 2
+    n = max(1, int(np.ceil(2 * half / rng.uniform(*spacing))))
+    return np.linspace(-half, half, n + 1)
+
+
+def _bars(rng: np.random.Generator, length: float, height: float) -> Mesh:
+    """Metal railing: square posts, top and bottom rails, vertical bars 10-13 cm apart."""
+    mat, pw, bw = "fence_metal", float(rng.uniform(0.05, 0.08)), float(rng.uniform(0.016, 0.025))
+    pitch = float(rng.uniform(0.12, 0.15))
+    posts = _posts(rng, length, (2.0, 2.6), pw)
+    parts = [_bar(x - pw / 2, x + pw / 2, -pw / 2, pw / 2, 0.0, height, mat) for x in posts]
+    for xa, xb in zip(posts[:-1], posts[1:]):
+        for z in (0.12, height - 0.12):
+            parts.append(_bar(xa, xb, -0.02, 0.02, z - 0.02, z + 0.02, mat, ends=False))
+        for x in _bars_between(xa + pw / 2, xb - pw / 2, pitch, bw):
+            parts.append(_bar(x - bw / 2, x + bw / 2, -bw / 2, bw / 2, 0.05, height - 0.03, mat))
+    return merge(parts)
+
+
+def _pickets(rng: np.random.Generator, length: float, height: float) -> Mesh:
+    """Wooden picket fence: posts, two rails behind, pointed pickets with 5-8 cm gaps."""
+    mat, pw, kw, kt = "fence_wood", 0.09, float(rng.uniform(0.07, 0.1)), 0.02
+    gap = float(rng.uniform(0.05, 0.08))
+    posts = _posts(rng, length, (1.8, 2.4), pw)
+    parts = [_bar(x - pw / 2, x + pw / 2, -pw / 2, pw / 2, 0.0, height - 0.05, mat) for x in posts]
+    tip = min(0.08, kw * 0.8)
+    outline = np.array([[-kw / 2, 0.0], [kw / 2, 0.0], [kw / 2, height - 0.05 - tip], [0.0, height - 0.05],
+                        [-kw / 2, height - 0.05 - tip]])
+    for xa, xb in zip(posts[:-1], posts[1:]):
+        for z in (0.3, height - 0.35):
+            parts.append(_bar(xa, xb, pw / 2 - 0.035, pw / 2 + 0.005, z - 0.04, z + 0.04, mat, ends=False))
+        for x in _bars_between(xa + pw / 2, xb - pw / 2, kw + gap, kw):
+            # picket outline in the x-z plane, extruded along y (roll +90 deg: prism z -> -y)
+            p = prism(outline, -pw / 2 - 0.007 - kt, -pw / 2 - 0.007, CLS, mat, bottom=True)
+            parts.append(p.transformed(pose(x, 0.0, 0.05, roll=np.pi / 2)))
+    return merge(parts)
+
+
+def _panels(rng: np.random.Generator, length: float, height: float) -> Mesh:
+    """Welded wire-mesh panels (as on school and garden fences): posts, framed 5 mm grid."""
+    mat, pw, wire = "fence_metal", float(rng.uniform(0.05, 0.07)), float(rng.uniform(0.005, 0.007))
+    cell_x = float(rng.choice([0.1, 0.2]))
+    cell_z = 0.2 if cell_x == 0.1 else 0.05 * 4
+    posts = _posts(rng, length, (2.4, 2.6), pw)
+    parts = [_bar(x - pw / 2, x + pw / 2, -pw / 2, pw / 2, 0.0, height + 0.05, mat) for x in posts]
+    z0, z1 = 0.06, height
+    for xa, xb in zip(posts[:-1], posts[1:]):
+        xa, xb = xa + pw / 2, xb - pw / 2
+        for x in _bars_between(xa, xb, cell_x, wire):
+            parts.append(_bar(x - wire / 2, x + wire / 2, -wire / 2, wire / 2, z0, z1, mat, ends=False))
+        nz = max(2, int(round((z1 - z0) / cell_z)) + 1)
+        for z in np.linspace(z0 + wire, z1 - wire, nz):
+            parts.append(_bar(xa - 0.02, xb + 0.02, wire / 2 + 0.001, 1.5 * wire + 0.001, z - wire / 2, z + wire / 2,
+                              mat, ends=False))
+    return merge(parts)
+
+
+STYLES = {"bars": _bars, "pickets": _pickets, "panels": _panels}
+
+
+def fence(rng: np.random.Generator, length: float, height: float = 1.5, style: str = "bars") -> Mesh:
+    """A fence along x from ``-length / 2`` to ``+length / 2``, centred on y = 0.
+
+    Parameters
+    ----------
+    length : float
+        Metres (>= 0.5).
+    height : float
+        Top of the posts, metres (0.5-3).
+    style : {"bars", "pickets", "panels"}
+        Metal railing, wooden picket fence or welded wire-mesh panels.
+
+    Returns
+    -------
+    Mesh
+        Class ``fence``, material ``fence_metal`` or ``fence_wood``; open gaps between bars.
+    """
+    if style not in STYLES:
+        raise ValueError(f"fence style must be one of {sorted(STYLES)}, got {style!r}")
+    if not (length >= 0.5 and 0.5 <= height <= 3.0):
+        raise ValueError(f"fence needs length >= 0.5 and height in [0.5, 3] m, got {length}, {height}")
+    return STYLES[style](rng, length, height)
