@@ -3,7 +3,9 @@
 One mesh datablock per prototype (repeated assets are linked duplicates: instancing),
 built with ``foreach_set`` from the very arrays the LiDAR casts against. Every mesh
 carries the per-face ``class_id`` (INT) and ``face_rand`` (FLOAT in [0, 1)) attributes;
-every object carries its instance id as ``pass_index`` and its colour in ``color``.
+every object carries its instance id as ``pass_index``, its colour (``attrs["color"]`` or
+``attrs["facade_color"]``) in ``color`` and ``attrs["roof_color"]`` as the custom
+property ``ug_roof_color``.
 Label proxies live in their own collection, hidden in the RGB pass.
 """
 
@@ -80,8 +82,9 @@ def build(scene: SceneModel, materials: list, parent: "bpy.types.Collection") ->
         ob = bpy.data.objects.new(o.name, meshes[o.prototype])
         ob.matrix_world = _matrix(o.transform)
         ob.pass_index = int(o.instance_id)
-        color = o.attrs.get("color", (1.0, 1.0, 1.0))
+        color = o.attrs.get("color", o.attrs.get("facade_color", (1.0, 1.0, 1.0)))
         ob.color = (float(color[0]), float(color[1]), float(color[2]), 1.0)
+        ob["ug_roof_color"] = [float(c) for c in o.attrs.get("roof_color", (1.0, 1.0, 1.0))]
         ob["ug_class"] = o.cls
         real.objects.link(ob)
         objs.append(ob)

@@ -178,7 +178,8 @@ def roof(g, rng):
     tiles = g.brick(uv, color1=_jit(rng, (0.22, 0.08, 0.06), 0.2), color2=_jit(rng, (0.16, 0.06, 0.05), 0.2),
                     mortar=(0.05, 0.05, 0.05), scale=1.0, mortar_size=0.01, brick_width=0.3, row_height=0.22)
     n = g.noise(co, scale=10, detail=4)
-    return g.principled(base_color=_tint(g, tiles), roughness=0.75, normal=g.bump(n, 0.2, 0.01))
+    tint = g.attr("ug_roof_color", "OBJECT", "Color")
+    return g.principled(base_color=g.mix(1.0, tiles, tint, "MULTIPLY"), roughness=0.75, normal=g.bump(n, 0.2, 0.01))
 
 
 def door(g, rng):
@@ -269,8 +270,8 @@ def _signal(g, color, which: int):
     """A signal lamp, lit when the object's state (Object Info > Random in thirds) selects it."""
     state = g.math("FLOOR", g.mul(g.object_info("Random"), 3.0))
     lit = g.math("COMPARE", state, float(which))
-    lens = g.principled(base_color=tuple(c * 0.25 for c in color), roughness=0.1)
-    on = g.add(g.mul(lit, 0.8), 0.2)
+    lens = g.principled(base_color=tuple(c * 0.06 for c in color), roughness=0.1)
+    on = g.add(g.mul(lit, 0.98), 0.02)
     return _emit(g, lens, color, 30.0, "traffic_lights", on)
 
 

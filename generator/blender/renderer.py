@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from generator import rig
-from generator.blender import camera, controls, geometry, lighting, materials, passes, session
+from generator.blender import camera, controls, geometry, lighting, materials, night, passes, session
 from generator.blender.bpy_guard import bpy
 from generator.scene import SceneModel
 from generator.spec.model import SceneSpec
@@ -50,6 +50,7 @@ class Renderer:
         self.device = session.configure(self.bscene, cfg)
         self.materials = materials.build_materials(spec.seed)
         self.handles = geometry.build(scene, self.materials, self.bscene.collection)
+        self.night_lights, self.night_counts = night.build_lights(scene, self.bscene.collection)
         self.k = rig.intrinsics(spec.sensors.camera.hfov_deg, cfg.width, cfg.height)
         controls.apply(self.bscene, controls.DAY_DEFAULTS)
         self.build_seconds = time.perf_counter() - t
@@ -60,8 +61,43 @@ class Renderer:
         return bpy.app.version_string
 
     def set_day(self, light: lighting.DayLight) -> dict:
-        """Day lighting; returns the lighting metadata."""
+        """Dry, clear day lighting; returns the lighting metadata."""
+        night.set_night(self.bscene, self.night_lights, False)
+        controls.apply(self.bscene, controls.DAY_DEFAULTS)
         return lighting.day_world(self.bscene, light)
+
+    def set_conditions(self, light, wetness: float = 0.0, puddle_seed: float = 0.0) -> dict:
+        """Time of day, lights and wet shaders for the next RGB render.
+
+        Parameters
+        ----------
+        light : generator.weather.Lighting
+            Day (sun position) or night (lit-window fraction).
+        wetness : float
+            0 (dry) .. 1 (soaked): darker, glossier ground with puddles.
+        puddle_seed : float
+            Moves the puddle pattern (a new draw per frame).
+
+        Returns
+        -------
+        dict
+            Lighting metadata: sky model, sun or moon, light groups switched on.
+        """
+        is_night = light.time_of_day == "night"
+        night.set_night(self.bscene, self.night_lights, is_night)
+        values = dict(controls.DAY_DEFAULTS, wetness=wetness, puddle_seed=puddle_seed)
+        if is_night:
+            values.update(lit_windows=light.lit_windows, light_windows=1.0, light_street_lamps=1.0,
+                          light_vehicle_lights=1.0, light_traffic_lights=1.0)
+            info = night.night_world(self.bscene)
+            info["lit_windows_fraction"] = light.lit_windows
+        else:
+            info = lighting.day_world(self.bscene, lighting.DayLight(light.sun_elevation_deg, light.sun_azimuth_deg))
+        controls.apply(self.bscene, values)
+        groups = [g[len("light_"):] for g, v in values.items() if g.startswith("light_") and v > 0]
+        info.update(time_of_day=light.time_of_day, light_groups_on=sorted(groups), wetness=wetness,
+                    light_objects={k: v for k, v in self.night_counts.items()} if is_night else {})
+        return info
 
     def render(self, T_world_camera: np.ndarray, seed: int, light_info: dict) -> RenderedFrame:
         """Render the RGB and label passes from one camera pose (optical frame, world)."""
