@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from assets_procedural.mesh import Mesh, box, merge, polygon
+from assets_procedural.mesh import Mesh, box, merge, quads
 from assets_procedural.building_roof import flat_roof, pitched_roof, rectangle_of
 
 log = logging.getLogger(__name__)
@@ -138,7 +138,11 @@ def _wall_rects(length: float, height: float, holes: list[Hole]) -> list[tuple[f
 
 
 class _Facade:
-    """Maps facade coordinates (u along the edge, v up, w outward) to the local frame."""
+    """Maps facade coordinates (u along the edge, v up, w outward) to the local frame.
+
+    Quads are collected (corners, material, facing) and turned into one mesh at the end:
+    a facade has hundreds of them.
+    """
 
     def __init__(self, p0: np.ndarray, p1: np.ndarray):
         d = p1 - p0
@@ -146,35 +150,41 @@ class _Facade:
         self.d = np.array([d[0], d[1], 0.0]) / self.length
         self.n = np.array([self.d[1], -self.d[0], 0.0])  # outward for a CCW footprint
         self.o = np.array([p0[0], p0[1], 0.0])
+        self.corners: list[np.ndarray] = []
+        self.materials: list[str] = []
+        self.facing: list[np.ndarray] = []
+        self.extra: list[Mesh] = []
 
     def pts(self, uvw: list[tuple[float, float, float]]) -> np.ndarray:
         a = np.asarray(uvw, float)
         return self.o + a[:, :1] * self.d + a[:, 1:2] * np.array([0, 0, 1.0]) + a[:, 2:3] * self.n
 
-    def rect(self, u0, u1, v0, v1, w, material, facing=None) -> Mesh:
-        """Quad in the plane at offset ``w``, facing ``facing`` (default outward)."""
-        p = self.pts([(u0, v0, w), (u1, v0, w), (u1, v1, w), (u0, v1, w)])
-        return polygon(p, CLS, material, normal=self.n if facing is None else facing)
+    def add(self, uvw: list[tuple[float, float, float]], material: str, facing: np.ndarray) -> None:
+        self.corners.append(self.pts(uvw))
+        self.materials.append(material)
+        self.facing.append(facing)
 
-    def ring(self, u0, u1, v0, v1, w, width, material) -> list[Mesh]:
+    def rect(self, u0, u1, v0, v1, w, material) -> None:
+        """Quad in the plane at offset ``w``, facing outward."""
+        self.add([(u0, v0, w), (u1, v0, w), (u1, v1, w), (u0, v1, w)], material, self.n)
+
+    def ring(self, u0, u1, v0, v1, w, width, material) -> None:
         """A flat frame ring of ``width`` inside the rectangle, facing outward."""
-        return [self.rect(u0, u1, v0, v0 + width, w, material), self.rect(u0, u1, v1 - width, v1, w, material),
-                self.rect(u0, u0 + width, v0 + width, v1 - width, w, material),
-                self.rect(u1 - width, u1, v0 + width, v1 - width, w, material)]
+        self.rect(u0, u1, v0, v0 + width, w, material)
+        self.rect(u0, u1, v1 - width, v1, w, material)
+        self.rect(u0, u0 + width, v0 + width, v1 - width, w, material)
+        self.rect(u1 - width, u1, v0 + width, v1 - width, w, material)
 
-    def reveals(self, h: Hole, depth: float, material: str) -> list[Mesh]:
+    def reveals(self, h: Hole, depth: float, material: str) -> None:
         """The four (three for a door) inner faces of the opening, facing into it."""
         up = np.array([0, 0, 1.0])
-        out = [
-            polygon(self.pts([(h.u0, h.v1, 0), (h.u1, h.v1, 0), (h.u1, h.v1, -depth), (h.u0, h.v1, -depth)]), CLS, material, -up),
-            polygon(self.pts([(h.u0, h.v0, 0), (h.u0, h.v1, 0), (h.u0, h.v1, -depth), (h.u0, h.v0, -depth)]), CLS, material, self.d),
-            polygon(self.pts([(h.u1, h.v0, 0), (h.u1, h.v1, 0), (h.u1, h.v1, -depth), (h.u1, h.v0, -depth)]), CLS, material, -self.d),
-        ]
+        self.add([(h.u0, h.v1, 0), (h.u1, h.v1, 0), (h.u1, h.v1, -depth), (h.u0, h.v1, -depth)], material, -up)
+        self.add([(h.u0, h.v0, 0), (h.u0, h.v1, 0), (h.u0, h.v1, -depth), (h.u0, h.v0, -depth)], material, self.d)
+        self.add([(h.u1, h.v0, 0), (h.u1, h.v1, 0), (h.u1, h.v1, -depth), (h.u1, h.v0, -depth)], material, -self.d)
         if h.v0 > 0:
-            out.append(polygon(self.pts([(h.u0, h.v0, 0), (h.u1, h.v0, 0), (h.u1, h.v0, -depth), (h.u0, h.v0, -depth)]), CLS, material, up))
-        return out
+            self.add([(h.u0, h.v0, 0), (h.u1, h.v0, 0), (h.u1, h.v0, -depth), (h.u0, h.v0, -depth)], material, up)
 
-    def sill(self, h: Hole, material: str) -> Mesh:
+    def sill(self, h: Hole, material: str) -> None:
         """A stone sill under a window, proud of the wall (top, front, bottom, ends)."""
         s = box((h.u1 - h.u0 + 0.1, 0.07, 0.06), CLS, material, center=(0, 0, 0))
         keep = s.vertices[s.faces].mean(1)[:, 1] < 0.035 - 1e-9  # drop the face against the wall
@@ -184,34 +194,37 @@ class _Facade:
         m = np.eye(4)
         m[:3, 0], m[:3, 1], m[:3, 2] = self.d, -self.n, (0, 0, 1.0)
         m[:3, 3] = self.o + uc * self.d + 0.035 * self.n + (h.v0 - 0.03) * np.array([0, 0, 1.0])
-        return s.transformed(m)
+        self.extra.append(s.transformed(m))
+
+    def mesh(self) -> Mesh:
+        return merge([quads(np.array(self.corners), CLS, self.materials, np.array(self.facing))] + self.extra)
 
 
-def _opening(fc: _Facade, h: Hole, st: Style, facade_mat: str) -> tuple[list[Mesh], np.ndarray]:
-    """Reveals, frame, glass (or door leaf) of one hole; returns meshes and the pane centre."""
+def _opening(fc: _Facade, h: Hole, st: Style, facade_mat: str) -> np.ndarray:
+    """Reveals, frame, glass (or door leaf) of one hole; returns the pane centre (3,)."""
     depth = st.recess
-    parts = fc.reveals(h, depth, facade_mat)
+    fc.reveals(h, depth, facade_mat)
     centre = fc.pts([((h.u0 + h.u1) / 2, (h.v0 + h.v1) / 2, -depth)])[0]
     wf = -depth + FRAME_FROM_GLASS
     if h.kind == "door":
-        parts.append(fc.rect(h.u0, h.u1, h.v0, h.v1, -depth, "door"))
-        parts += [fc.rect(h.u0, h.u1, h.v1 - FRAME_W, h.v1, wf, "window_frame"),
-                  fc.rect(h.u0, h.u0 + FRAME_W, h.v0, h.v1 - FRAME_W, wf, "window_frame"),
-                  fc.rect(h.u1 - FRAME_W, h.u1, h.v0, h.v1 - FRAME_W, wf, "window_frame")]
-        return parts, centre
-    parts.append(fc.rect(h.u0, h.u1, h.v0, h.v1, -depth, "window_glass"))
-    parts += fc.ring(h.u0, h.u1, h.v0, h.v1, wf, FRAME_W, "window_frame")
+        fc.rect(h.u0, h.u1, h.v0, h.v1, -depth, "door")
+        fc.rect(h.u0, h.u1, h.v1 - FRAME_W, h.v1, wf, "window_frame")
+        fc.rect(h.u0, h.u0 + FRAME_W, h.v0, h.v1 - FRAME_W, wf, "window_frame")
+        fc.rect(h.u1 - FRAME_W, h.u1, h.v0, h.v1 - FRAME_W, wf, "window_frame")
+        return centre
+    fc.rect(h.u0, h.u1, h.v0, h.v1, -depth, "window_glass")
+    fc.ring(h.u0, h.u1, h.v0, h.v1, wf, FRAME_W, "window_frame")
     a, b, c, e = h.u0 + FRAME_W, h.u1 - FRAME_W, h.v0 + FRAME_W, h.v1 - FRAME_W
     um = (h.u0 + h.u1) / 2
     if st.pattern in ("mullion", "cross") or h.kind == "shop":
-        parts.append(fc.rect(um - 0.03, um + 0.03, c, e, wf, "window_frame"))
+        fc.rect(um - 0.03, um + 0.03, c, e, wf, "window_frame")
     if st.pattern == "cross" and h.kind == "window":
         vt = h.v0 + 0.68 * (h.v1 - h.v0)
-        parts += [fc.rect(a, um - 0.03, vt - 0.03, vt + 0.03, wf, "window_frame"),
-                  fc.rect(um + 0.03, b, vt - 0.03, vt + 0.03, wf, "window_frame")]
+        fc.rect(a, um - 0.03, vt - 0.03, vt + 0.03, wf, "window_frame")
+        fc.rect(um + 0.03, b, vt - 0.03, vt + 0.03, wf, "window_frame")
     if h.kind == "window":
-        parts.append(fc.sill(h, "facade_concrete"))
-    return parts, centre
+        fc.sill(h, "facade_concrete")
+    return centre
 
 
 def building(rng: np.random.Generator, footprint: np.ndarray, height: float, floor_height: float = 3.2,
@@ -273,14 +286,14 @@ def building(rng: np.random.Generator, footprint: np.ndarray, height: float, flo
         d = dict(door) if i == front and fc.length >= 1.4 else None
         holes = _holes(fc.length, n_floors, floor_height, st, d)
         for u0, u1, v0, v1 in _wall_rects(fc.length, height, holes):
-            parts.append(fc.rect(u0, u1, v0, v1, 0.0, facade_mat))
+            fc.rect(u0, u1, v0, v1, 0.0, facade_mat)
         for h in holes:
-            meshes, centre = _opening(fc, h, st, facade_mat)
-            parts += meshes
+            centre = _opening(fc, h, st, facade_mat)
             if h.kind == "door":
                 door_point = fc.pts([((h.u0 + h.u1) / 2, 0.0, 0.0)])
             else:
                 panes.append(centre)
+        parts.append(fc.mesh())
     if roof == "flat":
         parts.append(flat_roof(rng, poly, height, parapet, facade_mat))
     else:

@@ -388,3 +388,36 @@ def face_normals(mesh: Mesh) -> np.ndarray:
     tri = mesh.vertices[mesh.faces]
     n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     return n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+
+
+def quads(corners: np.ndarray, cls: str | int, materials, normals: np.ndarray | None = None) -> Mesh:
+    """Many planar quads at once (facades with hundreds of windows).
+
+    Parameters
+    ----------
+    corners : (n, 4, 3) float
+        Corners of each quad in order around it, metres.
+    materials : str, int or sequence of (str or int), length n
+        One material for all quads or one per quad.
+    normals : (n, 3) float, optional
+        Direction each quad should face; quads wound the other way are flipped. Without it
+        the corner order decides (counter-clockwise seen from the front).
+    """
+    corners = np.asarray(corners, float).reshape(-1, 4, 3)
+    n = len(corners)
+    base = 4 * np.arange(n)[:, None]
+    tri_a = base + np.array([0, 1, 2])
+    tri_b = base + np.array([0, 2, 3])
+    if normals is not None:
+        nq = np.cross(corners[:, 2] - corners[:, 0], corners[:, 3] - corners[:, 1])
+        flip = np.einsum("ij,ij->i", nq, np.asarray(normals, float).reshape(-1, 3)) < 0
+        tri_a[flip] = tri_a[flip][:, ::-1]
+        tri_b[flip] = tri_b[flip][:, ::-1]
+    faces = np.stack([tri_a, tri_b], 1).reshape(-1, 3)
+    c, _ = _ids(cls, "default")
+    if isinstance(materials, (str, int, np.integer)):
+        mats = np.full(n, _ids(cls, materials)[1])
+    else:
+        table = {}
+        mats = np.array([table.setdefault(m, _ids(cls, m)[1]) for m in materials], np.int64)
+    return Mesh(corners.reshape(-1, 3), faces, c, np.repeat(mats, 2))

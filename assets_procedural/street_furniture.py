@@ -45,7 +45,7 @@ def lamp_post(rng: np.random.Generator, height: float = 7.0, arm: float = 1.5) -
     else:
         hx, hz = 0.0, height - head_h / 2
         head_len = head_w = float(rng.uniform(0.35, 0.5))
-    housing = box((head_len, head_w, head_h), "pole", "pole_metal", (hx, 0.0, hz), bottom=False)
+    housing = box((head_len, head_w, head_h), "pole", "pole_metal", (hx, 0.0, hz))
     glass_z = hz - head_h / 2 - 0.02
     glass = box((head_len * 0.85, head_w * 0.85, 0.02), "pole", "lamp_glass", (hx, 0.0, glass_z + 0.01))
     parts += [housing, glass]
