@@ -27,6 +27,12 @@ import numpy as np
 class RayCaster(Protocol):
     """What the scanner needs from a backend."""
 
+    #: (3,) float64 re-centring point: ``intersect_local`` takes origins minus this.
+    center: np.ndarray
+
+    def intersect_local(self, origins: np.ndarray, directions: np.ndarray, max_distance: float) -> tuple[np.ndarray, np.ndarray]:
+        """First hits of re-centred float32 rays; see :meth:`EmbreeCaster.intersect_local`."""
+
     def intersect(self, origins: np.ndarray, directions: np.ndarray, max_distance: float) -> tuple[np.ndarray, np.ndarray]:
         """First hits of rays; see :meth:`EmbreeCaster.intersect`."""
 
@@ -89,6 +95,33 @@ class EmbreeCaster:
         """(F, 3) float32 unit normals per face, world frame (zero for degenerate faces)."""
         return self._normals
 
+    def intersect_local(self, origins: np.ndarray, directions: np.ndarray, max_distance: float) -> tuple[np.ndarray, np.ndarray]:
+        """First hits of rays whose origins are already re-centred (``world - center``).
+
+        Parameters
+        ----------
+        origins : (n, 3) float32
+            Ray origins minus :attr:`center`, metres.
+        directions : (n, 3) float32
+            Unit directions, world axes.
+        max_distance : float
+            Hits farther than this are misses, metres.
+
+        Returns
+        -------
+        distance : (n,) float32
+            Distance along the ray to the hit, metres (``inf`` on a miss).
+        prim : (n,) int32
+            Row of the hit face (-1 on a miss).
+        """
+        o = np.ascontiguousarray(origins, np.float32)
+        d = np.ascontiguousarray(directions, np.float32)
+        out = self._scene.run(o, d, dists=np.full(len(o), max_distance, np.float32), output=1)
+        prim = out["primID"]
+        dist = out["tfar"]
+        dist[prim < 0] = np.inf
+        return dist, prim
+
     def intersect(self, origins: np.ndarray, directions: np.ndarray, max_distance: float) -> tuple[np.ndarray, np.ndarray]:
         """First hit of every ray.
 
@@ -108,13 +141,7 @@ class EmbreeCaster:
         prim : (n,) int32
             Row of the hit face in ``faces`` (-1 on a miss).
         """
-        o = np.ascontiguousarray(np.asarray(origins, np.float64) - self.center, np.float32)
-        d = np.ascontiguousarray(directions, np.float32)
-        tmax = np.full(len(o), max_distance, np.float32)
-        out = self._scene.run(o, d, dists=tmax, output=1)
-        prim = out["primID"]
-        dist = np.where(prim >= 0, out["tfar"], np.float32(np.inf)).astype(np.float32, copy=False)
-        return dist, prim
+        return self.intersect_local(np.asarray(origins, np.float64) - self.center, directions, max_distance)
 
     def run_raw(self, origins_local: np.ndarray, directions: np.ndarray) -> dict:
         """Plain ``EmbreeScene.run(..., output=1)`` on float32 rays already in the re-centred frame (benchmarks)."""
