@@ -18,6 +18,7 @@ from generator.errors import EXIT_USAGE, UserError
 #: Sub-command modules, in the order ``urbangen --help`` lists them.
 COMMANDS = [
     "layout",
+    "lidar",
 ]
 
 log = logging.getLogger("urbangen")
