@@ -17,16 +17,16 @@ GLASS_OFFSET = 0.02  # metres: glass in front of the body surface (>= 2 cm: no z
 #: variant -> ranges (low, high) in metres; ``rear``: notch (separate boot), hatch, box (vertical tail)
 CAR_VARIANTS: dict[str, dict] = {
     "sedan": dict(L=(4.4, 4.9), W=(1.74, 1.84), H=(1.42, 1.50), r=(0.31, 0.34), sill=(0.28, 0.32), front_oh=(0.85, 1.0),
-                  rear_oh=(1.0, 1.15), hood=(1.25, 1.45), ws=(0.85, 1.0), roof=(1.0, 1.25), rear_run=(0.6, 0.75),
+                  rear_oh=(1.0, 1.15), hood=(1.25, 1.45), ws=(0.85, 1.0), rear_run=(0.6, 0.75),
                   rear="notch", windows=2, belt=0.67),
     "hatchback": dict(L=(3.8, 4.3), W=(1.70, 1.80), H=(1.44, 1.55), r=(0.29, 0.32), sill=(0.27, 0.31), front_oh=(0.75, 0.9),
-                      rear_oh=(0.6, 0.75), hood=(0.95, 1.1), ws=(0.75, 0.9), roof=None, rear_run=(0.22, 0.32),
+                      rear_oh=(0.6, 0.75), hood=(0.95, 1.1), ws=(0.75, 0.9), rear_run=(0.22, 0.32),
                       rear="hatch", windows=2, belt=0.65),
     "estate": dict(L=(4.4, 4.9), W=(1.78, 1.86), H=(1.55, 1.75), r=(0.33, 0.37), sill=(0.34, 0.42), front_oh=(0.85, 0.95),
-                   rear_oh=(0.9, 1.05), hood=(1.05, 1.2), ws=(0.7, 0.85), roof=None, rear_run=(0.1, 0.18),
+                   rear_oh=(0.9, 1.05), hood=(1.05, 1.2), ws=(0.7, 0.85), rear_run=(0.1, 0.18),
                    rear="box", windows=3, belt=0.64),
     "van": dict(L=(4.5, 4.95), W=(1.78, 1.86), H=(1.75, 1.88), r=(0.31, 0.34), sill=(0.3, 0.34), front_oh=(0.85, 0.95),
-                rear_oh=(0.8, 0.95), hood=(0.75, 0.9), ws=(0.95, 1.1), roof=None, rear_run=(0.06, 0.1),
+                rear_oh=(0.8, 0.95), hood=(0.75, 0.9), ws=(0.95, 1.1), rear_run=(0.06, 0.1),
                 rear="box", windows=3, belt=0.56),
 }
 
@@ -34,6 +34,8 @@ CAR_VARIANTS: dict[str, dict] = {
 def wheel(x: float, y_out: float, side: float, radius: float, width: float, cls: str,
           sections: int = 12) -> Mesh:
     """A tyre (``rubber``) with a hub disc (``chrome``) on its outer face.
+
+    ``sections`` should be a multiple of 4 so that a vertex touches the ground (z = 0).
 
     Parameters
     ----------
@@ -142,21 +144,22 @@ def _cabin(p: dict, v: dict, xa: float, xb: float, xc: float, xd: float) -> list
         n = np.cross(q[1] - q[0], q[3] - q[0])
         n = n if np.dot(n, q.mean(0) - centre) > 0 else -n
         parts.append(_inset_quad(q, 0.07, 0.05, n, cls))
-    # side windows between A- and C/D-pillars, split by B (and C) pillars
-    z0, z1 = belt + 0.05, roof_z - 0.06
-    def x_front(z): return xa + (z - belt) / (roof_z - belt) * (xb - xa) - 0.1  # noqa: E704
-    def x_rear(z): return xd + (z - belt) / (roof_z - belt) * (xc - xd) + 0.12  # noqa: E704
+    # side windows between the A- and C/D-pillars, split by B (and C) pillars
+    z = np.array([belt + 0.05, roof_z - 0.06])                     # sill and top of the glass
+    f = (z - belt) / (roof_z - belt)
+    front = xa + f * (xb - xa) - 0.1                                 # behind the A-pillar
+    rear = xd + f * (xc - xd) + 0.12                                 # ahead of the C/D-pillar
     n_win = v["windows"]
-    t = np.linspace(0.0, 1.0, n_win + 1)
+    cuts = np.linspace(0.0, 1.0, n_win + 1)
     tilt = (wb - wr) / (roof_z - belt)
     for side in (1.0, -1.0):
-        normal = np.array([0.0, side, tilt])
+        normal = np.array([0.0, side, tilt]) / np.hypot(1.0, tilt)
         for k in range(n_win):
-            def xs(z, s): return x_rear(z) + s * (x_front(z) - x_rear(z))  # noqa: E704
-            s0, s1 = t[k] + (0.03 if k else 0.0), t[k + 1] - (0.03 if k < n_win - 1 else 0.0)
-            pts = [(xs(z0, s0), z0), (xs(z0, s1), z0), (xs(z1, s1), z1), (xs(z1, s0), z1)]
-            q = np.array([(x, side * half_w(z), z) for x, z in pts])
-            q = q + GLASS_OFFSET * normal / np.linalg.norm(normal)
+            s0 = cuts[k] + (0.03 if k else 0.0)
+            s1 = cuts[k + 1] - (0.03 if k < n_win - 1 else 0.0)
+            xs0, xs1 = rear + s0 * (front - rear), rear + s1 * (front - rear)
+            pts = [(xs0[0], z[0]), (xs1[0], z[0]), (xs1[1], z[1]), (xs0[1], z[1])]
+            q = np.array([(x, side * half_w(zz), zz) for x, zz in pts]) + GLASS_OFFSET * normal
             parts.append(polygon(q, cls, "car_glass", normal))
     return parts
 
@@ -223,7 +226,7 @@ def truck(rng: np.random.Generator) -> Mesh:
         Class ``truck``; 6.5-9.0 m long, 2.3-2.5 m wide (mirrors included), 3.0-3.8 m high;
         6 wheels; anchors ``"headlight"`` (2, 3) and ``"taillight"`` (2, 3).
     """
-    L, W, H = rng.uniform(6.5, 9.0), rng.uniform(2.25, 2.34), rng.uniform(3.0, 3.8)
+    L, W, H = rng.uniform(6.5, 8.97), rng.uniform(2.25, 2.34), rng.uniform(3.0, 3.8)  # lamps add 2 cm at the rear
     r = float(rng.uniform(0.45, 0.5))
     cab_l, cab_h = rng.uniform(1.75, 2.1), min(H - 0.15, rng.uniform(2.55, 2.9))
     xfront, xback = L / 2 - 0.05, L / 2 - 0.05 - cab_l
@@ -251,9 +254,9 @@ def truck(rng: np.random.Generator) -> Mesh:
                       [xback + 0.35, y, cab_h - 0.25]])
         parts.append(polygon(q, "truck", "car_glass", (0, side, 0)))
         parts.append(box((0.08, 0.08, 0.4), "truck", "chrome", (xfront - 0.3, side * (W / 2 + 0.04), cab_h - 0.75)))
-        parts.append(wheel(xf, W / 2 - 0.02, side, r, 0.28, "truck", 14))
-        parts.append(wheel(xr, W / 2 - 0.02, side, r, 0.28, "truck", 14))
-        parts.append(cylinder(r, 0.28, "truck", "rubber", 14).transformed(pose(xr, side * (W / 2 - 0.32), r, roll=side * np.pi / 2)))
+        parts.append(wheel(xf, W / 2 - 0.02, side, r, 0.28, "truck", 16))
+        parts.append(wheel(xr, W / 2 - 0.02, side, r, 0.28, "truck", 16))
+        parts.append(cylinder(r, 0.28, "truck", "rubber", 16).transformed(pose(xr, side * (W / 2 - 0.32), r, roll=side * np.pi / 2)))
     head = np.array([[xfront + 0.02, s * (W / 2 - 0.3), 0.75] for s in (1, -1)])
     tail = np.array([[-L / 2 - 0.02, s * (W / 2 - 0.25), floor - 0.3] for s in (1, -1)])
     for c in head:
