@@ -139,7 +139,8 @@ def render_map(scene: SceneModel, ppm: float | None = None, marker_spacing_m: fl
     top, _ = rasterize(V, F, shade_q * len(table) + cls, bounds, ppm)
     rgb = np.where(top[..., None] >= 0, palette[np.maximum(top, 0)], np.uint8(30)).astype(np.uint8)
     H, W = top.shape
-    img = Image.new("RGB", (W + PANEL_W, max(H, 560)), (245, 245, 245))
+    k = max(1.0, H / 1100)            # legend scale: readable next to big maps
+    img = Image.new("RGB", (W + int(PANEL_W * k), max(H, int(560 * k))), (245, 245, 245))
     img.paste(Image.fromarray(rgb), (0, 0))
     draw = ImageDraw.Draw(img)
 
@@ -160,34 +161,41 @@ def render_map(scene: SceneModel, ppm: float | None = None, marker_spacing_m: fl
             draw.polygon([tip, l, rr], fill=MARKER_RGB, outline=(0, 0, 0))
         x, y = to_px(pos[:1, :2])[0]
         draw.ellipse([x - r * 1.5, y - r * 1.5, x + r * 1.5, y + r * 1.5], outline=(255, 0, 0), width=3)
-    _legend(draw, W, table, scene, ppm, title)
+    _legend(draw, W, table, scene, ppm, title, k)
     return img
 
 
-def _legend(draw: ImageDraw.ImageDraw, x0: int, table, scene: SceneModel, ppm: float, title: str) -> None:
-    f, fs = _font(15), _font(12)
-    y = 10
+def _legend(draw: ImageDraw.ImageDraw, x0: int, table, scene: SceneModel, ppm: float, title: str,
+            k: float = 1.0) -> None:
+    """Class swatches (classes with geometry), route and frame symbols, scale bar; ``k`` scales it all."""
+    f, fs = _font(int(15 * k)), _font(int(12 * k))
+    u = lambda v: int(round(v * k))   # noqa: E731 - legend units
+    y = u(10)
     if title:
-        draw.text((x0 + 12, y), title, fill=(0, 0, 0), font=f)
-        y += 24
+        draw.text((x0 + u(12), y), title, fill=(0, 0, 0), font=f)
+        y += u(24)
     present = set(np.unique(scene.face_class).tolist())
     for cid, name in enumerate(table.names):
         if cid not in present:
             continue
-        draw.rectangle([x0 + 12, y, x0 + 34, y + 14], fill=tuple(int(c) for c in table.colors[cid]), outline=(0, 0, 0))
-        draw.text((x0 + 42, y), name, fill=(0, 0, 0), font=fs)
-        y += 20
-    y += 6
-    draw.line([(x0 + 12, y + 7), (x0 + 34, y + 7)], fill=ROUTE_RGB, width=4)
-    draw.text((x0 + 42, y), "route 0", fill=(0, 0, 0), font=fs)
-    y += 20
-    draw.polygon([(x0 + 30, y + 7), (x0 + 16, y), (x0 + 16, y + 14)], fill=MARKER_RGB, outline=(0, 0, 0))
-    draw.text((x0 + 42, y), "frame (driving dir.)", fill=(0, 0, 0), font=fs)
-    y += 34
-    metres = next(m for m in (200, 100, 50, 20, 10, 5) if m * ppm <= PANEL_W - 40)
+        draw.rectangle([x0 + u(12), y, x0 + u(34), y + u(14)], fill=tuple(int(c) for c in table.colors[cid]),
+                       outline=(0, 0, 0))
+        draw.text((x0 + u(42), y), name, fill=(0, 0, 0), font=fs)
+        y += u(20)
+    y += u(6)
+    draw.line([(x0 + u(12), y + u(7)), (x0 + u(34), y + u(7))], fill=ROUTE_RGB, width=u(4))
+    draw.text((x0 + u(42), y), "route 0", fill=(0, 0, 0), font=fs)
+    y += u(20)
+    draw.polygon([(x0 + u(30), y + u(7)), (x0 + u(16), y), (x0 + u(16), y + u(14))], fill=MARKER_RGB, outline=(0, 0, 0))
+    draw.text((x0 + u(42), y), "frame (driving dir.)", fill=(0, 0, 0), font=fs)
+    y += u(20)
+    draw.ellipse([x0 + u(16), y, x0 + u(30), y + u(14)], outline=(255, 0, 0), width=u(2))
+    draw.text((x0 + u(42), y), "frame 0", fill=(0, 0, 0), font=fs)
+    y += u(34)
+    metres = next((m for m in (200, 100, 50, 20, 10, 5, 2, 1) if m * ppm <= u(PANEL_W - 40)), 1)
     bar = metres * ppm
-    draw.rectangle([x0 + 12, y, x0 + 12 + bar, y + 8], fill=(0, 0, 0))
-    draw.rectangle([x0 + 12 + bar / 2, y + 1, x0 + 12 + bar - 1, y + 7], fill=(255, 255, 255))
-    draw.text((x0 + 12, y + 12), f"{metres} m  ({ppm:.1f} px/m)", fill=(0, 0, 0), font=fs)
-    y += 34
-    draw.text((x0 + 12, y), "north up", fill=(0, 0, 0), font=fs)
+    draw.rectangle([x0 + u(12), y, x0 + u(12) + bar, y + u(8)], fill=(0, 0, 0))
+    draw.rectangle([x0 + u(12) + bar / 2, y + 1, x0 + u(12) + bar - 1, y + u(8) - 1], fill=(255, 255, 255))
+    draw.text((x0 + u(12), y + u(12)), f"{metres} m  ({ppm:.1f} px/m)", fill=(0, 0, 0), font=fs)
+    y += u(34)
+    draw.text((x0 + u(12), y), "north up", fill=(0, 0, 0), font=fs)

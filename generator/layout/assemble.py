@@ -24,7 +24,7 @@ from generator.layout.lots import Lot, lot_ground_mesh, make_lots
 from generator.layout.placement_core import EGO_HALF_WIDTH_M, Keepout, Library, Placed, Placer, point_box_distance
 from generator.layout.routes import densify, make_routes
 from generator.layout.streets import (Grid, intersection_road_mesh, intersection_walk_mesh, make_grid, margin_mesh,
-                                      segment_road_mesh, segment_walk_mesh)
+                                      segment_frame_points, segment_road_mesh, segment_walk_mesh)
 from generator.scene import OrientedBox, Path, SceneModel, SceneObject
 from generator.spec.model import SceneSpec
 
@@ -58,18 +58,30 @@ def box_of(lo: np.ndarray, hi: np.ndarray, transform: np.ndarray) -> OrientedBox
     return OrientedBox(tuple(float(v) for v in c), tuple(float(v) for v in np.subtract(hi, lo)), yaw)
 
 
-def ground_pieces(grid: Grid, lots: list[Lot]) -> list[tuple[str, str, str, Mesh, np.ndarray]]:
+def _pits(grid: Grid, seg, trees: np.ndarray) -> np.ndarray:
+    """(k, 2) segment-frame centres of the street trees standing on ``seg``'s sidewalks."""
+    if not len(trees):
+        return np.zeros((0, 2))
+    uv = segment_frame_points(seg, trees)
+    u0 = grid.corridor_half - grid.road_half
+    on = (np.abs(uv[:, 1]) > grid.walk_inner) & (np.abs(uv[:, 1]) < grid.corridor_half) \
+        & (uv[:, 0] > u0) & (uv[:, 0] < seg.length - u0)
+    return uv[on]
+
+
+def ground_pieces(grid: Grid, lots: list[Lot], placed: list[Placed] = ()) -> list[tuple[str, str, str, Mesh, np.ndarray]]:
     """Stuff objects: ``(kind, class, prototype key or "", mesh, transform)``.
 
-    One road and one sidewalk object per street segment, one asphalt square (shared
-    prototype) and one corner-sidewalk object per intersection, one ground per lot, and
-    the terrain margin.
+    One road and one sidewalk object (with tree pits under the street trees of ``placed``)
+    per street segment, one asphalt square (shared prototype) and one corner-sidewalk
+    object per intersection, one ground per lot, and the terrain margin.
     """
     out = []
+    trees = np.array([p.transform[:2, 3] for p in placed if p.kind == "tree"]).reshape(-1, 2)
     for seg in grid.segments:
         T = seg.transform()
         out.append(("street", "road", "", segment_road_mesh(grid, seg), T))
-        out.append(("sidewalk", "sidewalk", "", segment_walk_mesh(grid, seg), T))
+        out.append(("sidewalk", "sidewalk", "", segment_walk_mesh(grid, seg, _pits(grid, seg, trees)), T))
     square = intersection_road_mesh(grid)
     for node in grid.nodes:
         T = pose(*grid.node_xy(node))
@@ -95,7 +107,7 @@ def _objects(grid: Grid, lots: list[Lot], placed: list[Placed], lib: Library):
         counters[kind] += 1
         return f"{kind}_{counters[kind] - 1:04d}"
 
-    for kind, cls, key, mesh, T in ground_pieces(grid, lots):
+    for kind, cls, key, mesh, T in ground_pieces(grid, lots, placed):
         nm = name(kind)
         key = key or nm
         prototypes.setdefault(key, mesh)

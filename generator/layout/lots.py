@@ -187,7 +187,7 @@ def _plan_lot(spec, index, block, origin, yaw, width, depth, d, g) -> Lot:
         lot.building = _building(spec, width, depth, float(setback), g)
     if lot.building is not None:
         lot.use = "building"
-        lot.ground = "grass" if g.random() < 0.6 else "paving"
+        lot.ground = "grass" if g.random() < 0.7 else "paving"
         lot.entrance_a = lot.building.center[0]
     else:
         lot.use = "park" if g.random() < d.parks else "yard"

@@ -16,6 +16,7 @@ from generator.spec.model import SceneSpec
 N_TREE_VARIANTS = 8
 N_BUSH_VARIANTS = 5
 FENCE_STYLES = ("bars", "pickets", "panels")
+LOT_INSET_M = 0.05      #: every part of a building stays this far inside its lot
 
 
 def tree_variant(placer: Placer, spec: SceneSpec, i: int) -> Proto:
@@ -35,6 +36,15 @@ def place_buildings(placer: Placer, spec: SceneSpec, lots: list[Lot], curb_h: fl
             continue
         proto = placer.lib.unique("building", footprint=plan.footprint, height=plan.height,
                                   floor_height=plan.floor_height, facade=plan.facade, roof=plan.roof)
+        # eaves and sills reach past the footprint: keep the whole mesh inside the lot
+        a0, a1 = plan.center[0] + proto.lo[0], plan.center[0] + proto.hi[0]
+        b0, b1 = plan.center[1] + proto.lo[1], plan.center[1] + proto.hi[1]
+        shift = max(0.0, LOT_INSET_M - b0)
+        if a0 < -lot.width / 2 + LOT_INSET_M or a1 > lot.width / 2 - LOT_INSET_M or b1 + shift > lot.depth - LOT_INSET_M:
+            placer.lib.discard(proto)
+            lot.building = None
+            continue
+        plan.center = (plan.center[0], plan.center[1] + shift)
         x, y = lot.to_world([plan.center])[0]
         attrs = dict(plan.attrs, facade=plan.facade, roof=plan.roof, lot=lot.index)
         if not placer.try_place(proto, x, y, curb_h, lot.yaw, attrs):

@@ -62,7 +62,8 @@ def route_from_nodes(grid: Grid, nodes: list[tuple[int, int]], name: str, step: 
     -------
     Path
         ``points`` (n, 3) float64 on the road surface (z = 0), ``headings`` (n,) radians,
-        ``s`` (n,) arc length; ``closed=True``.
+        ``s`` (n,) arc length; ``closed=True``. It starts where the turn at ``nodes[0]`` ends,
+        at the beginning of a straight leg.
     """
     nodes = _turning(nodes)
     xy = np.array([grid.node_xy(n) for n in nodes])
@@ -81,20 +82,18 @@ def route_from_nodes(grid: Grid, nodes: list[tuple[int, int]], name: str, step: 
         centre = t_in + r * sign * np.array([-a[1], a[0]])
         corners.append((t_in, t_out, centre, r, float(np.arctan2(a[1], a[0])), sign))
     pts, hds = [], []
-    for i in range(k):
-        t_in, t_out, centre, r, h0, sign = corners[i]
+    for i in range(k):      # straight leg i (from the end of turn i), then turn i + 1
+        t_out = corners[i][1]
+        t_in, _, centre, r, h0, sign = corners[(i + 1) % k]
+        length = float(np.linalg.norm(t_in - t_out))
+        n = max(1, int(np.ceil(length / step)))
+        pts.append(t_out + (t_in - t_out) * (np.arange(n)[:, None] / n))
+        hds.append(np.full(n, np.arctan2(dirs[i][1], dirs[i][0])))
         n = max(2, int(np.ceil(r * np.pi / 2 / step)))
         ang = h0 + sign * np.pi / 2 * np.arange(n) / n
-        # position on the arc: centre + r * (direction from centre), perpendicular to the heading
-        radial = ang - sign * np.pi / 2
+        radial = ang - sign * np.pi / 2          # from the arc centre to the point, normal to the heading
         pts.append(centre + r * np.stack([np.cos(radial), np.sin(radial)], 1))
         hds.append(ang)
-        nxt = corners[(i + 1) % k][0]
-        length = float(np.linalg.norm(nxt - t_out))
-        n = max(1, int(np.ceil(length / step)))
-        t = np.arange(n)[:, None] / n
-        pts.append(t_out + (nxt - t_out) * t)
-        hds.append(np.full(n, np.arctan2(*(dirs[i][::-1]))))
     p2 = np.concatenate(pts)
     heading = np.angle(np.exp(1j * np.concatenate(hds)))
     s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(p2, axis=0), axis=1))])

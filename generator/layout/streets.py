@@ -39,6 +39,7 @@ PARKING_START_U = 7.0      #: parking strips start this far from the intersectio
 BAY_M = 6.0                #: parking bay length
 DASH_M, GAP_M = 3.0, 6.0   #: centre-line dash pattern
 MIN_BLOCK_M = 15.0         #: blocks never shrink below this (jitter can be large)
+TREE_PIT_M = 1.2           #: side of the soil square around a street tree
 
 
 @dataclass(frozen=True)
@@ -331,13 +332,29 @@ def _curb(x0: float, y0: float, x1: float, y1: float, h: float) -> Mesh:
     return slab(min(x0, x1), min(y0, y1), max(x0, x1), max(y0, y1), 0.0, h, "curb", "curb_concrete")
 
 
-def segment_walk_mesh(grid: Grid, seg: Segment) -> Mesh:
-    """Curbs and sidewalks along both sides of ``seg`` between the corner squares (segment frame)."""
+def segment_walk_mesh(grid: Grid, seg: Segment, pits: np.ndarray | None = None) -> Mesh:
+    """Curbs and sidewalks along both sides of ``seg`` between the corner squares (segment frame).
+
+    Parameters
+    ----------
+    pits : (k, 2) float, optional
+        Tree-pit centres ``(u, v)`` in the segment frame: soil squares 3 mm above the paving.
+    """
     rh, wi, ch, h = grid.road_half, grid.walk_inner, grid.corridor_half, grid.curb_h
     u0, u1 = ch - rh, seg.length - (ch - rh)
     parts = [_curb(u0, rh, u1, wi, h), _curb(u0, -wi, u1, -rh, h),
              rects([(u0, wi, u1, ch), (u0, -ch, u1, -wi)], h, "sidewalk", "sidewalk_concrete")]
+    if pits is not None and len(pits):
+        r = min(TREE_PIT_M, grid.sidewalk_w) / 2
+        p = np.asarray(pits, np.float64).reshape(-1, 2)
+        parts.append(rects(np.c_[p - r, p + r], h + 0.003, "terrain", "soil"))
     return merge(parts)
+
+
+def segment_frame_points(seg: Segment, xy: np.ndarray) -> np.ndarray:
+    """(n, 2) segment-frame ``(u, v)`` of world points ``xy`` ((n, 2) metres)."""
+    d = np.asarray(xy, np.float64).reshape(-1, 2) - np.asarray(seg.origin)
+    return d if seg.axis == 0 else np.stack([d[:, 1], -d[:, 0]], 1)
 
 
 def intersection_road_mesh(grid: Grid) -> Mesh:

@@ -1,0 +1,294 @@
+"""The procedural town: deterministic, complete, nothing where it must not be, routes drivable."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+from scipy.spatial import ConvexHull
+
+from assets_procedural.mesh import apply
+from generator.labels import class_table
+from generator.layout.assemble import build_scene
+from generator.layout.frames import plan_frames
+from generator.layout.placement_core import EGO_HALF_WIDTH_M, overlaps, point_box_distance
+from generator.layout.streets import MARK_Z_M, make_grid
+from generator.materials import material_table
+from generator.scene import OrientedBox
+
+
+@pytest.fixture(scope="session")
+def test_scene(test_spec):
+    return build_scene(test_spec)
+
+
+@pytest.fixture(scope="session")
+def default_scene(default_spec):
+    return build_scene(default_spec)
+
+
+def _rect_boxes(rects) -> np.ndarray:
+    """(k, 4) AABBs -> (k, 7) boxes for :func:`overlaps` (z spans everything)."""
+    r = np.asarray(rects, np.float64).reshape(-1, 4)
+    c, h = (r[:, :2] + r[:, 2:]) / 2, (r[:, 2:] - r[:, :2]) / 2
+    return np.c_[c, h, np.zeros(len(r)), np.full(len(r), -1e9), np.full(len(r), 1e9)]
+
+
+def _obj_boxes(objs, shrink: float = 0.0) -> np.ndarray:
+    return np.array([[*o.box.center[:2], o.box.size[0] / 2 - shrink, o.box.size[1] / 2 - shrink, o.box.yaw,
+                      -1e9, 1e9] for o in objs])
+
+
+def _world_vertices(scene, o) -> np.ndarray:
+    return apply(o.transform, scene.prototypes[o.prototype].vertices)
+
+
+# -- determinism ------------------------------------------------------------------------------
+def test_same_spec_gives_identical_scene(test_spec, test_scene):
+    again = build_scene(test_spec)
+    assert again.digest() == test_scene.digest()
+    assert np.array_equal(again.vertices, test_scene.vertices)
+
+
+def test_different_seed_gives_different_town(test_spec, test_scene):
+    other = build_scene(dataclasses.replace(test_spec, seed=test_spec.seed + 1))
+    assert other.digest() != test_scene.digest()
+    boxes = {o.name: o.box.center for o in test_scene.objects}
+    moved = [n for n, c in ((o.name, o.box.center) for o in other.objects) if boxes.get(n) != c]
+    assert len(moved) > len(other.objects) // 4, "a new seed should move much of the town, not a detail"
+
+
+# -- completeness -----------------------------------------------------------------------------
+def test_every_class_is_present_in_the_default_town(default_scene):
+    table = class_table()
+    tri = np.bincount(default_scene.face_class, minlength=len(table))
+    missing = [n for i, n in enumerate(table.names) if n not in ("unlabeled", "sky") and tri[i] == 0]
+    assert not missing
+    assert tri[table.id("unlabeled")] == 0 and tri[table.id("sky")] == 0
+
+
+def test_ids_are_valid(default_scene):
+    s = default_scene
+    assert s.face_class.max() < len(class_table())
+    assert s.face_material.max() < len(material_table())
+    things = [o for o in s.objects if o.instance_id > 0]
+    ids = [o.instance_id for o in things]
+    assert sorted(ids) == list(range(1, len(ids) + 1))
+    table = class_table()
+    for o in s.objects:
+        assert table[o.cls].thing == (o.instance_id > 0), o.name
+    assert np.array_equal(s.face_instance, np.array([o.instance_id for o in s.objects], np.uint16)[s.face_object])
+    assert len({o.name for o in s.objects}) == len(s.objects)
+
+
+def test_repeated_assets_are_instanced(default_scene):
+    uses: dict[str, int] = {}
+    for o in default_scene.objects:
+        uses[o.prototype] = uses.get(o.prototype, 0) + 1
+    for kind in ("car", "person", "lamp_post", "tree"):
+        objs = [o for o in default_scene.objects if o.kind == kind]
+        assert len({o.prototype for o in objs}) <= 12 < len(objs), kind
+    for kind in ("building", "fence", "hedge"):
+        assert all(uses[o.prototype] == 1 for o in default_scene.objects if o.kind == kind), kind
+
+
+# -- where things stand -----------------------------------------------------------------------
+def test_no_building_or_parked_car_overlaps_a_driving_lane(default_spec, default_scene):
+    grid = make_grid(default_spec)
+    r = grid.road_half
+    squares = [(x - r, y - r, x + r, y + r) for x, y in (grid.node_xy(n) for n in grid.nodes)]
+    lanes = _rect_boxes([rect for *_, rect in grid.lane_rects()] + squares)
+    objs = [o for o in default_scene.objects
+            if o.kind == "building" or (o.kind in ("car", "truck") and o.attrs.get("placement") == "parked")]
+    assert any(o.kind == "car" for o in objs) and any(o.kind == "building" for o in objs)
+    assert not overlaps(_obj_boxes(objs, shrink=0.005), lanes).any()
+
+
+def test_buildings_stay_off_streets_and_sidewalks(default_spec, default_scene):
+    grid = make_grid(default_spec)
+    c, big = grid.corridor_half, 1e4
+    corridors = [(-big, y - c, big, y + c) for y in grid.ys] + [(x - c, -big, x + c, big) for x in grid.xs]
+    objs = default_scene.objects_of("building")
+    assert not overlaps(_obj_boxes(objs, shrink=0.005), _rect_boxes(corridors)).any()
+
+
+def test_vehicles_only_in_parking_strips_or_lanes(default_spec, default_scene):
+    grid = make_grid(default_spec)
+    rects = np.array([r for *_, r in grid.lane_rects()] + [r for *_, r in grid.parking_rects()])
+    vehicles = [o for o in default_scene.objects if o.kind in ("car", "truck")]
+    assert len(vehicles) > 20 and any(o.kind == "truck" for o in vehicles)
+    for o in vehicles:
+        corners = o.box.corners_xy()
+        inside = ((corners[:, None, 0] >= rects[None, :, 0] - 0.01) & (corners[:, None, 0] <= rects[None, :, 2] + 0.01)
+                  & (corners[:, None, 1] >= rects[None, :, 1] - 0.01) & (corners[:, None, 1] <= rects[None, :, 3] + 0.01))
+        assert inside.any(1).all(), f"{o.name} ({o.attrs.get('placement')}) leaves the parking strips and lanes"
+
+
+def test_objects_rest_on_their_ground(default_spec, default_scene):
+    grid = make_grid(default_spec)
+    things = [o for o in default_scene.objects if o.instance_id > 0]
+    ground = grid.ground_height(np.array([o.transform[:2, 3] for o in things]))    # where it stands
+    low = np.array([_world_vertices(default_scene, o)[:, 2].min() for o in things])
+    bad = [(o.name, float(z), float(g)) for o, z, g in zip(things, low, ground) if abs(z - g) > 0.01]
+    assert not bad
+    assert {round(float(g), 3) for g in ground} == {0.0, default_spec.town.curb_height_m}
+
+
+def test_objects_stand_upright(default_scene):
+    for o in default_scene.objects:
+        R = o.transform[:3, :3]
+        assert np.allclose(R[2], [0, 0, 1]) and np.allclose(R[:, 2], [0, 0, 1]), o.name
+
+
+def test_nothing_collides_at_street_level(default_scene):
+    """Below 1 m (where people, trunks, poles, cars and walls stand) no two things overlap."""
+    s = default_scene
+    boxes, names = [], []
+    for o in s.objects:
+        if o.instance_id == 0:
+            continue
+        m = s.prototypes[o.prototype]
+        tri = m.vertices[m.faces]
+        low = tri[tri[:, :, 2].min(1) < 1.0].reshape(-1, 3)     # every triangle reaching below 1 m
+        lo, hi = low.min(0), low.max(0)
+        c = apply(o.transform, ((lo + hi) / 2)[None])[0]
+        boxes.append([c[0], c[1], (hi[0] - lo[0]) / 2, (hi[1] - lo[1]) / 2, o.box.yaw, 0.0, 1.0])
+        names.append(o.name)
+    b = np.array(boxes)
+    hit = overlaps(b, b)
+    np.fill_diagonal(hit, False)
+    pairs = [(names[i], names[j]) for i, j in zip(*np.nonzero(np.triu(hit)))]
+    assert not pairs
+
+
+def test_street_cross_section(default_spec, default_scene):
+    """Sidewalks at curb height, curbs with a vertical face, markings 5 mm above the asphalt."""
+    table = class_table()
+    h = default_spec.town.curb_height_m
+    z = default_scene.vertices[default_scene.faces][:, :, 2]
+    fc = default_scene.face_class
+    side = fc == table.id("sidewalk")
+    assert np.allclose(z[side], h, atol=0.005)
+    pits = (fc == table.id("terrain")) & (default_scene.face_material == material_table().id("soil"))
+    assert pits.any() and np.allclose(z[pits], h + 0.003)
+    for name in ("road_marking", "crosswalk"):
+        assert np.allclose(z[fc == table.id(name)], MARK_Z_M)
+    assert np.allclose(z[(fc == table.id("road")) | (fc == table.id("parking"))], 0.0)
+    curb = default_scene.vertices[default_scene.faces[fc == table.id("curb")]].astype(np.float64)
+    n = np.cross(curb[:, 1] - curb[:, 0], curb[:, 2] - curb[:, 0])
+    assert (np.abs(n[:, 2]) < 1e-6 * np.linalg.norm(n, axis=1)).sum() > 0, "curbs need vertical faces"
+    assert curb[:, :, 2].max() == pytest.approx(h, abs=1e-5)
+
+
+def test_street_trees_stand_in_soil_pits(default_spec, default_scene):
+    grid = make_grid(default_spec)
+    s = default_scene
+    soil = (s.face_material == material_table().id("soil"))
+    tri = s.vertices[s.faces[soil]][:, :, :2]
+    lo, hi = tri.min(1), tri.max(1)
+    n_street = 0
+    for o in s.objects:
+        if o.kind != "tree":
+            continue
+        x, y = o.transform[:2, 3]
+        dist = min(np.abs(grid.xs - x).min(), np.abs(grid.ys - y).min())
+        if grid.walk_inner < dist < grid.corridor_half:         # on a sidewalk
+            n_street += 1
+            assert ((lo <= [x, y]) & (hi >= [x, y])).all(1).any(), f"{o.name} has no pit"
+    assert n_street > 50
+
+
+# -- routes ---------------------------------------------------------------------------------------
+@pytest.mark.parametrize("which", ["test", "default"])
+def test_routes_drive_on_lanes_clear_of_every_object(which, request):
+    spec = request.getfixturevalue(f"{which}_spec")
+    scene = request.getfixturevalue(f"{which}_scene")
+    grid = make_grid(spec)
+    drive = grid.drivable_rects()
+    limit = spec.paths.clearance_m + EGO_HALF_WIDTH_M
+    things = [o for o in scene.objects if o.instance_id > 0]
+    assert len(scene.paths) >= 2
+    for path in scene.paths:
+        xy = path.points[:, :2]
+        inside = ((xy[:, None, 0] >= drive[None, :, 0]) & (xy[:, None, 0] <= drive[None, :, 2])
+                  & (xy[:, None, 1] >= drive[None, :, 1]) & (xy[:, None, 1] <= drive[None, :, 3])).any(1)
+        assert inside.all(), path.name
+        near = min(float(point_box_distance(xy, o.box).min()) for o in things)
+        assert near >= limit, f"{path.name}: an object is {near:.2f} m from the route"
+
+
+def test_route_zero_is_a_smooth_closed_loop(default_scene):
+    p = default_scene.paths[0]
+    assert p.closed
+    step = np.linalg.norm(np.diff(np.vstack([p.points, p.points[:1]]), axis=0), axis=1)
+    assert step.max() <= 1.05 and step.min() > 0.3
+    assert np.allclose(np.diff(p.s), step[:-1])
+    d = np.diff(np.vstack([p.points, p.points[:1]])[:, :2], axis=0)
+    travel = np.arctan2(d[:, 1], d[:, 0])
+    assert np.abs(np.angle(np.exp(1j * (travel - p.headings)))).max() < 0.1, "headings follow the path"
+    curvature = np.abs(np.angle(np.exp(1j * np.diff(np.r_[p.headings, p.headings[0]])))) / step
+    assert curvature.max() <= 1 / 5.0, "turn radius below 5 m"
+    turns = np.angle(np.exp(1j * np.diff(np.r_[p.headings, p.headings[0]]))).sum()
+    assert abs(abs(turns) - 2 * np.pi) < 1e-6, "a simple loop turns once around"
+
+
+def test_route_zero_keeps_right(default_spec, default_scene):
+    """Right-hand traffic: the street centre line is on the driver's left."""
+    grid = make_grid(default_spec)
+    p = default_scene.paths[0]
+    left = np.stack([-np.sin(p.headings), np.cos(p.headings)], 1)
+    on_street = 0
+    for xy, n in zip(p.points[:, :2], left):
+        dx, dy = grid.xs - xy[0], grid.ys - xy[1]
+        i, j = np.argmin(np.abs(dx)), np.argmin(np.abs(dy))
+        if abs(dx[i]) < grid.lane_half and abs(dy[j]) > grid.road_half:      # on a north-south street
+            assert n[0] * dx[i] > 0
+            on_street += 1
+        elif abs(dy[j]) < grid.lane_half and abs(dx[i]) > grid.road_half:
+            assert n[1] * dy[j] > 0
+            on_street += 1
+    assert on_street > len(p.points) // 2
+
+
+def test_frames_follow_route_zero(default_spec, default_scene):
+    """Frame 0 starts on a straight leg, and every frame sits on route 0 facing along it."""
+    path = default_scene.paths[0]
+    frames = plan_frames(default_scene, default_spec, 4)
+    steps = [np.linalg.norm(b.T_world_ego[:2, 3] - a.T_world_ego[:2, 3]) for a, b in zip(frames, frames[1:])]
+    assert np.allclose(steps, default_spec.paths.spacing_m, rtol=1e-3)
+    for f in plan_frames(default_scene, default_spec, 30, first=5):
+        pos, hd = path.at(f.s)
+        assert np.allclose(f.T_world_ego[:3, 3], pos[0])
+        assert np.allclose(f.T_world_ego[:2, 0], [np.cos(hd[0]), np.sin(hd[0])])
+
+
+# -- label proxies ----------------------------------------------------------------------------------
+def test_hull_proxies_contain_their_objects_hull_class_vertices(default_scene):
+    hull_cls = class_table().hull_classes
+    s = default_scene
+    proxied = {o.prototype for o in s.objects if o.proxy is not None}
+    for o in s.objects:
+        has_hull_class = bool(hull_cls[s.prototypes[o.prototype].face_class].any())
+        assert (o.proxy is not None) == has_hull_class, o.name
+        if o.proxy is not None:
+            assert o.proxy == o.prototype
+    assert len(proxied) == len(s.proxies)
+    for key in proxied:
+        mesh, proxy = s.prototypes[key], s.proxies[key]
+        for c in np.unique(mesh.face_class[hull_cls[mesh.face_class]]):
+            pts = mesh.vertices[np.unique(mesh.faces[mesh.face_class == c])]
+            hull_pts = proxy.vertices[np.unique(proxy.faces[proxy.face_class == c])]
+            eq = ConvexHull(hull_pts).equations
+            assert (pts @ eq[:, :3].T + eq[:, 3]).max() <= 1e-6, f"{key}: class {c} pokes out of its hull"
+
+
+def test_oriented_boxes_enclose_object_vertices(default_scene):
+    for o in default_scene.objects[:: max(1, len(default_scene.objects) // 300)]:
+        v = _world_vertices(default_scene, o)
+        assert o.box.contains(v, margin=1e-6).all(), o.name
+
+
+def test_box_helper_sanity():
+    box = OrientedBox((0.0, 0.0, 0.5), (4.0, 2.0, 1.0), np.pi / 2)
+    assert point_box_distance(np.array([[0.0, 3.0], [2.0, 0.0], [0.0, 0.0]]), box).tolist() == pytest.approx([1.0, 1.0, 0.0])
