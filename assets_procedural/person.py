@@ -1,4 +1,4 @@
-"""Pedestrians: a low-poly articulated figure (~350 triangles) facing +x.
+"""Pedestrians: a low-poly articulated figure (~420 triangles) facing +x.
 
 Proportions follow standard anthropometric ratios of body height (shoulders at 0.8 h,
 hips at 0.53 h, knees at 0.285 h). Every face is class ``person``; materials ``skin``
@@ -71,8 +71,7 @@ def person(rng: np.random.Generator, height: float, pose: str = "standing") -> M
     short_sleeves = rng.random() < 0.3
     shorts = rng.random() < 0.2
     swing = np.radians(rng.uniform(15, 25)) * (1 if rng.random() < 0.5 else -1) if name == "walking" else 0.0
-    rings = [_ring(0.48 * h, 0.085 * h * girth, 0.06 * h * girth), _ring(0.55 * h, 0.09 * h * girth, 0.062 * h * girth),
-             _ring(0.62 * h, 0.078 * h * girth, 0.058 * h * girth), _ring(0.72 * h, 0.095 * h * girth, 0.066 * h * girth),
+    rings = [_ring(0.48 * h, 0.088 * h * girth, 0.06 * h * girth), _ring(0.62 * h, 0.078 * h * girth, 0.058 * h * girth), _ring(0.72 * h, 0.095 * h * girth, 0.066 * h * girth),
              _ring(0.795 * h, 0.11 * h * girth, 0.058 * h * girth), _ring(0.835 * h, 0.045 * h, 0.04 * h)]
     parts = [loft(np.array(rings), CLS, "clothing")] + _head(h, rng)
     for side, phase in ((1.0, 1.0), (-1.0, -1.0)):
