@@ -2,7 +2,7 @@
 
 One mesh datablock per prototype (repeated assets are linked duplicates: instancing),
 built with ``foreach_set`` from the very arrays the LiDAR casts against. Every mesh
-carries the per-face ``class_id`` (INT) and ``face_rand`` (FLOAT in [0, 1)) attributes;
+carries the per-face ``class_id`` (INT) attribute;
 every object carries its instance id as ``pass_index``, its colour (``attrs["color"]`` or
 ``attrs["facade_color"]``) in ``color`` and ``attrs["roof_color"]`` as the custom
 property ``ug_roof_color``.
@@ -18,7 +18,6 @@ import numpy as np
 from assets_procedural.mesh import Mesh
 from generator.blender.bpy_guard import bpy, mathutils
 from generator.materials import material_table
-from generator.rng import stream
 from generator.scene import SceneModel
 
 #: Materials shaded smooth (organic shapes); everything else is flat (hard surfaces).
@@ -36,7 +35,7 @@ class BlenderScene:
     meshes: dict
 
 
-def _mesh(name: str, m: Mesh, materials: list, seed: int) -> "bpy.types.Mesh":
+def _mesh(name: str, m: Mesh, materials: list) -> "bpy.types.Mesh":
     me = bpy.data.meshes.new(name)
     n_v, n_f = len(m.vertices), m.n_faces
     me.vertices.add(n_v)
@@ -54,8 +53,6 @@ def _mesh(name: str, m: Mesh, materials: list, seed: int) -> "bpy.types.Mesh":
     smooth = np.isin(m.face_material, [table.id(n) for n in SMOOTH_MATERIALS])
     me.attributes.new("sharp_face", "BOOLEAN", "FACE").data.foreach_set("value", ~smooth)
     me.attributes.new("class_id", "INT", "FACE").data.foreach_set("value", m.face_class.astype(np.int32))
-    rand = stream(seed, "blender", "face_rand", name).random(n_f).astype(np.float32)
-    me.attributes.new("face_rand", "FLOAT", "FACE").data.foreach_set("value", rand)
     me.update()
     return me
 
@@ -75,8 +72,8 @@ def build(scene: SceneModel, materials: list, parent: "bpy.types.Collection") ->
     proxies = bpy.data.collections.new("urbangen_proxies")
     parent.children.link(real)
     parent.children.link(proxies)
-    meshes = {key: _mesh(key, m, materials, scene.seed) for key, m in scene.prototypes.items()}
-    proxy_meshes = {key: _mesh("hull:" + key, m, materials, scene.seed) for key, m in scene.proxies.items()}
+    meshes = {key: _mesh(key, m, materials) for key, m in scene.prototypes.items()}
+    proxy_meshes = {key: _mesh("hull:" + key, m, materials) for key, m in scene.proxies.items()}
     objs, hulls = [], []
     for o in scene.objects:
         ob = bpy.data.objects.new(o.name, meshes[o.prototype])

@@ -4,7 +4,8 @@ Each recipe receives a :class:`Nodes` builder, a parameter generator (seeded per
 material, so every seed gives a slightly different town) and returns the surface
 shader socket. Scene-wide switches are scene custom properties read with
 ``VIEW_LAYER`` attributes (see :mod:`generator.blender.controls`); per-object colour
-is ``Object.color`` (Object Info > Color); ``face_rand`` is a per-face random in [0, 1).
+is ``Object.color`` (Object Info > Color); per-pane and per-leaf-cluster variation uses
+Cycles' "Random Per Island" (every window pane and leaf cluster is its own island).
 """
 
 from __future__ import annotations
@@ -163,7 +164,9 @@ def facade_concrete(g, rng):
 
 def window_glass(g, rng):
     lit_fraction = g.attr(CONTROL["lit_windows"], "VIEW_LAYER")
-    lit = g.math("LESS_THAN", g.attr("face_rand"), lit_fraction)
+    # One draw per pane: every pane is its own mesh island (two triangles with their own vertices).
+    pane = g.math("FRACT", g.add(g.geometry("Random Per Island"), g.object_info("Random")))
+    lit = g.math("LESS_THAN", pane, lit_fraction)
     warm = g.mix(g.object_info("Random"), (1.0, 0.75, 0.45), (0.9, 0.9, 1.0))
     glass = g.principled(base_color=(0.02, 0.025, 0.03), roughness=0.03, metallic=0.0, ior=1.5, specular=1.0)
     return _emit(g, glass, warm, 6.0, "windows", lit)
@@ -200,7 +203,7 @@ def _foliage(g, rng, color):
     n = g.noise(g.coords("Object"), scale=3, detail=4)
     hue = g.add(0.46, g.mul(g.object_info("Random"), 0.08))
     base = g.hsv(g.ramp(n, [(0.3, _jit(rng, color, 0.1)), (0.7, _jit(rng, np.asarray(color) * 1.6, 0.1))]),
-                 hue=hue, value=g.add(0.8, g.mul(g.attr("face_rand"), 0.4)))
+                 hue=hue, value=g.add(0.8, g.mul(g.geometry("Random Per Island"), 0.4)))
     leaf = g.principled(base_color=base, roughness=0.7, specular=0.3, normal=g.bump(g.noise(scale=40), 0.5, 0.02))
     return g.mix_shader(0.25, leaf, g.translucent(base))
 
