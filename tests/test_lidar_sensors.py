@@ -121,3 +121,10 @@ def test_missing_user_sensor_file_names_it(tmp_path):
     spec_path = _write(tmp_path, "spec.json", json.dumps({"name": "t", "seed": 1, "sensors": {"lidar": {"sensor_file": "nope.yaml"}}}))
     with pytest.raises(SpecError, match="nope.yaml: file not found"):
         sensor_for_spec(load_spec(spec_path))
+
+
+def test_unknown_preset_names_the_spec_field(tmp_path):
+    spec_path = _write(tmp_path, "spec.json", json.dumps({"name": "t", "seed": 1, "sensors": {"lidar": {"preset": "hdl128"}}}))
+    with pytest.raises(SpecError) as e:
+        sensor_for_spec(load_spec(spec_path))
+    assert e.value.field == "sensors.lidar.preset" and "hdl64e" in str(e.value) and str(spec_path) in str(e.value)

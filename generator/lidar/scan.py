@@ -84,7 +84,12 @@ class Scan:
         return np.stack([p["x"], p["y"], p["z"]], -1)
 
     def range_image(self) -> np.ndarray:
-        """(rings, columns) float32 range per beam and column, metres; 0 where no return."""
+        """(rings, columns) float32 range per beam and firing column, metres; 0 where no return.
+
+        Row = ring (0 = highest beam), column = firing column (not an azimuth bin): a laser's
+        ``rot_correction`` (up to about +-10 deg on the HDL-64E) shifts its beam sideways, so
+        an edge looks sheared across rows, as in the device's raw packet order.
+        """
         img = np.zeros((self.rings, self.columns), np.float32)
         img[self.points["ring"], self.points["column"]] = self.points["range"]
         return img
