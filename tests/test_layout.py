@@ -16,6 +16,7 @@ from generator.layout.placement_core import EGO_HALF_WIDTH_M, overlaps, point_bo
 from generator.layout.streets import MARK_Z_M, make_grid
 from generator.materials import material_table
 from generator.scene import OrientedBox
+from generator.spec import parse_spec
 
 
 @pytest.fixture(scope="session")
@@ -114,25 +115,58 @@ def test_buildings_stay_off_streets_and_sidewalks(default_spec, default_scene):
 
 
 def test_vehicles_only_in_parking_strips_or_lanes(default_spec, default_scene):
-    grid = make_grid(default_spec)
-    rects = np.array([r for *_, r in grid.lane_rects()] + [r for *_, r in grid.parking_rects()])
-    vehicles = [o for o in default_scene.objects if o.kind in ("car", "truck")]
+    vehicles = _check_vehicles(default_spec, default_scene)
     assert len(vehicles) > 20 and any(o.kind == "truck" for o in vehicles)
+
+
+def _check_vehicles(spec, scene) -> list:
+    grid = make_grid(spec)
+    rects = np.array([r for *_, r in grid.lane_rects()] + [r for *_, r in grid.parking_rects()])
+    vehicles = [o for o in scene.objects if o.kind in ("car", "truck")]
     for o in vehicles:
         corners = o.box.corners_xy()
         inside = ((corners[:, None, 0] >= rects[None, :, 0] - 0.01) & (corners[:, None, 0] <= rects[None, :, 2] + 0.01)
                   & (corners[:, None, 1] >= rects[None, :, 1] - 0.01) & (corners[:, None, 1] <= rects[None, :, 3] + 0.01))
         assert inside.any(1).all(), f"{o.name} ({o.attrs.get('placement')}) leaves the parking strips and lanes"
+    return vehicles
 
 
 def test_objects_rest_on_their_ground(default_spec, default_scene):
-    grid = make_grid(default_spec)
-    things = [o for o in default_scene.objects if o.instance_id > 0]
+    ground = _check_rest(default_spec, default_scene)
+    assert {round(float(g), 3) for g in ground} == {0.0, default_spec.town.curb_height_m}
+
+
+def _check_rest(spec, scene) -> np.ndarray:
+    grid = make_grid(spec)
+    things = [o for o in scene.objects if o.instance_id > 0]
     ground = grid.ground_height(np.array([o.transform[:2, 3] for o in things]))    # where it stands
-    low = np.array([_world_vertices(default_scene, o)[:, 2].min() for o in things])
+    low = np.array([_world_vertices(scene, o)[:, 2].min() for o in things])
     bad = [(o.name, float(z), float(g)) for o, z, g in zip(things, low, ground) if abs(z - g) > 0.01]
     assert not bad
-    assert {round(float(g), 3) for g in ground} == {0.0, default_spec.town.curb_height_m}
+    return ground
+
+
+UNUSUAL = {
+    "two_lanes_no_parking": {"blocks_x": 2, "blocks_y": 1, "lanes_per_direction": 2, "parking_strip_width_m": 0,
+                             "block_size_m": 30},
+    "wide_lanes_narrow_walk_no_margin": {"blocks_x": 1, "blocks_y": 2, "lanes_per_direction": 3, "lane_width_m": 5,
+                                         "parking_strip_width_m": 4, "sidewalk_width_m": 1, "block_size_m": 25,
+                                         "margin_m": 0},
+    "tight_jittered_blocks": {"blocks_x": 2, "blocks_y": 2, "block_size_m": 20, "block_size_jitter_m": 40,
+                              "lane_width_m": 2.5, "curb_height_m": 0.3, "sidewalk_width_m": 8},
+}
+
+
+@pytest.mark.parametrize("name", sorted(UNUSUAL))
+def test_unusual_cross_sections_keep_the_invariants(name):
+    """build_scene verifies its routes itself; objects still rest on the ground and vehicles stay on the road."""
+    spec = parse_spec({"name": name, "seed": 3, "town": UNUSUAL[name],
+                       "density": {"parked_cars_per_100m": 15, "moving_cars_per_100m": 6, "truck_fraction": 0.4}},
+                      f"{name}.json")
+    scene = build_scene(spec)
+    _check_rest(spec, scene)
+    _check_vehicles(spec, scene)
+    assert scene.objects_of("building") and scene.objects_of("car") and scene.objects_of("traffic_light")
 
 
 def test_objects_stand_upright(default_scene):
@@ -160,6 +194,43 @@ def test_nothing_collides_at_street_level(default_scene):
     np.fill_diagonal(hit, False)
     pairs = [(names[i], names[j]) for i, j in zip(*np.nonzero(np.triu(hit)))]
     assert not pairs
+
+
+def test_traffic_lights_guard_every_intersection_facing_approaching_traffic(default_spec, default_scene):
+    grid = make_grid(default_spec)
+    lights = default_scene.objects_of("traffic_light")
+    per_node = {n: 0 for n in grid.nodes}
+    for o in lights:
+        x, y = o.transform[:2, 3]
+        node = min(grid.nodes, key=lambda n: np.hypot(*(grid.node_xy(n) - (x, y))))
+        d = np.array([x, y]) - grid.node_xy(node)
+        assert grid.road_half < np.abs(d).min() and np.abs(d).max() < grid.corridor_half, f"{o.name} not on a corner"
+        face = o.transform[:2, 0]                       # lamps look along local +x
+        arm = int(np.round(np.arctan2(face[1], face[0]) / (np.pi / 2))) % 4
+        assert arm in grid.arms(node) and np.allclose(face, [np.cos(arm * np.pi / 2), np.sin(arm * np.pi / 2)])
+        # the light stands on the right of the traffic coming in along that arm
+        heading_in = -face
+        right = np.array([heading_in[1], -heading_in[0]])
+        assert d @ right > 0, o.name
+        per_node[node] += 1
+    assert min(per_node.values()) >= 2
+
+
+def test_signs_face_the_traffic_on_their_side(default_spec, default_scene):
+    grid = make_grid(default_spec)
+    signs = default_scene.objects_of("traffic_sign")
+    assert len(signs) >= default_spec.density.signs_per_block * 9 * 0.8
+    for o in signs:
+        x, y = o.transform[:2, 3]
+        face = o.transform[:2, 0]
+        i, j = np.argmin(np.abs(grid.xs - x)), np.argmin(np.abs(grid.ys - y))
+        if abs(grid.xs[i] - x) < grid.corridor_half:            # beside a north-south street
+            d = np.array([x - grid.xs[i], 0.0])
+        else:
+            d = np.array([0.0, y - grid.ys[j]])
+        traffic = np.array([d[1], -d[0]]) / np.linalg.norm(d)   # right-hand traffic next to this sidewalk...
+        traffic = -traffic                                      # ...drives with the sidewalk on its right
+        assert np.allclose(face, -traffic, atol=1e-6), o.name   # the sign looks at it
 
 
 def test_street_cross_section(default_spec, default_scene):

@@ -8,13 +8,19 @@ vehicles sit in the parking bays, lane cars on lane centres away from every rout
 
 from __future__ import annotations
 
+import logging
+
 import numpy as np
 
 from generator.layout.placement_core import Placer, Proto
+from generator.layout.placement_lots import N_TREE_VARIANTS, tree_variant
 from generator.layout.streets import BAY_M, CROSSWALK_U, PARKING_START_U, Grid, Segment
 from generator.rng import stream
 from generator.spec.model import SceneSpec
 
+log = logging.getLogger(__name__)
+
+MIN_TREE_M = 3.0        #: the smallest tree the asset builder makes
 SIGN_SHAPES = ("circle", "triangle", "square", "octagon", "diamond")
 CAR_COLORS = np.array([(0.92, 0.92, 0.92), (0.08, 0.08, 0.09), (0.55, 0.56, 0.58), (0.75, 0.76, 0.78),
                        (0.62, 0.08, 0.07), (0.1, 0.2, 0.5), (0.2, 0.35, 0.25), (0.85, 0.75, 0.55)])
@@ -100,12 +106,14 @@ def street_tree_variants(placer: Placer, spec: SceneSpec, half_width: float) -> 
         shape = ("oval", "round")[i % 2]
         for attempt in range(6):
             def params(g, attempt=attempt, shape=shape):
-                return {"height": float(g.uniform(lo, hi) * 0.85 ** attempt), "shape": shape}
+                return {"height": float(max(MIN_TREE_M, g.uniform(lo, hi) * 0.85 ** attempt)), "shape": shape}
             proto = placer.lib.variant("tree", i, params, tag=f"street{attempt}")
             if max(-proto.lo[0], proto.hi[0], -proto.lo[1], proto.hi[1]) <= half_width:
                 out.append(proto)
                 break
             placer.lib.discard(proto)
+            if proto.params["height"] <= MIN_TREE_M:
+                break
     return out
 
 
@@ -118,8 +126,9 @@ def place_street_trees(placer: Placer, spec: SceneSpec, st: Street) -> None:
     route_v = (grid.lanes - 0.5) * grid.lane_w          # |v| of a route's lane centre
     half = st.kerb_line - route_v - placer.keepout.limit - 0.1
     protos = street_tree_variants(placer, spec, half)
-    if not protos:
-        return
+    if not protos:      # no crown is narrow enough for a route street: trees only where no route drives
+        log.info("no street-tree crown fits within %.2f m of the kerb line; using park trees", half)
+        protos = [tree_variant(placer, spec, i) for i in range(N_TREE_VARIANTS)]
     g = stream(spec.seed, "layout", "trees")
     spacing = 100.0 / spec.density.trees_per_100m
     for seg in grid.segments:

@@ -2,8 +2,8 @@
 
 A route is a cycle of grid nodes (intersections). Each leg runs on the centre of the
 outermost (right-hand) lane for its driving direction (right-hand traffic); at every turn
-the two lane-centre lines are joined by a circular arc (radius >= 6 m, concentric for
-left turns), and the result is sampled about every metre with headings and arc length.
+the two lane-centre lines are joined by a circular arc (6 m, or down to 5 m when the
+intersection is tight; left turns concentric with it), and the result is sampled about every metre with headings and arc length.
 
 Route 0, the one :mod:`generator.layout.frames` follows, is a "comb" that drives the outer
 ring and snakes through the inner north-south streets; route 1 is the outer ring in the
@@ -18,7 +18,8 @@ from generator.layout.streets import Grid
 from generator.scene import Path
 
 STEP_M = 1.0            #: sampling step along a route
-MIN_RIGHT_RADIUS_M = 6.0
+RIGHT_RADIUS_M = 6.0    #: preferred right-turn radius (left turns are concentric, 2 lane offsets wider)
+MIN_RADIUS_M = 5.0
 
 
 def comb_nodes(nx: int, ny: int) -> list[tuple[int, int]]:
@@ -70,7 +71,8 @@ def route_from_nodes(grid: Grid, nodes: list[tuple[int, int]], name: str, step: 
     k = len(xy)
     dirs = [(xy[(i + 1) % k] - xy[i]) / np.linalg.norm(xy[(i + 1) % k] - xy[i]) for i in range(k)]
     off = (grid.lanes - 0.5) * grid.lane_w
-    r_right = max(MIN_RIGHT_RADIUS_M, off + 1.0)
+    # a right-turn arc bulges towards the corner by (1 - 1/sqrt 2) r: keep it 0.3 m inside the square
+    r_right = max(MIN_RADIUS_M, min(RIGHT_RADIUS_M, (grid.road_half - 0.3 - off) / (1 - np.sqrt(0.5))))
     corners = []  # per node: (tangent-in point, tangent-out point, arc centre, radius, heading in, turn sign)
     for i in range(k):
         a, b = dirs[i - 1], dirs[i]
