@@ -15,13 +15,14 @@ import time
 from collections import defaultdict
 
 import numpy as np
+from tqdm import tqdm
 
 from assets_procedural.mesh import Mesh, pose
 from generator.labels import class_table
 from generator.layout import placement_lots as pl
 from generator.layout import placement_street as ps
 from generator.layout.lots import Lot, lot_ground_mesh, make_lots
-from generator.layout.placement_core import EGO_HALF_WIDTH_M, Keepout, Library, Placed, Placer, point_box_distance
+from generator.layout.placement_core import EGO_HALF_WIDTH_M, Keepout, Library, Placed, Placer
 from generator.layout.routes import densify, make_routes
 from generator.layout.streets import (Grid, intersection_road_mesh, intersection_walk_mesh, make_grid, margin_mesh,
                                       segment_frame_points, segment_road_mesh, segment_walk_mesh)
@@ -132,7 +133,6 @@ def verify_routes(paths: list[Path], grid: Grid, objects: list[SceneObject], lim
     ``limit`` metres (2D) from every thing's box."""
     drive = grid.drivable_rects()
     things = [o for o in objects if o.instance_id > 0]
-    keep = Keepout(np.zeros((0, 2)), limit)
     for path in paths:
         xy = path.points[:, :2]
         inside = ((xy[:, None, 0] >= drive[None, :, 0] - 1e-6) & (xy[:, None, 0] <= drive[None, :, 2] + 1e-6)
@@ -171,7 +171,7 @@ def build_scene(spec: SceneSpec) -> SceneModel:
     street = ps.Street(grid)
     log.info("layout %s: %d x %d blocks, %d segments, %d lots", spec.name, len(grid.xs) - 1, len(grid.ys) - 1,
              len(grid.segments), len(lots))
-    for label, step in STEPS:
+    for label, step in tqdm(STEPS, desc=f"layout {spec.name}", unit="step", disable=None, leave=False):
         n0, t1 = len(placer.placed), time.perf_counter()
         step(placer, spec, grid, lots, street)
         log.info("placed %d %s (%.2f s)", len(placer.placed) - n0, label, time.perf_counter() - t1)

@@ -260,6 +260,3 @@ class Placer:
         self.occ.add(boxes)
         self.placed.append(Placed(proto.kind, self.lib.main_class(proto.kind), proto.key, T, box, dict(attrs or {})))
         return True
-
-    def count(self, kind: str) -> int:
-        return sum(1 for p in self.placed if p.kind == kind)

@@ -42,14 +42,14 @@ def place_buildings(placer: Placer, spec: SceneSpec, lots: list[Lot], curb_h: fl
         shift = max(0.0, LOT_INSET_M - b0)
         if a0 < -lot.width / 2 + LOT_INSET_M or a1 > lot.width / 2 - LOT_INSET_M or b1 + shift > lot.depth - LOT_INSET_M:
             placer.lib.discard(proto)
-            lot.building = None
+            lot.building, lot.use = None, "yard"
             continue
         plan.center = (plan.center[0], plan.center[1] + shift)
         x, y = lot.to_world([plan.center])[0]
         attrs = dict(plan.attrs, facade=plan.facade, roof=plan.roof, lot=lot.index)
         if not placer.try_place(proto, x, y, curb_h, lot.yaw, attrs):
             placer.lib.discard(proto)
-            lot.building = None
+            lot.building, lot.use = None, "yard"
 
 
 def place_fronts(placer: Placer, spec: SceneSpec, lots: list[Lot], curb_h: float) -> None:
