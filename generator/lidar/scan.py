@@ -185,16 +185,12 @@ class Scanner:
             parts = list(self._pool.map(self._cast_chunk, *zip(*work)))
         else:
             parts = [self._cast_chunk(*w) for w in work]
-        ends = np.cumsum([0] + [len(p["range"]) for p in parts])
-        points = np.empty(int(ends[-1]), POINT_DTYPE)
-        for part, a, b in zip(parts, ends[:-1], ends[1:]):
-            rows = points[a:b]
-            for name in POINT_DTYPE.names:
-                rows[name] = part[name]
+        # byte-level concatenation: numpy's structured concatenate is ~20x slower than memcpy
+        points = np.concatenate([p.view(np.uint8) for p in parts]).view(POINT_DTYPE)
         return Scan(points, poses[0] if skew else poses, self.sensor.rays_per_sweep, self.sensor.n_lasers,
                     self.sensor.azimuth_steps)
 
-    def _cast_chunk(self, cols: slice, rot_t: np.ndarray, trans: np.ndarray, skew: bool) -> dict[str, np.ndarray]:
+    def _cast_chunk(self, cols: slice, rot_t: np.ndarray, trans: np.ndarray, skew: bool) -> np.ndarray:
         o_loc, d_loc = self._o32[cols], self._d32[cols]  # (k, L, 3) float32
         if skew:
             d_w = np.matmul(d_loc, rot_t[cols])
@@ -211,7 +207,8 @@ class Scanner:
         face = take(prim, hit)
         r = take(dist, hit)
         ray = hit + cols.start * self.sensor.n_lasers
-        out = {"range": r}
+        out = np.empty(len(hit), POINT_DTYPE)  # filled here, in the worker thread
+        out["range"] = r
         for i, name in enumerate("xyz"):
             out[name] = take(self._o[i], ray) + r * take(self._d[i], ray)
         cos = take(d_w[:, 0], hit) * take(self._normal[0], face)
@@ -222,7 +219,7 @@ class Scanner:
             if skew or name != "time":
                 out[name] = take(values, ray)
         if not skew:
-            out["time"] = np.zeros(len(hit), np.float32)
+            out["time"] = 0.0
         out["class"] = take(self._face_class, face)
         out["instance"] = take(self._face_instance, face)
         out["material"] = take(self._face_material, face)
