@@ -9,10 +9,14 @@ ray, ``inf`` for sky, so the sky becomes pure airlight), ``V`` the meteorologica
 and ``A`` the airlight, the radiance of an infinitely deep column of fog.
 
 The airlight follows the time of day (:func:`airlight_for`): a bright, slightly bluish grey
-by day, a dark blue-grey at night, and at night it is lifted near lamps: the light of the
-bright emitters is scattered by the fog into a halo, modelled as a blurred map of the
-emitters (a sum of Gaussians, narrow to wide) added to the airlight in proportion to the
-fog density. Fog only changes RGB; masks and depth are never touched.
+by day, a dark blue-grey at night, and at night it is lifted near lamps: the light a bright
+emitter loses on its way to the camera, ``J (1 - t)``, is scattered (mostly forward) into a
+halo, modelled as a blurred map of that lost light (a sum of Gaussians, narrow to wide)
+added to the airlight. Thin fog and near lamps give faint halos, dense fog and far lamps
+bright ones. Fog only changes RGB; masks and depth are never touched.
+
+The blur helpers (:func:`block_mean`, :func:`upsample`, :func:`blur_sum`) work on
+block-averaged copies, so wide halos cost about as much as narrow ones.
 """
 
 from __future__ import annotations
@@ -84,8 +88,19 @@ def luminance(rgb: np.ndarray) -> np.ndarray:
     return rgb.astype(np.float32, copy=False) @ LUMA
 
 
+def emitter_mask(rgb: np.ndarray) -> np.ndarray:
+    """(H, W) bool: the bright emitters of an image (lamps, lit windows, head lights).
+
+    A pixel is an emitter when its luminance exceeds both :data:`EMITTER_MIN` and
+    :data:`EMITTER_RATIO` times the scene's median luminance.
+    """
+    lum = luminance(rgb)
+    threshold = max(EMITTER_MIN, EMITTER_RATIO * float(np.median(lum[::4, ::4])))  # median of a 1/16 sample
+    return lum > threshold
+
+
 def emitter_map(rgb: np.ndarray) -> np.ndarray:
-    """The bright emitters of an image (lamps, lit windows, head lights), else 0.
+    """The emitters' radiance, else 0.
 
     Parameters
     ----------
@@ -94,13 +109,12 @@ def emitter_map(rgb: np.ndarray) -> np.ndarray:
     Returns
     -------
     (H, W, 3) float32
-        The emitters' radiance (clipped at :data:`EMITTER_CLIP`) where a pixel is much
-        brighter than the scene, 0 elsewhere.
+        The radiance (clipped at :data:`EMITTER_CLIP`) where :func:`emitter_mask` is set.
     """
-    lum = luminance(rgb)
-    threshold = max(EMITTER_MIN, EMITTER_RATIO * float(np.median(lum[::4, ::4])))  # median of a 1/16 sample
-    on = lum > threshold
-    return np.where(on[..., None], np.minimum(rgb, EMITTER_CLIP), 0.0).astype(np.float32)
+    out = np.zeros(rgb.shape, np.float32)
+    on = emitter_mask(rgb)
+    out[on] = np.minimum(rgb[on], EMITTER_CLIP)
+    return out
 
 
 def block_mean(img: np.ndarray, f: int) -> np.ndarray:
@@ -159,7 +173,8 @@ def upsample(small: np.ndarray, f: int, h: int, w: int) -> np.ndarray:
     return _upsample_axis(_upsample_axis(small.astype(np.float32, copy=False), f, 1), f, 0)[:h, :w]
 
 
-def _gauss(img: np.ndarray, sigma: float) -> np.ndarray:
+def gaussian(img: np.ndarray, sigma: float) -> np.ndarray:
+    """Gaussian blur of a (H, W[, C]) image over its two image axes (edges: nearest)."""
     return ndimage.gaussian_filter(img, (sigma, sigma) + (0,) * (img.ndim - 2), mode="nearest", truncate=3.0)
 
 
@@ -176,7 +191,7 @@ def blur_sum(img: np.ndarray, sigmas_px, weights) -> np.ndarray:
     acc = np.zeros_like(base)
     for sigma, weight in zip(sigmas_px, weights):
         g = max(1, int(sigma / 3.0 / f0))
-        blurred = _gauss(block_mean(base, g), sigma / (f0 * g))
+        blurred = gaussian(block_mean(base, g), sigma / (f0 * g))
         acc += np.float32(weight) * upsample(blurred, g, *base.shape[:2])
     return upsample(acc, f0, h, w)
 
@@ -239,13 +254,15 @@ def lamp_halo(rgb: np.ndarray, depth: np.ndarray, beta_per_m: float) -> tuple[np
     params : dict
         Emitter pixel count, gain and halo widths (for metadata).
     """
-    w = rgb.shape[1]
-    emit = emitter_map(rgb)
-    on = emit.any(-1)
+    h, w = depth.shape
+    on = emitter_mask(rgb)
     n_emit = int(np.count_nonzero(on))
     glow = None
     if n_emit and beta_per_m > 0:
-        lost = emit * (HALO_GAIN * (1.0 - transmission(depth, beta_per_m)))[..., None]
+        # Only emitter pixels lose light to the halo: compute their share sparsely.
+        lost = np.zeros((h, w, 3), np.float32)
+        t = transmission(depth[on], beta_per_m)
+        lost[on] = np.minimum(rgb[on], EMITTER_CLIP) * (HALO_GAIN * (1.0 - t))[:, None]
         glow = blur_sum(lost, [frac * w for frac in HALO_WIDTHS], HALO_WEIGHTS)
     params = {"emitter_pixels": n_emit, "gain": HALO_GAIN, "widths_px": [round(f * w, 2) for f in HALO_WIDTHS]}
     return glow, params

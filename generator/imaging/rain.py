@@ -26,7 +26,7 @@ import math
 import numpy as np
 from scipy import ndimage
 
-from generator.imaging.fog import block_mean, blur_wide, emitter_map
+from generator.imaging.fog import block_mean, emitter_map, gaussian, upsample
 
 #: Nearest and farthest drop distance drawn (m).
 NEAR_M, FAR_M = 0.5, 25.0
@@ -147,15 +147,16 @@ def streak_radiance(rgb: np.ndarray, time_of_day: str) -> np.ndarray:
     included), a little desaturated; at night only local light counts, and the lamps'
     light adds glints near them. All terms are linear in the image, so one blur serves.
     """
-    w = rgb.shape[1]
-    src = np.minimum(rgb, 1.0).astype(np.float32)  # lamps enter through the glint term
+    h, w = rgb.shape[:2]
+    sigma = 0.04 * w
+    f = max(1, int(sigma / 3.0))  # the radiance is smooth: build it on a block-averaged grid
+    src = block_mean(np.minimum(rgb, 1.0), f)  # lamps enter through the glint term
     src = 0.6 * src + 0.4 * src.mean(-1, keepdims=True)
     if time_of_day == "night":
-        src += np.float32(LAMP_GLINT / STREAK_GAIN["night"]) * emitter_map(rgb)
-    local = blur_wide(src, 0.04 * w)
+        src += np.float32(LAMP_GLINT / STREAK_GAIN["night"]) * block_mean(emitter_map(rgb), f)
     share = ENV_SHARE[time_of_day]
-    out = STREAK_GAIN[time_of_day] * ((1.0 - share) * local + share * src.mean((0, 1), keepdims=True))
-    return out.astype(np.float32, copy=False)
+    small = STREAK_GAIN[time_of_day] * ((1.0 - share) * gaussian(src, sigma / f) + share * src.mean((0, 1), keepdims=True))
+    return upsample(small.astype(np.float32), f, h, w)
 
 
 def lens_drops(img: np.ndarray, rate_mmh: float, rng: np.random.Generator) -> tuple[np.ndarray, int]:
