@@ -19,6 +19,8 @@ from generator.errors import EXIT_USAGE, UserError
 COMMANDS = [
     "layout",
     "lidar",
+    "render",
+    "stats",
 ]
 
 log = logging.getLogger("urbangen")
