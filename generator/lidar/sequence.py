@@ -6,6 +6,9 @@ plus ``bev/NNNNNN.png`` (bird's-eye view), optionally ``range/NNNNNN.npy`` (rang
 rings x columns float32, 0 = no return) and ``ply/NNNNNN.ply``; ``lidar_meta.json`` says
 how the data was made (sensor, conventions, remission placeholder, point counts); the
 dataset's ``semantic-kitti.yaml`` label config sits in ``out/``.
+Side files for fusion: ``point_times/`` and ``native_labels/`` per scan
+(:mod:`generator.formats.point_sidecars`) and, in ``lidar_meta.json``,
+``sweep_poses_world`` (the LiDAR world pose at each sweep's start and one rotation later).
 
 Write order: calib first, then scans; ``poses.txt``, ``times.txt`` and the metadata last,
 so a sequence with ``poses.txt`` is complete. Re-running into the same folder overwrites
@@ -30,7 +33,8 @@ from generator.formats.label_config import count_raw_ids, merge_counts, write_la
 from generator.formats.ply import write_ply
 from generator.imaging.bev import write_bev
 from generator.labels import class_table
-from generator.layout.frames import max_frames, plan_frames
+from generator.formats.point_sidecars import write_point_sidecars
+from generator.layout.frames import ego_pose_at, max_frames, plan_frames
 from generator.lidar.remission import IntensityFn, intensity_fn_for_spec
 from generator.lidar.scan import Scanner, sensor_mount, sweep_poses
 from generator.lidar.sensors import Sensor, sensor_for_spec
@@ -119,6 +123,7 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
     to_sk = class_table().to_semantickitti
     t_ego_sensor = sensor_mount(spec)
     starts, n_points, counts = [], [], {}
+    ends = []  # LiDAR world pose one rotation after each sweep start (fusion de-skews between the two)
     with Scanner(scene, sensor, threads=options.threads) as scanner:
         for f in tqdm(frames, desc=f"lidar {name}", unit="scan", disable=None if progress else True):
             scan = scanner.scan(sweep_poses(scene, spec, sensor, f.t, route=options.route))
@@ -128,6 +133,7 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
             semantic = to_sk[pts["class"]]
             sk.write_scan(seq / "velodyne" / f"{stem}.bin", scan.xyz, remission)
             sk.write_labels(seq / "labels" / f"{stem}.label", semantic, pts["instance"])
+            write_point_sidecars(seq, stem, pts["time"], pts["class"])  # fusion: de-skew times, native classes
             if options.bev:
                 write_bev(seq / "bev" / f"{stem}.png", scan.xyz, pts["class"], title=f"{spec.name} {name}/{stem}")
             if options.range_image:
@@ -137,19 +143,23 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
                 write_ply(seq / "ply" / f"{stem}.ply", scan.xyz, remission, semantic, pts["instance"],
                           class_table().colors[pts["class"]])
             starts.append(f.T_world_ego @ t_ego_sensor)
+            ends.append(ego_pose_at(scene, spec, f.t + sensor.period_s, options.route)[0] @ t_ego_sensor)
             n_points.append(int(len(pts)))
             counts = merge_counts(counts, count_raw_ids(semantic))
     _remove_stale(seq, options.frames)
     sk.write_poses(seq / "poses.txt", kitti_calib.camera_poses(np.array(starts), tr))
     sk.write_times(seq / "times.txt", np.array([f.t for f in frames]))
     meta = _metadata(scene, spec, sensor, options, intensity_fn, n_points, counts)
+    meta["sweep_poses_world"] = {"period_s": sensor.period_s, "T_world_lidar_start": np.round(starts, 12).tolist(),
+                                 "T_world_lidar_end": np.round(ends, 12).tolist()}
     write_json(seq / META_NAME, meta)
     write_dataset_label_config(out)
     return meta
 
 
 def _remove_stale(seq: Path, n: int) -> None:
-    for sub, ext in (("velodyne", ".bin"), ("labels", ".label"), ("bev", ".png"), ("range", ".npy"), ("ply", ".ply")):
+    for sub, ext in (("velodyne", ".bin"), ("labels", ".label"), ("bev", ".png"), ("range", ".npy"), ("ply", ".ply"),
+                     ("point_times", ".bin"), ("native_labels", ".bin")):
         for p in sorted((seq / sub).glob(f"*{ext}")):
             if p.stem.isdigit() and int(p.stem) >= n:
                 log.warning("removing %s left by an earlier, longer run", p)

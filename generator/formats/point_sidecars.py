@@ -1,0 +1,69 @@
+"""Per-point side files of an urbangen SemanticKITTI sequence, aligned row by row with the ``.bin``.
+
+KITTI's ``.bin`` keeps only x, y, z, remission and the ``.label`` file only the SemanticKITTI
+raw id, which merges native classes (road_marking and crosswalk -> 60 lane-marking, curb and
+sidewalk -> 48, vegetation and tree_crown -> 70, traffic_light and traffic_sign -> 81). Fusion
+needs two more facts per point, written beside the scans:
+
+=================================  =======  ==================================================
+file                               dtype    content
+=================================  =======  ==================================================
+``point_times/NNNNNN.bin``         float32  firing offset after the sweep start, seconds (0 with
+                                            motion skew off): what de-skewing needs
+``native_labels/NNNNNN.bin``       uint8    native class id (``generator/labels/classes.yaml``)
+=================================  =======  ==================================================
+
+Both little-endian, one value per point in the order of the ``.bin`` rows. Datasets from
+elsewhere lack them; readers return None then.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from generator.atomic import write_bytes
+from generator.errors import UserError
+
+TIMES_DIR = "point_times"
+NATIVE_DIR = "native_labels"
+#: (folder, dtype) of each side file.
+SIDECARS = {TIMES_DIR: "<f4", NATIVE_DIR: "u1"}
+
+
+def write_point_sidecars(seq_dir: str | Path, stem: str, times: np.ndarray, native: np.ndarray) -> None:
+    """Write both side files of scan ``stem`` (atomically).
+
+    Parameters
+    ----------
+    seq_dir : path-like
+        ``root/sequences/NN``.
+    stem : str
+        ``NNNNNN``.
+    times : (n,) float
+        Firing offsets, seconds.
+    native : (n,) uint8
+        Native class ids.
+    """
+    if len(times) != len(native):
+        raise ValueError(f"{len(times)} times but {len(native)} native labels")
+    write_bytes(Path(seq_dir) / TIMES_DIR / f"{stem}.bin", np.asarray(times, "<f4").tobytes())
+    write_bytes(Path(seq_dir) / NATIVE_DIR / f"{stem}.bin", np.asarray(native, "u1").tobytes())
+
+
+def read_sidecar(seq_dir: str | Path, folder: str, index: int, n_points: int) -> np.ndarray | None:
+    """(n,) array of side file ``folder`` for scan ``index``, or None when the file does not exist.
+
+    Raises
+    ------
+    UserError
+        When its length disagrees with the scan's ``n_points``.
+    """
+    path = Path(seq_dir) / folder / f"{index:06d}.bin"
+    if not path.is_file():
+        return None
+    values = np.fromfile(path, dtype=SIDECARS[folder])
+    if len(values) != n_points:
+        raise UserError(f"{path}: {len(values)} values but the scan has {n_points} points")
+    return values
