@@ -109,11 +109,18 @@ class DomainGap:
 
 
 @dataclass(frozen=True)
+class LidarWeather:
+    enabled: bool | None
+    detection_threshold: float
+
+
+@dataclass(frozen=True)
 class LidarProcessing:
     intensity_model: str
     intensity_profile: str | None
     constant_intensity: float
     domain_gap: DomainGap
+    weather: LidarWeather
 
 
 @dataclass(frozen=True)
