@@ -7,7 +7,7 @@ import OpenEXR
 import pytest
 
 from generator.errors import UserError
-from generator.imaging.exr import LabelledImage, read_exr, write_exr
+from generator.imaging.exr import LabelledImage, mask_channel, read_exr, write_exr
 from generator.imaging.metadata import camera_angles, class_pixels
 from generator.imaging.preview import tonemap, write_preview
 from generator.labels import class_table
@@ -41,10 +41,10 @@ def test_layout_types_and_compression(tmp_path, image):
     with OpenEXR.File(str(p), separate_channels=True) as f:
         ch = {k: v for k, v in f.channels().items()}
         assert f.header()["compression"] == OpenEXR.ZIP_COMPRESSION
-    assert {f"mask.{n}" for n in class_table().names} <= set(ch)
-    assert ch["R"].pixels.dtype == np.float16 and ch["mask.road"].pixels.dtype == np.float16
+    assert {mask_channel(n) for n in class_table().names} <= set(ch)
+    assert ch["R"].pixels.dtype == np.float16 and ch["mask.road.V"].pixels.dtype == np.float16
     assert ch["depth.Z"].pixels.dtype == np.float32 and ch["instance.id"].pixels.dtype == np.uint32
-    masks = np.stack([ch[f"mask.{n}"].pixels for n in class_table().names]).astype(np.float32)
+    masks = np.stack([ch[mask_channel(n)].pixels for n in class_table().names]).astype(np.float32)
     assert set(np.unique(masks)) <= {0.0, 1.0}
     assert (masks.sum(0) == 1).all()
 
@@ -57,11 +57,11 @@ def test_opens_in_openimageio(tmp_path, image):
     spec = inp.spec()
     names = list(spec.channelnames)
     assert names[:3] == ["R", "G", "B"]
-    assert all(f"mask.{n}" in names for n in class_table().names)
+    assert all(mask_channel(n) in names for n in class_table().names)
     assert spec.getattribute("urbangen.classes") == ",".join(class_table().names)
     pixels = inp.read_image(0, 0, 0, spec.nchannels, "float")
     inp.close()
-    road = pixels[..., names.index("mask.road")]
+    road = pixels[..., names.index("mask.road.V")]
     assert np.array_equal(road == 1.0, image.class_id == class_table().id("road"))
 
 
@@ -75,9 +75,9 @@ def _tamper(src, dst, fn):
 
 
 @pytest.mark.parametrize("fault,message", [
-    (lambda ch: ch.pop("mask.car"), "missing channel(s) mask.car"),
-    (lambda ch: ch["mask.road"].__setitem__((0, 0), 0.5), "not binary"),
-    (lambda ch: ch["mask.road"].__setitem__((slice(None), slice(None)), 1.0), "do not partition"),
+    (lambda ch: ch.pop("mask.car.V"), "missing channel(s) mask.car"),
+    (lambda ch: ch["mask.road.V"].__setitem__((0, 0), 0.5), "not binary"),
+    (lambda ch: ch["mask.road.V"].__setitem__((slice(None), slice(None)), 1.0), "do not partition"),
 ])
 def test_reader_catches_faults(tmp_path, image, fault, message):
     write_exr(tmp_path / "a.exr", image)

@@ -99,12 +99,24 @@ class Renderer:
                     light_objects={k: v for k, v in self.night_counts.items()} if is_night else {})
         return info
 
+    def place_camera(self, T_world_camera: np.ndarray) -> None:
+        """Put the camera at an optical-frame pose (world)."""
+        camera.place(self.bscene, T_world_camera, self.spec.sensors.camera.hfov_deg)
+
+    def render_rgb(self, seed: int) -> tuple[np.ndarray, float]:
+        """The RGB pass from the current camera under the current conditions: ((H, W, 3) float32, seconds)."""
+        return passes.render_rgb(self.bscene, self.handles, self.cfg, seed, self.scratch)
+
+    def render_labels(self) -> passes.LabelPasses:
+        """The real and label passes from the current camera (independent of lighting and weather)."""
+        return passes.render_labels(self.bscene, self.handles, self.k, self.scratch)
+
     def render(self, T_world_camera: np.ndarray, seed: int, light_info: dict) -> RenderedFrame:
         """Render the RGB and label passes from one camera pose (optical frame, world)."""
         t0 = time.perf_counter()
-        camera.place(self.bscene, T_world_camera, self.spec.sensors.camera.hfov_deg)
-        rgb, rgb_s = passes.render_rgb(self.bscene, self.handles, self.cfg, seed, self.scratch)
-        labels = passes.render_labels(self.bscene, self.handles, self.k, self.scratch)
+        self.place_camera(T_world_camera)
+        rgb, rgb_s = self.render_rgb(seed)
+        labels = self.render_labels()
         secs = {"rgb_pass": rgb_s, **labels.seconds, "render_total": time.perf_counter() - t0}
         return RenderedFrame(rgb, labels, light_info, secs)
 

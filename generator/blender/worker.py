@@ -4,7 +4,8 @@ The parent (pure Python, no bpy) starts workers with the ``spawn`` start method 
 hands each one a job: the spec, render config, output folder and the list of frames.
 The worker builds the SceneModel and the Blender scene once, renders its frames, writes
 each image's files atomically and reports progress on a queue:
-``("frame", index, seconds_dict)``, ``("error", message)`` and ``("done", stats)``.
+``("frame", index, {image_name: seconds_dict})``, ``("error", message)`` and
+``("done", stats)``.
 Blender's own per-tile chatter on stdout is sent to ``blender.log`` in the scratch folder.
 """
 
@@ -49,7 +50,7 @@ def run(job: dict, queue) -> None:
 
 def _run(job: dict, queue, scratch: Path) -> None:
     from generator.blender.renderer import Renderer  # imports bpy (after the sys.path clean-up)
-    from generator.jobs.images import render_and_write
+    from generator.jobs.variants import render_frame
     from generator.layout.assemble import build_scene
     from generator.layout.frames import plan_frames
 
@@ -61,6 +62,6 @@ def _run(job: dict, queue, scratch: Path) -> None:
     queue.put(("ready", {"layout_s": layout_s, "blender_build_s": renderer.build_seconds, "pid": os.getpid()}))
     for index in job["frames"]:
         frame = plan_frames(scene, spec, 1, first=index)[0]
-        secs = render_and_write(renderer, scene, spec, cfg, frame, Path(job["out"]))
-        queue.put(("frame", index, secs))
+        images = render_frame(renderer, spec, cfg, frame, Path(job["out"]), job["combos"])
+        queue.put(("frame", index, images))
     queue.put(("done", {"max_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))

@@ -6,12 +6,17 @@ Channel layout (one scanline part, ZIP compression by default):
 channel          type    content
 ===============  ======  ===========================================================
 ``R G B``        HALF    linear scene-referred RGB (the default layer)
-``mask.<name>``  HALF    1.0 where the pixel's class is ``<name>``, else 0.0; one per
+``mask.<name>.V``  HALF  1.0 where the pixel's class is ``<name>``, else 0.0; one per
                          native class, in class-table order; exactly one is 1 per pixel
 ``depth.Z``      FLOAT   distance along the pixel's ray to the real geometry, metres;
                          +inf for sky
 ``instance.id``  UINT    instance id of the labelled surface (0 for stuff and sky)
 ===============  ======  ===========================================================
+
+The mask channels are named ``mask.<class>.V`` (layer ``mask``, pass ``<class>``, channel
+``V``): Blender's multilayer reader needs one-letter channel tokens and then shows each mask
+as its own pass of a ``mask`` layer; OpenEXR and OpenImageIO read the names as they are.
+Files with the two-part names ``mask.<class>`` are read too.
 
 Header attributes: ``urbangen.classes`` (comma-separated class names, index = class id),
 ``urbangen.depth`` (the depth definition), ``urbangen.image`` and ``urbangen.version``.
@@ -63,9 +68,14 @@ class LabelledImage:
         return {name: self.class_id == i for i, name in enumerate(class_table().names)}
 
 
+def mask_channel(name: str) -> str:
+    """EXR channel name of the mask of class ``name``."""
+    return f"mask.{name}.V"
+
+
 def mask_channels(class_id: np.ndarray) -> dict[str, np.ndarray]:
-    """``mask.<name>`` -> (H, W) float16 binary channel for every native class."""
-    return {f"mask.{name}": (class_id == i).astype(np.float16) for i, name in enumerate(class_table().names)}
+    """``mask.<name>.V`` -> (H, W) float16 binary channel for every native class."""
+    return {mask_channel(name): (class_id == i).astype(np.float16) for i, name in enumerate(class_table().names)}
 
 
 def write_exr(path: str | Path, image: LabelledImage, codec: str = "zip") -> None:
@@ -109,10 +119,11 @@ def read_exr(path: str | Path) -> LabelledImage:
         hdr = {k: v for k, v in f.header().items() if isinstance(k, str) and k.startswith("urbangen.")}
         ch = {k: v.pixels for k, v in f.channels().items()}
     names = str(hdr.get("urbangen.classes", ",".join(class_table().names))).split(",")
-    missing = [c for c in ["R", "G", "B", "depth.Z", "instance.id"] + [f"mask.{n}" for n in names] if c not in ch]
+    masks = {n: mask_channel(n) if mask_channel(n) in ch else f"mask.{n}" for n in names}
+    missing = [c for c in ["R", "G", "B", "depth.Z", "instance.id"] + list(masks.values()) if c not in ch]
     if missing:
         raise UserError(f"{path}: missing channel(s) {', '.join(missing)}")
-    stack = np.stack([ch[f"mask.{n}"] for n in names]).astype(np.float32)
+    stack = np.stack([ch[masks[n]] for n in names]).astype(np.float32)
     if not np.isin(stack, (0.0, 1.0)).all():
         raise UserError(f"{path}: mask channels are not binary")
     if not (stack.sum(0) == 1).all():

@@ -1,8 +1,9 @@
-"""Render one frame with a renderer and write its image files (EXR, metadata JSON, preview PNG).
+"""Write one image's files (EXR, metadata JSON, preview PNG).
 
 Pure Python: the renderer is passed in (a :class:`generator.blender.renderer.Renderer`
-in production), so this module never imports bpy. Every file is written atomically,
-the metadata last, so a metadata file present means the image is complete.
+in production) only for its intrinsics, device and version, so this module never
+imports bpy. Every file is written atomically, the metadata last, so a metadata file
+present means the image is complete.
 """
 
 from __future__ import annotations
@@ -14,7 +15,6 @@ from generator.atomic import inside, write_json
 from generator.imaging.exr import LabelledImage, write_exr
 from generator.imaging.metadata import image_metadata, validate_metadata
 from generator.imaging.preview import write_preview
-from generator.rng import stream
 
 
 def image_name(frame_index: int, time_of_day: str = "day", weather: str = "clear") -> str:
@@ -22,33 +22,15 @@ def image_name(frame_index: int, time_of_day: str = "day", weather: str = "clear
     return f"{frame_index:06d}_{time_of_day}_{weather}"
 
 
-def draw_sun(spec, frame_index: int) -> tuple[float, float]:
-    """Sun elevation and azimuth (degrees) of a day frame, from the spec ranges."""
-    g = stream(spec.seed, "frame", frame_index, "sun")
-    w = spec.weather
-    return float(g.uniform(*w.sun_elevation_deg)), float(g.uniform(*w.sun_azimuth_deg))
-
-
-def render_and_write(renderer, scene, spec, cfg, frame, out: Path) -> dict:
-    """Render ``frame`` by day in clear weather and write ``out/images/<name>.{exr,json}`` (+ preview).
+def write_image(out: Path, frame, spec, cfg, renderer, rendered, time_of_day: str, weather: dict,
+                rgb=None, name: str | None = None) -> tuple[str, dict]:
+    """Write one image variant (``rgb`` overrides the rendered RGB, e.g. after fog in post).
 
     Returns
     -------
-    dict
-        Seconds per stage (render passes, EXR write, metadata, preview).
+    (str, dict)
+        The image name and the seconds per stage.
     """
-    from generator.blender.lighting import DayLight  # data class only; no bpy import at module level
-
-    elevation, azimuth = draw_sun(spec, frame.index)
-    light = renderer.set_day(DayLight(elevation, azimuth))
-    light["time_of_day"] = "day"
-    rendered = renderer.render(frame.T_world_camera, seed=frame.index, light_info=light)
-    return write_image(out, frame, spec, cfg, renderer, rendered, "day", {"kind": "clear"})
-
-
-def write_image(out: Path, frame, spec, cfg, renderer, rendered, time_of_day: str, weather: dict,
-                rgb=None, name: str | None = None) -> dict:
-    """Write one image variant (``rgb`` overrides the rendered RGB, e.g. after fog in post)."""
     secs = dict(rendered.seconds)
     name = name or image_name(frame.index, time_of_day, weather["kind"])
     folder = inside(out, "images")
@@ -74,4 +56,4 @@ def write_image(out: Path, frame, spec, cfg, renderer, rendered, time_of_day: st
         raise RuntimeError(f"metadata of {name} does not match its schema: {problems[0]}")
     write_json(folder / f"{name}.json", record)
     secs["metadata"] = time.perf_counter() - t
-    return secs
+    return name, secs

@@ -57,7 +57,7 @@ def run_workers(target: str, jobs: list[dict], total: int, desc: str = "render")
         p.start()
     res = PoolResult()
     try:
-        with tqdm(total=total, desc=desc, unit="img", disable=None, smoothing=0.1) as bar:
+        with tqdm(total=total, desc=desc, unit="frame", disable=None, smoothing=0.1) as bar:
             while len(res.done) < len(procs):
                 try:
                     msg = q.get(timeout=1.0)

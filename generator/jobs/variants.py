@@ -1,0 +1,91 @@
+"""All weather x time-of-day variants of one frame, at the cost of a few renders.
+
+Per frame: the label passes once (masks, instances and depth are shared by every
+variant); one RGB render per (time of day, dry | wet); then fog and rain in
+post-processing from the depth pass (seed 003 Sec. III.A). The 12 combinations of
+Table II therefore cost 4 RGB renders, and a frame's variants differ only in RGB.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+from generator.imaging.fog import fog_image
+from generator.imaging.rain import rain_image
+from generator.jobs.images import write_image
+from generator.rng import stream
+from generator.weather import combinations, draw_lighting, draw_weather, frame_wetness, has_fog, has_rain, is_wet
+
+
+def parse_combos(text: str) -> list[tuple[str, str]]:
+    """``all`` | ``clear`` | ``day:clear,night:rain_fog,...`` -> list of (time_of_day, kind).
+
+    Raises
+    ------
+    ValueError
+        With a message naming the bad item.
+    """
+    if text == "all":
+        return combinations()
+    if text == "clear":
+        return [("day", "clear")]
+    out = []
+    valid = set(combinations())
+    for item in text.split(","):
+        pair = tuple(item.strip().split(":"))
+        if pair not in valid:
+            raise ValueError(f"unknown variant {item!r}; use all, clear or time:weather pairs like day:fog "
+                             f"(times: day, night; weather: clear, fog, rain, rain_fog, wet, wet_fog)")
+        out.append(pair)
+    return list(dict.fromkeys(out))
+
+
+def renders_needed(combos: list[tuple[str, str]]) -> list[tuple[str, bool]]:
+    """The (time_of_day, wet) renders that serve ``combos``, in a fixed order."""
+    return sorted({(t, is_wet(k)) for t, k in combos}, key=lambda r: (r[0] != "day", r[1]))
+
+
+def render_frame(renderer, spec, cfg, frame, out: Path, combos: list[tuple[str, str]]) -> dict[str, dict]:
+    """Render and write every variant in ``combos`` of ``frame``.
+
+    Returns
+    -------
+    dict
+        Image name -> seconds per stage.
+    """
+    t = time.perf_counter()
+    renderer.place_camera(frame.T_world_camera)
+    labels = renderer.render_labels()
+    label_s = time.perf_counter() - t
+    timings = {}
+    for tod, wet in renders_needed(combos):
+        light = draw_lighting(spec, frame.index, tod)
+        wetness, puddles = frame_wetness(spec, frame.index) if wet else (0.0, 0.0)
+        info = renderer.set_conditions(light, wetness, puddles)
+        info.update({k: v for k, v in light.to_dict().items() if v is not None})
+        rgb, rgb_s = renderer.render_rgb(seed=frame.index * 4 + (2 if tod == "night" else 0) + int(wet))
+        for kind in [k for t_, k in combos if t_ == tod and is_wet(k) == wet]:
+            weather = draw_weather(spec, frame.index, kind)
+            t = time.perf_counter()
+            img, params = rgb, weather.to_dict()
+            if has_fog(kind):
+                img, fog_params = fog_image(img, labels.depth, weather.visibility_m, tod)
+                params["fog"] = fog_params
+            if has_rain(kind):
+                g = stream(spec.seed, "frame", frame.index, "rain", tod, kind)
+                img, rain_params = rain_image(img, labels.depth, weather.rain_rate_mmh, g, tod, k=renderer.k)
+                params["rain"] = rain_params
+            post_s = time.perf_counter() - t
+            secs = {"rgb_pass": rgb_s, "label_passes_shared": label_s, "post_fx": post_s}
+            rendered = _Rendered(labels, info, secs)
+            name, written = write_image(out, frame, spec, cfg, renderer, rendered, tod, params, rgb=img)
+            timings[name] = written
+    return timings
+
+
+class _Rendered:
+    """The shared passes of a frame in the shape :func:`write_image` reads."""
+
+    def __init__(self, labels, lighting: dict, seconds: dict):
+        self.labels, self.lighting, self.seconds, self.rgb = labels, lighting, seconds, None
