@@ -32,3 +32,19 @@ def default_spec():
     from generator.spec import load_spec
 
     return load_spec(ROOT / "scenes" / "default_town.json")
+
+
+@pytest.fixture(scope="session")
+def test_scene(test_spec):
+    """The test town built once per session (read-only: do not mutate it)."""
+    from generator.layout import build_scene
+
+    return build_scene(test_spec)
+
+
+@pytest.fixture(scope="session")
+def default_scene(default_spec):
+    """The default town built once per session (read-only: do not mutate it)."""
+    from generator.layout import build_scene
+
+    return build_scene(default_spec)

@@ -15,6 +15,8 @@ from PIL import Image
 
 from generator.cli import main
 from generator.labels import class_table
+from generator.layout.streets import make_grid
+from generator.spec import load_spec
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -38,6 +40,12 @@ def test_layout_writes_map_glb_and_summary(tmp_path, capsys):
         img.load()
         rgb = np.asarray(img.convert("RGB"))
     assert min(rgb.shape[:2]) > 500
+    # the map frames the built town and its margin, not the ground that runs on to the horizon
+    grid = make_grid(load_spec(ROOT / "scenes" / "test_town.json"))
+    assert np.allclose(summary["bounds_m"], grid.bounds, atol=1e-3)
+    bx0, by0, bx1, by1 = grid.built_rect
+    assert np.allclose(grid.bounds, [[bx0 - 12, by0 - 12], [bx1 + 12, by1 + 12]])
+    assert rgb.shape[0] == max(560, int(np.ceil((grid.bounds[1, 1] - grid.bounds[0, 1]) * 8.0)))
     table = class_table()
     seen = {tuple(c) for c in np.unique(rgb.reshape(-1, 3), axis=0).tolist()}
     # flat, level surfaces are drawn in exactly their class colour (only slopes are shaded)

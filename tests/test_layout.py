@@ -10,23 +10,16 @@ from scipy.spatial import ConvexHull
 
 from assets_procedural.mesh import apply
 from generator.labels import class_table
-from generator.layout.assemble import build_scene
+from generator.layout import build_scene
 from generator.layout.frames import plan_frames
 from generator.layout.placement_core import EGO_HALF_WIDTH_M, overlaps, point_box_distance
-from generator.layout.streets import MARK_Z_M, make_grid
+from generator.imaging.layout_map import rasterize
+from generator.layout.lots import make_lots
+from generator.layout.outskirts import HORIZON_M
+from generator.layout.streets import MARK_Z_M, make_grid, segment_frame_points
 from generator.materials import material_table
 from generator.scene import OrientedBox
 from generator.spec import parse_spec
-
-
-@pytest.fixture(scope="session")
-def test_scene(test_spec):
-    return build_scene(test_spec)
-
-
-@pytest.fixture(scope="session")
-def default_scene(default_spec):
-    return build_scene(default_spec)
 
 
 def _rect_boxes(rects) -> np.ndarray:
@@ -108,8 +101,9 @@ def test_no_building_or_parked_car_overlaps_a_driving_lane(default_spec, default
 
 def test_buildings_stay_off_streets_and_sidewalks(default_spec, default_scene):
     grid = make_grid(default_spec)
-    c, big = grid.corridor_half, 1e4
-    corridors = [(-big, y - c, big, y + c) for y in grid.ys] + [(x - c, -big, x + c, big) for x in grid.xs]
+    c = grid.corridor_half
+    x0, y0, x1, y1 = grid.corridor_rect
+    corridors = [(x0, y - c, x1, y + c) for y in grid.ys] + [(x - c, y0, x + c, y1) for x in grid.xs]
     objs = default_scene.objects_of("building")
     assert not overlaps(_obj_boxes(objs, shrink=0.005), _rect_boxes(corridors)).any()
 
@@ -259,15 +253,159 @@ def test_street_trees_stand_in_soil_pits(default_spec, default_scene):
     tri = s.vertices[s.faces[soil]][:, :, :2]
     lo, hi = tri.min(1), tri.max(1)
     n_street = 0
+    u0 = grid.corridor_half - grid.road_half                    # sidewalks start after the corner squares
     for o in s.objects:
         if o.kind != "tree":
             continue
         x, y = o.transform[:2, 3]
-        dist = min(np.abs(grid.xs - x).min(), np.abs(grid.ys - y).min())
-        if grid.walk_inner < dist < grid.corridor_half:         # on a sidewalk
+        uv = np.array([segment_frame_points(seg, [(x, y)])[0] for seg in grid.segments])
+        length = np.array([seg.length for seg in grid.segments])
+        if ((grid.walk_inner < np.abs(uv[:, 1])) & (np.abs(uv[:, 1]) < grid.corridor_half)
+                & (uv[:, 0] > u0) & (uv[:, 0] < length - u0)).any():     # on a sidewalk
             n_street += 1
             assert ((lo <= [x, y]) & (hi >= [x, y])).all(1).any(), f"{o.name} has no pit"
     assert n_street > 50
+
+
+# -- outside the ring road ----------------------------------------------------------------------
+def _outer_lots(spec):
+    grid = make_grid(spec)
+    return grid, [lot for lot in make_lots(spec, grid) if lot.block[0] < 0]
+
+
+def test_outer_lots_tile_the_band_round_the_ring_road(default_spec):
+    grid, lots = _outer_lots(default_spec)
+    assert grid.outer_depth == max(15.0, default_spec.town.block_size_m / 2)
+    x0, y0, x1, y1 = grid.corridor_rect
+    bx0, by0, bx1, by1 = grid.built_rect
+    band = (bx1 - bx0) * (by1 - by0) - (x1 - x0) * (y1 - y0)
+    assert sum(lot.width * lot.depth for lot in lots) == pytest.approx(band, rel=1e-9)
+    corners = np.array([lot.corners_world() for lot in lots])
+    assert (corners >= [bx0 - 1e-6, by0 - 1e-6]).all() and (corners <= [bx1 + 1e-6, by1 + 1e-6]).all()
+    boxes = np.array([[*lot.to_world([(0.0, lot.depth / 2)])[0], lot.width / 2 - 0.01, lot.depth / 2 - 0.01,
+                       lot.yaw, -1.0, 1.0] for lot in lots])
+    hit = overlaps(boxes, np.vstack([boxes, _rect_boxes([grid.corridor_rect])[0]]))
+    hit[np.arange(len(lots)), np.arange(len(lots))] = False
+    assert not hit.any(), "outer lots overlap each other or the street grid"
+    # the same lot logic as inside the blocks: widths, uses, fronts
+    assert min(lot.width for lot in lots) >= min(9.0, 2 * grid.corridor_half) - 1e-9
+    assert {lot.use for lot in lots} >= {"building", "yard"}
+    assert {f.kind for lot in lots for f in lot.front} == {"hedge", "fence"}
+
+
+def test_outer_lots_face_the_ring_road(default_spec):
+    """Every outer lot's front lies on the ring road's outer sidewalk edge (or, for a corner
+    square, on its neighbour's side) and its depth axis points away from the town."""
+    grid, lots = _outer_lots(default_spec)
+    x0, y0, x1, y1 = grid.corridor_rect
+    fronts = {0: (1, y0), 1: (0, x1), 2: (1, y1), 3: (0, x0)}      # side -> (axis, coordinate of the front line)
+    outward = {0: (0, -1), 1: (1, 0), 2: (0, 1), 3: (-1, 0)}
+    per_side = {k: 0 for k in range(4)}
+    for lot in lots:
+        side = lot.block[1]
+        axis, coord = fronts[side]
+        assert lot.origin[axis] == pytest.approx(coord), lot.index
+        b = lot.to_world([(0.0, 1.0)])[0] - lot.origin
+        assert np.allclose(b, outward[side]), lot.index
+        per_side[side] += 1
+    assert min(per_side.values()) >= 5
+
+
+def test_ring_road_has_buildings_and_furniture_on_its_outer_side(default_spec, default_scene):
+    grid = make_grid(default_spec)
+    x0, y0, x1, y1 = grid.corridor_rect
+    outside = {0: lambda x, y: y < y0, 1: lambda x, y: x > x1, 2: lambda x, y: y > y1, 3: lambda x, y: x < x0}
+    for side, test in outside.items():
+        n = sum(test(*o.transform[:2, 3]) for o in default_scene.objects_of("building"))
+        assert n >= 5, f"side {side}: {n} buildings beyond the ring road"
+    # fronts face the ring road: a building's local -y (its front) points back towards the town
+    lots = {lot.index: lot for lot in make_lots(default_spec, grid) if lot.block[0] < 0}
+    for o in default_scene.objects_of("building"):
+        lot = lots.get(o.attrs["lot"])
+        if lot is not None:
+            front = -o.transform[:2, 1]
+            assert np.allclose(front, lot.origin - lot.to_world([(0.0, 1.0)])[0]), o.name
+    # street furniture on the outer sidewalks and cars in the outer parking strips, as on any street
+    ring_outer = {(seg.index, side): {} for seg in grid.segments for side in (-1, 1)
+                  if not x0 < seg.to_world(seg.length / 2, side * (grid.corridor_half + 1.0))[0][0] < x1
+                  or not y0 < seg.to_world(seg.length / 2, side * (grid.corridor_half + 1.0))[0][1] < y1}
+    assert len(ring_outer) == 2 * (len(grid.xs) - 1) + 2 * (len(grid.ys) - 1)
+    for o in default_scene.objects:
+        for seg in grid.segments:
+            u, v = segment_frame_points(seg, o.box.center[:2])[0]
+            key = (seg.index, int(np.sign(v)))
+            if key in ring_outer and 0 < u < seg.length and grid.lane_half < abs(v) <= grid.corridor_half:
+                kind = f"parked {o.kind}" if o.attrs.get("placement") == "parked" else o.kind
+                ring_outer[key][kind] = ring_outer[key].get(kind, 0) + 1
+    assert all(c.get("lamp_post", 0) >= 1 for c in ring_outer.values()), "a ring segment without an outer lamp"
+    total = {k: sum(c.get(k, 0) for c in ring_outer.values()) for k in ("tree", "person", "traffic_sign", "parked car")}
+    assert min(total.values()) >= 1, total
+
+
+def _horizon(scene):
+    objs = [o for o in scene.objects if o.kind == "horizon"]
+    assert len(objs) == 1
+    return objs[0]
+
+
+def test_horizon_ground_is_a_few_flat_grass_triangles(default_spec, default_scene):
+    o = _horizon(default_scene)
+    mesh = default_scene.prototypes[o.prototype]
+    assert o.instance_id == 0 and o.cls == "terrain" and o.proxy is None
+    assert mesh.n_faces <= 32
+    assert (mesh.face_class == class_table().id("terrain")).all()
+    assert (mesh.face_material == material_table().id("grass")).all()
+    v = _world_vertices(default_scene, o)
+    assert np.allclose(v[:, 2], default_spec.town.curb_height_m)
+    tri = v[mesh.faces]
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    assert (n[:, 2] > 0).all(), "every triangle faces up"
+    # it tiles the ring between the town bounds and its outer polygon exactly once
+    grid = make_grid(default_spec)
+    (bx0, by0), (bx1, by1) = grid.bounds
+    outer = v[np.hypot(v[:, 0], v[:, 1]) > 1000.0][:, :2]
+    outer = outer[np.argsort(np.arctan2(outer[:, 1], outer[:, 0]))]
+    poly = 0.5 * np.abs(np.sum(outer[:, 0] * np.roll(outer[:, 1], -1) - np.roll(outer[:, 0], -1) * outer[:, 1]))
+    assert n[:, 2].sum() / 2 == pytest.approx(poly - (bx1 - bx0) * (by1 - by0), rel=1e-9)
+    g = np.random.default_rng(0)
+    p = g.uniform(-outer.max(), outer.max(), (20000, 2))
+    a, b, c = tri[None, :, 0, :2], tri[None, :, 1, :2], tri[None, :, 2, :2]
+    cross = lambda u, w: u[..., 0] * w[..., 1] - u[..., 1] * w[..., 0]   # noqa: E731
+    q = p[:, None]
+    covered = ((cross(b - a, q - a) >= 0) & (cross(c - b, q - b) >= 0) & (cross(a - c, q - c) >= 0)).sum(1)
+    in_town = (p[:, 0] > bx0) & (p[:, 0] < bx1) & (p[:, 1] > by0) & (p[:, 1] < by1)
+    in_poly = np.all(cross(np.roll(outer, -1, 0)[None] - outer[None], p[:, None] - outer[None]) > 0, axis=1)
+    assert (covered[in_town] == 0).all() and (covered[in_poly & ~in_town] == 1).all()
+    assert (covered[~in_poly] == 0).all()
+
+
+def test_ground_has_no_holes_out_to_the_horizon(default_spec, default_scene):
+    """Seen from above, ground (stuff) covers every point of the town and every point
+    within HORIZON_M of it; from every route point the ground's edge is HORIZON_M or more away
+    (a camera 1.65 m up sees ground to within 0.05 degrees of the horizon)."""
+    s = default_scene
+    stuff = s.face_instance == 0
+    cls = s.face_class.astype(np.int64)
+    grid = make_grid(default_spec)
+    top, z = rasterize(s.vertices, s.faces[stuff], cls[stuff], np.asarray(grid.bounds), 2.0)
+    assert (top >= 0).all(), f"{int((top < 0).sum())} holes in the town ground at 0.5 m"
+    assert np.isin(np.round(z, 3), [0.0, MARK_Z_M, default_spec.town.curb_height_m,
+                                    default_spec.town.curb_height_m + 0.003]).all()
+    reach = float(np.hypot(*np.abs(grid.bounds).max(0))) + HORIZON_M
+    far = np.array([[-reach, -reach], [reach, reach]])
+    top, _ = rasterize(s.vertices, s.faces[stuff], cls[stuff], far, 0.02)
+    centres = (np.stack(np.meshgrid(np.arange(top.shape[1]) + 0.5, np.arange(top.shape[0]) + 0.5), -1) / 0.02
+               * [1, -1] + [-reach, reach])
+    assert (top[np.hypot(centres[..., 0], centres[..., 1]) < reach] >= 0).all()
+    # distance from every route sample to the ground's outer edge (a convex polygon)
+    v = _world_vertices(s, _horizon(s))[:, :2]
+    ring = v[np.hypot(v[:, 0], v[:, 1]) > 1000.0]
+    ring = ring[np.argsort(np.arctan2(ring[:, 1], ring[:, 0]))]
+    edge = np.roll(ring, -1, 0) - ring
+    normal = np.stack([edge[:, 1], -edge[:, 0]], 1) / np.linalg.norm(edge, axis=1)[:, None]
+    for path in s.paths:
+        d = ((ring[None] - path.points[:, None, :2]) * normal[None]).sum(-1).min(1)
+        assert d.min() >= HORIZON_M, path.name
 
 
 # -- routes ---------------------------------------------------------------------------------------

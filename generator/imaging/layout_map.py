@@ -118,6 +118,10 @@ def render_map(scene: SceneModel, ppm: float | None = None, marker_spacing_m: fl
                title: str = "") -> Image.Image:
     """The top-down class map of ``scene`` as an RGB image (legend panel on the right).
 
+    The map covers ``scene.bounds``: the built town (streets and the lots round the outer
+    ring road) and its terrain margin. The ground that runs on for kilometres beyond it (to
+    the horizon) is cropped; its triangles cost the rasteriser only their clipped bounding boxes.
+
     Parameters
     ----------
     ppm : float, optional

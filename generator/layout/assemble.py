@@ -1,7 +1,8 @@
 """``build_scene(spec) -> SceneModel``: the whole procedural town, deterministic in the spec.
 
 Order of work (each feature draws from its own named stream, so adding one does not
-shift the others): grid -> routes -> lots -> buildings -> hedges/fences -> traffic lights
+shift the others): grid -> routes -> lots (blocks, then the band outside the ring road)
+-> buildings -> hedges/fences -> traffic lights
 -> lamps -> street trees -> signs -> lot greenery -> parked vehicles -> lane cars ->
 people -> ground objects. Objects accepted earlier win space; everything keeps clear of
 the routes (see :mod:`generator.layout.placement_core`). Finally the routes are verified
@@ -22,6 +23,7 @@ from generator.labels import class_table
 from generator.layout import placement_lots as pl
 from generator.layout import placement_street as ps
 from generator.layout.lots import Lot, lot_ground_mesh, make_lots
+from generator.layout.outskirts import horizon_mesh
 from generator.layout.placement_core import EGO_HALF_WIDTH_M, Keepout, Library, Placed, Placer
 from generator.layout.routes import densify, make_routes
 from generator.layout.streets import (Grid, intersection_road_mesh, intersection_walk_mesh, make_grid, margin_mesh,
@@ -75,7 +77,8 @@ def ground_pieces(grid: Grid, lots: list[Lot], placed: list[Placed] = ()) -> lis
 
     One road and one sidewalk object (with tree pits under the street trees of ``placed``)
     per street segment, one asphalt square (shared prototype) and one corner-sidewalk
-    object per intersection, one ground per lot, and the terrain margin.
+    object per intersection, one ground per lot, the terrain margin round the built area,
+    and the flat ground beyond it to the horizon (kind ``horizon``).
     """
     out = []
     trees = np.array([p.transform[:2, 3] for p in placed if p.kind == "tree"]).reshape(-1, 2)
@@ -93,6 +96,7 @@ def ground_pieces(grid: Grid, lots: list[Lot], placed: list[Placed] = ()) -> lis
                     lot_ground_mesh(lot, grid.curb_h), lot.transform()))
     if grid.margin > 0:
         out.append(("terrain", "terrain", "", margin_mesh(grid), np.eye(4)))
+    out.append(("horizon", "terrain", "", horizon_mesh(grid), np.eye(4)))
     return out
 
 

@@ -2,7 +2,8 @@
 
 Each block (inside its sidewalks) is cut into one or two rows of lots; each row faces one
 street and is cut along its frontage into 2-6 lots of varied width (corner lots face the
-row's street). A lot has its own frame: ``a`` along the frontage, ``b`` into the lot (b = 0 at
+row's street). The band of lots outside the outer ring road
+(:func:`generator.layout.outskirts.outer_rows`) is planned the same way. A lot has its own frame: ``a`` along the frontage, ``b`` into the lot (b = 0 at
 the sidewalk's outer edge), z up; its yaw is chosen so that this frame is exactly the local
 frame of a building asset (front towards -y = towards the street).
 """
@@ -14,6 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from assets_procedural.mesh import Mesh, merge, pose
+from generator.layout.outskirts import outer_rows
 from generator.layout.streets import Grid, rects
 from generator.rng import stream
 from generator.spec.model import SceneSpec
@@ -70,7 +72,7 @@ class Lot:
     """One lot of a block (see the module docstring for its frame)."""
 
     index: int
-    block: tuple[int, int]
+    block: tuple[int, int]            #: block (i, j), or (-1, side) outside the ring road (side 0..3: S, E, N, W)
     origin: tuple[float, float]       #: world xy of the front centre, metres
     yaw: float                        #: radians; lot (a, b) axes = building local (x, y)
     width: float
@@ -162,19 +164,27 @@ def _front(kind: str, width: float, gap_at: float) -> list[FrontLine]:
 
 
 def make_lots(spec: SceneSpec, grid: Grid) -> list[Lot]:
-    """Split every block into lots and plan what stands on each (stream ``("layout", "lots")``)."""
+    """Split every block, then the band outside the outer ring road, into lots and plan what
+    stands on each (streams ``("layout", "lots")`` and ``("layout", "outer_lots")``)."""
     g = stream(spec.seed, "layout", "lots")
     d = spec.density
     lots: list[Lot] = []
+
+    def row(block, corner, ua, ub, widths, depth, g):
+        yaw = float(np.arctan2(ub[1], ub[0]) - np.pi / 2)
+        a = 0.0
+        for w in widths:
+            origin = np.asarray(corner) + np.asarray(ua) * (a + w / 2)
+            a += w
+            lots.append(_plan_lot(spec, len(lots), block, origin, yaw, float(w), float(depth), d, g))
+
     for j in range(len(grid.ys) - 1):
         for i in range(len(grid.xs) - 1):
             for (corner, ua, ub, frontage), depth in _rows(grid.block_rect(i, j), g):
-                yaw = float(np.arctan2(ub[1], ub[0]) - np.pi / 2)
-                a = 0.0
-                for w in _widths(frontage, g):
-                    origin = np.asarray(corner) + np.asarray(ua) * (a + w / 2)
-                    a += w
-                    lots.append(_plan_lot(spec, len(lots), (i, j), origin, yaw, float(w), float(depth), d, g))
+                row((i, j), corner, ua, ub, _widths(frontage, g), depth, g)
+    g = stream(spec.seed, "layout", "outer_lots")
+    for side, corner, ua, ub, frontage, is_corner in outer_rows(grid):
+        row((-1, side), corner, ua, ub, [frontage] if is_corner else _widths(frontage, g), grid.outer_depth, g)
     return lots
 
 

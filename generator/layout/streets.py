@@ -10,7 +10,10 @@ Cross-section of every street, from its centre line outwards (metres)::
     0                                      lane_half     road_half  walk_inner     corridor_half
 
 Road and parking surfaces are at z = 0 (the world's road plane); curbs and sidewalks rise to
-``curb_height_m``, as do lot grounds and the terrain margin. A *segment* is the stretch of one
+``curb_height_m``, as do lot grounds and the terrain. Beyond the outer ring road's outer
+sidewalks (:attr:`Grid.corridor_rect`) a band of lots ``Grid.outer_depth`` deep runs round
+the town (:mod:`generator.layout.outskirts`); the *built area* (:attr:`Grid.built_rect`) ends
+there, the terrain margin surrounds it, and flat terrain continues to the horizon. A *segment* is the stretch of one
 street between two adjacent intersections; its local frame has ``u`` along the street (from
 the start intersection's edge, metres) and ``v`` to the left, so right-hand traffic driving
 towards +u uses the lanes at ``v < 0``.
@@ -39,6 +42,7 @@ PARKING_START_U = 7.0      #: parking strips start this far from the intersectio
 BAY_M = 6.0                #: parking bay length
 DASH_M, GAP_M = 3.0, 6.0   #: centre-line dash pattern
 MIN_BLOCK_M = 15.0         #: blocks never shrink below this (jitter can be large)
+MIN_OUTER_DEPTH_M = 15.0   #: the lot band outside the outer ring road is at least this deep
 TREE_PIT_M = 1.2           #: side of the soil square around a street tree
 
 
@@ -103,7 +107,7 @@ class Grid:
     curb_h: float
     margin: float
     segments: tuple[Segment, ...]
-
+    outer_depth: float = 0.0         #: depth of the lot band outside the outer ring road
     @property
     def lane_half(self) -> float:
         """Centre line to the outer edge of the driving lanes."""
@@ -130,10 +134,25 @@ class Grid:
         return [(i, j) for j in range(len(self.ys)) for i in range(len(self.xs))]
 
     @property
+    def corridor_rect(self) -> tuple[float, float, float, float]:
+        """(x0, y0, x1, y1): the street grid up to the outer edge of the outer ring's outer sidewalks."""
+        c = self.corridor_half
+        return (float(self.xs[0] - c), float(self.ys[0] - c), float(self.xs[-1] + c), float(self.ys[-1] + c))
+
+    @property
+    def built_rect(self) -> tuple[float, float, float, float]:
+        """(x0, y0, x1, y1): the built area, the street grid plus the outer lot band."""
+        x0, y0, x1, y1 = self.corridor_rect
+        d = self.outer_depth
+        return (x0 - d, y0 - d, x1 + d, y1 + d)
+
+    @property
     def bounds(self) -> np.ndarray:
-        """(2, 2) float64 [[xmin, ymin], [xmax, ymax]] of the whole town including the margin."""
-        e = self.corridor_half + self.margin
-        return np.array([[self.xs[0] - e, self.ys[0] - e], [self.xs[-1] + e, self.ys[-1] + e]])
+        """(2, 2) float64 [[xmin, ymin], [xmax, ymax]] of the town: the built area and the margin
+        (the terrain to the horizon lies outside)."""
+        x0, y0, x1, y1 = self.built_rect
+        e = self.margin
+        return np.array([[x0 - e, y0 - e], [x1 + e, y1 + e]])
 
     def node_xy(self, node: tuple[int, int]) -> np.ndarray:
         return np.array([self.xs[node[0]], self.ys[node[1]]])
@@ -255,7 +274,8 @@ def make_grid(spec: SceneSpec) -> Grid:
             segs.append(((i, j), (i, j + 1), 1, (xs[i], ys[j] + road_half), ys[j + 1] - ys[j] - 2 * road_half))
     segments = tuple(Segment(k, ax, a, b, (float(o[0]), float(o[1])), float(n)) for k, (a, b, ax, o, n) in enumerate(segs))
     return Grid(xs, ys, t.lanes_per_direction, t.lane_width_m, t.parking_strip_width_m, CURB_WIDTH_M,
-                t.sidewalk_width_m, t.curb_height_m, t.margin_m, segments)
+                t.sidewalk_width_m, t.curb_height_m, t.margin_m, segments,
+                max(MIN_OUTER_DEPTH_M, t.block_size_m / 2))
 
 
 # -- meshes -------------------------------------------------------------------------------------
@@ -388,9 +408,8 @@ def intersection_walk_mesh(grid: Grid, node: tuple[int, int]) -> Mesh:
 
 
 def margin_mesh(grid: Grid) -> Mesh:
-    """The terrain ring between the outer sidewalks and the town bounds (world frame)."""
+    """The terrain ring between the built area and the town bounds (world frame)."""
     (bx0, by0), (bx1, by1) = grid.bounds
-    c = grid.corridor_half
-    ix0, iy0, ix1, iy1 = grid.xs[0] - c, grid.ys[0] - c, grid.xs[-1] + c, grid.ys[-1] + c
+    ix0, iy0, ix1, iy1 = grid.built_rect
     ring = [(bx0, by0, bx1, iy0), (bx0, iy1, bx1, by1), (bx0, iy0, ix0, iy1), (ix1, iy0, bx1, iy1)]
     return rects(ring, grid.curb_h, "terrain", "grass")
