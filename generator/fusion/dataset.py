@@ -1,0 +1,187 @@
+"""A dataset folder read frame by frame for fusion: image labels + depth + camera, and the scan.
+
+Layout (see the dataset layout of the project): ``DIR/images/NNNNNN_<tod>_<weather>.{exr,json}``
+and ``DIR/lidar/sequences/NN/``. Every image variant of a frame shares masks, depth and camera
+pose, so one variant per frame is read (``day_clear`` when present, else the first by name).
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Iterator
+
+import numpy as np
+
+from generator import rig
+from generator.errors import UserError
+from generator.formats import semantickitti as sk
+from generator.formats.point_sidecars import NATIVE_DIR, TIMES_DIR, read_sidecar
+from generator.imaging.exr import read_exr
+from generator.labels import class_table
+
+log = logging.getLogger(__name__)
+
+META_NAME = "lidar_meta.json"
+
+
+@dataclass
+class FusionFrame:
+    """One frame's image labels and scan.
+
+    Attributes
+    ----------
+    index : int
+    image_name : str
+    class_id : (H, W) uint8
+        Mask class per pixel (label proxies included).
+    depth : (H, W) float32
+        Distance along each pixel-centre ray to the real geometry, metres; inf = sky.
+    K : (3, 3) float64
+    T_world_camera : (4, 4) float64
+        Optical camera frame -> world, at the exposure (sweep start).
+    xyz : (n, 3) float32
+        Scan points, LiDAR frame at each point's firing instant, metres.
+    semantic, instance : (n,) uint16
+        SemanticKITTI raw id and instance id of each point.
+    native : (n,) uint8
+        Native class per point (the side file; without it, the canonical native class of
+        the raw id, which cannot tell road_marking from crosswalk etc.).
+    native_exact : bool
+        Whether ``native`` came from the side file.
+    times : (n,) float32 or None
+        Firing offsets, seconds (None when the sequence has no side file).
+    T_world_lidar_start, T_world_lidar_end : (4, 4) float64
+        LiDAR pose at the sweep start and one rotation later (end = start when unknown).
+    period_s : float
+    pose : (4, 4) float64
+        LiDAR pose in the first LiDAR frame (``poses.txt`` / SemanticKITTI convention).
+    """
+
+    index: int
+    image_name: str
+    class_id: np.ndarray
+    depth: np.ndarray
+    K: np.ndarray
+    T_world_camera: np.ndarray
+    xyz: np.ndarray
+    semantic: np.ndarray
+    instance: np.ndarray
+    native: np.ndarray
+    native_exact: bool
+    times: np.ndarray | None
+    T_world_lidar_start: np.ndarray
+    T_world_lidar_end: np.ndarray
+    period_s: float
+    pose: np.ndarray
+
+
+def native_from_raw(raw: np.ndarray) -> np.ndarray:
+    """(n,) uint8 canonical native class of SemanticKITTI raw ids (many-to-one: lossy; unknown -> 0)."""
+    t = class_table()
+    lut = np.zeros(1 << 16, np.uint8)
+    for sk_id in set(int(v) for v in t.to_semantickitti):
+        lut[sk_id] = t.from_semantickitti(sk_id)
+    return lut[np.asarray(raw, np.int64)]
+
+
+def frame_images(root: Path) -> dict[int, Path]:
+    """Frame index -> metadata JSON of one image variant per frame (``day_clear`` preferred)."""
+    folder = root / "images"
+    if not folder.is_dir():
+        raise UserError(f"{folder}: missing (render images first: urbangen render SPEC --out {root})")
+    out: dict[int, Path] = {}
+    for p in sorted(folder.glob("*.json")):
+        stem = p.stem.split("_", 1)[0]
+        if not stem.isdigit():
+            continue
+        k = int(stem)
+        if k not in out or p.stem.endswith("_day_clear"):
+            out[k] = p
+    return out
+
+
+def read_image(meta_path: Path) -> tuple[dict, object]:
+    """Metadata dict and :class:`generator.imaging.exr.LabelledImage` of one image."""
+    try:
+        meta = json.loads(meta_path.read_text(encoding="utf-8"))
+        exr = meta_path.parent / meta["files"]["exr"]
+        cam = meta["camera"]
+        np.asarray(cam["T_world_camera"], np.float64).reshape(4, 4)
+        np.asarray(cam["intrinsics"]["K"], np.float64).reshape(3, 3)
+    except (OSError, ValueError, KeyError, TypeError) as e:
+        raise UserError(f"{meta_path}: not an image metadata file ({type(e).__name__}: {e})") from None
+    return meta, read_exr(exr)
+
+
+class FusionDataset:
+    """Images and LiDAR sequence ``seq`` of dataset folder ``root``, joined by frame index.
+
+    Parameters
+    ----------
+    root : path-like
+        Dataset folder with ``images/`` and ``lidar/sequences/NN/``.
+    sequence : str
+        Sequence name (default ``00``).
+    """
+
+    def __init__(self, root: str | Path, sequence: str = "00"):
+        self.root = Path(root)
+        self.images = frame_images(self.root)
+        self.seq = sk.Sequence(self.root / "lidar", sequence)
+        self.meta = self._lidar_meta()
+        self.frames = [k for k in self.seq.frames if k in self.images]
+        if not self.frames:
+            raise UserError(f"{self.root}: no frame has both an image in images/ and a scan in {self.seq.velodyne}")
+        missing = sorted(set(self.seq.frames) - set(self.images))
+        if missing:
+            log.warning("%d scans without an image (first: %06d): left out", len(missing), missing[0])
+
+    def _lidar_meta(self) -> dict:
+        path = self.seq.dir / META_NAME
+        if not path.is_file():
+            return {}
+        try:
+            return json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, ValueError) as e:
+            raise UserError(f"{path}: cannot read ({e})") from None
+
+    def _lidar_poses(self, k: int, image_meta: dict) -> tuple[np.ndarray, np.ndarray, float]:
+        sweeps = self.meta.get("sweep_poses_world")
+        if sweeps and k < len(sweeps["T_world_lidar_start"]):
+            return (np.asarray(sweeps["T_world_lidar_start"][k], np.float64),
+                    np.asarray(sweeps["T_world_lidar_end"][k], np.float64), float(sweeps["period_s"]))
+        mount = self.meta.get("mount")
+        if not mount:
+            raise UserError(f"{self.seq.dir / META_NAME}: needs 'sweep_poses_world' or 'mount' to place the LiDAR")
+        start = np.asarray(image_meta["ego"]["T_world_ego"], np.float64) @ rig.mount(mount["lidar_xyz_m"], mount["lidar_rpy_deg"])
+        log.warning("%s: no sweep poses; scans are projected without de-skew", self.seq.dir)
+        return start, start, 0.1
+
+    def __len__(self) -> int:
+        return len(self.frames)
+
+    def read(self, k: int) -> FusionFrame:
+        """Frame ``k`` (must be in :attr:`frames`)."""
+        meta, img = read_image(self.images[k])
+        poses = self.seq.lidar_poses()
+        rec = self.seq.read(k, True, poses)
+        if rec.semantic is None:
+            raise UserError(f"{self.seq.labels_dir}: missing (fusion needs labelled scans)")
+        native = read_sidecar(self.seq.dir, NATIVE_DIR, k, len(rec.points))
+        times = read_sidecar(self.seq.dir, TIMES_DIR, k, len(rec.points))
+        start, end, period = self._lidar_poses(k, meta)
+        cam = meta["camera"]
+        return FusionFrame(
+            index=k, image_name=meta.get("image", self.images[k].stem), class_id=img.class_id, depth=img.depth,
+            K=np.asarray(cam["intrinsics"]["K"], np.float64), T_world_camera=np.asarray(cam["T_world_camera"], np.float64),
+            xyz=rec.points[:, :3], semantic=rec.semantic, instance=rec.instance,
+            native=native if native is not None else native_from_raw(rec.semantic), native_exact=native is not None,
+            times=times, T_world_lidar_start=start, T_world_lidar_end=end, period_s=period,
+            pose=rec.pose if rec.pose is not None else np.eye(4))
+
+    def __iter__(self) -> Iterator[FusionFrame]:
+        for k in self.frames:
+            yield self.read(k)
