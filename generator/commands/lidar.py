@@ -12,6 +12,7 @@ import logging
 import os
 from pathlib import Path
 
+from generator.commands.intensity import add_processing_args, spec_with_processing_args
 from generator.errors import UserError
 from generator.formats.semantickitti import sequence_name
 from generator.lidar.remission import intensity_fn_for_spec
@@ -35,12 +36,13 @@ def register(sub) -> None:
     p.add_argument("--no-bev", action="store_true", help="skip the bird's-eye PNGs")
     p.add_argument("--render-config", default="preview",
                    help="render config (preset or YAML) whose resolution goes into calib.txt (default preview)")
+    add_processing_args(p, weather=True)
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
     # Every check on user input comes before anything is built or written.
-    spec = load_spec(args.spec)
+    spec = spec_with_processing_args(load_spec(args.spec), args)
     cfg = load_render_config(args.render_config)
     sensor = sensor_for_spec(spec)
     intensity_fn = intensity_fn_for_spec(spec)

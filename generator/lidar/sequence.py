@@ -17,6 +17,7 @@ so a sequence with ``poses.txt`` is complete. Re-running into the same folder ov
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import logging
 from dataclasses import dataclass
@@ -35,10 +36,10 @@ from generator.imaging.bev import write_bev
 from generator.labels import class_table
 from generator.formats.point_sidecars import write_point_sidecars
 from generator.layout.frames import ego_pose_at, max_frames, plan_frames
+from generator.lidar.pipeline import process_scan, processing_for_spec
 from generator.lidar.remission import IntensityFn, intensity_fn_for_spec
 from generator.lidar.scan import Scanner, sensor_mount, sweep_poses
 from generator.lidar.sensors import Sensor, sensor_for_spec
-from generator.rng import stream
 
 log = logging.getLogger(__name__)
 
@@ -72,6 +73,9 @@ class SequenceOptions:
         Name of that render config (recorded in the metadata).
     route : int
         Route index of the scene.
+    weather : bool
+        LiDAR weather when ``spec.lidar.weather.enabled`` is null (auto): ``generate`` sets
+        True (its images carry the weather), the ``lidar`` command leaves it False.
     """
 
     frames: int
@@ -83,6 +87,7 @@ class SequenceOptions:
     resolution: tuple[int, int] = (640, 360)
     render_config: str = "preview"
     route: int = 0
+    weather: bool = False
 
 
 def check_frames(scene, spec, n: int, route: int = 0) -> None:
@@ -110,9 +115,14 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
         Default: :func:`generator.lidar.sensors.sensor_for_spec`.
     intensity_fn : IntensityFn, optional
         Default: the spec's ``lidar.intensity_model``.
+
+    Every scan goes through :func:`generator.lidar.pipeline.process_scan` (intensity ->
+    domain gap -> LiDAR weather) before anything is written; ``lidar_meta.json`` records
+    the chain's parameters (``processing``) and what it did to each scan (``scans``).
     """
     sensor = sensor_for_spec(spec) if sensor is None else sensor
     intensity_fn = intensity_fn_for_spec(spec) if intensity_fn is None else intensity_fn
+    processing = processing_for_spec(spec, sensor, options.weather, intensity_fn)
     check_frames(scene, spec, options.frames, options.route)
     name = sk.sequence_name(options.sequence)
     seq = inside(out, "sequences", name)
@@ -122,14 +132,15 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
     kitti_calib.write_calib(seq / "calib.txt", calib)
     to_sk = class_table().to_semantickitti
     t_ego_sensor = sensor_mount(spec)
-    starts, n_points, counts = [], [], {}
+    starts, n_points, counts, records = [], [], {}, []
     ends = []  # LiDAR world pose one rotation after each sweep start (fusion de-skews between the two)
     with Scanner(scene, sensor, threads=options.threads) as scanner:
         for f in tqdm(frames, desc=f"lidar {name}", unit="scan", disable=None if progress else True):
             scan = scanner.scan(sweep_poses(scene, spec, sensor, f.t, route=options.route))
-            pts = scan.points
+            pts, remission, record = process_scan(scan.points, processing, spec, f.index)
+            scan = dataclasses.replace(scan, points=pts)  # xyz, range image and side files follow the processed points
+            records.append(record)
             stem = f"{f.index:06d}"
-            remission = np.asarray(intensity_fn(pts, stream(spec.seed, "lidar", "intensity", f.index)), np.float32)
             semantic = to_sk[pts["class"]]
             sk.write_scan(seq / "velodyne" / f"{stem}.bin", scan.xyz, remission)
             sk.write_labels(seq / "labels" / f"{stem}.label", semantic, pts["instance"])
@@ -150,6 +161,7 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
     sk.write_poses(seq / "poses.txt", kitti_calib.camera_poses(np.array(starts), tr))
     sk.write_times(seq / "times.txt", np.array([f.t for f in frames]))
     meta = _metadata(scene, spec, sensor, options, intensity_fn, n_points, counts)
+    meta["processing"], meta["scans"] = processing.describe(), records
     meta["sweep_poses_world"] = {"period_s": sensor.period_s, "T_world_lidar_start": np.round(starts, 12).tolist(),
                                  "T_world_lidar_end": np.round(ends, 12).tolist()}
     write_json(seq / META_NAME, meta)
