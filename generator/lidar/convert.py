@@ -1,0 +1,201 @@
+"""Label conversion: native -> SemanticKITTI raw ids -> the unified 11 classes of seed 000.
+
+All mappings are data: native -> raw is ``generator/labels/classes.yaml`` (``semantickitti``
+column), raw -> unified and the canonical unified -> raw are ``generator/labels/unified11.yaml``.
+This module turns them into lookup arrays and rewrites whole SemanticKITTI-layout datasets.
+
+:func:`convert_dataset` copies ``velodyne/*.bin``, ``poses.txt``, ``calib.txt`` and
+``times.txt`` of each sequence, rewrites every ``.label`` with unified ids in the low 16
+bits (instance ids in the high 16 bits kept), and writes ``OUT/unified11.yaml`` (the
+unified label config in the layout of ``semantic-kitti.yaml``: labels, color_map (BGR),
+content, identity learning maps, 0 = unlabeled ignored, split) and ``OUT/conversion.json``.
+Everything is staged in a temporary folder inside OUT and moved into place only once every
+scan has converted, so a bad input leaves OUT as it was.
+"""
+
+from __future__ import annotations
+
+import logging
+import shutil
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+from tqdm import tqdm
+
+from generator import __version__
+from generator.atomic import TMP_PREFIX, write_json, write_text
+from generator.errors import UserError
+from generator.formats import semantickitti as sk
+from generator.formats.label_config import count_raw_ids, format_label_config, merge_counts
+from generator.labels import class_table
+
+log = logging.getLogger(__name__)
+
+COPIED_FILES = ("poses.txt", "calib.txt", "times.txt")
+
+
+# -- lookups --------------------------------------------------------------------------------
+def native_to_semantickitti(native: np.ndarray) -> np.ndarray:
+    """(n,) uint16 SemanticKITTI raw ids of (n,) native class ids."""
+    return class_table().to_semantickitti[np.asarray(native)]
+
+
+def semantickitti_to_unified(raw: np.ndarray, source: str = "labels") -> np.ndarray:
+    """(n,) uint16 unified-11 ids of (n,) SemanticKITTI raw ids.
+
+    Raises
+    ------
+    UserError
+        If a raw id is not in the reference label set (e.g. labels that are already unified).
+    """
+    table = class_table()
+    raw = np.asarray(raw)
+    ids = np.unique(raw)
+    unknown = [int(i) for i in ids if int(i) not in table.sk_labels]
+    if unknown:
+        raise UserError(f"{source}: raw ids {unknown[:8]} are not SemanticKITTI labels (already converted?)")
+    return table.sk_to_unified[raw].astype(np.uint16)
+
+
+def unified_to_semantickitti(unified: np.ndarray) -> np.ndarray:
+    """(n,) uint16 canonical SemanticKITTI raw id of each unified-11 id (``unified11.yaml`` ``to_semantickitti``)."""
+    m = class_table().unified_to_sk_map
+    lut = np.zeros(max(m) + 1, np.uint16)
+    for u, r in m.items():
+        lut[u] = r
+    return lut[np.asarray(unified)]
+
+
+def unified_label_config(counts: dict[int, int], sequences: list[int]) -> dict:
+    """The unified set's label config as plain data (sections of ``semantic-kitti.yaml``).
+
+    ``color_map`` (BGR) is the reference colour of each class's canonical raw id;
+    ``learning_map`` is the identity with 0 (unlabeled) ignored.
+    """
+    table = class_table()
+    names = table.unified_names
+    total = sum(counts.values())
+    return {
+        "labels": dict(names),
+        "color_map": {u: list(table.sk_colors_bgr[table.unified_to_sk_map[u]]) for u in names},
+        "content": {u: (counts.get(u, 0) / total if total else 0.0) for u in names},
+        "learning_map": {u: u for u in names},
+        "learning_map_inv": {u: u for u in names},
+        "learning_ignore": {u: u == 0 for u in names},
+        "split": {"train": sorted(int(s) for s in sequences), "valid": [], "test": []},
+    }
+
+
+def format_unified_config(cfg: dict) -> str:
+    """YAML text of :func:`unified_label_config`, laid out like the reference file."""
+    body = format_label_config(cfg).split("\n", 2)[2]  # drop the SemanticKITTI header comment
+    return ("# Unified 11-class label config (seed 000 Sec. IV.A) of a dataset converted by urbangen convert;\n"
+            "# raw -> unified map: generator/labels/unified11.yaml; content from the written labels.\n" + body)
+
+
+@dataclass(frozen=True)
+class LabelSet:
+    """A target label set: per-scan relabelling and its config file."""
+
+    relabel: Callable[[np.ndarray, str], np.ndarray]
+    config_name: str
+    config: Callable[[dict, list], dict]
+    formatter: Callable[[dict], str]
+
+
+#: Target label sets by ``--labels`` name.
+LABEL_SETS: dict[str, LabelSet] = {
+    "unified11": LabelSet(semantickitti_to_unified, "unified11.yaml", unified_label_config, format_unified_config),
+}
+
+
+# -- datasets -------------------------------------------------------------------------------
+def pick_sequences(root: Path, sequences: list[str] | None) -> list[str]:
+    """The sequences to convert: all with labels, or the listed ones (each must exist with labels)."""
+    present = sk.list_sequences(root)
+    names = present if sequences is None else [sk.sequence_name(s) for s in sequences]
+    for n in names:
+        if n not in present:
+            raise UserError(f"{root / 'sequences' / n}: sequence not found (present: {', '.join(present) or 'none'})")
+        if not (root / "sequences" / n / "labels").is_dir():
+            raise UserError(f"{root / 'sequences' / n / 'labels'}: missing; nothing to convert")
+    if not names:
+        raise UserError(f"{root / 'sequences'}: no sequences")
+    return names
+
+
+def convert_dataset(src: str | Path, dst: str | Path, labels: str = "unified11", sequences: list[str] | None = None,
+                    progress: bool = True) -> dict:
+    """Rewrite the labels of a SemanticKITTI-layout dataset into another label set.
+
+    Parameters
+    ----------
+    src, dst : path-like
+        Dataset roots (``src/sequences/NN``); ``dst`` may exist but must not hold the sequences written.
+    labels : str
+        A key of :data:`LABEL_SETS`.
+    sequences : list of str, optional
+        Sequence numbers (default: every sequence with labels).
+
+    Returns
+    -------
+    dict
+        The summary written to ``dst/conversion.json``.
+    """
+    if labels not in LABEL_SETS:
+        raise UserError(f"--labels: unknown label set {labels!r}; known: {', '.join(LABEL_SETS)}")
+    target = LABEL_SETS[labels]
+    src, dst = Path(src), Path(dst)
+    if dst.exists() and not dst.is_dir():
+        raise UserError(f"{dst}: exists and is not a folder")
+    if dst.resolve() == src.resolve():
+        raise UserError(f"{dst}: output must differ from the input dataset")
+    names = pick_sequences(src, sequences)
+    seqs = [sk.Sequence(src, n) for n in names]  # validates folders, poses/times lengths
+    for n in names:
+        if (dst / "sequences" / n).exists():
+            raise UserError(f"{dst / 'sequences' / n}: exists; remove it or choose another output folder")
+    created = not dst.exists()
+    dst.mkdir(parents=True, exist_ok=True)
+    stage = Path(tempfile.mkdtemp(prefix=TMP_PREFIX + "convert-", dir=dst))
+    counts: dict[int, int] = {}
+    try:
+        bar = tqdm(total=sum(len(s) for s in seqs), desc=f"convert -> {labels}", unit="scan", disable=None if progress else True)
+        with bar:
+            for seq in seqs:
+                out = stage / "sequences" / seq.dir.name
+                (out / "velodyne").mkdir(parents=True)
+                for f in COPIED_FILES:
+                    if (seq.dir / f).is_file():
+                        shutil.copyfile(seq.dir / f, out / f)
+                for i in seq.frames:
+                    sem, inst = sk.read_labels(seq.label_path(i))
+                    n_pts = seq.scan_path(i).stat().st_size // 16
+                    if len(sem) != n_pts:
+                        raise UserError(f"{seq.label_path(i)}: {len(sem)} labels but {seq.scan_path(i)} has {n_pts} points")
+                    new = target.relabel(sem, str(seq.label_path(i)))
+                    sk.write_labels(out / "labels" / seq.label_path(i).name, new, inst)
+                    shutil.copyfile(seq.scan_path(i), out / "velodyne" / seq.scan_path(i).name)
+                    counts = merge_counts(counts, count_raw_ids(new))
+                    bar.update()
+        (dst / "sequences").mkdir(exist_ok=True)
+        for n in names:
+            (stage / "sequences" / n).rename(dst / "sequences" / n)
+    except BaseException:
+        shutil.rmtree(stage, ignore_errors=True)
+        if created:
+            shutil.rmtree(dst, ignore_errors=True)
+        raise
+    shutil.rmtree(stage, ignore_errors=True)
+    cfg = target.config(counts, [int(s) for s in names])  # content and split: the sequences of this run
+    write_text(dst / target.config_name, target.formatter(cfg))
+    summary = {"generator": f"urbangen {__version__} convert", "source": str(src), "labels": labels,
+               "mapping": "native -> SemanticKITTI raw (generator/labels/classes.yaml) -> unified "
+                          "(generator/labels/unified11.yaml from_semantickitti); instance ids kept",
+               "sequences": names, "scans": int(sum(len(s) for s in seqs)),
+               "label_counts": {str(k): v for k, v in sorted(counts.items())}, "config": target.config_name}
+    write_json(dst / "conversion.json", summary)
+    return summary
