@@ -19,6 +19,9 @@ from generator.errors import EXIT_USAGE, UserError
 COMMANDS = [
     "layout",
     "lidar",
+    "intensity",
+    "convert",
+    "import_carla",
     "fuse",
     "eval",
     "openlabel",
