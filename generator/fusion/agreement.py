@@ -81,7 +81,7 @@ def fuse_frame(frame: FusionFrame, deskew: bool = True, abs_tol_m: float = P.ABS
     T = P.camera_from_lidar(frame.T_world_camera, frame.T_world_lidar_start)
     h, w = frame.class_id.shape
     proj = P.project(P.transform(T, xyz), frame.K, w, h)
-    vis = P.visible(proj, frame.depth, abs_tol_m, rel_tol)
+    vis = P.visible(proj, frame.depth, frame.K, abs_tol_m, rel_tol)
     boundary = P.boundary_mask(frame.class_id)[proj.row, proj.col]
     return FusedFrame(frame.index, xyz, proj, vis, boundary, frame.class_id[proj.row, proj.col],
                       frame.native[proj.index])

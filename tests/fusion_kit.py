@@ -1,0 +1,51 @@
+"""Helpers for the fusion tests: camera images ray-cast with Embree instead of rendered.
+
+A ray-cast "render" shoots one ray per pixel centre at the real geometry (no label proxies),
+which is what Blender's real pass does; it lets the fusion pipeline run end to end in tests
+without Blender.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from generator import rig
+from generator.imaging.exr import LabelledImage, write_exr
+from generator.labels import class_table
+
+SKY = class_table().id("sky")
+
+
+def raycast_image(caster, scene, T_world_camera: np.ndarray, K: np.ndarray, width: int, height: int):
+    """(class_id uint8, instance uint32, depth float32) seen through the pixel centres (sky: inf)."""
+    d = rig.pixel_rays(K, width, height).reshape(-1, 3) @ T_world_camera[:3, :3].T
+    o = np.repeat(T_world_camera[None, :3, 3], len(d), 0)
+    dist, prim = caster.intersect(o, d.astype(np.float32), 1e4)
+    hit = prim >= 0
+    cls = np.full(len(d), SKY, np.uint8)
+    inst = np.zeros(len(d), np.uint32)
+    cls[hit] = scene.face_class[prim[hit]]
+    inst[hit] = scene.face_instance[prim[hit]]
+    depth = np.where(hit, dist, np.inf).astype(np.float32)
+    return cls.reshape(height, width), inst.reshape(height, width), depth.reshape(height, width)
+
+
+def write_raycast_images(root: Path, scene, spec, n_frames: int, width: int = 160, height: int = 96) -> None:
+    """``root/images/NNNNNN_day_clear.{exr,json}`` for frames 0..n-1, ray-cast (metadata: the keys fusion reads)."""
+    from generator.layout.frames import plan_frames
+    from generator.lidar.caster import EmbreeCaster
+
+    caster = EmbreeCaster.from_scene(scene)
+    K = rig.intrinsics(spec.sensors.camera.hfov_deg, width, height)
+    for f in plan_frames(scene, spec, n_frames):
+        cls, inst, depth = raycast_image(caster, scene, f.T_world_camera, K, width, height)
+        name = f"{f.index:06d}_day_clear"
+        write_exr(root / "images" / f"{name}.exr", LabelledImage(np.zeros((height, width, 3), np.float32), cls, inst, depth))
+        meta = {"image": name, "files": {"exr": f"{name}.exr"}, "frame": f.index,
+                "camera": {"T_world_camera": f.T_world_camera.tolist(), "T_ego_camera": f.T_ego_camera.tolist(),
+                           "intrinsics": {"width": width, "height": height, "K": K.tolist()}},
+                "ego": {"T_world_ego": f.T_world_ego.tolist()}}
+        (root / "images" / f"{name}.json").write_text(json.dumps(meta))
