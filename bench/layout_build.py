@@ -2,7 +2,8 @@
 
     python bench/layout_build.py [--spec scenes/default_town.json] [--sizes 1 2 3 4] [--repeat 1]
 
-Every town is the spec (default: the default town) with ``blocks_x = blocks_y = n``.
+Every town is the spec (default: the default town) with ``blocks_x = blocks_y = n``: the
+street grid, the band of lots round the outer ring road, and the ground to the horizon.
 Columns:
 
 * ``build s``  -- the whole ``build_scene`` (grid, lots, placement, assets, proxies, checks);
