@@ -209,6 +209,7 @@ def result_dict(ls: LabelSet, res: IoUResult, conf: np.ndarray, scans: int) -> d
         "absent_classes": [ls.names[c] for c in range(len(ls.names)) if c != IGNORE and not res.evaluated[c]],
         "scans": scans,
         "points": int(conf.sum()),
+        "points_evaluated": int(res.tp.sum() + res.fn.sum()),
         "classes": classes,
         "confusion_gt_pred": conf.tolist(),
     }
@@ -224,5 +225,6 @@ def format_table(result: dict) -> str:
     lines.append(f"{'mIoU':<16} {'n/a' if miou is None else f'{100 * miou:8.2f}':>8}  over {result['evaluated_classes']} classes")
     if result["absent_classes"]:
         lines.append(f"left out of the mean (absent from prediction and ground truth): {', '.join(result['absent_classes'])}")
-    lines.append(f"ignored: {', '.join(result['ignored'])}; {result['points']} points in {result['scans']} scans")
+    lines.append(f"ignored: {', '.join(result['ignored'])}; {result['points_evaluated']} of {result['points']} points "
+                 f"evaluated, {result['scans']} scans")
     return "\n".join(lines)
