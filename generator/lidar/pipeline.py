@@ -11,6 +11,12 @@ domain gap      ``("frame", k, "lidar_domain_gap")``
 weather         ``("frame", k, "lidar_weather")``
 =============== ==============================================
 
+The weather comes last because it is physics the scan should show whatever the
+processing before it: it multiplies every remission by the two-way transmission, including
+the domain gap's constant intensity (so a foggy scan under the seed002 preset is no longer
+constant), and drops points by received power, which depends on the surface, not on the
+remission written.
+
 :func:`process_scan` returns the processed points plus a record of what each stage did
 (``lidar_meta.json`` keeps one per scan); :meth:`ScanProcessing.describe` gives the
 parameters once per sequence.
