@@ -106,3 +106,34 @@ def test_sequence_applies_the_gap_and_records_it(test_spec, tmp_path):
         assert np.all(rec.points[:, 3] == 1.0) and len(rec.semantic) == len(rec.points)
     on_disk = json.loads((tmp_path / "sequences" / "00" / "lidar_meta.json").read_text())
     assert on_disk["scans"][0]["domain_gap"]["constant_intensity"] == 1.0
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["--dropout", "1.5"], "domain gap: dropout must be in [0, 1), got 1.5"),
+    (["--gap-intensity", "abc"], "--gap-intensity: expected a number in [0, 1] or 'none'"),
+    (["--domain-gap", "off", "--dropout", "0.2"], "--domain-gap off contradicts"),
+    (["--constant-intensity", "3"], "lidar.constant_intensity: must be a number in [0, 1]"),
+])
+def test_lidar_command_processing_options_errors(root, tmp_path, capsys, monkeypatch, extra, message):
+    import generator.cli as cli
+    monkeypatch.setattr(cli, "COMMANDS", ["lidar"])
+    out = tmp_path / "ds"
+    rc = cli.main(["lidar", str(root / "scenes" / "test_town.json"), "--out", str(out), "--frames", "1", *extra])
+    err = capsys.readouterr().err
+    assert rc == 2 and message in err and err.count("\n") == 1, err
+    assert not out.exists()
+
+
+def test_command_line_options_reach_the_spec(test_spec):
+    import argparse
+    from generator.commands.intensity import add_processing_args, spec_with_processing_args
+    p = argparse.ArgumentParser()
+    add_processing_args(p, weather=True)
+    spec = spec_with_processing_args(test_spec, p.parse_args(["--intensity", "hybrid", "--domain-gap", "seed002",
+                                                              "--jitter-m", "0.02", "--lidar-weather", "on"]))
+    g = spec.lidar.domain_gap
+    assert spec.lidar.intensity_model == "hybrid" and spec.lidar.weather.enabled is True
+    assert (g.enabled, g.dropout, g.jitter_m, g.constant_intensity) == (True, 0.1, 0.02, 1.0)
+    assert spec.spec_hash != test_spec.spec_hash
+    same = spec_with_processing_args(test_spec, p.parse_args([]))
+    assert same == test_spec  # no options: the spec (and its hash) unchanged
