@@ -32,7 +32,8 @@ def register(sub) -> None:
     p.add_argument("--rel-tol", type=float, default=None, help="occlusion tolerance per metre of distance (default 0.01)")
     p.add_argument("--voxel", type=float, default=0.2, help="semantic-map voxel edge, metres (default 0.2)")
     p.add_argument("--no-deskew", action="store_true", help="project the raw (motion-skewed) points")
-    p.add_argument("--overlay-frame", type=int, default=None, help="frame drawn in agreement.png (default: the first)")
+    p.add_argument("--overlay-frame", type=int, default=None,
+                   help="frame drawn in agreement.png (default: the one where the occlusion test rejects most mislabelled points)")
     p.set_defaults(func=run)
 
 
@@ -54,13 +55,13 @@ def run(args) -> int:
     if not root.is_dir():
         raise UserError(f"{root}: not a folder")
     ds = FusionDataset(root, sequence_name(args.sequence))
-    overlay_k = ds.frames[0] if args.overlay_frame is None else args.overlay_frame
-    if overlay_k not in ds.frames:
+    overlay_k = args.overlay_frame
+    if overlay_k is not None and overlay_k not in ds.frames:
         raise UserError(f"--overlay-frame: frame {overlay_k} has no image and scan (have {ds.frames[0]}..{ds.frames[-1]})")
     deskew = not args.no_deskew
     agree, raw = Agreement(), Agreement()
     maps = {"lidar": VoxelMap(args.voxel), "camera": VoxelMap(args.voxel)}
-    trajectory, overlay, exact, timed = [], None, True, True
+    overlay, best, exact, timed = None, -1, True, True
     for frame in tqdm(ds, total=len(ds), desc="fuse", unit="frame", disable=None):
         fused = fuse_frame(frame, deskew, abs_tol, rel_tol)
         agree.add(fused)
@@ -72,9 +73,17 @@ def run(args) -> int:
         maps["lidar"].add(world, frame.native)
         seen = fused.proj.index[fused.visible]
         maps["camera"].add(world[seen], fused.image_class[fused.visible])
-        trajectory.append(frame.pose[:3, 3])
-        if frame.index == overlay_k:
-            overlay = (frame.class_id, fused)
+        smeared = int((~fused.visible & (fused.image_class != fused.lidar_class)).sum())
+        if frame.index == overlay_k or (overlay_k is None and smeared > best):
+            overlay, best = (frame.class_id, fused), smeared
+    # scans without an image still go into the LiDAR-labelled map
+    for k in tqdm(ds.seq.frames, desc="map", unit="scan", disable=None):
+        if k not in ds.frames:
+            scan = ds.read_scan(k)
+            xyz = scan["xyz"].astype(np.float64)
+            if deskew and scan["times"] is not None:
+                xyz = P.deskew(xyz, scan["times"], scan["T_world_lidar_start"], scan["T_world_lidar_end"], scan["period_s"])
+            maps["lidar"].add(P.transform(scan["pose"], xyz), scan["native"])
     settings = {
         "dataset": str(root), "sequence": ds.seq.dir.name, "abs_tol_m": abs_tol, "rel_tol": rel_tol,
         "deskew": ("on (point_times/ + sweep start/end poses)" if deskew and timed else
@@ -98,7 +107,9 @@ def run(args) -> int:
 
     with atomic_path(out / "agreement.png") as tmp:
         report_png(report, *overlay).save(tmp, format="PNG")
-    traj = np.array(trajectory)
+    positions = {k: (ds.poses[k][:3, 3] if ds.poses is not None else np.zeros(3)) for k in ds.seq.frames}
+    trajectory = {"lidar": np.array([positions[k] for k in ds.seq.frames]),
+                  "camera": np.array([positions[k] for k in ds.frames])}
     for name, vm in maps.items():
         xyz, label, count = vm.voxels()
         if not len(xyz):
@@ -106,8 +117,8 @@ def run(args) -> int:
             continue
         write_map_ply(out / f"semantic_map_{name}.ply", xyz, label, count,
                       comment=f"urbangen semantic map ({name} labels), first LiDAR frame, voxel {args.voxel} m")
-        write_top_down(out / f"semantic_map_{name}.png", xyz, label, traj,
-                       title=f"{ds.seq.dir.name}: {name} labels, {len(ds)} scans")
+        write_top_down(out / f"semantic_map_{name}.png", xyz, label, trajectory[name],
+                       title=f"{ds.seq.dir.name}: {name} labels, {len(ds.seq.frames) if name == 'lidar' else len(ds)} scans")
     print(text.split("\n\n## ")[0].splitlines()[-1].strip("*"))
     print(f"wrote {out}/agreement.{{md,json,png}} and semantic_map_{{lidar,camera}}.{{ply,png}}")
     return 0

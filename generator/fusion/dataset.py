@@ -132,6 +132,8 @@ class FusionDataset:
         self.images = frame_images(self.root)
         self.seq = sk.Sequence(self.root / "lidar", sequence)
         self.meta = self._lidar_meta()
+        #: (n, 4, 4) LiDAR poses in the first LiDAR frame (poses.txt + calib.txt), or None
+        self.poses = self.seq.lidar_poses()
         self.frames = [k for k in self.seq.frames if k in self.images]
         if not self.frames:
             raise UserError(f"{self.root}: no frame has both an image in images/ and a scan in {self.seq.velodyne}")
@@ -148,14 +150,17 @@ class FusionDataset:
         except (OSError, ValueError) as e:
             raise UserError(f"{path}: cannot read ({e})") from None
 
-    def _lidar_poses(self, k: int, image_meta: dict) -> tuple[np.ndarray, np.ndarray, float]:
+    def _lidar_poses(self, k: int, image_meta: dict | None) -> tuple[np.ndarray, np.ndarray, float]:
         sweeps = self.meta.get("sweep_poses_world")
         if sweeps and k < len(sweeps["T_world_lidar_start"]):
             return (np.asarray(sweeps["T_world_lidar_start"][k], np.float64),
                     np.asarray(sweeps["T_world_lidar_end"][k], np.float64), float(sweeps["period_s"]))
         mount = self.meta.get("mount")
-        if not mount:
-            raise UserError(f"{self.seq.dir / META_NAME}: needs 'sweep_poses_world' or 'mount' to place the LiDAR")
+        if image_meta is None and k in self.images:
+            image_meta = json.loads(self.images[k].read_text(encoding="utf-8"))
+        if not mount or image_meta is None:
+            raise UserError(f"{self.seq.dir / META_NAME}: needs 'sweep_poses_world' (or 'mount' and an image) "
+                            f"to place scan {k:06d} of the LiDAR")
         start = np.asarray(image_meta["ego"]["T_world_ego"], np.float64) @ rig.mount(mount["lidar_xyz_m"], mount["lidar_rpy_deg"])
         log.warning("%s: no sweep poses; scans are projected without de-skew", self.seq.dir)
         return start, start, 0.1
@@ -163,24 +168,28 @@ class FusionDataset:
     def __len__(self) -> int:
         return len(self.frames)
 
-    def read(self, k: int) -> FusionFrame:
-        """Frame ``k`` (must be in :attr:`frames`)."""
-        meta, img = read_image(self.images[k])
-        poses = self.seq.lidar_poses()
-        rec = self.seq.read(k, True, poses)
+    def read_scan(self, k: int, image_meta: dict | None = None) -> dict:
+        """The LiDAR part of frame ``k`` (any scan of the sequence): the :class:`FusionFrame`
+        fields ``xyz, semantic, instance, native, native_exact, times, T_world_lidar_start,
+        T_world_lidar_end, period_s, pose``."""
+        rec = self.seq.read(k, True, self.poses)
         if rec.semantic is None:
             raise UserError(f"{self.seq.labels_dir}: missing (fusion needs labelled scans)")
         native = read_sidecar(self.seq.dir, NATIVE_DIR, k, len(rec.points))
         times = read_sidecar(self.seq.dir, TIMES_DIR, k, len(rec.points))
-        start, end, period = self._lidar_poses(k, meta)
+        start, end, period = self._lidar_poses(k, image_meta)
+        return dict(xyz=rec.points[:, :3], semantic=rec.semantic, instance=rec.instance,
+                    native=native if native is not None else native_from_raw(rec.semantic),
+                    native_exact=native is not None, times=times, T_world_lidar_start=start,
+                    T_world_lidar_end=end, period_s=period, pose=rec.pose if rec.pose is not None else np.eye(4))
+
+    def read(self, k: int) -> FusionFrame:
+        """Frame ``k`` (must be in :attr:`frames`)."""
+        meta, img = read_image(self.images[k])
         cam = meta["camera"]
-        return FusionFrame(
-            index=k, image_name=meta.get("image", self.images[k].stem), class_id=img.class_id, depth=img.depth,
-            K=np.asarray(cam["intrinsics"]["K"], np.float64), T_world_camera=np.asarray(cam["T_world_camera"], np.float64),
-            xyz=rec.points[:, :3], semantic=rec.semantic, instance=rec.instance,
-            native=native if native is not None else native_from_raw(rec.semantic), native_exact=native is not None,
-            times=times, T_world_lidar_start=start, T_world_lidar_end=end, period_s=period,
-            pose=rec.pose if rec.pose is not None else np.eye(4))
+        return FusionFrame(index=k, image_name=meta.get("image", self.images[k].stem), class_id=img.class_id,
+                           depth=img.depth, K=np.asarray(cam["intrinsics"]["K"], np.float64),
+                           T_world_camera=np.asarray(cam["T_world_camera"], np.float64), **self.read_scan(k, meta))
 
     def __iter__(self) -> Iterator[FusionFrame]:
         for k in self.frames:

@@ -26,7 +26,8 @@ def markdown(report: dict) -> str:
         f"* Projection: seed 001 Eq. 1, `d [u v 1]^T = K T X` with `T = inv(T_world_camera) @ T_world_lidar` "
         f"(per-frame camera jitter included); de-skew: **{s['deskew']}**.",
         f"* Occlusion test: visible when `|distance - depth| <= max({s['abs_tol_m']} m, {100 * s['rel_tol']:g} % of "
-        "distance) + sub-pixel depth-gradient term` (depth = rendered distance to the real geometry).",
+        "distance)`, depth = rendered distance to the real geometry at the pixel centre or extrapolated (planar, "
+        "in inverse depth) to the point's sub-pixel position.",
         f"* LiDAR classes: {s['lidar_classes']}.",
         f"* Points: {report['points']} in the scans, {report['in_view']} in front of the camera and inside the "
         f"image, {report['visible']} pass the occlusion test.",
