@@ -122,26 +122,37 @@ def test_boundary_mask_marks_pixels_next_to_another_class():
 
 
 # -- de-skew ------------------------------------------------------------------------------------------
-def test_deskew_moves_skewed_points_into_the_sweep_start_frame(test_spec):
-    from generator.layout.frames import ego_pose_at
+def test_deskew_with_the_recorded_sweep_poses_is_exact_through_a_turn(test_spec):
+    from generator.formats.sweep_poses import sweep_record
     from generator.lidar.scan import Scanner, sensor_mount, sweep_poses
     from generator.lidar.sensors import sensor_for_spec
+    from generator.scene import Path
 
+    # a straight that turns into an arc (0.1 rad per metre) at s = 10 m: the yaw rate jumps mid-sweep
+    s = np.arange(0.0, 40.0, 1.0)
+    heading = np.where(s <= 10.0, 0.0, 0.1 * (s - 10.0))
+    pts = np.zeros((len(s), 3))
+    for i in range(1, len(s)):
+        pts[i] = pts[i - 1] + [np.cos(heading[i - 1]), np.sin(heading[i - 1]), 0.0]
     scene = fence_scene()
+    scene.paths = [Path("kink", pts - [8.0, 0.0, 0.0], heading, s, False)]
     sensor = sensor_for_spec(test_spec)
-    poses = sweep_poses(scene, test_spec, sensor, 1.0)  # one pose per column: skew on
-    assert poses.ndim == 3
+    t0 = 9.6 / test_spec.paths.speed_mps  # the sweep covers s = 9.6 .. 10.4
+    poses = sweep_poses(scene, test_spec, sensor, t0)  # one pose per column: skew on
     with Scanner(scene, sensor, threads=2) as sc:
         scan = sc.scan(poses)
-    pts = scan.points
+    p = scan.points
     xyz = scan.xyz.astype(np.float64)
-    col = pts["column"]
-    exact_world = np.einsum("nij,nj->ni", poses[col, :3, :3], xyz) + poses[col, :3, 3]
-    end = ego_pose_at(scene, test_spec, 1.0 + sensor.period_s)[0] @ sensor_mount(test_spec)
-    fixed = P.transform(poses[0], P.deskew(xyz, pts["time"], poses[0], end, sensor.period_s))
-    raw = P.transform(poses[0], xyz)
+    exact_world = np.einsum("nij,nj->ni", poses[p["column"], :3, :3], xyz) + poses[p["column"], :3, 3]
+    rec = sweep_record(scene, test_spec, t0, sensor.period_s, sensor_mount(test_spec))
+    assert len(rec["t_s"]) == 3 and rec["t_s"][1] == pytest.approx(0.4 / test_spec.paths.speed_mps)
+    fixed = P.transform(poses[0], P.deskew(xyz, p["time"], rec["t_s"], rec["T_world_lidar"]))
     assert np.abs(fixed - exact_world).max() < 1e-3
-    assert np.linalg.norm(raw - exact_world, axis=1).max() > 0.5  # 8 m/s x 0.1 s: the skew is real
+    # start and end poses alone miss the kink; raw points carry the whole skew
+    ends = [rec["T_world_lidar"][0], rec["T_world_lidar"][-1]]
+    two = P.transform(poses[0], P.deskew(xyz, p["time"], [0.0, sensor.period_s], ends))
+    assert np.linalg.norm(two - exact_world, axis=1).max() > 0.05
+    assert np.linalg.norm(P.transform(poses[0], xyz) - exact_world, axis=1).max() > 0.5
 
 
 # -- agreement bookkeeping ------------------------------------------------------------------------------

@@ -74,9 +74,8 @@ def _vehicle_points(root: Path, k: int, meta: dict, T_ego_lidar: np.ndarray):
     seq = sk.Sequence(root / "lidar", "00")
     rec = seq.read(k)
     times = read_sidecar(seq.dir, TIMES_DIR, k, len(rec.points))
-    sw = meta["sweep_poses_world"]
-    xyz = deskew(rec.points[:, :3], times, np.array(sw["T_world_lidar_start"][k]), np.array(sw["T_world_lidar_end"][k]),
-                 sw["period_s"])
+    sweep = meta["sweep_poses_world"]["frames"][k]
+    xyz = deskew(rec.points[:, :3], times, sweep["t_s"], sweep["T_world_lidar"])
     return transform(T_ego_lidar, xyz), rec.instance
 
 

@@ -40,7 +40,7 @@ def register(sub) -> None:
 def run(args) -> int:
     from generator.fusion import projection as P
     from generator.fusion.agreement import HEADLINE, Agreement, fuse_frame
-    from generator.fusion.dataset import FusionDataset
+    from generator.fusion.dataset import FusionDataset, deskewed
     from generator.fusion.report import markdown, report_png
     from generator.fusion.semantic_map import VoxelMap, write_map_ply, write_top_down
     from generator.formats.semantickitti import sequence_name
@@ -80,13 +80,10 @@ def run(args) -> int:
     for k in tqdm(ds.seq.frames, desc="map", unit="scan", disable=None):
         if k not in ds.frames:
             scan = ds.read_scan(k)
-            xyz = scan["xyz"].astype(np.float64)
-            if deskew and scan["times"] is not None:
-                xyz = P.deskew(xyz, scan["times"], scan["T_world_lidar_start"], scan["T_world_lidar_end"], scan["period_s"])
-            maps["lidar"].add(P.transform(scan["pose"], xyz), scan["native"])
+            maps["lidar"].add(P.transform(scan["pose"], deskewed(scan, deskew)), scan["native"])
     settings = {
         "dataset": str(root), "sequence": ds.seq.dir.name, "abs_tol_m": abs_tol, "rel_tol": rel_tol,
-        "deskew": ("on (point_times/ + sweep start/end poses)" if deskew and timed else
+        "deskew": ("on (point_times/ + sweep poses of lidar_meta.json)" if deskew and timed else
                    "off (--no-deskew)" if not deskew else "off (the sequence has no point_times/)"),
         "lidar_classes": ("native, from native_labels/" if exact else
                           "canonical native class of the SemanticKITTI raw id (lossy: no native_labels/)"),

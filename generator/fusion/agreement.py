@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from generator.fusion import projection as P
-from generator.fusion.dataset import FusionFrame
+from generator.fusion.dataset import FusionFrame, deskewed
 from generator.labels import class_table
 from generator.stats.evaluate import iou_from_confusion
 
@@ -75,9 +75,7 @@ class FusedFrame:
 def fuse_frame(frame: FusionFrame, deskew: bool = True, abs_tol_m: float = P.ABS_TOL_M,
                rel_tol: float = P.REL_TOL) -> FusedFrame:
     """De-skew, project, occlusion-test and label one frame (see the module docstring)."""
-    xyz = frame.xyz.astype(np.float64)
-    if deskew and frame.times is not None:
-        xyz = P.deskew(xyz, frame.times, frame.T_world_lidar_start, frame.T_world_lidar_end, frame.period_s)
+    xyz = deskewed(frame, deskew)
     T = P.camera_from_lidar(frame.T_world_camera, frame.T_world_lidar_start)
     h, w = frame.class_id.shape
     proj = P.project(P.transform(T, xyz), frame.K, w, h)

@@ -53,9 +53,13 @@ class FusionFrame:
         Whether ``native`` came from the side file.
     times : (n,) float32 or None
         Firing offsets, seconds (None when the sequence has no side file).
-    T_world_lidar_start, T_world_lidar_end : (4, 4) float64
-        LiDAR pose at the sweep start and one rotation later (end = start when unknown).
-    period_s : float
+    T_world_lidar_start : (4, 4) float64
+        LiDAR pose at the sweep start (when the image is exposed), world frame.
+    sweep_times : (k,) float64
+        Offsets after the sweep start of the known LiDAR poses, seconds (``[0.0]`` when only
+        the start is known).
+    sweep_poses : (k, 4, 4) float64
+        LiDAR world poses at ``sweep_times`` (see :mod:`generator.formats.sweep_poses`).
     pose : (4, 4) float64
         LiDAR pose in the first LiDAR frame (``poses.txt`` / SemanticKITTI convention).
     """
@@ -73,8 +77,8 @@ class FusionFrame:
     native_exact: bool
     times: np.ndarray | None
     T_world_lidar_start: np.ndarray
-    T_world_lidar_end: np.ndarray
-    period_s: float
+    sweep_times: np.ndarray
+    sweep_poses: np.ndarray
     pose: np.ndarray
 
 
@@ -150,11 +154,12 @@ class FusionDataset:
         except (OSError, ValueError) as e:
             raise UserError(f"{path}: cannot read ({e})") from None
 
-    def _lidar_poses(self, k: int, image_meta: dict | None) -> tuple[np.ndarray, np.ndarray, float]:
-        sweeps = self.meta.get("sweep_poses_world")
-        if sweeps and k < len(sweeps["T_world_lidar_start"]):
-            return (np.asarray(sweeps["T_world_lidar_start"][k], np.float64),
-                    np.asarray(sweeps["T_world_lidar_end"][k], np.float64), float(sweeps["period_s"]))
+    def _lidar_poses(self, k: int, image_meta: dict | None) -> tuple[np.ndarray, np.ndarray]:
+        """(sweep_times (k,), sweep_poses (k, 4, 4)) of scan ``k``."""
+        sweeps = self.meta.get("sweep_poses_world") or {}
+        frames = sweeps.get("frames", [])
+        if k < len(frames):
+            return np.asarray(frames[k]["t_s"], np.float64), np.asarray(frames[k]["T_world_lidar"], np.float64)
         mount = self.meta.get("mount")
         if image_meta is None and k in self.images:
             image_meta = json.loads(self.images[k].read_text(encoding="utf-8"))
@@ -162,8 +167,8 @@ class FusionDataset:
             raise UserError(f"{self.seq.dir / META_NAME}: needs 'sweep_poses_world' (or 'mount' and an image) "
                             f"to place scan {k:06d} of the LiDAR")
         start = np.asarray(image_meta["ego"]["T_world_ego"], np.float64) @ rig.mount(mount["lidar_xyz_m"], mount["lidar_rpy_deg"])
-        log.warning("%s: no sweep poses; scans are projected without de-skew", self.seq.dir)
-        return start, start, 0.1
+        log.warning("%s: no sweep poses for scan %06d; it is projected without de-skew", self.seq.dir, k)
+        return np.zeros(1), start[None]
 
     def __len__(self) -> int:
         return len(self.frames)
@@ -171,17 +176,18 @@ class FusionDataset:
     def read_scan(self, k: int, image_meta: dict | None = None) -> dict:
         """The LiDAR part of frame ``k`` (any scan of the sequence): the :class:`FusionFrame`
         fields ``xyz, semantic, instance, native, native_exact, times, T_world_lidar_start,
-        T_world_lidar_end, period_s, pose``."""
+        sweep_times, sweep_poses, pose``."""
         rec = self.seq.read(k, True, self.poses)
         if rec.semantic is None:
             raise UserError(f"{self.seq.labels_dir}: missing (fusion needs labelled scans)")
         native = read_sidecar(self.seq.dir, NATIVE_DIR, k, len(rec.points))
         times = read_sidecar(self.seq.dir, TIMES_DIR, k, len(rec.points))
-        start, end, period = self._lidar_poses(k, image_meta)
+        sweep_times, sweep_poses = self._lidar_poses(k, image_meta)
         return dict(xyz=rec.points[:, :3], semantic=rec.semantic, instance=rec.instance,
                     native=native if native is not None else native_from_raw(rec.semantic),
-                    native_exact=native is not None, times=times, T_world_lidar_start=start,
-                    T_world_lidar_end=end, period_s=period, pose=rec.pose if rec.pose is not None else np.eye(4))
+                    native_exact=native is not None, times=times, T_world_lidar_start=sweep_poses[0],
+                    sweep_times=sweep_times, sweep_poses=sweep_poses,
+                    pose=rec.pose if rec.pose is not None else np.eye(4))
 
     def read(self, k: int) -> FusionFrame:
         """Frame ``k`` (must be in :attr:`frames`)."""
@@ -194,3 +200,16 @@ class FusionDataset:
     def __iter__(self) -> Iterator[FusionFrame]:
         for k in self.frames:
             yield self.read(k)
+
+
+def deskewed(scan: dict | FusionFrame, deskew: bool = True) -> np.ndarray:
+    """(n, 3) float64 points of a scan in the LiDAR frame at the sweep start (raw when
+    ``deskew`` is False or the scan has no firing times / only one known pose)."""
+    get = scan.get if isinstance(scan, dict) else lambda key: getattr(scan, key)
+    xyz = np.asarray(get("xyz"), np.float64)
+    times, ts = get("times"), get("sweep_times")
+    if not deskew or times is None or len(ts) < 2:
+        return xyz
+    from generator.fusion.projection import deskew as _deskew
+
+    return _deskew(xyz, times, ts, get("sweep_poses"))

@@ -8,7 +8,7 @@ how the data was made (sensor, conventions, remission placeholder, point counts)
 dataset's ``semantic-kitti.yaml`` label config sits in ``out/``.
 Side files for fusion: ``point_times/`` and ``native_labels/`` per scan
 (:mod:`generator.formats.point_sidecars`) and, in ``lidar_meta.json``,
-``sweep_poses_world`` (the LiDAR world pose at each sweep's start and one rotation later).
+``sweep_poses_world`` (the LiDAR world poses during each sweep, :mod:`generator.formats.sweep_poses`).
 
 Write order: calib first, then scans; ``poses.txt``, ``times.txt`` and the metadata last,
 so a sequence with ``poses.txt`` is complete. Re-running into the same folder overwrites
@@ -35,7 +35,8 @@ from generator.formats.ply import write_ply
 from generator.imaging.bev import write_bev
 from generator.labels import class_table
 from generator.formats.point_sidecars import write_point_sidecars
-from generator.layout.frames import ego_pose_at, max_frames, plan_frames
+from generator.formats.sweep_poses import sweep_record
+from generator.layout.frames import max_frames, plan_frames
 from generator.lidar.pipeline import process_scan, processing_for_spec
 from generator.lidar.remission import IntensityFn, intensity_fn_for_spec
 from generator.lidar.scan import Scanner, sensor_mount, sweep_poses
@@ -133,7 +134,7 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
     to_sk = class_table().to_semantickitti
     t_ego_sensor = sensor_mount(spec)
     starts, n_points, counts, records = [], [], {}, []
-    ends = []  # LiDAR world pose one rotation after each sweep start (fusion de-skews between the two)
+    sweeps = []  # LiDAR world poses during each sweep (fusion de-skews with them)
     with Scanner(scene, sensor, threads=options.threads) as scanner:
         for f in tqdm(frames, desc=f"lidar {name}", unit="scan", disable=None if progress else True):
             scan = scanner.scan(sweep_poses(scene, spec, sensor, f.t, route=options.route))
@@ -154,7 +155,7 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
                 write_ply(seq / "ply" / f"{stem}.ply", scan.xyz, remission, semantic, pts["instance"],
                           class_table().colors[pts["class"]])
             starts.append(f.T_world_ego @ t_ego_sensor)
-            ends.append(ego_pose_at(scene, spec, f.t + sensor.period_s, options.route)[0] @ t_ego_sensor)
+            sweeps.append(sweep_record(scene, spec, f.t, sensor.period_s, t_ego_sensor, options.route))
             n_points.append(int(len(pts)))
             counts = merge_counts(counts, count_raw_ids(semantic))
     _remove_stale(seq, options.frames)
@@ -162,8 +163,7 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
     sk.write_times(seq / "times.txt", np.array([f.t for f in frames]))
     meta = _metadata(scene, spec, sensor, options, intensity_fn, n_points, counts)
     meta["processing"], meta["scans"] = processing.describe(), records
-    meta["sweep_poses_world"] = {"period_s": sensor.period_s, "T_world_lidar_start": np.round(starts, 12).tolist(),
-                                 "T_world_lidar_end": np.round(ends, 12).tolist()}
+    meta["sweep_poses_world"] = {"period_s": sensor.period_s, "frames": sweeps}
     write_json(seq / META_NAME, meta)
     write_dataset_label_config(out)
     return meta
