@@ -30,6 +30,12 @@ at the frame time (the sweep start): ``(x, y, z, qx, qy, qz, qw, sx, sy, sz)`` w
 length (along the heading), width, height in metres; and ``num`` ``lidar_points`` = points
 of that instance in the frame's scan. Objects with fewer points than the threshold
 (``spec.labels.openlabel_min_points``) are left out of that frame.
+
+Motion skew: the ``.bin`` scans keep the coordinates of each column's firing instant (KITTI
+convention), so on a moving ego a raw scan drawn in the frame's vehicle frame is shifted by
+up to speed x 0.1 s (0.8 m at 8 m/s) against its cuboids. De-skewed with ``point_times/``
+and ``lidar_meta.json`` ``sweep_poses_world`` (:func:`generator.fusion.projection.deskew`)
+every point of an object lies inside its cuboid (``tests/test_openlabel.py``).
 """
 
 from __future__ import annotations

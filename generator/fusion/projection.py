@@ -98,10 +98,11 @@ def deskew(xyz: np.ndarray, times: np.ndarray, sample_times: np.ndarray, T_world
     ts = np.asarray(sample_times, np.float64)
     poses = np.asarray(T_world_samples, np.float64)
     rel = rig.invert(poses[0]) @ poses  # (k, 4, 4) sample poses in the start frame
-    t = np.clip(np.asarray(times, np.float64), ts[0], ts[-1])
-    rot = Slerp(ts, Rotation.from_matrix(rel[:, :3, :3]))(t)
+    # points share their column's firing time: interpolate once per distinct time
+    t, inv = np.unique(np.clip(np.asarray(times, np.float64), ts[0], ts[-1]), return_inverse=True)
+    rot = Slerp(ts, Rotation.from_matrix(rel[:, :3, :3]))(t).as_matrix()
     trans = np.stack([np.interp(t, ts, rel[:, i, 3]) for i in range(3)], -1)
-    return rot.apply(np.asarray(xyz, np.float64)) + trans
+    return np.einsum("nij,nj->ni", rot[inv], np.asarray(xyz, np.float64)) + trans[inv]
 
 
 @dataclass
