@@ -35,6 +35,6 @@ def place(scene: "bpy.types.Scene", T_world_camera: np.ndarray, hfov_deg: float)
     data.angle_x = math.radians(hfov_deg)
     data.shift_x = data.shift_y = 0.0
     data.clip_start = 0.05
-    data.clip_end = 2000.0
+    data.clip_end = 10000.0  # beyond the 2 km ground ring: no gap at the horizon
     scene.camera = cam
     return cam

@@ -36,6 +36,17 @@ def sun_direction(elevation_deg: float, azimuth_deg: float) -> np.ndarray:
     return np.array([math.sin(az) * math.cos(el), math.cos(az) * math.cos(el), math.sin(el)])
 
 
+def ensure_sun(scene: "bpy.types.Scene") -> "bpy.types.Object":
+    """The sun lamp (created once; every Renderer creates it up front so that the scene's
+    contents, and therefore Cycles' sampling, never depend on which renders came before)."""
+    sun = bpy.data.objects.get("urbangen_sun")
+    if sun is None:
+        sun = bpy.data.objects.new("urbangen_sun", bpy.data.lights.new("urbangen_sun", "SUN"))
+        scene.collection.objects.link(sun)
+        sun.data.energy = 0.0
+    return sun
+
+
 def day_world(scene: "bpy.types.Scene", light: DayLight) -> dict:
     """Set a physical sky and a sun lamp; return the lighting parameters for metadata."""
     world = bpy.data.worlds.get("urbangen_sky") or bpy.data.worlds.new("urbangen_sky")
@@ -54,10 +65,7 @@ def day_world(scene: "bpy.types.Scene", light: DayLight) -> dict:
     g.output(bg.outputs[0], "ShaderNodeOutputWorld")
     scene.world = world
 
-    sun = bpy.data.objects.get("urbangen_sun")
-    if sun is None:
-        sun = bpy.data.objects.new("urbangen_sun", bpy.data.lights.new("urbangen_sun", "SUN"))
-        scene.collection.objects.link(sun)
+    sun = ensure_sun(scene)
     d = sun_direction(light.sun_elevation_deg, light.sun_azimuth_deg)
     # A sun lamp shines along its local -z: align -z with -d.
     sun.rotation_euler = mathutils.Vector((-d).tolist()).to_track_quat("-Z", "Y").to_euler()

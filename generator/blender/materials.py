@@ -40,6 +40,11 @@ def build_materials(seed: int) -> list["bpy.types.Material"]:
         mat = bpy.data.materials.new(row.name)
         g = Nodes(mat.node_tree)
         g.output(recipe(g, stream(seed, "materials", row.name)))
+        if row.emissive is not None:
+            # Emission strength follows scene switches (day/night); Cycles would estimate it for
+            # its light tree once and keep the estimate with persistent data, so a render would
+            # depend on the renders before it. Lamps light the scene through real lights instead.
+            mat.cycles.emission_sampling = "NONE"
         out.append(mat)
     return out
 

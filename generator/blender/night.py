@@ -32,6 +32,7 @@ def _spot(name: str, power: float, cone_deg: float, color, location, direction, 
     data.spot_blend = 0.6
     data.color = color
     data.shadow_soft_size = 0.15
+    data["ug_energy"] = power
     ob = bpy.data.objects.new(name, data)
     ob.location = tuple(float(v) for v in location)
     ob.rotation_euler = mathutils.Vector(tuple(float(v) for v in direction)).to_track_quat("-Z", "Y").to_euler()
@@ -54,8 +55,18 @@ def build_lights(model: SceneModel, parent: "bpy.types.Collection") -> tuple["bp
             for p in apply(o.transform, anchors["headlight"]):
                 _spot(f"{o.name}_headlight", HEADLIGHT_POWER_W, HEADLIGHT_CONE_DEG, (1.0, 0.95, 0.85), p, fwd, coll)
                 counts["headlights"] += 1
-    coll.hide_render = True
+    set_night(None, coll, False)
     return coll, counts
+
+
+def ensure_moon(scene: "bpy.types.Scene") -> "bpy.types.Object":
+    """The moon lamp, created once and hidden (see :func:`generator.blender.lighting.ensure_sun`)."""
+    moon = bpy.data.objects.get("urbangen_moon")
+    if moon is None:
+        moon = bpy.data.objects.new("urbangen_moon", bpy.data.lights.new("urbangen_moon", "SUN"))
+        scene.collection.objects.link(moon)
+        moon.data.energy = 0.0
+    return moon
 
 
 def night_world(scene: "bpy.types.Scene") -> dict:
@@ -67,22 +78,26 @@ def night_world(scene: "bpy.types.Scene") -> dict:
     g.set(bg.inputs["Strength"], 1.0)
     g.output(bg.outputs[0], "ShaderNodeOutputWorld")
     scene.world = world
-    moon = bpy.data.objects.get("urbangen_moon")
-    if moon is None:
-        moon = bpy.data.objects.new("urbangen_moon", bpy.data.lights.new("urbangen_moon", "SUN"))
-        scene.collection.objects.link(moon)
+    moon = ensure_moon(scene)
     moon.rotation_euler = (math.radians(50), 0.0, math.radians(30))
-    moon.data.energy = MOON_STRENGTH
     moon.data.color = (0.7, 0.8, 1.0)
     moon.data.angle = math.radians(0.5)
     return {"sky_model": "night_constant", "sky_color": list(NIGHT_SKY), "moon_strength_w_m2": MOON_STRENGTH,
             "street_lamp_power_w": LAMP_POWER_W, "headlight_power_w": HEADLIGHT_POWER_W}
 
 
-def set_night(scene: "bpy.types.Scene", lights: "bpy.types.Collection", night: bool) -> None:
-    """Show the night lights and moon at night, the sun by day."""
-    lights.hide_render = not night
-    for name, show in (("urbangen_moon", night), ("urbangen_sun", not night)):
-        ob = bpy.data.objects.get(name)
-        if ob is not None:
-            ob.hide_render = not show
+def set_night(scene, lights: "bpy.types.Collection", night: bool) -> None:
+    """Switch the night lights and the moon on at night and the sun on by day.
+
+    Lights are never hidden or unhidden, only dimmed to zero: with persistent data, adding or
+    removing lights reorders Cycles' light list in a run-dependent way and changes the noise
+    of every later render. Zero-strength lights are skipped by Cycles without reordering.
+    """
+    for ob in lights.objects:
+        ob.data.energy = ob.data["ug_energy"] if night else 0.0
+    moon = bpy.data.objects.get("urbangen_moon")
+    if moon is not None:
+        moon.data.energy = MOON_STRENGTH if night else 0.0
+    sun = bpy.data.objects.get("urbangen_sun")
+    if sun is not None and night:
+        sun.data.energy = 0.0

@@ -54,8 +54,14 @@ class LabelPasses:
     seconds: dict = field(default_factory=dict)
 
 
-def _render(scene, path: Path) -> dict[str, np.ndarray]:
+#: Seconds spent inside Cycles' render call, accumulated per process (sampling, sync, denoise).
+CYCLES_SECONDS = {"rgb": 0.0, "labels": 0.0}
+
+
+def _render(scene, path: Path, kind: str = "labels") -> dict[str, np.ndarray]:
+    t = time.perf_counter()
     bpy.ops.render.render(write_still=False)
+    CYCLES_SECONDS[kind] += time.perf_counter() - t
     bpy.data.images["Render Result"].save_render(str(path), scene=scene)
     with OpenEXR.File(str(path)) as f:
         chans = {}
@@ -71,7 +77,7 @@ def render_rgb(scene, bs: geometry.BlenderScene, cfg, seed: int, scratch: Path) 
     session.rgb_state(scene, cfg, seed)
     geometry.set_proxies_visible(bs, False)
     t = time.perf_counter()
-    chans = _render(scene, scratch / "rgb.exr")
+    chans = _render(scene, scratch / "rgb.exr", "rgb")
     combined = chans["Combined"]
     return np.ascontiguousarray(combined[..., :3], np.float32), time.perf_counter() - t
 

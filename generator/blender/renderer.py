@@ -51,6 +51,10 @@ class Renderer:
         self.materials = materials.build_materials(spec.seed)
         self.handles = geometry.build(scene, self.materials, self.bscene.collection)
         self.night_lights, self.night_counts = night.build_lights(scene, self.bscene.collection)
+        # Every light and world exists from the start: a render must not depend on earlier renders.
+        lighting.ensure_sun(self.bscene)
+        night.ensure_moon(self.bscene)
+        night.night_world(self.bscene)
         self.k = rig.intrinsics(spec.sensors.camera.hfov_deg, cfg.width, cfg.height)
         controls.apply(self.bscene, controls.DAY_DEFAULTS)
         self.build_seconds = time.perf_counter() - t

@@ -4,8 +4,9 @@ The parent (pure Python, no bpy) starts workers with the ``spawn`` start method 
 hands each one a job: the spec, render config, output folder and the list of frames.
 The worker builds the SceneModel and the Blender scene once, renders its frames, writes
 each image's files atomically and reports progress on a queue:
-``("frame", index, {image_name: seconds_dict})``, ``("error", message)`` and
-``("done", stats)``.
+``("ready", stats)``, ``("frame", index, {"images": {name: seconds}, "rss_mb": ...})``,
+``("error", message)`` and ``("done", stats)`` (including the seconds spent inside
+Cycles' render calls, to measure the share of wall time outside sampling).
 Blender's own per-tile chatter on stdout is sent to ``blender.log`` in the scratch folder.
 """
 
@@ -36,8 +37,27 @@ def _stdout_to(path: Path):
         os.close(fd)
 
 
+def _exit_with_parent(parent: int, period_s: float = 0.5) -> None:
+    """Exit at once when the parent process dies (a SIGKILLed parent cannot stop its workers).
+
+    The parent's pid is passed in the job: comparing with the current parent pid also
+    catches a parent that died before this thread started.
+    """
+    import threading
+
+    def watch() -> None:
+        while True:
+            if os.getppid() != parent:
+                os._exit(1)
+            time.sleep(period_s)
+
+    threading.Thread(target=watch, name="parent-watchdog", daemon=True).start()
+
+
 def run(job: dict, queue) -> None:
     """Render ``job["frames"]`` and report on ``queue`` (a multiprocessing queue)."""
+    if job.get("parent_pid"):
+        _exit_with_parent(job["parent_pid"])
     try:
         scratch = Path(job["scratch"])
         scratch.mkdir(parents=True, exist_ok=True)
@@ -60,8 +80,24 @@ def _run(job: dict, queue, scratch: Path) -> None:
     layout_s = time.perf_counter() - t
     renderer = Renderer(scene, spec, cfg, scratch)
     queue.put(("ready", {"layout_s": layout_s, "blender_build_s": renderer.build_seconds, "pid": os.getpid()}))
-    for index in job["frames"]:
+    from generator.blender.passes import CYCLES_SECONDS
+
+    t_start = time.perf_counter()
+    for n, index in enumerate(job["frames"], 1):
         frame = plan_frames(scene, spec, 1, first=index)[0]
         images = render_frame(renderer, spec, cfg, frame, Path(job["out"]), job["combos"])
-        queue.put(("frame", index, images))
-    queue.put(("done", {"max_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
+        queue.put(("frame", index, {"images": images, "rss_mb": _rss_mb(), "frames_done": n}))
+    queue.put(("done", {
+        "pid": os.getpid(), "frames": len(job["frames"]), "max_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
+        "rss_mb": _rss_mb(), "setup_s": layout_s + renderer.build_seconds, "frames_s": time.perf_counter() - t_start,
+        "cycles_rgb_s": CYCLES_SECONDS["rgb"], "cycles_labels_s": CYCLES_SECONDS["labels"],
+    }))
+
+
+def _rss_mb() -> float:
+    """Resident set size of this process now, MiB (Linux /proc; 0 elsewhere)."""
+    try:
+        with open("/proc/self/statm") as f:
+            return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE") / 2**20
+    except OSError:
+        return 0.0

@@ -66,6 +66,6 @@ def run(args) -> int:
              "scratch": str(scratch_dir(out, i))} for i, frames in enumerate(deal(todo, args.workers))]
     res = run_workers("generator.blender.worker:run", jobs, total=len(todo), desc="render")
     shutil.rmtree(out / ".scratch", ignore_errors=True)
-    n = sum(len(images) for images in res.frame_seconds.values())
+    n = sum(len(msg["images"]) for msg in res.frame_seconds.values())
     print(f"rendered {n} images of {len(res.frame_seconds)} frames into {out / 'images'} in {res.wall_s:.1f} s")
     return 0

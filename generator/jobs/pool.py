@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import logging
 import multiprocessing as mp
+import os
 import queue as queue_mod
 import time
 from dataclasses import dataclass, field
@@ -28,7 +29,7 @@ class PoolResult:
     wall_s: float = 0.0
 
 
-def run_workers(target: str, jobs: list[dict], total: int, desc: str = "render") -> PoolResult:
+def run_workers(target: str, jobs: list[dict], total: int, desc: str = "render", on_frame=None) -> PoolResult:
     """Start one spawned process per job running ``target`` (``"module:function"``) and wait.
 
     Parameters
@@ -39,6 +40,8 @@ def run_workers(target: str, jobs: list[dict], total: int, desc: str = "render")
         One job per worker (picklable).
     total : int
         Number of ``("frame", ...)`` reports expected, for the progress bar.
+    on_frame : callable, optional
+        Called in the parent as ``on_frame(index, payload)`` for every finished frame.
 
     Raises
     ------
@@ -51,38 +54,56 @@ def run_workers(target: str, jobs: list[dict], total: int, desc: str = "render")
     import importlib
 
     fn = getattr(importlib.import_module(module), func)
+    jobs = [{**job, "parent_pid": os.getpid()} for job in jobs]
     procs = [ctx.Process(target=fn, args=(job, q), daemon=False) for job in jobs]
     t0 = time.perf_counter()
     for p in procs:
         p.start()
-    res = PoolResult()
+
+    def failed() -> str | None:
+        dead = [p for p in procs if p.exitcode not in (None, 0)]
+        return f"render worker {dead[0].pid} exited with code {dead[0].exitcode}" if dead else None
+
     try:
-        with tqdm(total=total, desc=desc, unit="frame", disable=None, smoothing=0.1) as bar:
-            while len(res.done) < len(procs):
-                try:
-                    msg = q.get(timeout=1.0)
-                except queue_mod.Empty:
-                    dead = [p for p in procs if p.exitcode not in (None, 0)]
-                    if dead:
-                        raise RuntimeError(f"render worker {dead[0].pid} exited with code {dead[0].exitcode}")
-                    continue
-                kind = msg[0]
-                if kind == "frame":
-                    res.frame_seconds[msg[1]] = msg[2]
-                    bar.update(1)
-                elif kind == "ready":
-                    res.ready.append(msg[1])
-                elif kind == "done":
-                    res.done.append(msg[1])
-                elif kind == "error":
-                    raise RuntimeError("render worker failed:\n" + msg[1])
+        res = follow(q.get, len(procs), total, desc, on_frame, failed)
     finally:
         for p in procs:
-            if p.is_alive() and len(res.done) < len(procs):
+            if p.is_alive():
                 p.terminate()
         for p in procs:
             p.join(timeout=30)
     res.wall_s = time.perf_counter() - t0
+    return res
+
+
+def follow(get, n_workers: int, total: int, desc: str, on_frame, failed) -> PoolResult:
+    """Read worker messages with ``get(timeout=...)`` until every worker is done; drive the progress bar.
+
+    ``failed()`` returns a message when a worker died without reporting (checked on timeouts).
+    Shared by the local pool and the Ray executor.
+    """
+    res = PoolResult()
+    with tqdm(total=total, desc=desc, unit="frame", disable=None, smoothing=0.1) as bar:
+        while len(res.done) < n_workers:
+            try:
+                msg = get(timeout=1.0)
+            except queue_mod.Empty:  # Ray's queue raises a subclass (wrapped in RayTaskError)
+                problem = failed()
+                if problem:
+                    raise RuntimeError(problem)
+                continue
+            kind = msg[0]
+            if kind == "frame":
+                res.frame_seconds[msg[1]] = msg[2]
+                if on_frame is not None:
+                    on_frame(msg[1], msg[2])
+                bar.update(1)
+            elif kind == "ready":
+                res.ready.append(msg[1])
+            elif kind == "done":
+                res.done.append(msg[1])
+            elif kind == "error":
+                raise RuntimeError("render worker failed:\n" + msg[1])
     return res
 
 

@@ -1,0 +1,105 @@
+"""``urbangen preview DIR [--frames 0,3]``: contact sheets per frame.
+
+``DIR/preview/NNNNNN.png``: RGB | colourised masks | LiDAR bird's-eye view by class;
+``DIR/preview/NNNNNN_variants.png``: every weather x time-of-day variant of the frame.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+from PIL import Image
+
+from generator.atomic import atomic_path
+from generator.errors import UserError
+from generator.imaging.contact_sheet import variants_sheet
+from generator.imaging.exr import read_exr
+from generator.imaging.preview import colorize, side_by_side, tonemap
+from generator.labels import class_table
+
+PREFERRED = ("day_clear", "night_clear")
+MIN_HEIGHT = 360
+
+
+def _height(panel: np.ndarray, h: int, smooth: bool) -> np.ndarray:
+    if panel.shape[0] == h:
+        return panel
+    w = int(round(panel.shape[1] * h / panel.shape[0]))
+    return np.asarray(Image.fromarray(panel).resize((w, h), Image.BILINEAR if smooth else Image.NEAREST))
+
+
+def register(sub) -> None:
+    p = sub.add_parser("preview", help="contact sheets per frame: RGB | masks | LiDAR bird's-eye; all variants",
+                       description=__doc__.split("\n\n")[1].strip())
+    p.add_argument("dataset", type=Path, help="dataset folder")
+    p.add_argument("--frames", default=None, help="comma-separated frame numbers (default: all)")
+    p.set_defaults(func=run)
+
+
+def _frames(root: Path) -> dict[int, list[Path]]:
+    out: dict[int, list[Path]] = {}
+    for p in sorted((root / "images").glob("*.exr")):
+        m = re.match(r"^(\d{6})_", p.name)
+        if m:
+            out.setdefault(int(m.group(1)), []).append(p)
+    return out
+
+
+def _bev(root: Path, frame: int, size: int) -> np.ndarray | None:
+    from generator.formats.point_sidecars import NATIVE_DIR, read_sidecar
+    from generator.formats.semantickitti import list_sequences, read_labels, read_scan
+    from generator.imaging.bev import bev_image
+
+    lidar = root / "lidar"
+    if not (lidar / "sequences").is_dir():
+        return None
+    for name in list_sequences(lidar):
+        seq = lidar / "sequences" / name
+        scan = seq / "velodyne" / f"{frame:06d}.bin"
+        if not scan.exists():
+            continue
+        pts = read_scan(scan)
+        native = read_sidecar(seq, NATIVE_DIR, frame, len(pts))
+        if native is None:
+            sem, _ = read_labels(seq / "labels" / f"{frame:06d}.label")
+            t = class_table()
+            native = np.array([t.from_semantickitti(int(r)) if r in t.sk_labels else 0 for r in sem], np.uint8)
+        img = bev_image(pts[:, :3], native, extent_m=80.0, res_m=0.1, legend=False, title=f"scan {frame:06d}")
+        img = img.resize((size * img.width // img.height, size), Image.NEAREST)
+        return np.asarray(img.convert("RGB"))
+    return None
+
+
+def run(args) -> int:
+    root: Path = args.dataset
+    if not (root / "images").is_dir():
+        raise UserError(f"{root}: no images/ folder (is it a dataset from urbangen generate?)")
+    frames = _frames(root)
+    if args.frames:
+        try:
+            wanted = [int(x) for x in args.frames.split(",")]
+        except ValueError:
+            raise UserError(f"--frames: expected comma-separated numbers, got {args.frames!r}") from None
+        missing = [k for k in wanted if k not in frames]
+        if missing:
+            raise UserError(f"--frames: no images of frame(s) {missing} in {root / 'images'}")
+        frames = {k: frames[k] for k in wanted}
+    if not frames:
+        raise UserError(f"{root / 'images'}: no images")
+    out = root / "preview"
+    for k, paths in frames.items():
+        pick = next((p for pref in PREFERRED for p in paths if p.stem.endswith(pref)), paths[0])
+        img = read_exr(pick)
+        h = max(img.class_id.shape[0], MIN_HEIGHT)
+        panels = [_height(tonemap(img.rgb), h, True), _height(colorize(img.class_id), h, False)]
+        bev = _bev(root, k, h)
+        if bev is not None:
+            panels.append(bev)
+        with atomic_path(out / f"{k:06d}.png", suffix=".png") as tmp:
+            Image.fromarray(side_by_side(panels)).save(tmp, format="PNG")
+        if len(paths) > 1:
+            variants_sheet(root / "images", k, out / f"{k:06d}_variants.png", scale=1.0 if img.rgb.shape[1] <= 320 else 0.5)
+    print(f"wrote {len(frames)} preview sheet(s) into {out}")
+    return 0

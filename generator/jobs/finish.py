@@ -1,0 +1,28 @@
+"""Dataset-level outputs written after the frames: OpenLABEL per sequence and statistics."""
+
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+log = logging.getLogger(__name__)
+
+
+def write_stats(out: Path) -> list[Path]:
+    """Write ``out/stats/`` (seed 003 Tables I and II, charts) from the dataset's metadata."""
+    from generator.stats import section_modules
+    from generator.stats.report import write_report
+
+    sections = [mod.section(data) for mod in section_modules() if (data := mod.load(out)) is not None]
+    return write_report(Path(out) / "stats", out, sections) if sections else []
+
+
+def write_openlabel(spec, out: Path, plan) -> None:
+    """Write ``out/openlabel/NN.json`` for the plan's sequence (cuboids of cars, trucks, people)."""
+    import argparse
+
+    from generator.commands import openlabel
+
+    args = argparse.Namespace(spec=spec.source, dataset=Path(out), sequence=plan.sequence,
+                              classes=list(openlabel.DEFAULT_CLASSES), min_points=None)
+    openlabel.run(args)

@@ -1,0 +1,177 @@
+"""`urbangen generate` / `validate` / `preview` end to end on the test town (Blender, test preset).
+
+One uninterrupted 2-worker run is the reference; a run killed with SIGKILL and rerun,
+and a Ray run, must end with the same files and identical LiDAR bytes.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import OpenEXR
+import pytest
+
+from generator.cli import main
+from generator.imaging.exr import read_exr
+
+pytestmark = [pytest.mark.blender, pytest.mark.slow]
+VARIANTS = "day:clear,night:rain,day:fog"
+FRAMES = "3"
+
+
+def _args(root, out, *extra):
+    return ["generate", str(root / "scenes/test_town.json"), "--config", "test", "--out", str(out),
+            "--frames", FRAMES, "--variants", VARIANTS, *extra]
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory, root):
+    out = tmp_path_factory.mktemp("gen") / "ref"
+    assert main(["-q", *_args(root, out, "--workers", "2")]) == 0
+    return out
+
+
+def _files(root: Path) -> set[str]:
+    return {str(p.relative_to(root)) for p in root.rglob("*") if p.is_file() and p.name != "manifest.json"}
+
+
+def _lidar_bytes(root: Path) -> dict[str, bytes]:
+    seq = root / "lidar" / "sequences"
+    return {str(p.relative_to(seq)): p.read_bytes() for p in sorted(seq.rglob("*"))
+            if p.is_file() and p.suffix in (".bin", ".label", ".txt")}
+
+
+def _same_images(a: Path, b: Path) -> None:
+    for exr in sorted((a / "images").glob("*.exr")):
+        x, y = read_exr(exr), read_exr(b / "images" / exr.name)
+        assert np.array_equal(x.class_id, y.class_id), exr.name
+        assert np.array_equal(x.depth, y.depth), exr.name
+        assert np.allclose(x.rgb, y.rgb, atol=1e-3), exr.name
+
+
+def test_dataset_is_complete_balanced_and_valid(reference, capsys):
+    m = json.loads((reference / "manifest.json").read_text())
+    assert m["finished"] == {**m["finished"], "lidar": True, "openlabel": True, "stats": True}
+    assert len(m["finished"]["images"]) == 3 * 3 == len(list((reference / "images").glob("*.exr")))
+    counts = {}
+    for p in (reference / "images").glob("*.json"):
+        meta = json.loads(p.read_text())
+        key = (meta["time_of_day"], meta["weather"]["kind"])
+        counts[key] = counts.get(key, 0) + 1
+    assert set(counts.values()) == {3}
+    assert (reference / "openlabel" / "00.json").exists()
+    assert (reference / "stats" / "table2_conditions.csv").exists()
+    assert len(list((reference / "lidar/sequences/00/velodyne").glob("*.bin"))) == 3
+    capsys.readouterr()
+    assert main(["validate", str(reference)]) == 0
+    assert "valid: 9 images, 3 scans, 1 OpenLABEL" in capsys.readouterr().out
+
+
+def test_rerun_skips_finished_work(reference, root, capsys):
+    before = {p: p.stat().st_mtime_ns for p in (reference / "images").glob("*.exr")}
+    assert main(["-q", *_args(root, reference, "--workers", "2")]) == 0
+    assert "nothing left to render" in capsys.readouterr().out
+    assert before == {p: p.stat().st_mtime_ns for p in (reference / "images").glob("*.exr")}
+
+
+def test_preview_sheets(reference, tmp_path):
+    from PIL import Image
+
+    data = tmp_path / "data"
+    shutil.copytree(reference, data)
+    assert main(["preview", str(data)]) == 0
+    sheet = Image.open(data / "preview" / "000000.png")
+    assert sheet.height >= 360 and sheet.width > 2 * sheet.height
+    assert (data / "preview" / "000000_variants.png").exists()
+
+
+def _rewrite_exr(path: Path, fn) -> None:
+    with OpenEXR.File(str(path), separate_channels=True) as f:
+        header = {k: v for k, v in f.header().items() if k in ("compression", "type") or k.startswith("urbangen.")}
+        ch = {k: np.ascontiguousarray(v.pixels.copy()) for k, v in f.channels().items()}
+    fn(ch)
+    with OpenEXR.File(header, ch) as f:
+        f.write(str(path))
+
+
+def _truncate_bin(d):
+    p = d / "lidar/sequences/00/velodyne/000001.bin"
+    p.write_bytes(p.read_bytes()[:-5])
+
+
+def _label_out_of_table(d):
+    p = d / "lidar/sequences/00/labels/000000.label"
+    lab = np.fromfile(p, np.uint32)
+    lab[:10] = 77
+    lab.tofile(p)
+
+
+def _drop_metadata_field(d):
+    p = d / "images/000001_night_rain.json"
+    meta = json.loads(p.read_text())
+    del meta["camera"]
+    p.write_text(json.dumps(meta))
+
+
+def _non_binary_mask(d):
+    _rewrite_exr(d / "images/000000_day_clear.exr", lambda ch: ch["mask.road.V"].__setitem__((0, 0), 0.5))
+
+
+def _missing_channel(d):
+    _rewrite_exr(d / "images/000002_day_fog.exr", lambda ch: ch.pop("mask.car.V"))
+
+
+@pytest.mark.parametrize("fault,expected", [
+    (_truncate_bin, "velodyne/000001.bin: size"),
+    (_label_out_of_table, "label ids [77] are not in the label table"),
+    (_drop_metadata_field, "000001_night_rain.json: (top level): 'camera' is a required property"),
+    (_non_binary_mask, "000000_day_clear.exr: mask channels are not binary"),
+    (_missing_channel, "000002_day_fog.exr: missing channel(s) mask.car"),
+])
+def test_validate_catches_each_fault(reference, tmp_path, capsys, fault, expected):
+    broken = tmp_path / "broken"
+    shutil.copytree(reference, broken)
+    fault(broken)
+    capsys.readouterr()
+    assert main(["validate", str(broken)]) == 1
+    err = capsys.readouterr().err
+    assert expected in err
+    assert "1 problem(s)" in err
+
+
+def test_sigkill_then_resume_gives_the_uninterrupted_files(reference, root, tmp_path):
+    out = tmp_path / "killed"
+    cmd = [sys.executable, "-m", "generator.cli", "-q", *_args(root, out, "--workers", "2")]
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.time() + 300
+    while time.time() < deadline and not list((out / "images").glob("*.json")) if out.exists() else True:
+        if proc.poll() is not None:
+            pytest.fail("generate finished before it could be killed")
+        time.sleep(0.05)
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait()
+    time.sleep(1.5)  # the workers' watchdog notices the dead parent and exits
+    done = len(list((out / "images").glob("*.json")))
+    assert 0 < done < 9, "the kill should land mid-run"
+    assert main(["-q", *_args(root, out, "--workers", "2")]) == 0
+    assert _files(out) == _files(reference)
+    assert _lidar_bytes(out) == _lidar_bytes(reference)
+    _same_images(out, reference)
+    assert main(["validate", str(out)]) == 0
+
+
+def test_ray_executor_equals_local(reference, root, tmp_path):
+    pytest.importorskip("ray")
+    out = tmp_path / "ray"
+    assert main(["-q", *_args(root, out, "--workers", "2", "--executor", "ray")]) == 0
+    assert _files(out) == _files(reference)
+    assert _lidar_bytes(out) == _lidar_bytes(reference)
+    _same_images(out, reference)
