@@ -20,7 +20,6 @@ The real HDL-64E produces about 1.33 M points/s.
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import json
 import os
 import subprocess

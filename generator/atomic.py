@@ -11,6 +11,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import shutil
 import tempfile
 from pathlib import Path
 from typing import Any, Iterator
@@ -92,3 +93,25 @@ def inside(root: str | os.PathLike, *parts: str) -> Path:
     if target != base and base not in target.parents:
         raise ValueError(f"refusing path outside the output folder: {'/'.join(parts)}")
     return target
+
+
+@contextlib.contextmanager
+def staging(out: str | os.PathLike, label: str) -> Iterator[Path]:
+    """Yield a temporary folder inside ``out`` for building outputs that appear all at once.
+
+    The caller builds files in the stage and moves them into ``out`` before leaving the
+    block. On any error the stage is removed, and ``out`` too when this call created it,
+    so a failed run leaves nothing behind; on success only the (emptied) stage is removed.
+    """
+    out = Path(out)
+    created = not out.exists()
+    out.mkdir(parents=True, exist_ok=True)
+    stage = Path(tempfile.mkdtemp(prefix=f"{TMP_PREFIX}{label}-", dir=out))
+    try:
+        yield stage
+    except BaseException:
+        shutil.rmtree(stage, ignore_errors=True)
+        if created:
+            shutil.rmtree(out, ignore_errors=True)
+        raise
+    shutil.rmtree(stage, ignore_errors=True)

@@ -40,7 +40,7 @@ def censored_moments(mean: float, std: float) -> tuple[float, float]:
         return v, 0.0
     y = np.linspace(0, 1, 200001)
     pdf = stats.norm.pdf(y, mean, std)
-    lo, hi = stats.norm.cdf(0, mean, std), stats.norm.sf(1, mean, std)
+    hi = stats.norm.sf(1, mean, std)  # mass clipped to 1; the mass clipped to 0 adds nothing to the moments
     m1 = np.trapz(y * pdf, y) + hi
     m2 = np.trapz(y * y * pdf, y) + hi
     return m1, float(np.sqrt(m2 - m1 * m1))

@@ -9,6 +9,7 @@ import pytest
 
 from generator import rig
 from generator.labels import class_table
+from generator.weather import Lighting
 from scene_kit import fence_scene
 
 pytestmark = pytest.mark.blender
@@ -24,7 +25,7 @@ def fence_render(tmp_path_factory, test_spec):
     cfg = dataclasses.replace(load_render_config("test"), resolution=(192, 108), samples=4)
     scene = fence_scene()
     r = Renderer(scene, test_spec, cfg, tmp_path_factory.mktemp("scratch"))
-    r.set_day(__import__("generator.blender.lighting", fromlist=["DayLight"]).DayLight(45.0, 200.0))
+    r.set_conditions(Lighting("day", sun_elevation_deg=45.0, sun_azimuth_deg=200.0))
     T = rig.camera_extrinsics((0.0, 0.0, 1.0), (0, 0, 0))
     out = r.render(T, seed=0, light_info={})
     return r, scene, out

@@ -64,12 +64,6 @@ class Renderer:
     def blender_version(self) -> str:
         return bpy.app.version_string
 
-    def set_day(self, light: lighting.DayLight) -> dict:
-        """Dry, clear day lighting; returns the lighting metadata."""
-        night.set_night(self.bscene, self.night_lights, False)
-        controls.apply(self.bscene, controls.DAY_DEFAULTS)
-        return lighting.day_world(self.bscene, light)
-
     def set_conditions(self, light, wetness: float = 0.0, puddle_seed: float = 0.0) -> dict:
         """Time of day, lights and wet shaders for the next RGB render.
 

@@ -11,15 +11,13 @@ from __future__ import annotations
 
 import json
 import logging
-import shutil
-import tempfile
 from pathlib import Path
 
 import numpy as np
 from tqdm import tqdm
 
 from generator import __version__, rig
-from generator.atomic import TMP_PREFIX, write_json
+from generator.atomic import staging, write_json
 from generator.commands.intensity import add_processing_args, gap_from_args, intensity_fn_from_args
 from generator.errors import UserError
 from generator.formats import carla_ply, kitti_calib, semantickitti as sk
@@ -94,11 +92,8 @@ def import_town(town: Path, out: Path, name: str, processing: ScanProcessing, se
     if out.exists() and not out.is_dir():
         raise UserError(f"{out}: exists and is not a folder")
     poses_all, pose_times = carla_ply.read_pose_file(pose_file) if pose_file else (None, None)
-    created = not out.exists()
-    out.mkdir(parents=True, exist_ok=True)
-    stage = Path(tempfile.mkdtemp(prefix=TMP_PREFIX + "import-", dir=out))
-    seq = stage / name
-    try:
+    with staging(out, "import") as stage:
+        seq = stage / name
         poses, times, counts, records, instances = [], [], {}, [], {}
         for k, path in enumerate(tqdm(frames, desc=f"import-carla {name}", unit="scan", disable=None if progress else True)):
             f = carla_ply.read_frame(path)
@@ -138,12 +133,6 @@ def import_town(town: Path, out: Path, name: str, processing: ScanProcessing, se
         write_json(seq / "lidar_meta.json", meta)
         (out / "sequences").mkdir(exist_ok=True)
         seq.rename(dest)
-    except BaseException:
-        shutil.rmtree(stage, ignore_errors=True)
-        if created:
-            shutil.rmtree(out, ignore_errors=True)
-        raise
-    shutil.rmtree(stage, ignore_errors=True)
     _label_config(out)
     return meta
 

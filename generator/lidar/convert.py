@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import logging
 import shutil
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
@@ -26,7 +25,7 @@ import numpy as np
 from tqdm import tqdm
 
 from generator import __version__
-from generator.atomic import TMP_PREFIX, write_json, write_text
+from generator.atomic import staging, write_json, write_text
 from generator.errors import UserError
 from generator.formats import semantickitti as sk
 from generator.formats.label_config import count_raw_ids, format_label_config, merge_counts
@@ -158,11 +157,8 @@ def convert_dataset(src: str | Path, dst: str | Path, labels: str = "unified11",
     for n in names:
         if (dst / "sequences" / n).exists():
             raise UserError(f"{dst / 'sequences' / n}: exists; remove it or choose another output folder")
-    created = not dst.exists()
-    dst.mkdir(parents=True, exist_ok=True)
-    stage = Path(tempfile.mkdtemp(prefix=TMP_PREFIX + "convert-", dir=dst))
     counts: dict[int, int] = {}
-    try:
+    with staging(dst, "convert") as stage:
         bar = tqdm(total=sum(len(s) for s in seqs), desc=f"convert -> {labels}", unit="scan", disable=None if progress else True)
         with bar:
             for seq in seqs:
@@ -184,12 +180,6 @@ def convert_dataset(src: str | Path, dst: str | Path, labels: str = "unified11",
         (dst / "sequences").mkdir(exist_ok=True)
         for n in names:
             (stage / "sequences" / n).rename(dst / "sequences" / n)
-    except BaseException:
-        shutil.rmtree(stage, ignore_errors=True)
-        if created:
-            shutil.rmtree(dst, ignore_errors=True)
-        raise
-    shutil.rmtree(stage, ignore_errors=True)
     cfg = target.config(counts, [int(s) for s in names])  # content and split: the sequences of this run
     write_text(dst / target.config_name, target.formatter(cfg))
     summary = {"generator": f"urbangen {__version__} convert", "source": str(src), "labels": labels,
