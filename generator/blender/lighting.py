@@ -54,8 +54,9 @@ def day_world(scene: "bpy.types.Scene", light: DayLight) -> dict:
     sky = g.node("ShaderNodeTexSky", sky_type="MULTIPLE_SCATTERING")
     sky.sun_disc = False
     sky.sun_elevation = math.radians(light.sun_elevation_deg)
-    # Blender's sky rotation is counter-clockwise from +x... measured so that the bright side matches the lamp.
-    sky.sun_rotation = math.radians(90.0 - light.sun_azimuth_deg)
+    # Blender's sky "sun rotation" is a compass bearing like ours (0 = +y, clockwise seen from above):
+    # checked by aiming a camera at the lamp's direction and finding the sky's sun disc at the centre.
+    sky.sun_rotation = math.radians(light.sun_azimuth_deg)
     sky.altitude = 0.0
     sky.air_density = 1.0
     sky.aerosol_density = 1.0
