@@ -64,14 +64,18 @@ def run_workers(target: str, jobs: list[dict], total: int, desc: str = "render",
         dead = [p for p in procs if p.exitcode not in (None, 0)]
         return f"render worker {dead[0].pid} exited with code {dead[0].exitcode}" if dead else None
 
+    ok = False
     try:
         res = follow(q.get, len(procs), total, desc, on_frame, failed)
+        ok = True
     finally:
-        for p in procs:
+        for p in procs:  # finished workers are still flushing their queue: let them exit on their own
+            p.join(timeout=60 if ok else 0)
             if p.is_alive():
                 p.terminate()
-        for p in procs:
-            p.join(timeout=30)
+                p.join(timeout=30)
+        q.close()
+        q.join_thread()
     res.wall_s = time.perf_counter() - t0
     return res
 
