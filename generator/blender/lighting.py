@@ -36,15 +36,23 @@ def sun_direction(elevation_deg: float, azimuth_deg: float) -> np.ndarray:
     return np.array([math.sin(az) * math.cos(el), math.cos(az) * math.cos(el), math.sin(el)])
 
 
+def ensure_lamp(scene: "bpy.types.Scene", name: str) -> "bpy.types.Object":
+    """A directional lamp ``name`` (created once, switched off).
+
+    Every Renderer creates its sun and moon up front and only changes their strength, so the
+    scene's light list -- and therefore Cycles' sampling -- never depends on earlier renders.
+    """
+    lamp = bpy.data.objects.get(name)
+    if lamp is None:
+        lamp = bpy.data.objects.new(name, bpy.data.lights.new(name, "SUN"))
+        scene.collection.objects.link(lamp)
+        lamp.data.energy = 0.0
+    return lamp
+
+
 def ensure_sun(scene: "bpy.types.Scene") -> "bpy.types.Object":
-    """The sun lamp (created once; every Renderer creates it up front so that the scene's
-    contents, and therefore Cycles' sampling, never depend on which renders came before)."""
-    sun = bpy.data.objects.get("urbangen_sun")
-    if sun is None:
-        sun = bpy.data.objects.new("urbangen_sun", bpy.data.lights.new("urbangen_sun", "SUN"))
-        scene.collection.objects.link(sun)
-        sun.data.energy = 0.0
-    return sun
+    """The sun lamp (see :func:`ensure_lamp`)."""
+    return ensure_lamp(scene, "urbangen_sun")
 
 
 def day_world(scene: "bpy.types.Scene", light: DayLight) -> dict:

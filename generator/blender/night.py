@@ -13,6 +13,7 @@ import numpy as np
 
 from assets_procedural.mesh import apply
 from generator.blender.bpy_guard import bpy, mathutils
+from generator.blender.lighting import ensure_lamp
 from generator.blender.nodes import Nodes
 from generator.scene import SceneModel
 
@@ -60,13 +61,8 @@ def build_lights(model: SceneModel, parent: "bpy.types.Collection") -> tuple["bp
 
 
 def ensure_moon(scene: "bpy.types.Scene") -> "bpy.types.Object":
-    """The moon lamp, created once and hidden (see :func:`generator.blender.lighting.ensure_sun`)."""
-    moon = bpy.data.objects.get("urbangen_moon")
-    if moon is None:
-        moon = bpy.data.objects.new("urbangen_moon", bpy.data.lights.new("urbangen_moon", "SUN"))
-        scene.collection.objects.link(moon)
-        moon.data.energy = 0.0
-    return moon
+    """The moon lamp, created once and dark (see :func:`generator.blender.lighting.ensure_lamp`)."""
+    return ensure_lamp(scene, "urbangen_moon")
 
 
 def night_world(scene: "bpy.types.Scene") -> dict:

@@ -11,7 +11,7 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
-from generator.commands.render import positive
+from generator.commands.render import add_render_arguments, positive
 from generator.errors import UserError
 from generator.jobs.executors import EXECUTORS
 from generator.jobs.generate import GenerateOptions, run_generate
@@ -26,14 +26,8 @@ log = logging.getLogger(__name__)
 def register(sub) -> None:
     p = sub.add_parser("generate", help="the main job: images x weather + LiDAR + boxes + stats, resumable",
                        description=__doc__.split("\n\n")[1])
-    p.add_argument("spec", help="scene spec JSON (e.g. scenes/default_town.json)")
-    p.add_argument("--config", required=True, help="render config YAML or preset name (test, preview, paper)")
-    p.add_argument("--out", required=True, type=Path, help="dataset folder (created; a rerun resumes it)")
-    p.add_argument("--frames", type=int, default=2, help="frames along the route (default 2)")
-    p.add_argument("--variants", default="all",
-                   help="all (12 weather x time combinations per frame; default), clear, or pairs like day:fog,night:rain")
+    add_render_arguments(p, "dataset folder (created; a rerun resumes it)", frames=2, variants="all")
     p.add_argument("--sequence", default="00", help="SemanticKITTI sequence id of the scans (default 00)")
-    p.add_argument("--workers", type=int, default=1, help="parallel Blender processes (default 1)")
     p.add_argument("--executor", default="local", help="local (default) or ray")
     p.add_argument("--ray-address", default=None, help="address of an existing Ray cluster (default: start a local one)")
     p.set_defaults(func=run)

@@ -23,17 +23,23 @@ from generator.spec.render import load_render_config
 log = logging.getLogger(__name__)
 
 
+def add_render_arguments(p, out_help: str, frames: int, variants: str) -> None:
+    """The options ``render`` and ``generate`` share (with their own defaults)."""
+    p.add_argument("spec", help="scene spec JSON (e.g. scenes/default_town.json)")
+    p.add_argument("--config", required=True, help="render config YAML or preset name (test, preview, paper)")
+    p.add_argument("--out", required=True, type=Path, help=out_help)
+    p.add_argument("--frames", type=int, default=frames, help=f"frames along the route (default {frames})")
+    p.add_argument("--variants", default=variants,
+                   help=f"all (12 weather x time combinations per frame), clear (day, clear), or pairs like "
+                        f"day:fog,night:rain (default {variants})")
+    p.add_argument("--workers", type=int, default=1, help="parallel Blender processes (default 1)")
+
+
 def register(sub) -> None:
     p = sub.add_parser("render", help="render RGB + label EXRs with metadata along the route",
                        description=__doc__.split("\n\n")[1])
-    p.add_argument("spec", help="scene spec JSON (e.g. scenes/default_town.json)")
-    p.add_argument("--config", required=True, help="render config YAML or preset name (test, preview, paper)")
-    p.add_argument("--out", required=True, type=Path, help="output folder")
-    p.add_argument("--frames", type=int, default=4, help="number of frames (default 4)")
+    add_render_arguments(p, "output folder", frames=4, variants="clear")
     p.add_argument("--first", type=int, default=0, help="index of the first frame (default 0)")
-    p.add_argument("--variants", default="clear",
-                   help="clear (day, clear; default), all (12 weather x time combinations), or pairs like day:fog,night:rain")
-    p.add_argument("--workers", type=int, default=1, help="parallel Blender processes (default 1)")
     p.set_defaults(func=run)
 
 
