@@ -17,12 +17,9 @@ def write_stats(out: Path) -> list[Path]:
     return write_report(Path(out) / "stats", out, sections) if sections else []
 
 
-def write_openlabel(spec, out: Path, plan) -> None:
+def write_openlabel(spec, out: Path, plan, scene=None) -> Path:
     """Write ``out/openlabel/NN.json`` for the plan's sequence (cuboids of cars, trucks, people)."""
-    import argparse
+    from generator.jobs.boxes import write_sequence_openlabel
 
-    from generator.commands import openlabel
-
-    args = argparse.Namespace(spec=spec.source, dataset=Path(out), sequence=plan.sequence,
-                              classes=list(openlabel.DEFAULT_CLASSES), min_points=None)
-    openlabel.run(args)
+    path, _ = write_sequence_openlabel(spec, out, plan.sequence, scene=scene)
+    return path

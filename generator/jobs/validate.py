@@ -27,6 +27,15 @@ def _rel(path: Path, root: Path) -> str:
         return str(path)
 
 
+def _read_json(path: Path, root: Path, problems: list[str]):
+    """Parsed JSON of ``path``, or None after recording why it cannot be read."""
+    try:
+        return json.loads(path.read_text())
+    except (json.JSONDecodeError, UnicodeDecodeError) as e:
+        problems.append(f"{_rel(path, root)}: invalid JSON ({e})")
+        return None
+
+
 def check_images(root: Path) -> tuple[list[str], int]:
     """Problems of ``root/images`` and the number of images checked."""
     folder = root / "images"
@@ -53,10 +62,8 @@ def check_images(root: Path) -> tuple[list[str], int]:
         if not meta_path.exists():
             problems.append(f"{rel}: no metadata JSON beside it")
             continue
-        try:
-            meta = json.loads(meta_path.read_text())
-        except (json.JSONDecodeError, UnicodeDecodeError) as e:
-            problems.append(f"{_rel(meta_path, root)}: invalid JSON ({e})")
+        meta = _read_json(meta_path, root, problems)
+        if meta is None:
             continue
         problems += [f"{_rel(meta_path, root)}: {p}" for p in validate_metadata(meta)]
         if isinstance(meta, dict) and meta.get("classes_present") not in (None, class_pixels(img.class_id)):
@@ -124,10 +131,8 @@ def check_openlabel(root: Path) -> tuple[list[str], int]:
     files = sorted((root / "openlabel").glob("*.json"))
     problems = []
     for f in files:
-        try:
-            doc = json.loads(f.read_text())
-        except (json.JSONDecodeError, UnicodeDecodeError) as e:
-            problems.append(f"{_rel(f, root)}: invalid JSON ({e})")
+        doc = _read_json(f, root, problems)
+        if doc is None:
             continue
         problems += [f"{_rel(f, root)}: {p}" for p in validate_openlabel(doc)]
     return problems, len(files)
