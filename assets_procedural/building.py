@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from assets_procedural.mesh import Mesh, box, merge, quads
+from generator.geometry import Mesh, box, merge, quads
 from assets_procedural.building_roof import flat_roof, pitched_roof, rectangle_of
 
 log = logging.getLogger(__name__)

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from assets_procedural.mesh import Mesh, _ids, _triangulate, box, merge, polygon, pose
+from generator.geometry import Mesh, resolve_ids, triangulate, box, merge, polygon, pose
 
 CLS = "building"
 UP = np.array([0.0, 0.0, 1.0])
@@ -64,8 +64,8 @@ def flat_roof(rng: np.random.Generator, poly: np.ndarray, height: float, parapet
     inner = _offset_inward(poly, t)
     zr = height - parapet
     k = len(poly)
-    tris = _triangulate(inner)
-    parts = [Mesh(np.c_[inner, np.full(k, zr)], tris, *_ids(CLS, "roof"))]
+    tris = triangulate(inner)
+    parts = [Mesh(np.c_[inner, np.full(k, zr)], tris, *resolve_ids(CLS, "roof"))]
     for i in range(k):
         j = (i + 1) % k
         q0, q1, p0, p1 = inner[i], inner[j], poly[i], poly[j]

@@ -12,7 +12,7 @@ import numpy as np
 
 from assets_procedural.building import building
 from assets_procedural.fence import fence
-from assets_procedural.mesh import Mesh
+from generator.geometry import Mesh
 from assets_procedural.person import person
 from assets_procedural.street_furniture import lamp_post, traffic_light, traffic_sign
 from assets_procedural.vegetation import bush, hedge, tree

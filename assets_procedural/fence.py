@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from assets_procedural.mesh import Mesh, box, merge, prism, pose
+from generator.geometry import Mesh, box, merge, prism, pose
 
 CLS = "fence"
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from assets_procedural.mesh import Mesh, box, icosphere, loft, merge, on_ground, tube
+from generator.geometry import Mesh, box, icosphere, loft, merge, on_ground, tube
 
 CLS = "person"
 POSES = ("standing", "walking")

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from assets_procedural.mesh import Mesh, box, cylinder, disc, merge, pose, prism, tube
+from generator.geometry import Mesh, box, cylinder, disc, merge, pose, prism, tube
 
 X = np.array([1.0, 0.0, 0.0])
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from assets_procedural.mesh import Mesh, icosphere, merge, on_ground, tube
+from generator.geometry import Mesh, icosphere, merge, on_ground, tube
 
 CROWN_BASE_MIN = 2.4  # metres: pedestrians and cars fit under a street tree
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from assets_procedural.mesh import Mesh, box, cylinder, disc, loft, merge, on_ground, polygon, pose, prism
+from generator.geometry import Mesh, box, cylinder, disc, loft, merge, on_ground, polygon, pose, prism
 
 GLASS_OFFSET = 0.02  # metres: glass in front of the body surface (>= 2 cm: no z-fighting)
 

@@ -25,7 +25,7 @@ import numpy as np
 from PIL import Image, ImageDraw
 
 from assets_procedural import catalog
-from assets_procedural.mesh import face_normals
+from generator.geometry import face_normals
 from generator.labels import class_table
 from generator.materials import material_table
 

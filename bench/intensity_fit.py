@@ -7,7 +7,7 @@ folder (SemanticKITTI-like class mix, normal remission per class, ~120k points p
 
 Methods (both read the same .bin/.label files with the same reader):
 
-* ours: :func:`generator.lidar.intensity_fit.fit_dataset` -- per scan three ``np.bincount``
+* ours: :func:`generator.remission.fit.fit_dataset` -- per scan three ``np.bincount``
   calls and a vectorised Chan merge;
 * Welford (published): the KITTI-CARLA converter's loop as published -- for every point,
   index the numpy arrays, map the label through SemanticKITTI's ``learning_map`` and do one
@@ -35,7 +35,7 @@ sys.path.insert(0, str(ROOT))
 
 from generator.formats import semantickitti as sk  # noqa: E402
 from generator.labels import class_table  # noqa: E402
-from generator.lidar.intensity_fit import accumulate, fit_dataset  # noqa: E402
+from generator.remission.fit import accumulate, fit_dataset  # noqa: E402
 
 #: raw id: (share of points, mean, std) -- roughly SemanticKITTI's mix
 MIX = {40: (0.22, 0.30, 0.09), 48: (0.12, 0.30, 0.10), 50: (0.15, 0.30, 0.14), 70: (0.25, 0.30, 0.16),

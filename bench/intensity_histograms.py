@@ -27,7 +27,7 @@ sys.path.insert(0, str(ROOT))
 
 from generator.formats import semantickitti as sk  # noqa: E402
 from generator.labels import class_table  # noqa: E402
-from generator.lidar.intensity import resolve_profile  # noqa: E402
+from generator.remission.class_profiles import resolve_profile  # noqa: E402
 
 COLORS = [(31, 119, 180), (255, 127, 14), (44, 160, 44), (214, 39, 40)]
 BINS = 40

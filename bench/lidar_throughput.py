@@ -36,9 +36,9 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from generator.layout.assemble import build_scene  # noqa: E402
-from generator.layout.frames import plan_frames  # noqa: E402
+from generator.world.rig import Rig  # noqa: E402
 from generator.lidar.caster import EmbreeCaster  # noqa: E402
-from generator.lidar.scan import Scanner, sweep_poses  # noqa: E402
+from generator.lidar.scan import Scanner  # noqa: E402
 from generator.lidar.sensors import sensor_for_spec  # noqa: E402
 from generator.spec import load_spec, parse_spec  # noqa: E402
 
@@ -123,8 +123,8 @@ def main(argv=None) -> int:
           f"{time.perf_counter() - t0:.1f} s; machine: {os.cpu_count()} cores")
     sensor = sensor_for_spec(spec)
     caster = EmbreeCaster.from_scene(scene)
-    frames = plan_frames(scene, spec, args.sweeps)
-    poses = [sweep_poses(scene, spec, sensor, f.t, motion_skew=True) for f in frames]
+    rig = Rig.from_spec(spec, scene)
+    poses = [rig.sweep_poses(f.t, sensor.column_time()) for f in rig.frames(args.sweeps)]
     n_rays = sensor.rays_per_sweep * len(poses)
     rows = []
 
@@ -249,8 +249,8 @@ def main(argv=None) -> int:
             t0 = time.perf_counter()
             c = EmbreeCaster.from_scene(sc_n)
             t_bvh = time.perf_counter() - t0
-            fr = plan_frames(sc_n, s, 5)
-            ps = [sweep_poses(sc_n, s, sensor, f.t, motion_skew=True) for f in fr]
+            rig_n = Rig.from_spec(s, sc_n)
+            ps = [rig_n.sweep_poses(f.t, sensor.column_time()) for f in rig_n.frames(5)]
             with Scanner(sc_n, sensor, threads=args.threads, caster=c) as sc:
                 sc.scan(ps[0])
                 secs, scans = timed(lambda: [sc.scan(p) for p in ps], repeat=2)

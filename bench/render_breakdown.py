@@ -23,7 +23,7 @@ def run(spec_path: str, config: str, frames: int, first: int) -> dict:
     from generator.blender.renderer import Renderer
     from generator.jobs.images import write_image
     from generator.layout.assemble import build_scene
-    from generator.layout.frames import plan_frames
+    from generator.world.rig import Rig
     from generator.spec import load_spec
     from generator.spec.render import load_render_config
     from generator.weather import draw_lighting
@@ -35,7 +35,7 @@ def run(spec_path: str, config: str, frames: int, first: int) -> dict:
     layout_s = time.perf_counter() - t
     r = Renderer(scene, spec, cfg, out / "scratch")
     rows = []
-    for f in plan_frames(scene, spec, frames, first=first):
+    for f in Rig.from_spec(spec, scene).frames(frames, first=first):
         info = r.set_conditions(draw_lighting(spec, f.index, "day"))
         rendered = r.render(f.T_world_camera, seed=f.index, light_info=info)
         _, secs = write_image(out, f, spec, cfg, r, rendered, "day", {"kind": "clear"})

@@ -27,9 +27,9 @@ import numpy as np
 from PIL import Image, ImageDraw
 
 from generator.imaging.exr import LabelledImage, read_exr, write_exr
-from generator.imaging.fog import fog_image
-from generator.imaging.preview import tonemap
-from generator.imaging.rain import rain_image
+from generator.postfx.fog import fog_image
+from generator.previews.preview import tonemap
+from generator.postfx.rain import rain_image
 from generator.rng import stream
 
 

@@ -3,6 +3,11 @@
 One integer seed comes from the spec. Every consumer asks for its own stream by
 name (``stream(seed, "layout", "trees")``), so adding a feature that draws numbers
 does not shift the draws of any other feature. No global seeding anywhere.
+
+Naming convention: scene-wide draws start with what they build (``("layout", "trees")``,
+``("assets", kind, i)``, ``("materials", name)``); per-frame draws start with the frame,
+then the feature (``("frame", k, "camera")``, ``("frame", k, "lidar_intensity")``,
+``("frame", k, "cycles", time_of_day, wet)``).
 """
 
 from __future__ import annotations

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from generator import rig
+from generator.world import rig
 from generator.imaging.exr import LabelledImage, write_exr
 from generator.labels import class_table
 
@@ -35,12 +35,12 @@ def raycast_image(caster, scene, T_world_camera: np.ndarray, K: np.ndarray, widt
 
 def write_raycast_images(root: Path, scene, spec, n_frames: int, width: int = 160, height: int = 96) -> None:
     """``root/images/NNNNNN_day_clear.{exr,json}`` for frames 0..n-1, ray-cast (metadata: the keys fusion reads)."""
-    from generator.layout.frames import plan_frames
+    from generator.world.rig import Rig
     from generator.lidar.caster import EmbreeCaster
 
     caster = EmbreeCaster.from_scene(scene)
     K = rig.intrinsics(spec.sensors.camera.hfov_deg, width, height)
-    for f in plan_frames(scene, spec, n_frames):
+    for f in Rig.from_spec(spec, scene).frames(n_frames):
         cls, inst, depth = raycast_image(caster, scene, f.T_world_camera, K, width, height)
         name = f"{f.index:06d}_day_clear"
         write_exr(root / "images" / f"{name}.exr", LabelledImage(np.zeros((height, width, 3), np.float32), cls, inst, depth))

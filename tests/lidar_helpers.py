@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from assets_procedural.mesh import Mesh
-from generator.scene import OrientedBox, Path, SceneModel, SceneObject
+from generator.geometry import Mesh
+from generator.world.scene import OrientedBox, Path, SceneModel, SceneObject
 
 
 def straight_path(x0: float = -200.0, x1: float = 200.0, y: float = 0.0, heading: float = 0.0,

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from assets_procedural import mesh as M
+from generator import geometry as M
 from generator.labels import class_table
-from generator.scene import OrientedBox, Path, SceneModel, SceneObject
+from generator.world.scene import OrientedBox, Path, SceneModel, SceneObject
 
 
 def make_scene(parts, seed: int = 0, paths=None, proxies=None) -> SceneModel:

@@ -11,8 +11,8 @@ import pytest
 from trimesh.ray.ray_pyembree import RayMeshIntersector
 
 from assets_procedural import catalog
-from assets_procedural.mesh import Mesh, face_normals, loft, tube
-from assets_procedural.proxy import label_proxy
+from generator.geometry import Mesh, face_normals, loft, tube
+from generator.geometry.proxy import label_proxy
 from generator.labels import class_table
 from generator.materials import material_table
 

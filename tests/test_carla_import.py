@@ -9,7 +9,7 @@ import pytest
 import yaml
 
 import generator.cli as cli
-from generator import rig
+from generator.world import rig
 from generator.formats import carla_ply
 from generator.formats import semantickitti as sk
 from generator.labels import class_table

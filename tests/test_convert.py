@@ -12,7 +12,7 @@ import yaml
 import generator.cli as cli
 from generator.formats import semantickitti as sk
 from generator.labels import class_table
-from generator.lidar.convert import native_to_semantickitti, semantickitti_to_unified, unified_to_semantickitti
+from generator.labels.sets import native_to_semantickitti, semantickitti_to_unified, unified_to_semantickitti
 
 
 @pytest.fixture(autouse=True)

@@ -8,12 +8,12 @@ import json
 import numpy as np
 import pytest
 
-from assets_procedural.mesh import box, rect
+from generator.geometry import box, rect
 from generator.errors import UserError
 from generator.formats import semantickitti as sk
-from generator.lidar.domain_gap import DomainGap, PRESETS, apply_domain_gap, apply_to_points, preset
+from generator.scan_effects.domain_gap import DomainGap, PRESETS, apply_domain_gap, apply_to_points, preset
 from generator.lidar.scan import POINT_DTYPE
-from generator.lidar.sequence import SequenceOptions, write_sequence
+from generator.jobs.lidar_sequence import SequenceOptions, write_sequence
 from generator.rng import stream
 from lidar_helpers import scene_of
 

@@ -9,7 +9,7 @@ import pytest
 from generator.errors import UserError
 from generator.imaging.exr import LabelledImage, mask_channel, read_exr, write_exr
 from generator.imaging.metadata import camera_angles, class_pixels
-from generator.imaging.preview import tonemap, write_preview
+from generator.previews.preview import tonemap, write_preview
 from generator.labels import class_table
 
 
@@ -100,7 +100,7 @@ def test_class_pixels_sum_to_image(image):
 
 
 def test_camera_angles():
-    from generator import rig
+    from generator.world import rig
 
     t = rig.ego_pose(np.zeros(3), np.radians(30)) @ rig.camera_extrinsics((0, 0, 1.6), (0, 0, 0),
                                                                           np.radians([10, -5, 4]))

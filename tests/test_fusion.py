@@ -7,8 +7,8 @@ import json
 import numpy as np
 import pytest
 
-from assets_procedural import mesh as M
-from generator import rig
+from generator import geometry as M
+from generator.world import rig
 from generator.cli import main
 from generator.fusion import projection as P
 from generator.fusion.agreement import HEADLINE, Agreement, FusedFrame, variant_key
@@ -123,10 +123,10 @@ def test_boundary_mask_marks_pixels_next_to_another_class():
 
 # -- de-skew ------------------------------------------------------------------------------------------
 def test_deskew_with_the_recorded_sweep_poses_is_exact_through_a_turn(test_spec):
-    from generator.formats.sweep_poses import sweep_record
-    from generator.lidar.scan import Scanner, sensor_mount, sweep_poses
+    from generator.lidar.scan import Scanner
+    from generator.world.rig import Rig
     from generator.lidar.sensors import sensor_for_spec
-    from generator.scene import Path
+    from generator.world.scene import Path
 
     # a straight that turns into an arc (0.1 rad per metre) at s = 10 m: the yaw rate jumps mid-sweep
     s = np.arange(0.0, 40.0, 1.0)
@@ -138,13 +138,14 @@ def test_deskew_with_the_recorded_sweep_poses_is_exact_through_a_turn(test_spec)
     scene.paths = [Path("kink", pts - [8.0, 0.0, 0.0], heading, s, False)]
     sensor = sensor_for_spec(test_spec)
     t0 = 9.6 / test_spec.paths.speed_mps  # the sweep covers s = 9.6 .. 10.4
-    poses = sweep_poses(scene, test_spec, sensor, t0)  # one pose per column: skew on
+    rig = Rig.from_spec(test_spec, scene)
+    poses = rig.sweep_poses(t0, sensor.column_time())  # one pose per column: skew on
     with Scanner(scene, sensor, threads=2) as sc:
         scan = sc.scan(poses)
     p = scan.points
     xyz = scan.xyz.astype(np.float64)
     exact_world = np.einsum("nij,nj->ni", poses[p["column"], :3, :3], xyz) + poses[p["column"], :3, 3]
-    rec = sweep_record(scene, test_spec, t0, sensor.period_s, sensor_mount(test_spec))
+    rec = rig.sweep_record(t0, sensor.period_s)
     assert len(rec["t_s"]) == 3 and rec["t_s"][1] == pytest.approx(0.4 / test_spec.paths.speed_mps)
     fixed = P.transform(poses[0], P.deskew(xyz, p["time"], rec["t_s"], rec["T_world_lidar"]))
     assert np.abs(fixed - exact_world).max() < 1e-3
@@ -204,7 +205,7 @@ def test_voxel_map_keeps_the_majority_label_and_the_centroid():
 @pytest.fixture(scope="module")
 def raycast_dataset(tmp_path_factory, test_spec):
     from generator.layout.assemble import build_scene
-    from generator.lidar.sequence import SequenceOptions, write_sequence
+    from generator.jobs.lidar_sequence import SequenceOptions, write_sequence
 
     root = tmp_path_factory.mktemp("fuse")
     scene = build_scene(test_spec)
@@ -240,7 +241,7 @@ def test_fuse_refuses_a_folder_without_images(tmp_path, capsys):
 @pytest.fixture(scope="module")
 def rendered_dataset(tmp_path_factory, test_spec):
     from generator.layout.assemble import build_scene
-    from generator.lidar.sequence import SequenceOptions, write_sequence
+    from generator.jobs.lidar_sequence import SequenceOptions, write_sequence
 
     root = tmp_path_factory.mktemp("rendered")
     assert main(["render", test_spec.source, "--config", "test", "--out", str(root), "--frames", "2"]) == 0

@@ -13,9 +13,9 @@ import generator.cli as cli
 from generator.errors import SpecError, UserError
 from generator.formats import semantickitti as sk
 from generator.labels import class_table
-from generator.lidar import intensity
-from generator.lidar.intensity_fit import ClassMoments, fit_dataset
-from generator.lidar.remission import intensity_fn_for_spec, intensity_model
+from generator.remission import class_profiles, models as intensity
+from generator.remission.fit import ClassMoments, fit_dataset
+from generator.remission.models import intensity_fn_for_spec, intensity_model
 from generator.lidar.scan import POINT_DTYPE
 from generator.materials import material_table
 
@@ -47,15 +47,15 @@ def censored_moments(mean: float, std: float) -> tuple[float, float]:
 
 
 def test_table3_profile_is_shipped_and_complete():
-    prof = intensity.resolve_profile(None)
+    prof = class_profiles.resolve_profile(None)
     assert prof.name == "semantickitti_table3"
     assert set(prof.unified) == set(class_table().unified_names.values())
-    assert prof.unified["traffic-sign"] == intensity.ClassStats(0.499, 0.367, None)
+    assert prof.unified["traffic-sign"] == class_profiles.ClassStats(0.499, 0.367, None)
     assert prof.unified["road"].mean == 0.303 and prof.unified["road"].std == 0.087
 
 
 def test_class_normal_samples_have_profile_moments_and_stay_in_unit_interval():
-    prof = intensity.resolve_profile(None)
+    prof = class_profiles.resolve_profile(None)
     table = class_table()
     fn = intensity.class_normal(prof)
     n = 200_000
@@ -75,7 +75,7 @@ def test_class_normal_samples_have_profile_moments_and_stay_in_unit_interval():
 
 def test_native_points_use_raw_then_unified_class():
     table = class_table()
-    prof = intensity.resolve_profile(None)
+    prof = class_profiles.resolve_profile(None)
     fn = intensity.class_normal(prof)
     n = 100_000
     for native in ("car", "truck", "traffic_light", "tree_trunk", "crosswalk", "parking"):
@@ -88,7 +88,7 @@ def test_native_points_use_raw_then_unified_class():
 
 
 def test_raw_entry_takes_precedence_over_unified():
-    prof = intensity.parse_profile({"unified": {"unlabeled": {"mean": 0.1, "std": 0.0}, "road": {"mean": 0.3, "std": 0.0}},
+    prof = class_profiles.parse_profile({"unified": {"unlabeled": {"mean": 0.1, "std": 0.0}, "road": {"mean": 0.3, "std": 0.0}},
                                     "semantickitti": {60: {"mean": 0.9, "std": 0.0}}}, "p.yaml")
     x = intensity.class_normal(prof)(semantic_points(np.array([40, 60, 48, 10], np.uint16)), np.random.default_rng(0))
     # 40 road -> unified road, 60 raw entry, 48 sidewalk and 10 car fall back to unlabeled
@@ -109,12 +109,12 @@ def test_bad_profiles_name_the_file(tmp_path, doc, message):
     p = tmp_path / "bad.yaml"
     p.write_text(yaml.safe_dump(doc))
     with pytest.raises(UserError, match="bad.yaml") as e:
-        intensity.load_profile(p)
+        class_profiles.load_profile(p)
     assert message in str(e.value)
 
 
 def test_missing_class_without_unlabeled_entry_is_refused():
-    prof = intensity.parse_profile({"unified": {"road": {"mean": 0.3, "std": 0.1}}}, "p.yaml")
+    prof = class_profiles.parse_profile({"unified": {"road": {"mean": 0.3, "std": 0.1}}}, "p.yaml")
     with pytest.raises(UserError, match="no .unlabeled. or .pooled. entry"):
         intensity.class_normal(prof)
 
@@ -168,7 +168,7 @@ def test_physical_without_materials_uses_class_reflectivity():
 
 
 def test_hybrid_keeps_the_class_mean_at_reference_geometry_and_darkens_grazing_far_points():
-    prof = intensity.resolve_profile(None)
+    prof = class_profiles.resolve_profile(None)
     fn = intensity.hybrid(prof)
     n = 100_000
     ref = fn(semantic_points(np.full(n, 40, np.uint16), 15.0, 0.5), np.random.default_rng(0))
@@ -267,7 +267,7 @@ def test_fit_command_writes_a_profile_class_normal_can_use(tmp_path, capsys):
     out = tmp_path / "p.yaml"
     assert cli.main(["intensity", "fit", str(tmp_path / "ds"), "--sequences", "00", "-o", str(out)]) == 0
     assert "from 2 scans" in capsys.readouterr().out
-    prof = intensity.load_profile(out)
+    prof = class_profiles.load_profile(out)
     doc = yaml.safe_load(out.read_text())
     assert doc["semantickitti"][40]["name"] == "road" and doc["semantickitti"][40]["count"] > 0
     x = intensity.class_normal(prof)(semantic_points(np.full(50_000, 60, np.uint16)), np.random.default_rng(0))

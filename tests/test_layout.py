@@ -8,17 +8,18 @@ import numpy as np
 import pytest
 from scipy.spatial import ConvexHull
 
-from assets_procedural.mesh import apply
+from generator.geometry import apply
 from generator.labels import class_table
 from generator.layout import build_scene
-from generator.layout.frames import plan_frames
+from generator.world.rig import Rig
 from generator.layout.placement_core import EGO_HALF_WIDTH_M, overlaps, point_box_distance
-from generator.imaging.layout_map import rasterize
+from generator.previews.layout_map import rasterize
 from generator.layout.lots import make_lots
 from generator.layout.outskirts import HORIZON_M
-from generator.layout.streets import MARK_Z_M, make_grid, segment_frame_points
+from generator.layout.street_meshes import segment_frame_points
+from generator.layout.streets import MARK_Z_M, make_grid
 from generator.materials import material_table
-from generator.scene import OrientedBox
+from generator.world.scene import OrientedBox
 from generator.spec import parse_spec
 
 
@@ -463,10 +464,10 @@ def test_route_zero_keeps_right(default_spec, default_scene):
 def test_frames_follow_route_zero(default_spec, default_scene):
     """Frame 0 starts on a straight leg, and every frame sits on route 0 facing along it."""
     path = default_scene.paths[0]
-    frames = plan_frames(default_scene, default_spec, 4)
+    frames = Rig.from_spec(default_spec, default_scene).frames(4)
     steps = [np.linalg.norm(b.T_world_ego[:2, 3] - a.T_world_ego[:2, 3]) for a, b in zip(frames, frames[1:])]
     assert np.allclose(steps, default_spec.paths.spacing_m, rtol=1e-3)
-    for f in plan_frames(default_scene, default_spec, 30, first=5):
+    for f in Rig.from_spec(default_spec, default_scene).frames(30, first=5):
         pos, hd = path.at(f.s)
         assert np.allclose(f.T_world_ego[:3, 3], pos[0])
         assert np.allclose(f.T_world_ego[:2, 0], [np.cos(hd[0]), np.sin(hd[0])])

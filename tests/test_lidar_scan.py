@@ -7,11 +7,12 @@ import dataclasses
 import numpy as np
 import pytest
 
-from assets_procedural.mesh import box, convex_hull, rect
-from generator import rig
+from generator.geometry import box, convex_hull, rect
+from generator.world import rig
 from generator.labels import class_table
 from generator.lidar.caster import EmbreeCaster
-from generator.lidar.scan import POINT_DTYPE, Scanner, sweep_poses
+from generator.lidar.scan import POINT_DTYPE, Scanner
+from generator.world.rig import Rig
 from generator.lidar.sensors import load_preset
 from generator.materials import material_table
 from lidar_helpers import scene_of, straight_path
@@ -138,7 +139,7 @@ def test_motion_skew_first_and_last_columns_are_a_sweep_apart(hdl64e, test_spec,
     scene = _wall_scene()
     building = class_table().id("building")
     with Scanner(scene, hdl64e, threads=2) as sc:
-        poses = sweep_poses(scene, spec, hdl64e, t0=0.0)
+        poses = Rig.from_spec(spec, scene).sweep_poses(0.0, hdl64e.column_time() if skew else None)
         p = sc.scan(poses).points
     assert poses.shape == ((hdl64e.azimuth_steps, 4, 4) if skew else (4, 4))
     last = hdl64e.azimuth_steps - 1

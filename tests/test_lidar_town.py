@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from generator.labels import class_table
-from generator.layout.frames import plan_frames
-from generator.lidar.scan import Scanner, sweep_poses
+from generator.lidar.scan import Scanner
+from generator.world.rig import Rig
 from generator.lidar.sensors import sensor_for_spec
 
 assemble = pytest.importorskip("generator.layout.assemble")
@@ -18,7 +18,8 @@ def town_scans(default_spec):
     scene = assemble.build_scene(default_spec)
     sensor = sensor_for_spec(default_spec)
     with Scanner(scene, sensor, threads=2) as sc:
-        scans = [sc.scan(sweep_poses(scene, default_spec, sensor, f.t)) for f in plan_frames(scene, default_spec, 3)]
+        rig = Rig.from_spec(default_spec, scene)
+        scans = [sc.sweep(rig, f.t, default_spec.sensors.lidar.motion_skew) for f in rig.frames(3)]
     return scene, sensor, scans
 
 

@@ -8,14 +8,14 @@ import json
 import numpy as np
 import pytest
 
-from assets_procedural.mesh import box, rect
+from generator.geometry import box, rect
 from generator.formats import semantickitti as sk
 from generator.labels import class_table
-from generator.lidar.pipeline import ScanProcessing, process_scan, processing_for_spec
-from generator.lidar.remission import constant
+from generator.scan_effects.pipeline import ScanProcessing, process_scan, processing_for_spec
+from generator.remission.models import constant
 from generator.lidar.scan import POINT_DTYPE
-from generator.lidar.sequence import SequenceOptions, write_sequence
-from generator.lidar.weather import (LidarWeatherParams, apply_lidar_weather, extinction_per_m, frame_weather,
+from generator.jobs.lidar_sequence import SequenceOptions, write_sequence
+from generator.scan_effects.weather import (LidarWeatherParams, apply_lidar_weather, extinction_per_m, frame_weather,
                                      weather_config)
 from generator.materials import material_table
 from generator.weather import KOSCHMIEDER, Weather, draw_weather, lidar_combination

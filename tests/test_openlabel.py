@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from generator import rig
+from generator.world import rig
 from generator.cli import main
 from generator.formats import semantickitti as sk
 from generator.formats.openlabel import (SCHEMA_PATH, cuboid_contains, cuboid_val, validate_openlabel,
@@ -16,7 +16,7 @@ from generator.formats.openlabel import (SCHEMA_PATH, cuboid_contains, cuboid_va
 from generator.formats.point_sidecars import TIMES_DIR, read_sidecar
 from generator.fusion.projection import deskew, transform
 from generator.labels import class_table
-from generator.scene import OrientedBox
+from generator.world.scene import OrientedBox
 
 ROOT = Path(__file__).resolve().parents[1]
 REFERENCE_SCHEMA = ROOT.parent / "shared" / "reference" / "openlabel_json_schema-v1.0.0.json"
@@ -26,7 +26,7 @@ REFERENCE_SCHEMA = ROOT.parent / "shared" / "reference" / "openlabel_json_schema
 def town_dataset(tmp_path_factory, test_spec):
     """The test town cast for 3 frames into DIR/lidar, then ``urbangen openlabel`` on it."""
     from generator.layout.assemble import build_scene
-    from generator.lidar.sequence import SequenceOptions, write_sequence
+    from generator.jobs.lidar_sequence import SequenceOptions, write_sequence
 
     root = tmp_path_factory.mktemp("olds")
     scene = build_scene(test_spec)
@@ -80,7 +80,7 @@ def _vehicle_points(root: Path, k: int, meta: dict, T_ego_lidar: np.ndarray):
 
 
 def test_every_cuboid_holds_its_objects_points_and_no_other_objects(town_dataset, test_spec):
-    from generator.lidar.scan import sensor_mount
+    from generator.world.rig import Rig
 
     root, scene, doc = town_dataset
     ol = doc["openlabel"]
@@ -90,7 +90,7 @@ def test_every_cuboid_holds_its_objects_points_and_no_other_objects(town_dataset
     thing_instances = {o.instance_id for o in scene.objects if o.instance_id > 0 and thing[class_table().id(o.cls)]}
     checked = 0
     for key, frame in ol["frames"].items():
-        xyz, inst = _vehicle_points(root, int(key), meta, sensor_mount(test_spec))
+        xyz, inst = _vehicle_points(root, int(key), meta, Rig.from_spec(test_spec).T_ego_lidar)
         counts = np.bincount(inst, minlength=65536)
         for uid, data in frame["objects"].items():
             val = data["object_data"]["cuboid"][0]["val"]

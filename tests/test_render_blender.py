@@ -7,7 +7,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from generator import rig
+from generator.world import rig
 from generator.labels import class_table
 from generator.weather import Lighting
 from scene_kit import fence_scene

@@ -12,7 +12,7 @@ import pytest
 
 from generator.cli import main
 from generator.imaging.exr import read_exr
-from generator.imaging.preview import tonemap
+from generator.previews.preview import tonemap
 from generator.labels import class_table
 from generator.weather import combinations
 

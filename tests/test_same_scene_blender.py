@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from generator.lidar.caster import EmbreeCaster
-from generator.lidar.scan import sensor_mount
+from generator.world.rig import Rig
 from generator.lidar.sensors import sensor_for_spec
 
 pytestmark = pytest.mark.blender
@@ -38,7 +38,7 @@ def test_embree_distances_equal_blender_ray_cast(town, test_spec):
     T = np.asarray(scene.paths[0].at(5.0)[0][0])
     pose = np.eye(4)
     pose[:3, 3] = T
-    T_world = pose @ sensor_mount(test_spec)
+    T_world = pose @ Rig.from_spec(test_spec).T_ego_lidar
     o = (origins.reshape(-1, 3) @ T_world[:3, :3].T + T_world[:3, 3])
     d = dirs.reshape(-1, 3) @ T_world[:3, :3].T
     pick = np.random.default_rng(0).choice(len(o), 3000, replace=False)

@@ -10,15 +10,16 @@ import numpy as np
 import pytest
 import yaml
 
-from assets_procedural.mesh import box, rect
-from generator import rig
+from generator.geometry import box, rect
+from generator.world import rig
+from generator.world.rig import Rig
 from generator.errors import UserError
 from generator.formats import kitti_calib
 from generator.formats import semantickitti as sk
 from generator.formats.label_config import label_config
 from generator.formats.ply import read_ply, write_ply
 from generator.labels import class_table
-from generator.lidar.sequence import SequenceOptions, write_sequence
+from generator.jobs.lidar_sequence import SequenceOptions, write_sequence
 from lidar_helpers import scene_of, straight_path
 
 HEADING = 0.7  # a diagonal route, so the pose chain is tested with a rotation
@@ -69,7 +70,7 @@ def test_reader_errors_name_the_file(tmp_path):
 
 
 def test_calib_from_the_rig_is_kitti_like(default_spec, tmp_path):
-    calib = kitti_calib.kitti_calib(default_spec, 640, 360)
+    calib = kitti_calib.kitti_calib(Rig.from_spec(default_spec), 640, 360)
     tr = kitti_calib.homogeneous(calib["Tr"])
     # velodyne x forward -> camera z; y left -> -x; z up -> -y (KITTI's Tr rotation)
     np.testing.assert_allclose(tr[:3, :3], [[0, -1, 0], [0, 0, -1], [1, 0, 0]], atol=1e-12)

@@ -9,7 +9,7 @@ import numpy as np
 import OpenEXR
 import pytest
 
-from generator import rig
+from generator.world import rig
 
 pytestmark = pytest.mark.blender
 

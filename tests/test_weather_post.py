@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 from generator.imaging.exr import LabelledImage, read_exr, write_exr
-from generator.imaging.fog import (DAY_AIRLIGHT, NIGHT_AIRLIGHT, airlight_for, apply_fog, beta_from_visibility,
-                                   block_mean, blur_wide, fog_image, upsample)
-from generator.imaging.rain import apply_rain, rain_image, streak_alpha, streak_radiance
+from generator.postfx.filters import block_mean, blur_wide, upsample
+from generator.postfx.fog import DAY_AIRLIGHT, NIGHT_AIRLIGHT, airlight_for, apply_fog, beta_from_visibility, fog_image
+from generator.postfx.rain import apply_rain, rain_image, streak_alpha, streak_radiance
 from generator.rng import stream
 
 H, W = 90, 160

@@ -15,10 +15,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from assets_procedural.mesh import Mesh
+from generator.geometry import Mesh
 from generator.blender.bpy_guard import bpy, mathutils
 from generator.materials import material_table
-from generator.scene import SceneModel
+from generator.world.scene import SceneModel
 
 #: Materials shaded smooth (organic shapes); everything else is flat (hard surfaces).
 SMOOTH_MATERIALS = frozenset({"leaves", "hedge_leaves", "bark", "skin", "hair", "clothing", "rubber"})

@@ -11,11 +11,11 @@ import math
 
 import numpy as np
 
-from assets_procedural.mesh import apply
+from generator.geometry import apply
 from generator.blender.bpy_guard import bpy, mathutils
 from generator.blender.lighting import ensure_lamp
 from generator.blender.nodes import Nodes
-from generator.scene import SceneModel
+from generator.world.scene import SceneModel
 
 LAMP_POWER_W = 900.0
 LAMP_CONE_DEG = 130.0

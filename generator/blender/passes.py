@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 import OpenEXR
 
-from generator import rig
+from generator.world import rig
 from generator.blender import geometry, session
 from generator.blender.bpy_guard import bpy
 from generator.blender.materials import label_material, label_world

@@ -9,10 +9,10 @@ from pathlib import Path
 
 import numpy as np
 
-from generator import rig
+from generator.world import rig
 from generator.blender import camera, controls, geometry, lighting, materials, night, passes, session
 from generator.blender.bpy_guard import bpy
-from generator.scene import SceneModel
+from generator.world.scene import SceneModel
 from generator.spec.model import SceneSpec
 from generator.spec.render import RenderConfig
 
@@ -59,6 +59,11 @@ class Renderer:
         controls.apply(self.bscene, controls.DAY_DEFAULTS)
         self.build_seconds = time.perf_counter() - t
         log.info("Blender scene built in %.2f s (%d objects, device %s)", self.build_seconds, len(scene.objects), self.device)
+
+    @property
+    def cycles_seconds(self) -> dict[str, float]:
+        """Seconds spent inside Cycles' render calls in this process: ``{"rgb": s, "labels": s}``."""
+        return dict(passes.CYCLES_SECONDS)
 
     @property
     def blender_version(self) -> str:

@@ -12,7 +12,7 @@ from pathlib import Path
 
 from generator.commands.intensity import parse_sequences
 from generator.errors import UserError
-from generator.lidar.convert import LABEL_SETS, convert_dataset
+from generator.formats.relabel import TARGETS, convert_dataset
 
 
 def register(sub) -> None:
@@ -20,7 +20,7 @@ def register(sub) -> None:
                        description=__doc__.split("\n\n")[1])
     p.add_argument("input", type=Path, help="dataset root (holds sequences/NN)")
     p.add_argument("output", type=Path, help="output dataset root")
-    p.add_argument("--labels", required=True, choices=tuple(LABEL_SETS), help="target label set")
+    p.add_argument("--labels", required=True, choices=tuple(TARGETS), help="target label set")
     p.add_argument("--sequences", default=None, help="comma-separated sequence numbers (default: all with labels)")
     p.set_defaults(func=run)
 

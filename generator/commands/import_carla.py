@@ -16,13 +16,14 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from generator import __version__, rig
+from generator import __version__
+from generator.world import rig
 from generator.atomic import staging, write_json
 from generator.commands.intensity import add_processing_args, gap_from_args, intensity_fn_from_args
 from generator.errors import UserError
 from generator.formats import carla_ply, kitti_calib, semantickitti as sk
 from generator.formats.label_config import count_raw_ids, merge_counts
-from generator.lidar.pipeline import ScanProcessing, process_scan
+from generator.scan_effects.pipeline import ScanProcessing, process_scan
 
 log = logging.getLogger(__name__)
 
@@ -168,7 +169,7 @@ def _metadata(town, frames, pose_file, name, processing, seed, records, counts, 
 
 def _label_config(out: Path) -> None:
     """Rewrite ``out/semantic-kitti.yaml`` when every sequence has metadata with counts (no label re-reading)."""
-    from generator.lidar.sequence import META_NAME, write_dataset_label_config
+    from generator.jobs.lidar_sequence import META_NAME, write_dataset_label_config
 
     names = sk.list_sequences(out)
     missing = [n for n in names if not (out / "sequences" / n / META_NAME).is_file()]

@@ -1,7 +1,7 @@
 """``urbangen intensity fit DATASET [--sequences 00,01] [--labels semantickitti|unified11] -o PROFILE.yaml``.
 
 Fits per-class remission mean and standard deviation from any SemanticKITTI-layout dataset
-(streaming, vectorised; see :mod:`generator.lidar.intensity_fit`) and writes a profile the
+(streaming, vectorised; see :mod:`generator.remission.fit`) and writes a profile the
 ``class_normal`` and ``hybrid`` intensity models read (``lidar.intensity_profile`` or
 ``--intensity-profile``). Also home of the intensity / domain-gap / LiDAR-weather options
 that ``lidar`` and ``import-carla`` share.
@@ -13,9 +13,9 @@ import argparse
 from pathlib import Path
 
 from generator.errors import UserError
-from generator.lidar.domain_gap import DomainGap, preset
-from generator.lidar.intensity import LABEL_SPACES, resolve_profile
-from generator.lidar.remission import MODEL_NAMES, IntensityFn, intensity_model
+from generator.scan_effects.domain_gap import DomainGap, preset
+from generator.remission.class_profiles import LABEL_SPACES, resolve_profile
+from generator.remission.models import MODEL_NAMES, IntensityFn, intensity_model
 
 WEATHER_CHOICES = {"auto": None, "on": True, "off": False}
 
@@ -45,7 +45,7 @@ def parse_sequences(text: str | None) -> list[str] | None:
 
 
 def run_fit(args) -> int:
-    from generator.lidar.intensity_fit import fit_dataset, write_profile
+    from generator.remission.fit import fit_dataset, write_profile
 
     if not args.dataset.is_dir():
         raise UserError(f"{args.dataset}: dataset folder not found")

@@ -64,7 +64,7 @@ def _kinds(scene) -> dict[str, int]:
 
 def run(args: argparse.Namespace) -> int:
     from generator.formats.glb import scene_to_glb
-    from generator.imaging.layout_map import render_map
+    from generator.previews.layout_map import render_map
     from generator.layout.assemble import build_scene
 
     spec = load_spec(args.spec)

@@ -15,7 +15,7 @@ from pathlib import Path
 from generator.commands.intensity import add_processing_args, spec_with_processing_args
 from generator.errors import UserError
 from generator.formats.semantickitti import sequence_name
-from generator.lidar.remission import intensity_fn_for_spec
+from generator.remission.models import intensity_fn_for_spec
 from generator.lidar.sensors import sensor_for_spec
 from generator.spec import load_spec
 from generator.spec.render import load_render_config
@@ -60,7 +60,7 @@ def run(args) -> int:
         raise UserError(f"--out: {out} is not writable")
 
     from generator.layout.assemble import build_scene
-    from generator.lidar.sequence import SequenceOptions, check_frames, write_sequence
+    from generator.jobs.lidar_sequence import SequenceOptions, check_frames, write_sequence
 
     scene = build_scene(spec)
     check_frames(scene, spec, args.frames)

@@ -14,9 +14,9 @@ from PIL import Image
 
 from generator.atomic import atomic_path
 from generator.errors import UserError
-from generator.imaging.contact_sheet import variants_sheet
+from generator.previews.contact_sheet import variants_sheet
 from generator.imaging.exr import read_exr
-from generator.imaging.preview import colorize, side_by_side, tonemap
+from generator.previews.preview import colorize, side_by_side, tonemap
 from generator.labels import class_table
 
 PREFERRED = ("day_clear", "night_clear")
@@ -50,7 +50,7 @@ def _frames(root: Path) -> dict[int, list[Path]]:
 def _bev(root: Path, frame: int, size: int) -> np.ndarray | None:
     from generator.formats.point_sidecars import NATIVE_DIR, read_sidecar
     from generator.formats.semantickitti import list_sequences, read_labels, read_scan
-    from generator.imaging.bev import bev_image
+    from generator.previews.bev import bev_image
 
     lidar = root / "lidar"
     if not (lidar / "sequences").is_dir():

@@ -1,4 +1,4 @@
-"""``urbangen render SPEC --config CFG --out DIR [--frames N] [--variants V] [--workers N]``.
+"""``urbangen render SPEC --config CFG --out DIR [--frames N] [--variants V] [--workers N] [--executor local|ray]``.
 
 Renders frames along the scene's route: per image one multilayer EXR (RGB + one mask
 channel per class + depth + instance), a metadata JSON and a preview PNG, in
@@ -13,9 +13,11 @@ import logging
 import shutil
 from pathlib import Path
 
+from dataclasses import dataclass
+
 from generator.errors import UserError
+from generator.jobs.executors import EXECUTORS, make_jobs, run_jobs
 from generator.jobs.images import image_name
-from generator.jobs.pool import deal, run_workers, scratch_dir
 from generator.jobs.variants import parse_combos
 from generator.spec import load_spec
 from generator.spec.render import load_render_config
@@ -33,6 +35,9 @@ def add_render_arguments(p, out_help: str, frames: int, variants: str) -> None:
                    help=f"all (12 weather x time combinations per frame), clear (day, clear), or pairs like "
                         f"day:fog,night:rain (default {variants})")
     p.add_argument("--workers", type=int, default=1, help="parallel Blender processes (default 1)")
+    p.add_argument("--executor", default="local", choices=EXECUTORS,
+                   help="where the render workers run: local (spawned processes, default) or ray")
+    p.add_argument("--ray-address", default=None, help="address of an existing Ray cluster (default: start a local one)")
 
 
 def register(sub) -> None:
@@ -50,12 +55,22 @@ def positive(name: str, value: int, minimum: int = 1) -> int:
     return value
 
 
-def run(args) -> int:
+@dataclass(frozen=True)
+class RenderArgs:
+    """The validated options ``render`` and ``generate`` share."""
+
+    spec: object
+    cfg: object
+    out: Path
+    combos: list
+
+
+def check_render_args(args) -> RenderArgs:
+    """Load the spec and config and check the shared options; a bad one is a one-line user error."""
     spec = load_spec(args.spec)
     cfg = load_render_config(args.config)
     positive("frames", args.frames)
     positive("workers", args.workers)
-    positive("first", args.first, 0)
     out: Path = args.out
     if out.exists() and not out.is_dir():
         raise UserError(f"--out: {out} exists and is not a folder")
@@ -63,14 +78,20 @@ def run(args) -> int:
         combos = parse_combos(args.variants)
     except ValueError as e:
         raise UserError(f"--variants: {e}") from None
+    return RenderArgs(spec, cfg, out, combos)
+
+
+def run(args) -> int:
+    r = check_render_args(args)
+    positive("first", args.first, 0)
+    out, combos = r.out, r.combos
     todo = [k for k in range(args.first, args.first + args.frames)
             if not all((out / "images" / f"{image_name(k, t, w)}.json").exists() for t, w in combos)]
     if not todo:
         log.info("all %d frames already rendered in %s", args.frames, out)
         return 0
-    jobs = [{"spec": spec, "config": cfg, "out": str(out), "frames": frames, "combos": combos,
-             "scratch": str(scratch_dir(out, i))} for i, frames in enumerate(deal(todo, args.workers))]
-    res = run_workers("generator.blender.worker:run", jobs, total=len(todo), desc="render")
+    jobs = make_jobs(r.spec, r.cfg, out, todo, combos, args.workers)
+    res = run_jobs(args.executor, jobs, len(todo), None, args.ray_address)
     shutil.rmtree(out / ".scratch", ignore_errors=True)
     n = sum(len(msg["images"]) for msg in res.frame_seconds.values())
     print(f"rendered {n} images of {len(res.frame_seconds)} frames into {out / 'images'} in {res.wall_s:.1f} s")

@@ -12,7 +12,7 @@ import numpy as np
 import trimesh
 
 from generator.labels import class_table
-from generator.scene import SceneModel
+from generator.world.scene import SceneModel
 
 #: world (z-up) -> glTF (y-up)
 Z_UP_TO_Y_UP = np.array([[1, 0, 0, 0], [0, 0, 1, 0], [0, -1, 0, 0], [0, 0, 0, 1]], np.float64)

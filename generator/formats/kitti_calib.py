@@ -3,7 +3,7 @@
 ``calib.txt`` (one ``KEY: 12 numbers`` line each, row-major 3x4):
 
 * ``P0`` .. ``P3``: projection matrices ``K [I | 0]`` of the rig camera, with ``K`` from
-  :func:`generator.rig.intrinsics` (hfov of the spec, resolution of the render config).
+  :meth:`generator.world.rig.Rig.K` (hfov of the spec, resolution of the render config).
   urbangen renders ONE camera, which plays KITTI's cam0 and cam2 at once, so all four
   matrices are equal with zero baselines: a KITTI tool projecting with ``P2 @ Tr`` lands
   on urbangen's image. (Stereo tools dividing by the P1 baseline do not apply.) Pixel
@@ -11,7 +11,7 @@
   ``floor(u), floor(v)`` is the pixel hit; for OpenCV's integer-centre convention
   subtract 0.5 from ``cx, cy``.
 * ``Tr``: velodyne -> cam0 (``T_cam0_velo``), from the rig mounts WITHOUT the per-frame
-  camera jitter (``rig.camera_extrinsics(xyz, rpy)`` and ``rig.mount`` of the LiDAR).
+  camera jitter (:meth:`generator.world.rig.Rig.T_camera_lidar`).
   With the default KITTI-like mounts it is about ``R = [[0,-1,0],[0,0,-1],[1,0,0]]``,
   ``t = (0, -0.08, -0.27)`` m, like KITTI's own.
 
@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from generator import rig
+from generator.geometry.transforms import invert
 from generator.atomic import write_text
 from generator.errors import UserError
 
@@ -41,19 +41,17 @@ def homogeneous(m: np.ndarray) -> np.ndarray:
     return out
 
 
-def velo_to_cam(spec) -> np.ndarray:
-    """``Tr`` = ``T_cam0_velo`` (4, 4) float64 from the spec's camera and LiDAR mounts (no jitter)."""
-    cam, lidar = spec.sensors.camera, spec.sensors.lidar
-    t_ego_cam = rig.camera_extrinsics(cam.xyz_m, cam.rpy_deg)
-    return rig.invert(t_ego_cam) @ rig.mount(lidar.xyz_m, lidar.rpy_deg)
+def kitti_calib(rig, width: int, height: int) -> dict[str, np.ndarray]:
+    """``P0``..``P3`` and ``Tr`` as (3, 4) float64 for a render of ``width`` x ``height`` pixels.
 
-
-def kitti_calib(spec, width: int, height: int) -> dict[str, np.ndarray]:
-    """``P0``..``P3`` and ``Tr`` as (3, 4) float64 for a render of ``width`` x ``height`` pixels."""
-    k = rig.intrinsics(spec.sensors.camera.hfov_deg, width, height)
-    p = np.hstack([k, np.zeros((3, 1))])
+    Parameters
+    ----------
+    rig : generator.world.rig.Rig
+        Camera intrinsics and the nominal (jitter-free) camera and LiDAR mounts.
+    """
+    p = np.hstack([rig.K(width, height), np.zeros((3, 1))])
     out = {f"P{i}": p.copy() for i in range(4)}
-    out["Tr"] = velo_to_cam(spec)[:3]
+    out["Tr"] = rig.T_camera_lidar()[:3]
     return out
 
 
@@ -128,10 +126,10 @@ def camera_poses(T_world_velo: np.ndarray, tr: np.ndarray) -> np.ndarray:
     (n, 4, 4) float64
         ``T_cam0(0)_cam0(i)``.
     """
-    t_world_cam = np.asarray(T_world_velo, np.float64) @ rig.invert(tr)
-    return rig.invert(t_world_cam[0]) @ t_world_cam
+    t_world_cam = np.asarray(T_world_velo, np.float64) @ invert(tr)
+    return invert(t_world_cam[0]) @ t_world_cam
 
 
 def lidar_poses(cam_poses: np.ndarray, tr: np.ndarray) -> np.ndarray:
     """(n, 4, 4) LiDAR poses in the first LiDAR frame: ``inv(Tr) @ pose @ Tr`` (SemanticKITTI API)."""
-    return rig.invert(tr) @ np.asarray(cam_poses, np.float64) @ tr
+    return invert(tr) @ np.asarray(cam_poses, np.float64) @ tr

@@ -47,7 +47,8 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from generator import __version__, rig
+from generator import __version__
+from generator.world import rig
 from generator.atomic import write_text
 
 SCHEMA_PATH = Path(__file__).resolve().parent / "schemas" / "openlabel_json_schema-v1.0.0.json"
@@ -80,7 +81,7 @@ def cuboid_val(box, T_frame_world: np.ndarray) -> list[float]:
 
     Parameters
     ----------
-    box : generator.scene.OrientedBox
+    box : generator.world.scene.OrientedBox
         World frame, metres; size = (length, width, height).
     T_frame_world : (4, 4) float64
         World -> target frame.
@@ -118,9 +119,9 @@ def build_openlabel(*, objects, frames, times, counts, min_points: int, T_ego_li
 
     Parameters
     ----------
-    objects : list of generator.scene.SceneObject
+    objects : list of generator.world.scene.SceneObject
         Candidate objects (their ``box`` and ``instance_id``).
-    frames : list of generator.layout.frames.Frame
+    frames : list of generator.world.rig.Frame
         The sequence's frames (``T_world_ego`` and ``T_ego_camera`` at the sweep start).
     times : (n_frames,) float
         Seconds since the sequence start.

@@ -27,6 +27,7 @@ import numpy as np
 from generator.fusion import projection as P
 from generator.fusion.dataset import FusionFrame, deskewed
 from generator.labels import class_table
+from generator.labels.sets import label_sets as all_label_sets
 from generator.stats.evaluate import iou_from_confusion
 
 OCCLUSION = ("off", "on")
@@ -86,12 +87,9 @@ def fuse_frame(frame: FusionFrame, deskew: bool = True, abs_tol_m: float = P.ABS
 
 
 def label_sets() -> dict[str, tuple[list[str], np.ndarray]]:
-    """Agreement label sets: name -> (class names, lookup from native id)."""
-    t = class_table()
-    return {
-        "native": (list(t.names), np.arange(len(t), dtype=np.int64)),
-        "unified11": ([t.unified_names[i] for i in sorted(t.unified_names)], t.to_unified.astype(np.int64)),
-    }
+    """Agreement label sets: name -> (class names, lookup from native id); views of :mod:`generator.labels.sets`."""
+    sets = all_label_sets()
+    return {name: (list(sets[name].names), sets[name].from_native) for name in ("native", "unified11")}
 
 
 class Agreement:

@@ -15,7 +15,7 @@ from typing import Iterator
 
 import numpy as np
 
-from generator import rig
+from generator.world import rig
 from generator.errors import UserError
 from generator.formats import semantickitti as sk
 from generator.formats.point_sidecars import NATIVE_DIR, TIMES_DIR, read_sidecar
@@ -59,7 +59,7 @@ class FusionFrame:
         Offsets after the sweep start of the known LiDAR poses, seconds (``[0.0]`` when only
         the start is known).
     sweep_poses : (k, 4, 4) float64
-        LiDAR world poses at ``sweep_times`` (see :mod:`generator.formats.sweep_poses`).
+        LiDAR world poses at ``sweep_times`` (see :meth:`generator.world.rig.Rig.sweep_record`).
     pose : (4, 4) float64
         LiDAR pose in the first LiDAR frame (``poses.txt`` / SemanticKITTI convention).
     """

@@ -2,7 +2,7 @@
 
 Eq. 1 of seed 001: ``d [u, v, 1]^T = K T [X, Y, Z, 1]^T`` with ``T`` the camera-from-LiDAR
 transform and ``d`` the depth along the optical axis. The rig's pixel convention
-(:mod:`generator.rig`) puts the origin at the top-left CORNER of the top-left pixel, so a
+(:mod:`generator.world.rig`) puts the origin at the top-left CORNER of the top-left pixel, so a
 point at ``(u, v)`` falls in pixel ``(row, col) = (floor(v), floor(u))``.
 
 Which transform
@@ -16,7 +16,7 @@ Motion skew
 With motion skew on, each firing column keeps the sensor-frame coordinates of its own
 firing instant ``t_k + tau`` while the ego moves; the image is exposed at ``t_k``.
 :func:`deskew` moves every point into the sensor frame at the sweep start with the sensor
-poses recorded during the sweep (:mod:`generator.formats.sweep_poses`; exact for urbangen's
+poses recorded during the sweep (:meth:`generator.world.rig.Rig.sweep_record`; exact for urbangen's
 routes). Seed 001 projected raw KITTI scans: on the default town at 8 m/s that leaves up to
 0.8 m of skew and lowers the agreement (``bench/fusion_skew.py``).
 
@@ -55,7 +55,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
 
-from generator import rig
+from generator.world import rig
 
 #: Default occlusion tolerances (see the module docstring).
 ABS_TOL_M = 0.1
@@ -87,7 +87,7 @@ def deskew(xyz: np.ndarray, times: np.ndarray, sample_times: np.ndarray, T_world
         Increasing offsets of the known sensor poses, seconds; the first is 0 (sweep start).
     T_world_samples : (k, 4, 4) float64
         Sensor poses at ``sample_times`` (``lidar_meta.json`` ``sweep_poses_world``, see
-        :mod:`generator.formats.sweep_poses`). Between samples the pose is interpolated
+        :meth:`generator.world.rig.Rig.sweep_record`). Between samples the pose is interpolated
         (translation linear, rotation by slerp), exact for urbangen's piecewise-linear routes.
 
     Returns

@@ -1,1 +1,1 @@
-"""Image outputs: previews, post effects, EXR and metadata."""
+"""Image files: the multilayer EXR (RGB, masks, depth, instances) and the metadata JSON."""

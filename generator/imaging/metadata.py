@@ -67,7 +67,7 @@ def image_metadata(*, image: str, files: dict, frame, k: np.ndarray, width: int,
 
     Parameters
     ----------
-    frame : generator.layout.frames.Frame
+    frame : generator.world.rig.Frame
     k : (3, 3) float64
         Intrinsics.
     class_id : (H, W) uint8

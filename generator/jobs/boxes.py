@@ -7,13 +7,11 @@ from pathlib import Path
 
 import numpy as np
 
-from generator import rig
 from generator.atomic import inside
 from generator.errors import UserError
 from generator.formats import semantickitti as sk
 from generator.formats.openlabel import build_openlabel, write_openlabel
-from generator.layout.frames import plan_frames
-from generator.lidar.scan import sensor_mount
+from generator.world.rig import Rig
 
 DEFAULT_CLASSES = ("car", "truck", "person")
 
@@ -71,8 +69,8 @@ def write_sequence_openlabel(spec, root: Path, sequence: str = "00", classes=DEF
 
         scene = build_scene(spec)
     route = int(meta["scene"].get("route", 0))
-    frames = plan_frames(scene, spec, max(seq.frames) + 1, route=route)
-    frames = [frames[k] for k in seq.frames]
+    rig = Rig.from_spec(spec, scene, route)
+    frames = [rig.frame(k) for k in seq.frames]
     counts = []
     for k in seq.frames:
         _, inst = sk.read_labels(seq.label_path(k))
@@ -94,14 +92,9 @@ def write_sequence_openlabel(spec, root: Path, sequence: str = "00", classes=DEF
     frame_uris = [{"camera": f"images/{exr.get(k, f'{k:06d}_day_clear.exr')}",
                    "lidar": f"lidar/sequences/{name}/velodyne/{k:06d}.bin"} for k in seq.frames]
     doc = build_openlabel(objects=objects, frames=frames, times=[seq.times[k] for k in seq.frames], counts=counts,
-                          min_points=min_points, T_ego_lidar=sensor_mount(spec),
-                          T_ego_camera_nominal=rig.camera_extrinsics(cam.xyz_m, cam.rpy_deg), K=K, width=w, height=h,
+                          min_points=min_points, T_ego_lidar=rig.T_ego_lidar,
+                          T_ego_camera_nominal=rig.T_ego_camera(), K=K, width=w, height=h,
                           streams=streams, frame_uris=frame_uris, info=info)
-    out = inside(root, "openlabel", f"{name}.json")
-    try:
-        write_openlabel(out, doc)
-    except ValueError as e:  # a bug, not a user error: say so loudly
-        raise RuntimeError(str(e)) from None
     out = inside(root, "openlabel", f"{name}.json")
     try:
         write_openlabel(out, doc)

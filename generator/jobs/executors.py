@@ -5,25 +5,71 @@
 * ``ray``: the same jobs as Ray tasks, on a local Ray instance or a cluster
   (``--ray-address``); the output folder must be on storage every node can write.
 
-Both run :func:`generator.blender.worker.run` per job (one Blender and one scene build
+Both run :func:`generator.jobs.worker.run` per :class:`RenderJob` (one Blender and one scene build
 per job, many frames) and report through a queue, so the parent's progress bar,
 manifest updates and error handling are the same.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import logging
+import os
 import time
+from dataclasses import dataclass
+from pathlib import Path
 
 from generator.errors import UserError
-from generator.jobs.pool import PoolResult, follow, run_workers
+from generator.jobs.pool import PoolResult, deal, follow, run_workers, scratch_dir
 
 log = logging.getLogger(__name__)
-WORKER = "generator.blender.worker:run"
+WORKER = "generator.jobs.worker:run"
 EXECUTORS = ("local", "ray")
 
 
-def run_jobs(executor: str, jobs: list[dict], total: int, on_frame=None, ray_address: str | None = None) -> PoolResult:
+@dataclass(frozen=True)
+class RenderJob:
+    """What one render worker does: one scene build, one Blender, many frames (picklable).
+
+    Attributes
+    ----------
+    spec : generator.spec.SceneSpec
+    config : generator.spec.render.RenderConfig
+    out : str
+        Dataset folder; images go to ``out/images``.
+    frames : tuple of int
+        Frame indices this worker renders.
+    combos : tuple of (str, str)
+        (time_of_day, weather) variants of every frame.
+    scratch : str
+        The worker's own scratch folder (Blender's temporary EXRs, ``blender.log``).
+    parent_pid : int
+        Set by the local pool: the worker exits when its parent dies.
+    """
+
+    spec: object
+    config: object
+    out: str
+    frames: tuple[int, ...]
+    combos: tuple[tuple[str, str], ...]
+    scratch: str
+    parent_pid: int = 0
+
+
+def make_jobs(spec, cfg, out: Path, frames: list[int], combos, workers: int) -> list[RenderJob]:
+    """Deal ``frames`` round-robin to ``workers`` jobs (fewer when there are fewer frames).
+
+    With a render config that asks for all cores (``threads: 0``) and several local
+    workers, each job gets its share of the machine's cores.
+    """
+    parts = deal(list(frames), workers)
+    if cfg.threads == 0 and len(parts) > 1:
+        cfg = dataclasses.replace(cfg, threads=max(1, (os.cpu_count() or 1) // len(parts)))
+    return [RenderJob(spec, cfg, str(out), tuple(fr), tuple(tuple(c) for c in combos), str(scratch_dir(out, i)))
+            for i, fr in enumerate(parts)]
+
+
+def run_jobs(executor: str, jobs: list[RenderJob], total: int, on_frame=None, ray_address: str | None = None) -> PoolResult:
     """Run render ``jobs`` on ``executor``; see :func:`generator.jobs.pool.run_workers`."""
     if executor == "local":
         return run_workers(WORKER, jobs, total, "render", on_frame)
@@ -32,13 +78,13 @@ def run_jobs(executor: str, jobs: list[dict], total: int, on_frame=None, ray_add
     raise UserError(f"--executor: must be one of {', '.join(EXECUTORS)}, got {executor!r}")
 
 
-def _ray_worker(job: dict, queue) -> None:
-    from generator.blender.worker import run
+def _ray_worker(job: RenderJob, queue) -> None:
+    from generator.jobs.worker import run
 
     run(job, queue)
 
 
-def _run_ray(jobs: list[dict], total: int, on_frame, address: str | None) -> PoolResult:
+def _run_ray(jobs: list[RenderJob], total: int, on_frame, address: str | None) -> PoolResult:
     try:
         import ray
         from ray.util.queue import Queue

@@ -18,16 +18,14 @@ from __future__ import annotations
 import dataclasses
 import json
 import logging
-import os
 import shutil
 import time
 from pathlib import Path
 
 from generator.atomic import clean_temporaries
 from generator.jobs import manifest as mf
-from generator.jobs.executors import run_jobs
+from generator.jobs.executors import make_jobs, run_jobs
 from generator.jobs.plan import Plan
-from generator.jobs.pool import deal, scratch_dir
 
 log = logging.getLogger(__name__)
 
@@ -41,13 +39,6 @@ class GenerateOptions:
     workers: int = 1
     executor: str = "local"
     ray_address: str | None = None
-
-
-def _worker_config(cfg, workers: int):
-    """Split the machine's cores between local workers when the config says 'all cores'."""
-    if cfg.threads > 0 or workers <= 1:
-        return cfg
-    return dataclasses.replace(cfg, threads=max(1, (os.cpu_count() or 1) // workers))
 
 
 def lidar_done(out: Path, plan: Plan, spec) -> bool:
@@ -69,7 +60,7 @@ def images_done(out: Path, plan: Plan) -> list[int]:
 
 def write_lidar(spec, cfg, out: Path, plan: Plan, scene=None) -> dict:
     from generator.layout.assemble import build_scene
-    from generator.lidar.sequence import SequenceOptions, write_dataset_label_config, write_sequence
+    from generator.jobs.lidar_sequence import SequenceOptions, write_dataset_label_config, write_sequence
 
     scene = build_scene(spec) if scene is None else scene
     opts = SequenceOptions(frames=len(plan.frames), sequence=plan.sequence, resolution=cfg.resolution,
@@ -118,9 +109,7 @@ def run_generate(spec, cfg, opts: GenerateOptions) -> dict:
     manifest["finished"]["images"] = [n for k in plan.frames if k in done for n in plan.images_of(k)]
     todo = [k for k in plan.frames if k not in done]
     if todo:
-        wcfg = _worker_config(cfg, opts.workers)
-        jobs = [{"spec": spec, "config": wcfg, "out": str(out), "frames": frames, "combos": list(plan.combos),
-                 "scratch": str(scratch_dir(out, i))} for i, frames in enumerate(deal(todo, opts.workers))]
+        jobs = make_jobs(spec, cfg, out, todo, plan.combos, opts.workers)
 
         def on_frame(index: int, payload: dict) -> None:
             manifest["finished"]["images"] += list(payload["images"])

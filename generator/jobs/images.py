@@ -14,7 +14,7 @@ from pathlib import Path
 from generator.atomic import inside, write_json
 from generator.imaging.exr import LabelledImage, write_exr
 from generator.imaging.metadata import image_metadata, validate_metadata
-from generator.imaging.preview import write_preview
+from generator.previews.preview import write_preview
 
 
 def image_name(frame_index: int, time_of_day: str = "day", weather: str = "clear") -> str:

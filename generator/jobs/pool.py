@@ -6,6 +6,7 @@ round-robin. The parent never imports bpy, so spawning is always safe.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import multiprocessing as mp
 import os
@@ -29,15 +30,15 @@ class PoolResult:
     wall_s: float = 0.0
 
 
-def run_workers(target: str, jobs: list[dict], total: int, desc: str = "render", on_frame=None) -> PoolResult:
+def run_workers(target: str, jobs: list, total: int, desc: str = "render", on_frame=None) -> PoolResult:
     """Start one spawned process per job running ``target`` (``"module:function"``) and wait.
 
     Parameters
     ----------
     target : str
         Worker entry, called as ``function(job, queue)``.
-    jobs : list of dict
-        One job per worker (picklable).
+    jobs : list of dataclass
+        One job per worker (picklable, with a ``parent_pid`` field).
     total : int
         Number of ``("frame", ...)`` reports expected, for the progress bar.
     on_frame : callable, optional
@@ -54,7 +55,7 @@ def run_workers(target: str, jobs: list[dict], total: int, desc: str = "render",
     import importlib
 
     fn = getattr(importlib.import_module(module), func)
-    jobs = [{**job, "parent_pid": os.getpid()} for job in jobs]
+    jobs = [dataclasses.replace(job, parent_pid=os.getpid()) for job in jobs]
     procs = [ctx.Process(target=fn, args=(job, q), daemon=False) for job in jobs]
     t0 = time.perf_counter()
     for p in procs:

@@ -11,10 +11,10 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from generator.imaging.fog import fog_image
-from generator.imaging.rain import rain_image
+from generator.postfx.fog import fog_image
+from generator.postfx.rain import rain_image
 from generator.jobs.images import write_image
-from generator.rng import stream
+from generator.rng import child_seed, stream
 from generator.weather import combinations, draw_lighting, draw_weather, frame_wetness, has_fog, has_rain, is_wet
 
 
@@ -64,7 +64,7 @@ def render_frame(renderer, spec, cfg, frame, out: Path, combos: list[tuple[str, 
         wetness, puddles = frame_wetness(spec, frame.index) if wet else (0.0, 0.0)
         info = renderer.set_conditions(light, wetness, puddles)
         info.update({k: v for k, v in light.to_dict().items() if v is not None})
-        rgb, rgb_s = renderer.render_rgb(seed=frame.index * 4 + (2 if tod == "night" else 0) + int(wet))
+        rgb, rgb_s = renderer.render_rgb(seed=child_seed(spec.seed, "frame", frame.index, "cycles", tod, int(wet)))
         for kind in [k for t_, k in combos if t_ == tod and is_wet(k) == wet]:
             weather = draw_weather(spec, frame.index, kind)
             t = time.perf_counter()

@@ -48,7 +48,7 @@ class ClassTable:
     Lookup arrays are indexed by native id and have one entry per class.
     """
 
-    def __init__(self, rows: list[ClassInfo], sk_config: dict, unified: dict):
+    def __init__(self, rows: list[ClassInfo], sk_config: dict, unified: dict, wet_ground: list[int] = ()):
         ids = [r.id for r in rows]
         if ids != list(range(len(rows))):
             raise ValueError(f"classes.yaml: ids must be 0..{len(rows) - 1} in order, got {ids}")
@@ -64,6 +64,11 @@ class ClassTable:
         self.unified_names: dict[int, str] = {int(k): v for k, v in unified["classes"].items()}
         self.sk_to_unified_map: dict[int, int] = {int(k): int(v) for k, v in unified["from_semantickitti"].items()}
         self.unified_to_sk_map: dict[int, int] = {int(k): int(v) for k, v in unified["to_semantickitti"].items()}
+        #: SemanticKITTI raw ids of paved ground (``wet_ground_semantickitti`` in ``classes.yaml``)
+        self.wet_ground_raw_ids: tuple[int, ...] = tuple(int(i) for i in wet_ground)
+        for raw in self.wet_ground_raw_ids:
+            if raw not in self.sk_labels:
+                raise ValueError(f"classes.yaml: wet_ground_semantickitti: unknown SemanticKITTI id {raw}")
         for r in rows:
             if r.semantickitti is not None and r.semantickitti not in self.sk_labels:
                 raise ValueError(f"classes.yaml: {r.name}: unknown SemanticKITTI id {r.semantickitti}")
@@ -160,7 +165,8 @@ class ClassTable:
 @functools.cache
 def class_table() -> ClassTable:
     """The package's class table (read once from ``classes.yaml``)."""
-    raw = _load_yaml("classes.yaml")["classes"]
+    doc = _load_yaml("classes.yaml")
+    raw = doc["classes"]
     rows = [
         ClassInfo(
             id=int(r["id"]), name=str(r["name"]), seed003=r["seed003"], semantickitti=r["semantickitti"],
@@ -169,4 +175,5 @@ def class_table() -> ClassTable:
         )
         for r in raw
     ]
-    return ClassTable(rows, _load_yaml("semantic-kitti.yaml"), _load_yaml("unified11.yaml"))
+    return ClassTable(rows, _load_yaml("semantic-kitti.yaml"), _load_yaml("unified11.yaml"),
+                      doc.get("wet_ground_semantickitti", ()))

@@ -18,7 +18,7 @@ from collections import defaultdict
 import numpy as np
 from tqdm import tqdm
 
-from assets_procedural.mesh import Mesh, pose
+from generator.geometry import Mesh, pose
 from generator.labels import class_table
 from generator.layout import placement_lots as pl
 from generator.layout import placement_street as ps
@@ -26,9 +26,10 @@ from generator.layout.lots import Lot, lot_ground_mesh, make_lots
 from generator.layout.outskirts import horizon_mesh
 from generator.layout.placement_core import EGO_HALF_WIDTH_M, Keepout, Library, Placed, Placer
 from generator.layout.routes import densify, make_routes
-from generator.layout.streets import (Grid, intersection_road_mesh, intersection_walk_mesh, make_grid, margin_mesh,
-                                      segment_frame_points, segment_road_mesh, segment_walk_mesh)
-from generator.scene import OrientedBox, Path, SceneModel, SceneObject
+from generator.layout.street_meshes import (intersection_road_mesh, intersection_walk_mesh, margin_mesh,
+                                            segment_frame_points, segment_road_mesh, segment_walk_mesh)
+from generator.layout.streets import Grid, make_grid
+from generator.world.scene import OrientedBox, Path, SceneModel, SceneObject
 from generator.spec.model import SceneSpec
 
 log = logging.getLogger(__name__)
@@ -101,7 +102,7 @@ def ground_pieces(grid: Grid, lots: list[Lot], placed: list[Placed] = ()) -> lis
 
 
 def _objects(grid: Grid, lots: list[Lot], placed: list[Placed], lib: Library):
-    from assets_procedural.proxy import label_proxy
+    from generator.geometry.proxy import label_proxy
 
     prototypes: dict[str, Mesh] = {}
     proxies: dict[str, Mesh] = {}
@@ -157,7 +158,7 @@ def build_scene(spec: SceneSpec) -> SceneModel:
     -------
     SceneModel
         Stuff objects first (instance id 0), then things with instance ids 1..N in placement
-        order; route 0 is the comb loop :mod:`generator.layout.frames` follows.
+        order; route 0 is the comb loop :class:`generator.world.rig.Rig` follows.
 
     Raises
     ------

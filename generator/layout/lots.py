@@ -14,9 +14,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from assets_procedural.mesh import Mesh, merge, pose
+from generator.geometry import Mesh, merge, pose
 from generator.layout.outskirts import outer_rows
-from generator.layout.streets import Grid, rects
+from generator.layout.street_meshes import rects
+from generator.layout.streets import Grid
 from generator.rng import stream
 from generator.spec.model import SceneSpec
 

@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from assets_procedural.mesh import Mesh
+from generator.geometry import Mesh
 from generator.labels import class_table
 from generator.layout.streets import Grid
 from generator.materials import material_table

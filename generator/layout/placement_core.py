@@ -18,9 +18,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial import cKDTree
 
-from assets_procedural.mesh import Mesh, pose
+from generator.geometry import Mesh, pose
 from generator.rng import stream
-from generator.scene import OrientedBox
+from generator.world.scene import OrientedBox
 
 EGO_HALF_WIDTH_M = 1.2   #: half the width of the ego vehicle that drives the routes
 BAND_M = 0.5             #: height of a collision band

@@ -5,7 +5,7 @@ outermost (right-hand) lane for its driving direction (right-hand traffic); at e
 the two lane-centre lines are joined by a circular arc (6 m, or down to 5 m when the
 intersection is tight; left turns concentric with it), and the result is sampled about every metre with headings and arc length.
 
-Route 0, the one :mod:`generator.layout.frames` follows, is a "comb" that drives the outer
+Route 0, the one :class:`generator.world.rig.Rig` follows, is a "comb" that drives the outer
 ring and snakes through the inner north-south streets; route 1 is the outer ring in the
 opposite direction.
 """
@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from generator.layout.streets import Grid
-from generator.scene import Path
+from generator.world.scene import Path
 
 STEP_M = 1.0            #: sampling step along a route
 RIGHT_RADIUS_M = 6.0    #: preferred right-turn radius (left turns are concentric, 2 lane offsets wider)

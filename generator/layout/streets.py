@@ -26,9 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from assets_procedural.mesh import Mesh, merge, pose, slab
-from generator.labels import class_table
-from generator.materials import material_table
+from generator.geometry import pose
 from generator.rng import stream
 from generator.spec.model import SceneSpec
 
@@ -40,7 +38,6 @@ CROSSWALK_U = (0.6, 3.6)   #: crosswalk band, metres from the intersection edge
 STOP_U = (4.6, 5.0)        #: stop line band, metres from the intersection edge
 PARKING_START_U = 7.0      #: parking strips start this far from the intersection edge
 BAY_M = 6.0                #: parking bay length
-DASH_M, GAP_M = 3.0, 6.0   #: centre-line dash pattern
 MIN_BLOCK_M = 15.0         #: blocks never shrink below this (jitter can be large)
 MIN_OUTER_DEPTH_M = 15.0   #: the lot band outside the outer ring road is at least this deep
 TREE_PIT_M = 1.2           #: side of the soil square around a street tree
@@ -276,140 +273,3 @@ def make_grid(spec: SceneSpec) -> Grid:
     return Grid(xs, ys, t.lanes_per_direction, t.lane_width_m, t.parking_strip_width_m, CURB_WIDTH_M,
                 t.sidewalk_width_m, t.curb_height_m, t.margin_m, segments,
                 max(MIN_OUTER_DEPTH_M, t.block_size_m / 2))
-
-
-# -- meshes -------------------------------------------------------------------------------------
-def rects(boxes: np.ndarray, z: float, cls: str, material: str) -> Mesh:
-    """Many flat upward-facing rectangles at height ``z`` in one mesh.
-
-    Parameters
-    ----------
-    boxes : (k, 4) float
-        ``(x0, y0, x1, y1)`` per rectangle (any corner order), metres.
-    """
-    b = np.asarray(boxes, np.float64).reshape(-1, 4)
-    x0, x1 = np.minimum(b[:, 0], b[:, 2]), np.maximum(b[:, 0], b[:, 2])
-    y0, y1 = np.minimum(b[:, 1], b[:, 3]), np.maximum(b[:, 1], b[:, 3])
-    keep = (x1 - x0 > 1e-6) & (y1 - y0 > 1e-6)
-    x0, x1, y0, y1 = x0[keep], x1[keep], y0[keep], y1[keep]
-    k = len(x0)
-    zz = np.full(k, z)
-    v = np.stack([np.stack([x0, y0, zz], 1), np.stack([x1, y0, zz], 1),
-                  np.stack([x1, y1, zz], 1), np.stack([x0, y1, zz], 1)], 1).reshape(-1, 3)
-    base = (np.arange(k) * 4)[:, None]
-    f = np.concatenate([base + [0, 1, 2], base + [0, 2, 3]], 1).reshape(-1, 3)
-    return Mesh(v, f, class_table().id(cls), material_table().id(material))
-
-
-def _dashes(a0: float, a1: float, v0: float, v1: float, dash: float = DASH_M, gap: float = GAP_M) -> np.ndarray:
-    starts = np.arange(a0, a1, dash + gap)
-    return np.stack([starts, np.full_like(starts, v0), np.minimum(starts + dash, a1), np.full_like(starts, v1)], 1)
-
-
-def segment_road_mesh(grid: Grid, seg: Segment) -> Mesh:
-    """Road surface, parking strips, lane markings, stop lines and crosswalks of ``seg`` (segment frame)."""
-    L, lh, rh, p = seg.length, grid.lane_half, grid.road_half, grid.parking_w
-    parts = [rects([(0, -lh, L, lh)], 0.0, "road", "asphalt")]
-    pk0, pk1 = PARKING_START_U, L - PARKING_START_U
-    has_parking = p > 0 and pk1 - pk0 >= BAY_M
-    if p > 0:
-        sides = [(lh, rh), (-rh, -lh)]
-        if has_parking:
-            road = [(0, a, pk0, b) for a, b in sides] + [(pk1, a, L, b) for a, b in sides]
-            parts.append(rects(road, 0.0, "road", "asphalt"))
-            parts.append(rects([(pk0, a, pk1, b) for a, b in sides], 0.0, "parking", "parking_asphalt"))
-        else:
-            parts.append(rects([(0, a, L, b) for a, b in sides], 0.0, "road", "asphalt"))
-    z = MARK_Z_M
-    m0, m1 = STOP_U[1], L - STOP_U[1]       # markings run between the stop lines
-    marks = []
-    if grid.lanes == 1:
-        marks.append(_dashes(m0, m1, -0.06, 0.06))
-    else:
-        marks += [np.array([(m0, -0.18, m1, -0.06), (m0, 0.06, m1, 0.18)])]
-        for k in range(1, grid.lanes):
-            for sgn in (-1, 1):
-                marks.append(_dashes(m0, m1, sgn * k * grid.lane_w - 0.06, sgn * k * grid.lane_w + 0.06))
-    edge = lh if p > 0 else rh - 0.3
-    marks.append(np.array([(m0, edge - 0.075, m1, edge + 0.075), (m0, -edge - 0.075, m1, -edge + 0.075)]))
-    marks.append(np.array([(STOP_U[0], 0.06, STOP_U[1], lh), (L - STOP_U[1], -lh, L - STOP_U[0], -0.06)]))
-    if has_parking:
-        bays = np.arange(pk0, pk1 + 1e-6, BAY_M)
-        for a, b in ((lh + 0.075, rh), (-rh, -lh - 0.075)):
-            marks.append(np.stack([bays - 0.05, np.full_like(bays, a), bays + 0.05, np.full_like(bays, b)], 1))
-    parts.append(rects(np.concatenate(marks), z, "road_marking", "lane_paint"))
-    span = 2 * (rh - 0.25)
-    n = int((span + 0.5) // 1.0)
-    v = -(n * 1.0 - 0.5) / 2 + np.arange(n) * 1.0
-    bars = []
-    for u0, u1 in (CROSSWALK_U, (L - CROSSWALK_U[1], L - CROSSWALK_U[0])):
-        bars.append(np.stack([np.full(n, u0), v, np.full(n, u1), v + 0.5], 1))
-    parts.append(rects(np.concatenate(bars), z, "crosswalk", "crosswalk_paint"))
-    return merge(parts)
-
-
-def _curb(x0: float, y0: float, x1: float, y1: float, h: float) -> Mesh:
-    return slab(min(x0, x1), min(y0, y1), max(x0, x1), max(y0, y1), 0.0, h, "curb", "curb_concrete")
-
-
-def segment_walk_mesh(grid: Grid, seg: Segment, pits: np.ndarray | None = None) -> Mesh:
-    """Curbs and sidewalks along both sides of ``seg`` between the corner squares (segment frame).
-
-    Parameters
-    ----------
-    pits : (k, 2) float, optional
-        Tree-pit centres ``(u, v)`` in the segment frame: soil squares 3 mm above the paving.
-    """
-    rh, wi, ch, h = grid.road_half, grid.walk_inner, grid.corridor_half, grid.curb_h
-    u0, u1 = ch - rh, seg.length - (ch - rh)
-    parts = [_curb(u0, rh, u1, wi, h), _curb(u0, -wi, u1, -rh, h),
-             rects([(u0, wi, u1, ch), (u0, -ch, u1, -wi)], h, "sidewalk", "sidewalk_concrete")]
-    if pits is not None and len(pits):
-        r = min(TREE_PIT_M, grid.sidewalk_w) / 2
-        p = np.asarray(pits, np.float64).reshape(-1, 2)
-        parts.append(rects(np.c_[p - r, p + r], h + 0.003, "terrain", "soil"))
-    return merge(parts)
-
-
-def segment_frame_points(seg: Segment, xy: np.ndarray) -> np.ndarray:
-    """(n, 2) segment-frame ``(u, v)`` of world points ``xy`` ((n, 2) metres)."""
-    d = np.asarray(xy, np.float64).reshape(-1, 2) - np.asarray(seg.origin)
-    return d if seg.axis == 0 else np.stack([d[:, 1], -d[:, 0]], 1)
-
-
-def intersection_road_mesh(grid: Grid) -> Mesh:
-    """The asphalt square of an intersection (node frame: origin at the node, axes = world axes)."""
-    r = grid.road_half
-    return rects([(-r, -r, r, r)], 0.0, "road", "asphalt")
-
-
-def intersection_walk_mesh(grid: Grid, node: tuple[int, int]) -> Mesh:
-    """Corner squares (L-shaped curb + sidewalk) and, where an arm is missing, a curb closing it (node frame)."""
-    rh, wi, ch, h = grid.road_half, grid.walk_inner, grid.corridor_half, grid.curb_h
-    parts = []
-    arms = grid.arms(node)
-    for sx in (-1, 1):
-        for sy in (-1, 1):
-            x_arm, y_arm = (0 if sx > 0 else 2) in arms, (1 if sy > 0 else 3) in arms
-            # curbs only along the road edges that exist; the rest of the square is sidewalk
-            if x_arm:
-                parts.append(_curb(sx * rh, sy * rh, sx * ch, sy * wi, h))
-            if y_arm:
-                parts.append(_curb(sx * rh, sy * (wi if x_arm else rh), sx * wi, sy * ch, h))
-            x_in = wi if y_arm else rh
-            y_in = wi if x_arm else rh
-            parts.append(rects([(sx * x_in, sy * y_in, sx * ch, sy * ch)], h, "sidewalk", "sidewalk_concrete"))
-    for d in range(4):
-        if d in arms:
-            continue
-        cap = merge([_curb(rh, -rh, wi, rh, h), rects([(wi, -rh, ch, rh)], h, "sidewalk", "sidewalk_concrete")])
-        parts.append(cap.transformed(pose(yaw=d * np.pi / 2)))
-    return merge(parts)
-
-
-def margin_mesh(grid: Grid) -> Mesh:
-    """The terrain ring between the built area and the town bounds (world frame)."""
-    (bx0, by0), (bx1, by1) = grid.bounds
-    ix0, iy0, ix1, iy1 = grid.built_rect
-    ring = [(bx0, by0, bx1, iy0), (bx0, iy1, bx1, by1), (bx0, iy0, ix0, iy1), (ix1, iy0, bx1, iy1)]
-    return rects(ring, grid.curb_h, "terrain", "grass")

@@ -2,7 +2,7 @@
 
 Motion convention (KITTI-like, NOT de-skewed)
 ---------------------------------------------
-A sweep of frame ``k`` starts at ``t_k`` (``generator.layout.frames``) and lasts one
+A sweep of frame ``k`` starts at ``t_k`` (:meth:`generator.world.rig.Rig.frame`) and lasts one
 rotation. With motion skew on, column ``c`` is fired at ``t_k + c / (steps * rotation_hz)``
 from the sensor pose at that instant, and its points keep the raw coordinates the sensor
 measures: the emission point plus range times beam direction, in the sensor frame AT
@@ -44,8 +44,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from generator import rig
-from generator.layout.frames import ego_pose_at
 from generator.lidar.caster import RayCaster, make_caster
 from generator.lidar.sensors import Sensor
 
@@ -100,7 +98,7 @@ class Scanner:
 
     Parameters
     ----------
-    scene : generator.scene.SceneModel
+    scene : generator.world.scene.SceneModel
         Cast against ``scene.vertices`` / ``scene.faces`` (real geometry, not label proxies).
     sensor : Sensor
     threads : int, optional
@@ -190,6 +188,19 @@ class Scanner:
         return Scan(points, poses[0] if skew else poses, self.sensor.rays_per_sweep, self.sensor.n_lasers,
                     self.sensor.azimuth_steps)
 
+    def sweep(self, rig, t0: float, motion_skew: bool = True) -> Scan:
+        """Cast the sweep starting at ``t0`` seconds from ``rig``'s LiDAR.
+
+        Parameters
+        ----------
+        rig : generator.world.rig.Rig
+            A rig with a trajectory.
+        motion_skew : bool
+            Fire each column from the pose of its own instant (a real spinning sensor), or
+            every column from the pose at ``t0``.
+        """
+        return self.scan(rig.sweep_poses(t0, self.sensor.column_time() if motion_skew else None))
+
     def _cast_chunk(self, cols: slice, rot_t: np.ndarray, trans: np.ndarray, skew: bool) -> np.ndarray:
         o_loc, d_loc = self._o32[cols], self._d32[cols]  # (k, L, 3) float32
         if skew:
@@ -224,27 +235,3 @@ class Scanner:
         out["instance"] = take(self._face_instance, face)
         out["material"] = take(self._face_material, face)
         return out
-
-
-def sensor_mount(spec) -> np.ndarray:
-    """``T_ego_sensor`` (4, 4) float64 of the spec's LiDAR (``sensors.lidar.xyz_m`` / ``rpy_deg``)."""
-    lidar = spec.sensors.lidar
-    return rig.mount(lidar.xyz_m, lidar.rpy_deg)
-
-
-def sweep_poses(scene, spec, sensor: Sensor, t0: float, motion_skew: bool | None = None, route: int = 0) -> np.ndarray:
-    """Sensor poses for a sweep starting at ``t0`` seconds along route ``route``.
-
-    Parameters
-    ----------
-    motion_skew : bool, optional
-        Default: ``spec.sensors.lidar.motion_skew``.
-
-    Returns
-    -------
-    (steps, 4, 4) float64 with skew (one ``T_world_sensor`` per firing column), else (4, 4) at ``t0``.
-    """
-    skew = spec.sensors.lidar.motion_skew if motion_skew is None else motion_skew
-    t = t0 + sensor.column_time() if skew else np.array([t0], np.float64)
-    poses = ego_pose_at(scene, spec, t, route) @ sensor_mount(spec)
-    return poses if skew else poses[0]

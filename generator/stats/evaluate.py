@@ -21,7 +21,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, Iterator
+from typing import Iterator
 
 import numpy as np
 from tqdm import tqdm
@@ -29,7 +29,7 @@ from tqdm import tqdm
 from generator.errors import UserError
 from generator.formats import semantickitti as sk
 from generator.formats.point_sidecars import NATIVE_DIR, read_sidecar
-from generator.labels import class_table
+from generator.labels.sets import LABEL_SET_NAMES as LABEL_SETS, LabelSet, label_sets
 
 IGNORE = 0
 
@@ -88,31 +88,6 @@ def iou_from_confusion(conf: np.ndarray, ignore: tuple[int, ...] = (IGNORE,)) ->
     return IoUResult(iou, tp, fp, fn, evaluated, miou, float(tp.sum() / total) if total else float("nan"))
 
 
-@dataclass(frozen=True)
-class LabelSet:
-    """A label set for evaluation: class names and how to read a scan's labels in it."""
-
-    name: str
-    names: list[str]
-    #: (seq_dir, index, raw semantic (n,) uint16) -> (n,) int64 ids in 0..len(names)-1
-    read: Callable[[Path, int, np.ndarray], np.ndarray]
-
-
-def _lut(mapping: dict[int, int], size: int) -> np.ndarray:
-    lut = np.zeros(size, np.int64)
-    for k, v in mapping.items():
-        lut[int(k)] = int(v)
-    return lut
-
-
-def _raw_lut(mapping: dict[int, int]) -> Callable[[Path, int, np.ndarray], np.ndarray]:
-    lut = _lut(mapping, 1 << 16)  # every uint16 raw id; unknown ids -> 0 (ignored)
-
-    def read(_seq: Path, _index: int, raw: np.ndarray) -> np.ndarray:
-        return lut[raw]
-    return read
-
-
 def _read_native(seq: Path, index: int, raw: np.ndarray) -> np.ndarray:
     native = read_sidecar(seq, NATIVE_DIR, index, len(raw))
     if native is None:
@@ -120,20 +95,9 @@ def _read_native(seq: Path, index: int, raw: np.ndarray) -> np.ndarray:
     return native.astype(np.int64)
 
 
-def label_sets() -> dict[str, LabelSet]:
-    """The label sets by name."""
-    t = class_table()
-    cfg = t.sk_config
-    learn_names = [t.sk_labels[int(cfg["learning_map_inv"][i])] for i in sorted(int(k) for k in cfg["learning_map_inv"])]
-    return {
-        "unified11": LabelSet("unified11", [t.unified_names[i] for i in sorted(t.unified_names)],
-                              _raw_lut(t.sk_to_unified_map)),
-        "semantickitti": LabelSet("semantickitti", learn_names, _raw_lut({int(k): int(v) for k, v in cfg["learning_map"].items()})),
-        "native": LabelSet("native", list(t.names), _read_native),
-    }
-
-
-LABEL_SETS = ("unified11", "semantickitti", "native")
+def read_ids(ls: LabelSet, seq: Path, index: int, raw: np.ndarray) -> np.ndarray:
+    """(n,) int64 ids in label set ``ls`` of scan ``index``: from its raw ids, or its native side file."""
+    return _read_native(seq, index, raw) if ls.from_raw is None else ls.from_raw[raw]
 
 
 def _pairs(pred_root: Path, gt_root: Path, sequences: list[str] | None) -> Iterator[tuple[Path, Path, int]]:
@@ -187,7 +151,7 @@ def evaluate_trees(pred_root: str | Path, gt_root: str | Path, labels: str = "un
         pred_raw, _ = sk.read_labels(pred_path)
         if len(pred_raw) != len(gt_raw):
             raise UserError(f"{pred_path}: {len(pred_raw)} labels but the ground truth has {len(gt_raw)} points")
-        conf += confusion(ls.read(gt_dir, i, gt_raw), ls.read(pred_dir, i, pred_raw), n)
+        conf += confusion(read_ids(ls, gt_dir, i, gt_raw), read_ids(ls, pred_dir, i, pred_raw), n)
     res = iou_from_confusion(conf)
     return result_dict(ls, res, conf, scans=len(pairs))
 

@@ -33,7 +33,8 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from generator.lidar.intensity import received_power, semantic_ids
+from generator.labels import class_table
+from generator.remission.models import received_power, semantic_ids
 from generator.weather import Weather, draw_weather, lidar_combination
 
 CONFIG_FILE = Path(__file__).resolve().parent / "weather.yaml"
@@ -41,8 +42,10 @@ CONFIG_FILE = Path(__file__).resolve().parent / "weather.yaml"
 
 @functools.cache
 def weather_config() -> dict:
-    """``weather.yaml`` as a dict."""
-    return yaml.safe_load(CONFIG_FILE.read_text(encoding="utf-8"))
+    """``weather.yaml`` as a dict, with ``wet.semantickitti_ids`` (paved ground) from the class table."""
+    cfg = yaml.safe_load(CONFIG_FILE.read_text(encoding="utf-8"))
+    cfg["wet"] = {"semantickitti_ids": list(class_table().wet_ground_raw_ids), **cfg["wet"]}
+    return cfg
 
 
 @dataclass(frozen=True)
@@ -94,7 +97,7 @@ def apply_lidar_weather(points: np.ndarray, remission: np.ndarray, weather: Weat
     ----------
     points : (n,) structured
         Needs ``x, y, z, range`` (sensor frame, metres), ``cos_incidence`` and ``material``/class
-        fields (see :func:`generator.lidar.intensity.received_power`); native scans also get
+        fields (see :func:`generator.remission.models.received_power`); native scans also get
         ``class``, ``instance``, ``material`` reset on soft returns.
     remission : (n,) float32
     weather : generator.weather.Weather

@@ -1,8 +1,8 @@
-"""Label conversion: native -> SemanticKITTI raw ids -> the unified 11 classes of seed 000.
+"""Relabel a SemanticKITTI-layout dataset into another label set (seed 000's unified 11 classes).
 
 All mappings are data: native -> raw is ``generator/labels/classes.yaml`` (``semantickitti``
 column), raw -> unified and the canonical unified -> raw are ``generator/labels/unified11.yaml``.
-This module turns them into lookup arrays and rewrites whole SemanticKITTI-layout datasets.
+The lookups are :mod:`generator.labels.sets`; this module rewrites whole datasets.
 
 :func:`convert_dataset` copies ``velodyne/*.bin``, ``poses.txt``, ``calib.txt`` and
 ``times.txt`` of each sequence, rewrites every ``.label`` with unified ids in the low 16
@@ -30,44 +30,14 @@ from generator.errors import UserError
 from generator.formats import semantickitti as sk
 from generator.formats.label_config import count_raw_ids, format_label_config, merge_counts
 from generator.labels import class_table
+from generator.labels.sets import semantickitti_to_unified
 
 log = logging.getLogger(__name__)
 
 COPIED_FILES = ("poses.txt", "calib.txt", "times.txt")
 
 
-# -- lookups --------------------------------------------------------------------------------
-def native_to_semantickitti(native: np.ndarray) -> np.ndarray:
-    """(n,) uint16 SemanticKITTI raw ids of (n,) native class ids."""
-    return class_table().to_semantickitti[np.asarray(native)]
-
-
-def semantickitti_to_unified(raw: np.ndarray, source: str = "labels") -> np.ndarray:
-    """(n,) uint16 unified-11 ids of (n,) SemanticKITTI raw ids.
-
-    Raises
-    ------
-    UserError
-        If a raw id is not in the reference label set (e.g. labels that are already unified).
-    """
-    table = class_table()
-    raw = np.asarray(raw)
-    ids = np.unique(raw)
-    unknown = [int(i) for i in ids if int(i) not in table.sk_labels]
-    if unknown:
-        raise UserError(f"{source}: raw ids {unknown[:8]} are not SemanticKITTI labels (already converted?)")
-    return table.sk_to_unified[raw].astype(np.uint16)
-
-
-def unified_to_semantickitti(unified: np.ndarray) -> np.ndarray:
-    """(n,) uint16 canonical SemanticKITTI raw id of each unified-11 id (``unified11.yaml`` ``to_semantickitti``)."""
-    m = class_table().unified_to_sk_map
-    lut = np.zeros(max(m) + 1, np.uint16)
-    for u, r in m.items():
-        lut[u] = r
-    return lut[np.asarray(unified)]
-
-
+# -- target label configs ----------------------------------------------------------------
 def unified_label_config(counts: dict[int, int], sequences: list[int]) -> dict:
     """The unified set's label config as plain data (sections of ``semantic-kitti.yaml``).
 
@@ -96,8 +66,8 @@ def format_unified_config(cfg: dict) -> str:
 
 
 @dataclass(frozen=True)
-class LabelSet:
-    """A target label set: per-scan relabelling and its config file."""
+class Target:
+    """A label set a dataset can be converted into: per-scan relabelling and its config file."""
 
     relabel: Callable[[np.ndarray, str], np.ndarray]
     config_name: str
@@ -105,9 +75,9 @@ class LabelSet:
     formatter: Callable[[dict], str]
 
 
-#: Target label sets by ``--labels`` name.
-LABEL_SETS: dict[str, LabelSet] = {
-    "unified11": LabelSet(semantickitti_to_unified, "unified11.yaml", unified_label_config, format_unified_config),
+#: Conversion targets by ``--labels`` name (label sets of :mod:`generator.labels.sets`).
+TARGETS: dict[str, Target] = {
+    "unified11": Target(semantickitti_to_unified, "unified11.yaml", unified_label_config, format_unified_config),
 }
 
 
@@ -135,7 +105,7 @@ def convert_dataset(src: str | Path, dst: str | Path, labels: str = "unified11",
     src, dst : path-like
         Dataset roots (``src/sequences/NN``); ``dst`` may exist but must not hold the sequences written.
     labels : str
-        A key of :data:`LABEL_SETS`.
+        A key of :data:`TARGETS`.
     sequences : list of str, optional
         Sequence numbers (default: every sequence with labels).
 
@@ -144,9 +114,9 @@ def convert_dataset(src: str | Path, dst: str | Path, labels: str = "unified11",
     dict
         The summary written to ``dst/conversion.json``.
     """
-    if labels not in LABEL_SETS:
-        raise UserError(f"--labels: unknown label set {labels!r}; known: {', '.join(LABEL_SETS)}")
-    target = LABEL_SETS[labels]
+    if labels not in TARGETS:
+        raise UserError(f"--labels: unknown label set {labels!r}; known: {', '.join(TARGETS)}")
+    target = TARGETS[labels]
     src, dst = Path(src), Path(dst)
     if dst.exists() and not dst.is_dir():
         raise UserError(f"{dst}: exists and is not a folder")

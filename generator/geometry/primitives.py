@@ -1,130 +1,23 @@
-"""Triangle meshes with per-face labels, and the primitives assets are built from.
+"""Mesh primitives assets are built from: boxes, slabs, cylinders, tubes, lofts, polygons...
 
-A :class:`Mesh` is the unit every asset builder returns and the SceneModel stores
-as a prototype. It carries, per triangle, the native class id (a tree has trunk and
-crown faces) and the material id (from ``generator/materials.yaml``), plus named
-anchor points (lamp positions, headlights) the renderer uses to place lights.
+Every primitive takes a native class (name or id, ``generator/labels/classes.yaml``) and a
+material (name or id, ``generator/materials.yaml``) and returns a
+:class:`generator.geometry.mesh.Mesh` in metres, z up, faces wound counter-clockwise seen
+from outside.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 import numpy as np
 import trimesh
 
+from generator.geometry.mesh import Mesh
 from generator.labels import class_table
 from generator.materials import material_table
 
 
-@dataclass
-class Mesh:
-    """A labelled triangle mesh in a local frame.
-
-    Attributes
-    ----------
-    vertices : (n, 3) float64
-        Local frame, metres, z up.
-    faces : (m, 3) int64
-        Vertex indices, counter-clockwise seen from outside (outward normals).
-    face_class : (m,) uint8
-        Native class id per triangle (``generator/labels/classes.yaml``).
-    face_material : (m,) uint16
-        Material id per triangle (``generator/materials.yaml``).
-    anchors : dict of str to (k, 3) float64
-        Named points in the local frame (e.g. ``"lamp"``, ``"headlight"``).
-    """
-
-    vertices: np.ndarray
-    faces: np.ndarray
-    face_class: np.ndarray
-    face_material: np.ndarray
-    anchors: dict[str, np.ndarray] = field(default_factory=dict)
-
-    def __post_init__(self) -> None:
-        self.vertices = np.asarray(self.vertices, np.float64).reshape(-1, 3)
-        self.faces = np.asarray(self.faces, np.int64).reshape(-1, 3)
-        m = len(self.faces)
-        self.face_class = np.broadcast_to(np.asarray(self.face_class, np.uint8), (m,)).copy()
-        self.face_material = np.broadcast_to(np.asarray(self.face_material, np.uint16), (m,)).copy()
-        self.anchors = {k: np.asarray(v, np.float64).reshape(-1, 3) for k, v in self.anchors.items()}
-
-    @property
-    def n_faces(self) -> int:
-        return len(self.faces)
-
-    def bounds(self) -> np.ndarray:
-        """(2, 3) float64: min and max corner of the vertices."""
-        if len(self.vertices) == 0:
-            return np.zeros((2, 3))
-        return np.stack([self.vertices.min(0), self.vertices.max(0)])
-
-    def transformed(self, matrix: np.ndarray) -> "Mesh":
-        """A copy with vertices and anchors mapped by the 4x4 ``matrix``."""
-        return Mesh(
-            apply(matrix, self.vertices), self.faces, self.face_class, self.face_material,
-            {k: apply(matrix, v) for k, v in self.anchors.items()},
-        )
-
-    def select(self, face_mask: np.ndarray) -> "Mesh":
-        """The sub-mesh of the faces where ``face_mask`` is True (unused vertices dropped)."""
-        faces = self.faces[face_mask]
-        used, inverse = np.unique(faces, return_inverse=True)
-        return Mesh(self.vertices[used], inverse.reshape(-1, 3), self.face_class[face_mask],
-                    self.face_material[face_mask], dict(self.anchors))
-
-    def to_trimesh(self) -> trimesh.Trimesh:
-        """A :class:`trimesh.Trimesh` of the geometry (labels not carried)."""
-        return trimesh.Trimesh(self.vertices, self.faces, process=False)
-
-
-def empty() -> Mesh:
-    """A mesh with no faces."""
-    return Mesh(np.zeros((0, 3)), np.zeros((0, 3), np.int64), np.zeros(0, np.uint8), np.zeros(0, np.uint16))
-
-
-def merge(meshes: list[Mesh]) -> Mesh:
-    """Concatenate meshes (anchors with the same name are stacked)."""
-    meshes = [m for m in meshes if m.n_faces or m.anchors]
-    if not meshes:
-        return empty()
-    offsets = np.cumsum([0] + [len(m.vertices) for m in meshes[:-1]])
-    anchors: dict[str, list[np.ndarray]] = {}
-    for m in meshes:
-        for k, v in m.anchors.items():
-            anchors.setdefault(k, []).append(v)
-    return Mesh(
-        np.concatenate([m.vertices for m in meshes]),
-        np.concatenate([m.faces + o for m, o in zip(meshes, offsets)]),
-        np.concatenate([m.face_class for m in meshes]),
-        np.concatenate([m.face_material for m in meshes]),
-        {k: np.concatenate(v) for k, v in anchors.items()},
-    )
-
-
-def apply(matrix: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """Map (n, 3) points by a 4x4 homogeneous ``matrix``."""
-    points = np.asarray(points, np.float64).reshape(-1, 3)
-    return points @ matrix[:3, :3].T + matrix[:3, 3]
-
-
-def pose(x: float = 0.0, y: float = 0.0, z: float = 0.0, yaw: float = 0.0,
-         pitch: float = 0.0, roll: float = 0.0) -> np.ndarray:
-    """4x4 float64 transform: rotate by roll (x), pitch (y), yaw (z), in that order, then translate.
-
-    Angles in radians; yaw counter-clockwise seen from above.
-    """
-    cr, sr, cp, sp, cy, sy = np.cos(roll), np.sin(roll), np.cos(pitch), np.sin(pitch), np.cos(yaw), np.sin(yaw)
-    rz = np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]])
-    ry = np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
-    rx = np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]])
-    m = np.eye(4)
-    m[:3, :3] = rz @ ry @ rx
-    m[:3, 3] = (x, y, z)
-    return m
-
-
-def _ids(cls: str | int, material: str | int) -> tuple[int, int]:
+def resolve_ids(cls: str | int, material: str | int) -> tuple[int, int]:
+    """(class id, material id) from names or ids (``classes.yaml``, ``materials.yaml``)."""
     c = class_table().id(cls) if isinstance(cls, str) else int(cls)
     m = material_table().id(material) if isinstance(material, str) else int(material)
     return c, m
@@ -142,7 +35,7 @@ def box(size: tuple[float, float, float], cls: str | int, material: str | int,
     if not bottom:
         centroids_z = tm.vertices[faces].mean(1)[:, 2]
         faces = faces[centroids_z > -size[2] / 2 + 1e-9]
-    c, m = _ids(cls, material)
+    c, m = resolve_ids(cls, material)
     return Mesh(tm.vertices + np.asarray(center, float), faces, c, m)
 
 
@@ -155,13 +48,13 @@ def slab(x0: float, y0: float, x1: float, y1: float, z0: float, z1: float, cls: 
 def rect(x0: float, y0: float, x1: float, y1: float, z: float, cls: str | int, material: str | int) -> Mesh:
     """A flat upward-facing rectangle at height ``z`` (markings, ground patches)."""
     v = np.array([[x0, y0, z], [x1, y0, z], [x1, y1, z], [x0, y1, z]], float)
-    c, m = _ids(cls, material)
+    c, m = resolve_ids(cls, material)
     return Mesh(v, [[0, 1, 2], [0, 2, 3]], c, m)
 
 
 def quad(corners: np.ndarray, cls: str | int, material: str | int) -> Mesh:
     """A planar quad from four (x, y, z) corners in counter-clockwise order (seen from its front)."""
-    c, m = _ids(cls, material)
+    c, m = resolve_ids(cls, material)
     return Mesh(np.asarray(corners, float), [[0, 1, 2], [0, 2, 3]], c, m)
 
 
@@ -179,7 +72,7 @@ def cylinder(radius: float, height: float, cls: str | int, material: str | int, 
         v = np.concatenate([v, [[0, 0, z0], [0, 0, z0 + height]]])
         cb, ct = 2 * sections, 2 * sections + 1
         faces += [np.stack([np.full(sections, cb), j, i], 1), np.stack([np.full(sections, ct), i + sections, j + sections], 1)]
-    c, m = _ids(cls, material)
+    c, m = resolve_ids(cls, material)
     return Mesh(v, np.concatenate(faces), c, m)
 
 
@@ -188,7 +81,7 @@ def icosphere(radius: float, cls: str | int, material: str | int, subdivisions: 
               scale: tuple[float, float, float] = (1.0, 1.0, 1.0)) -> Mesh:
     """An icosphere (20 * 4**subdivisions triangles), optionally scaled per axis into an ellipsoid."""
     tm = trimesh.creation.icosphere(subdivisions=subdivisions, radius=radius)
-    c, m = _ids(cls, material)
+    c, m = resolve_ids(cls, material)
     return Mesh(tm.vertices * np.asarray(scale, float) + np.asarray(center, float), tm.faces, c, m)
 
 
@@ -200,13 +93,13 @@ def prism(polygon: np.ndarray, z0: float, z1: float, cls: str | int, material: s
     """
     poly = np.asarray(polygon, float)
     k = len(poly)
-    tris = _triangulate(poly)
+    tris = triangulate(poly)
     v = np.concatenate([np.c_[poly, np.full(k, z0)], np.c_[poly, np.full(k, z1)]])
     i = np.arange(k)
     j = (i + 1) % k
     sides = np.concatenate([np.stack([i, j, j + k], 1), np.stack([i, j + k, i + k], 1)])
-    c, m = _ids(cls, material)
-    mt = m if top_material is None else _ids(cls, top_material)[1]
+    c, m = resolve_ids(cls, material)
+    mt = m if top_material is None else resolve_ids(cls, top_material)[1]
     faces = [sides, tris + k]
     mats = [np.full(len(sides), m), np.full(len(tris), mt)]
     if bottom:
@@ -215,7 +108,7 @@ def prism(polygon: np.ndarray, z0: float, z1: float, cls: str | int, material: s
     return Mesh(v, np.concatenate(faces), c, np.concatenate(mats))
 
 
-def _triangulate(poly: np.ndarray) -> np.ndarray:
+def triangulate(poly: np.ndarray) -> np.ndarray:
     """Ear-clipping triangulation of a simple counter-clockwise polygon: (k-2, 3) int indices."""
     idx = list(range(len(poly)))
     out = []
@@ -258,7 +151,7 @@ def convex_hull(mesh: Mesh, cls: str | int, inflate: float = 0.02) -> Mesh:
     """
     hull = trimesh.convex.convex_hull(mesh.vertices)
     normals = hull.vertex_normals
-    c, _ = _ids(cls, "default")
+    c, _ = resolve_ids(cls, "default")
     return Mesh(hull.vertices + normals * inflate, hull.faces, c, 0)
 
 
@@ -344,7 +237,7 @@ def loft(rings: np.ndarray, cls: str | int, material: str | int, caps: bool = Tr
             if np.dot(n, inward) > 0:
                 cap[:] = cap[:, ::-1]
         faces = np.concatenate([faces, cap0, cap1])
-    c, m = _ids(cls, material)
+    c, m = resolve_ids(cls, material)
     return Mesh(v, faces, c, m)
 
 
@@ -362,7 +255,7 @@ def polygon(points: np.ndarray, cls: str | int, material: str | int,
         n = np.cross(p[faces[:, 1]] - p[faces[:, 0]], p[faces[:, 2]] - p[faces[:, 0]]).sum(0)
         if np.dot(n, normal) < 0:
             faces = faces[:, ::-1]
-    c, m = _ids(cls, material)
+    c, m = resolve_ids(cls, material)
     return Mesh(p, faces, c, m)
 
 
@@ -374,20 +267,6 @@ def disc(center: tuple[float, float, float], normal: tuple[float, float, float],
     a = np.linspace(0, 2 * np.pi, sections, endpoint=False)
     pts = np.asarray(center, float) + radius * (np.cos(a)[:, None] * u + np.sin(a)[:, None] * v)
     return polygon(pts, cls, material, normal=n)
-
-
-def on_ground(mesh: Mesh) -> Mesh:
-    """The mesh shifted along z so that its lowest vertex is at z = 0 (anchors move with it)."""
-    if len(mesh.vertices) == 0:
-        return mesh
-    return mesh.transformed(pose(z=-float(mesh.vertices[:, 2].min())))
-
-
-def face_normals(mesh: Mesh) -> np.ndarray:
-    """(m, 3) float64 unit normals of the faces (right-hand rule on the vertex order)."""
-    tri = mesh.vertices[mesh.faces]
-    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    return n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
 
 
 def quads(corners: np.ndarray, cls: str | int, materials, normals: np.ndarray | None = None) -> Mesh:
@@ -414,10 +293,10 @@ def quads(corners: np.ndarray, cls: str | int, materials, normals: np.ndarray | 
         tri_a[flip] = tri_a[flip][:, ::-1]
         tri_b[flip] = tri_b[flip][:, ::-1]
     faces = np.stack([tri_a, tri_b], 1).reshape(-1, 3)
-    c, _ = _ids(cls, "default")
+    c, _ = resolve_ids(cls, "default")
     if isinstance(materials, (str, int, np.integer)):
-        mats = np.full(n, _ids(cls, materials)[1])
+        mats = np.full(n, resolve_ids(cls, materials)[1])
     else:
         table = {}
-        mats = np.array([table.setdefault(m, _ids(cls, m)[1]) for m in materials], np.int64)
+        mats = np.array([table.setdefault(m, resolve_ids(cls, m)[1]) for m in materials], np.int64)
     return Mesh(corners.reshape(-1, 3), faces, c, np.repeat(mats, 2))

@@ -1,6 +1,6 @@
 """Cast a whole SemanticKITTI sequence along a route: scans, labels, poses, calib, previews.
 
-Per frame ``k`` of :func:`generator.layout.frames.plan_frames` one sweep starting at
+Per frame ``k`` of :meth:`generator.world.rig.Rig.frames` one sweep starting at
 ``t_k``; files under ``out/sequences/NN/`` (see :mod:`generator.formats.semantickitti`)
 plus ``bev/NNNNNN.png`` (bird's-eye view), optionally ``range/NNNNNN.npy`` (range image,
 rings x columns float32, 0 = no return) and ``ply/NNNNNN.ply``; ``lidar_meta.json`` says
@@ -8,7 +8,7 @@ how the data was made (sensor, conventions, remission placeholder, point counts)
 dataset's ``semantic-kitti.yaml`` label config sits in ``out/``.
 Side files for fusion: ``point_times/`` and ``native_labels/`` per scan
 (:mod:`generator.formats.point_sidecars`) and, in ``lidar_meta.json``,
-``sweep_poses_world`` (the LiDAR world poses during each sweep, :mod:`generator.formats.sweep_poses`).
+``sweep_poses_world`` (the LiDAR world poses during each sweep, :meth:`generator.world.rig.Rig.sweep_record`).
 
 Write order: calib first, then scans; ``poses.txt``, ``times.txt`` and the metadata last,
 so a sequence with ``poses.txt`` is complete. Re-running into the same folder overwrites
@@ -32,15 +32,14 @@ from generator.errors import UserError
 from generator.formats import kitti_calib, semantickitti as sk
 from generator.formats.label_config import count_raw_ids, merge_counts, write_label_config
 from generator.formats.ply import write_ply
-from generator.imaging.bev import write_bev
+from generator.previews.bev import write_bev
 from generator.labels import class_table
 from generator.formats.point_sidecars import write_point_sidecars
-from generator.formats.sweep_poses import sweep_record
-from generator.layout.frames import max_frames, plan_frames
-from generator.lidar.pipeline import process_scan, processing_for_spec
-from generator.lidar.remission import IntensityFn, intensity_fn_for_spec
-from generator.lidar.scan import Scanner, sensor_mount, sweep_poses
+from generator.scan_effects.pipeline import process_scan, processing_for_spec
+from generator.remission.models import IntensityFn, intensity_fn_for_spec
+from generator.lidar.scan import Scanner
 from generator.lidar.sensors import Sensor, sensor_for_spec
+from generator.world.rig import Rig
 
 log = logging.getLogger(__name__)
 
@@ -97,8 +96,9 @@ def check_frames(scene, spec, n: int, route: int = 0) -> None:
         raise UserError(f"--frames must be >= 1, got {n}")
     if route >= len(scene.paths):
         raise UserError(f"{spec.source}: the scene has no route {route}")
-    if not scene.paths[route].closed and n > max_frames(scene, spec, route):
-        raise UserError(f"{spec.source}: route {route} fits {max_frames(scene, spec, route)} frames at "
+    fits = Rig.from_spec(spec, scene, route).max_frames()
+    if not scene.paths[route].closed and n > fits:
+        raise UserError(f"{spec.source}: route {route} fits {fits} frames at "
                         f"paths.spacing_m = {spec.paths.spacing_m}, asked for {n}")
 
 
@@ -108,7 +108,7 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
 
     Parameters
     ----------
-    scene : generator.scene.SceneModel
+    scene : generator.world.scene.SceneModel
     spec : generator.spec.SceneSpec
     out : path-like
         Dataset root (``out/sequences/NN`` is created).
@@ -117,7 +117,7 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
     intensity_fn : IntensityFn, optional
         Default: the spec's ``lidar.intensity_model``.
 
-    Every scan goes through :func:`generator.lidar.pipeline.process_scan` (intensity ->
+    Every scan goes through :func:`generator.scan_effects.pipeline.process_scan` (intensity ->
     domain gap -> LiDAR weather) before anything is written; ``lidar_meta.json`` records
     the chain's parameters (``processing``) and what it did to each scan (``scans``).
     """
@@ -127,17 +127,18 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
     check_frames(scene, spec, options.frames, options.route)
     name = sk.sequence_name(options.sequence)
     seq = inside(out, "sequences", name)
-    frames = plan_frames(scene, spec, options.frames, route=options.route)
-    calib = kitti_calib.kitti_calib(spec, *options.resolution)
+    rig = Rig.from_spec(spec, scene, options.route)
+    frames = rig.frames(options.frames)
+    calib = kitti_calib.kitti_calib(rig, *options.resolution)
     tr = kitti_calib.homogeneous(calib["Tr"])
     kitti_calib.write_calib(seq / "calib.txt", calib)
     to_sk = class_table().to_semantickitti
-    t_ego_sensor = sensor_mount(spec)
+    skew = spec.sensors.lidar.motion_skew
     starts, n_points, counts, records = [], [], {}, []
     sweeps = []  # LiDAR world poses during each sweep (fusion de-skews with them)
     with Scanner(scene, sensor, threads=options.threads) as scanner:
         for f in tqdm(frames, desc=f"lidar {name}", unit="scan", disable=None if progress else True):
-            scan = scanner.scan(sweep_poses(scene, spec, sensor, f.t, route=options.route))
+            scan = scanner.sweep(rig, f.t, skew)
             pts, remission, record = process_scan(scan.points, processing, spec, f.index)
             scan = dataclasses.replace(scan, points=pts)  # xyz, range image and side files follow the processed points
             records.append(record)
@@ -154,8 +155,8 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
             if options.ply:
                 write_ply(seq / "ply" / f"{stem}.ply", scan.xyz, remission, semantic, pts["instance"],
                           class_table().colors[pts["class"]])
-            starts.append(f.T_world_ego @ t_ego_sensor)
-            sweeps.append(sweep_record(scene, spec, f.t, sensor.period_s, t_ego_sensor, options.route))
+            starts.append(f.T_world_ego @ rig.T_ego_lidar)
+            sweeps.append(rig.sweep_record(f.t, sensor.period_s))
             n_points.append(int(len(pts)))
             counts = merge_counts(counts, count_raw_ids(semantic))
     _remove_stale(seq, options.frames)

@@ -1,8 +1,9 @@
-"""Entry point of a spawned render worker process.
+"""Entry point of a render worker process (spawned locally, or a Ray task).
 
 The parent (pure Python, no bpy) starts workers with the ``spawn`` start method and
-hands each one a job: the spec, render config, output folder and the list of frames.
-The worker builds the SceneModel and the Blender scene once, renders its frames, writes
+hands each one a :class:`generator.jobs.executors.RenderJob`. The worker builds the
+SceneModel and the Blender renderer once (:class:`generator.blender.renderer.Renderer`,
+the only bpy it touches), asks the rig for each frame, renders its variants, writes
 each image's files atomically and reports progress on a queue:
 ``("ready", stats)``, ``("frame", index, {"images": {name: seconds}, "rss_mb": ...})``,
 ``("error", message)`` and ``("done", stats)`` (including the seconds spent inside
@@ -54,12 +55,12 @@ def _exit_with_parent(parent: int, period_s: float = 0.5) -> None:
     threading.Thread(target=watch, name="parent-watchdog", daemon=True).start()
 
 
-def run(job: dict, queue) -> None:
-    """Render ``job["frames"]`` and report on ``queue`` (a multiprocessing queue)."""
-    if job.get("parent_pid"):
-        _exit_with_parent(job["parent_pid"])
+def run(job, queue) -> None:
+    """Render ``job.frames`` (a :class:`~generator.jobs.executors.RenderJob`) and report on ``queue``."""
+    if job.parent_pid:
+        _exit_with_parent(job.parent_pid)
     try:
-        scratch = Path(job["scratch"])
+        scratch = Path(job.scratch)
         scratch.mkdir(parents=True, exist_ok=True)
         with _stdout_to(scratch / "blender.log"):
             _run(job, queue, scratch)
@@ -68,29 +69,29 @@ def run(job: dict, queue) -> None:
         raise SystemExit(1)
 
 
-def _run(job: dict, queue, scratch: Path) -> None:
+def _run(job, queue, scratch: Path) -> None:
     from generator.blender.renderer import Renderer  # imports bpy (after the sys.path clean-up)
     from generator.jobs.variants import render_frame
-    from generator.layout.assemble import build_scene
-    from generator.layout.frames import plan_frames
+    from generator.layout import build_scene
+    from generator.world.rig import Rig
 
-    spec, cfg = job["spec"], job["config"]
+    spec, cfg = job.spec, job.config
     t = time.perf_counter()
     scene = build_scene(spec)
     layout_s = time.perf_counter() - t
     renderer = Renderer(scene, spec, cfg, scratch)
+    rig = Rig.from_spec(spec, scene)
     queue.put(("ready", {"layout_s": layout_s, "blender_build_s": renderer.build_seconds, "pid": os.getpid()}))
-    from generator.blender.passes import CYCLES_SECONDS
 
     t_start = time.perf_counter()
-    for n, index in enumerate(job["frames"], 1):
-        frame = plan_frames(scene, spec, 1, first=index)[0]
-        images = render_frame(renderer, spec, cfg, frame, Path(job["out"]), job["combos"])
+    for n, index in enumerate(job.frames, 1):
+        images = render_frame(renderer, spec, cfg, rig.frame(index), Path(job.out), job.combos)
         queue.put(("frame", index, {"images": images, "rss_mb": _rss_mb(), "frames_done": n}))
+    cycles = renderer.cycles_seconds
     queue.put(("done", {
-        "pid": os.getpid(), "frames": len(job["frames"]), "max_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
+        "pid": os.getpid(), "frames": len(job.frames), "max_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
         "rss_mb": _rss_mb(), "setup_s": layout_s + renderer.build_seconds, "frames_s": time.perf_counter() - t_start,
-        "cycles_rgb_s": CYCLES_SECONDS["rgb"], "cycles_labels_s": CYCLES_SECONDS["labels"],
+        "cycles_rgb_s": cycles["rgb"], "cycles_labels_s": cycles["labels"],
     }))
 
 

@@ -9,7 +9,7 @@ from PIL import Image, ImageDraw
 
 from generator.atomic import atomic_path
 from generator.imaging.exr import read_exr
-from generator.imaging.preview import colorize, tonemap
+from generator.previews.preview import colorize, tonemap
 from generator.weather import KINDS, TIMES
 
 

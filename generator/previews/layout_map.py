@@ -13,7 +13,7 @@ import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
 from generator.labels import class_table
-from generator.scene import SceneModel
+from generator.world.scene import SceneModel
 
 log = logging.getLogger(__name__)
 

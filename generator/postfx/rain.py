@@ -26,7 +26,7 @@ import math
 import numpy as np
 from scipy import ndimage
 
-from generator.imaging.fog import block_mean, emitter_map, gaussian, upsample
+from generator.postfx.filters import block_mean, emitter_map, gaussian, upsample
 
 #: Nearest and farthest drop distance drawn (m).
 NEAR_M, FAR_M = 0.5, 25.0

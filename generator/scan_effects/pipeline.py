@@ -6,7 +6,7 @@ on or off never changes the draws of another:
 =============== ==============================================
 stage           stream
 =============== ==============================================
-intensity       ``("lidar", "intensity", k)``
+intensity       ``("frame", k, "lidar_intensity")``
 domain gap      ``("frame", k, "lidar_domain_gap")``
 weather         ``("frame", k, "lidar_weather")``
 =============== ==============================================
@@ -28,9 +28,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from generator.lidar.domain_gap import DomainGap, apply_to_points, gap_for_spec
-from generator.lidar.remission import IntensityFn, intensity_fn_for_spec
-from generator.lidar.weather import (LidarWeatherParams, apply_lidar_weather, enabled_for_spec, frame_weather,
+from generator.scan_effects.domain_gap import DomainGap, apply_to_points, gap_for_spec
+from generator.remission.models import IntensityFn, intensity_fn_for_spec
+from generator.scan_effects.weather import (LidarWeatherParams, apply_lidar_weather, enabled_for_spec, frame_weather,
                                      weather_config)
 from generator.rng import stream
 
@@ -109,7 +109,7 @@ def process_scan(points: np.ndarray, processing: ScanProcessing, spec, frame_ind
     """
     seed = spec.seed
     record = {"frame": int(frame_index), "points_cast": int(len(points)), "domain_gap": None, "weather": None}
-    remission = np.asarray(processing.intensity_fn(points, stream(seed, "lidar", "intensity", frame_index)), np.float32)
+    remission = np.asarray(processing.intensity_fn(points, stream(seed, "frame", frame_index, "lidar_intensity")), np.float32)
     if processing.domain_gap is not None:
         points, remission, record["domain_gap"] = apply_to_points(
             points, remission, processing.domain_gap, stream(seed, "frame", frame_index, "lidar_domain_gap"))

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from assets_procedural.mesh import Mesh, apply
+from generator.geometry import Mesh, apply
 
 
 @dataclass(frozen=True)

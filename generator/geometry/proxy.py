@@ -9,7 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from assets_procedural.mesh import Mesh, convex_hull, merge
+from generator.geometry.mesh import Mesh, merge
+from generator.geometry.primitives import convex_hull
 from generator.labels import class_table
 
 

@@ -1,4 +1,4 @@
-"""Intensity (remission) models: per-class normal profiles, physical received power, hybrid.
+"""Intensity (remission) models: constant, per-class normal profiles, physical received power, hybrid.
 
 Every model is an :data:`IntensityFn` ``fn(points, rng) -> (n,) float32`` in [0, 1] and
 carries a ``description`` dict that goes into ``lidar_meta.json``. ``points`` is a
@@ -34,182 +34,21 @@ from __future__ import annotations
 
 import functools
 import logging
-import math
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
 
 import numpy as np
 import yaml
 
-from generator.errors import SpecError, UserError
+from generator.errors import SpecError
 from generator.labels import class_table
 from generator.materials import material_table
+from generator.remission.class_profiles import LABEL_SPACES, IntensityProfile, profile_for_spec, resolve_profile
 
 log = logging.getLogger(__name__)
 
 IntensityFn = Callable[[np.ndarray, np.random.Generator], np.ndarray]
-PROFILE_DIR = Path(__file__).resolve().parent / "profiles"
-DEFAULT_PROFILE = "semantickitti_table3"
 REFLECTIVITY_FILE = Path(__file__).resolve().parent / "reflectivity.yaml"
-#: Label spaces a profile lookup can be indexed by.
-LABEL_SPACES = ("semantickitti", "unified11")
-
-
-# -- profiles -------------------------------------------------------------------------------
-@dataclass(frozen=True)
-class ClassStats:
-    """Remission statistics of one class: mean, standard deviation, number of points (None if unknown)."""
-
-    mean: float
-    std: float
-    count: int | None = None
-
-
-@dataclass(frozen=True)
-class IntensityProfile:
-    """Per-class remission statistics.
-
-    Attributes
-    ----------
-    name, source : str
-        Profile name and where its numbers come from.
-    unified : dict of str to ClassStats
-        By unified-11 class name (``unlabeled``, ``vehicle``, ...).
-    semantickitti : dict of int to ClassStats
-        By SemanticKITTI raw id; takes precedence over ``unified`` for that raw id.
-    pooled : ClassStats or None
-        All points together (fitted profiles): the fallback for classes the data did not have
-        when there is no ``unlabeled`` entry.
-    file : str
-        The file it was read from ('' if built in memory).
-    """
-
-    name: str
-    source: str
-    unified: dict[str, ClassStats] = field(default_factory=dict)
-    semantickitti: dict[int, ClassStats] = field(default_factory=dict)
-    pooled: ClassStats | None = None
-    file: str = ""
-
-    def unified_tables(self) -> tuple[np.ndarray, np.ndarray, list[str]]:
-        """(12,) float64 mean and std per unified id, and the class names that fell back.
-
-        A missing class uses the ``unlabeled`` entry, else ``pooled``.
-
-        Raises
-        ------
-        UserError
-            If a unified class is missing and there is neither an ``unlabeled`` nor a ``pooled`` entry.
-        """
-        names = class_table().unified_names
-        mean = np.zeros(max(names) + 1)
-        std = np.zeros(max(names) + 1)
-        fallback = [names[u] for u in sorted(names) if names[u] not in self.unified]
-        spare = self.unified.get("unlabeled", self.pooled)
-        if fallback and spare is None:
-            raise UserError(f"{self.file or self.name}: unified: no entry for {', '.join(fallback)} "
-                            "and no 'unlabeled' or 'pooled' entry to fall back on")
-        for u, n in names.items():
-            st = self.unified.get(n, spare)
-            mean[u], std[u] = st.mean, st.std
-        return mean, std, fallback
-
-    def raw_tables(self) -> tuple[np.ndarray, np.ndarray, list[str]]:
-        """(K,) float64 mean and std per SemanticKITTI raw id 0..K-1 (raw entry, else its unified class)."""
-        table = class_table()
-        u_mean, u_std, fallback = self.unified_tables()
-        size = max(len(table.sk_to_unified), max(self.semantickitti, default=0) + 1)
-        uni = np.zeros(size, np.int64)
-        uni[: len(table.sk_to_unified)] = table.sk_to_unified
-        mean, std = u_mean[uni], u_std[uni]
-        for raw, st in self.semantickitti.items():
-            mean[raw], std[raw] = st.mean, st.std
-        return mean, std, fallback
-
-    def to_dict(self) -> dict:
-        """Plain data in the YAML layout of ``profiles/*.yaml``."""
-        def row(st: ClassStats) -> dict:
-            return {"mean": float(st.mean), "std": float(st.std), "count": None if st.count is None else int(st.count)}
-        out = {"name": self.name, "source": self.source,
-               "label_space": "semantickitti" if self.semantickitti else "unified11",
-               "unified": {k: row(v) for k, v in self.unified.items()}}
-        if self.semantickitti:
-            out["semantickitti"] = {int(k): dict(row(v), name=class_table().sk_labels.get(int(k), "unknown"))
-                                    for k, v in sorted(self.semantickitti.items())}
-        if self.pooled is not None:
-            out["pooled"] = row(self.pooled)
-        return out
-
-
-def _stats(value, where: str) -> ClassStats:
-    if not isinstance(value, dict) or "mean" not in value or "std" not in value:
-        raise UserError(f"{where}: must be a mapping with mean and std")
-    try:
-        mean, std = float(value["mean"]), float(value["std"])
-    except (TypeError, ValueError):
-        raise UserError(f"{where}: mean and std must be numbers") from None
-    if not (math.isfinite(mean) and math.isfinite(std)) or std < 0:
-        raise UserError(f"{where}: needs a finite mean and a finite std >= 0, got mean={mean}, std={std}")
-    count = value.get("count")
-    if count is not None and (not isinstance(count, int) or count < 0):
-        raise UserError(f"{where}: count must be a non-negative integer or null, got {count!r}")
-    return ClassStats(mean, std, count)
-
-
-def parse_profile(doc, source: str) -> IntensityProfile:
-    """Validate a profile document (``yaml.safe_load`` output) read from ``source``."""
-    if not isinstance(doc, dict):
-        raise UserError(f"{source}: an intensity profile must be a YAML mapping")
-    known = set(class_table().unified_names.values())
-    unified_doc, raw_doc = doc.get("unified") or {}, doc.get("semantickitti") or {}
-    if not isinstance(unified_doc, dict) or not isinstance(raw_doc, dict):
-        raise UserError(f"{source}: 'unified' and 'semantickitti' must be mappings")
-    if not unified_doc and not raw_doc:
-        raise UserError(f"{source}: no 'unified' or 'semantickitti' class statistics")
-    unified = {}
-    for name, v in unified_doc.items():
-        if name not in known:
-            raise UserError(f"{source}: unified: unknown class {name!r}; known: {', '.join(sorted(known))}")
-        unified[name] = _stats(v, f"{source}: unified.{name}")
-    raw = {}
-    for k, v in raw_doc.items():
-        if not isinstance(k, int) or not 0 <= k <= 0xFFFF:
-            raise UserError(f"{source}: semantickitti: keys must be raw ids 0..65535, got {k!r}")
-        raw[k] = _stats(v, f"{source}: semantickitti.{k}")
-    pooled = _stats(doc["pooled"], f"{source}: pooled") if doc.get("pooled") is not None else None
-    return IntensityProfile(str(doc.get("name", Path(source).stem)), str(doc.get("source", "")), unified, raw, pooled,
-                            source)
-
-
-def load_profile(path: str | Path, name: str | None = None) -> IntensityProfile:
-    """Read a profile YAML (``UserError`` naming the file on any problem); ``name`` replaces the path in records."""
-    path = Path(path)
-    try:
-        doc = yaml.safe_load(path.read_text(encoding="utf-8"))
-    except OSError as e:
-        raise UserError(f"{path}: cannot read intensity profile: {e.strerror or e}") from None
-    except yaml.YAMLError as e:
-        raise UserError(f"{path}: not valid YAML: {str(e).splitlines()[0]}") from None
-    return parse_profile(doc, name or str(path))
-
-
-def shipped_profiles() -> list[str]:
-    """Names of the profiles in ``generator/lidar/profiles``."""
-    return sorted(p.stem for p in PROFILE_DIR.glob("*.yaml"))
-
-
-def resolve_profile(value: str | None, base: str | Path | None = None) -> IntensityProfile:
-    """A shipped profile by name (None = :data:`DEFAULT_PROFILE`) or a file path (relative to ``base``)."""
-    value = value or DEFAULT_PROFILE
-    if value in shipped_profiles():
-        return load_profile(PROFILE_DIR / f"{value}.yaml", f"generator/lidar/profiles/{value}.yaml")
-    path = Path(value)
-    if not path.is_absolute() and base is not None:
-        path = Path(base) / path
-    if not path.is_file():
-        raise UserError(f"{value}: intensity profile not found (not a file, nor one of {', '.join(shipped_profiles())})")
-    return load_profile(path)
 
 
 # -- per-point inputs -----------------------------------------------------------------------
@@ -345,10 +184,68 @@ def hybrid(profile: IntensityProfile, label_space: str = "semantickitti") -> Int
     return fn
 
 
-def profile_for_spec(spec) -> IntensityProfile:
-    """The spec's ``lidar.intensity_profile`` (a shipped name or a path relative to the spec file)."""
-    base = Path(spec.source).parent if spec.source else None
+def constant(value: float = 0.5) -> IntensityFn:
+    """An intensity function giving every point ``value``."""
+    v = np.float32(value)
+
+    def fn(points: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        return np.full(len(points), v, np.float32)
+
+    fn.description = {"model": "constant", "value": float(value), "placeholder": True}
+    return fn
+
+
+#: Factories by spec name; each takes the spec and returns an :data:`IntensityFn`.
+#: ``class_normal``, ``physical`` and ``hybrid`` live in :mod:`generator.remission.models`.
+INTENSITY_MODELS: dict[str, Callable[[object], IntensityFn]] = {
+    "constant": lambda spec: constant(spec.lidar.constant_intensity),
+    "class_normal": lambda spec: class_normal(profile_for_spec(spec)),
+    "physical": lambda spec: physical(),
+    "hybrid": lambda spec: hybrid(profile_for_spec(spec)),
+}
+
+
+def intensity_fn_for_spec(spec) -> IntensityFn:
+    """The intensity function ``spec.lidar.intensity_model`` names.
+
+    Raises
+    ------
+    SpecError
+        If the model is not available (yet).
+    """
+    name = spec.lidar.intensity_model
     try:
-        return resolve_profile(spec.lidar.intensity_profile, base)
-    except UserError as e:
-        raise SpecError(spec.source or "spec", "lidar.intensity_profile", str(e)) from None
+        return INTENSITY_MODELS[name](spec)
+    except KeyError:
+        raise SpecError(spec.source or "spec", "lidar.intensity_model",
+                        f"{name!r} is not available in this version (available: {', '.join(INTENSITY_MODELS)})") from None
+
+
+#: Every model name, in the order the spec's enum lists them.
+MODEL_NAMES = ("constant", "class_normal", "physical", "hybrid")
+
+
+def intensity_model(name: str, profile: "IntensityProfile | None" = None, constant_value: float = 0.5,
+                    label_space: str = "semantickitti") -> IntensityFn:
+    """An intensity function by model name, without a spec (importers, converters).
+
+    Parameters
+    ----------
+    name : str
+        One of :data:`MODEL_NAMES`.
+    profile : IntensityProfile, optional
+        For ``class_normal`` / ``hybrid`` (default: seed 000 Table III).
+    constant_value : float
+        For ``constant``.
+    label_space : {'semantickitti', 'unified11'}
+        What the points' ``semantic`` ids are, for the profile lookup.
+    """
+    factories = {
+        "constant": lambda: constant(constant_value),
+        "class_normal": lambda: class_normal(profile or resolve_profile(None), label_space),
+        "physical": physical,
+        "hybrid": lambda: hybrid(profile or resolve_profile(None), label_space),
+    }
+    if name not in factories:
+        raise SpecError("--intensity", "", f"unknown intensity model {name!r}; known: {', '.join(MODEL_NAMES)}")
+    return factories[name]()

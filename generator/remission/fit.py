@@ -31,7 +31,7 @@ from generator.atomic import write_text
 from generator.errors import UserError
 from generator.formats import semantickitti as sk
 from generator.labels import class_table
-from generator.lidar.intensity import ClassStats, IntensityProfile, LABEL_SPACES
+from generator.remission.class_profiles import LABEL_SPACES, ClassStats, IntensityProfile
 
 log = logging.getLogger(__name__)
 

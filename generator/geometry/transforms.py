@@ -1,0 +1,48 @@
+"""Rigid transforms as (4, 4) float64 homogeneous matrices.
+
+A transform ``T_a_b`` maps points in frame b to frame a. Angles in radians unless a name
+says degrees; yaw is counter-clockwise seen from above (z up).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def apply(matrix: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Map (n, 3) points by a 4x4 homogeneous ``matrix``."""
+    points = np.asarray(points, np.float64).reshape(-1, 3)
+    return points @ matrix[:3, :3].T + matrix[:3, 3]
+
+
+def pose(x: float = 0.0, y: float = 0.0, z: float = 0.0, yaw: float = 0.0,
+         pitch: float = 0.0, roll: float = 0.0) -> np.ndarray:
+    """4x4 float64 transform: rotate by roll (x), pitch (y), yaw (z), in that order, then translate.
+
+    Angles in radians; yaw counter-clockwise seen from above.
+    """
+    cr, sr, cp, sp, cy, sy = np.cos(roll), np.sin(roll), np.cos(pitch), np.sin(pitch), np.cos(yaw), np.sin(yaw)
+    rz = np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]])
+    ry = np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
+    rx = np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]])
+    m = np.eye(4)
+    m[:3, :3] = rz @ ry @ rx
+    m[:3, 3] = (x, y, z)
+    return m
+
+
+
+def invert(t: np.ndarray) -> np.ndarray:
+    """Inverse of a rigid (4, 4) transform."""
+    out = np.eye(4)
+    out[:3, :3] = t[:3, :3].T
+    out[:3, 3] = -t[:3, :3].T @ t[:3, 3]
+    return out
+
+
+def mount(xyz_m, rpy_deg) -> np.ndarray:
+    """``T_parent_child`` of a body mounted at ``xyz_m`` (metres) with roll, pitch, yaw in degrees."""
+    r, p, y = (math.radians(a) for a in rpy_deg)
+    return pose(*xyz_m, yaw=y, pitch=p, roll=r)

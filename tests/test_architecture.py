@@ -1,0 +1,161 @@
+"""The package layering holds: imports run one way, bpy stays in the Blender edge.
+
+Walks every module's imports with ``ast`` (module-level and function-level alike, so a lazy
+import cannot hide a back edge) and checks them against :data:`ALLOWED`, the layer table
+README's "Tour of the code" shows.
+"""
+
+from __future__ import annotations
+
+import ast
+from collections import defaultdict
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+#: Bottom of the house: imported by anything, import nothing of ours but each other.
+BASE = {"generator", "errors", "atomic", "rng", "safeload"}
+
+#: Package -> the packages it may import (besides BASE). ``generator`` is the package root
+#: (``__version__``); ``assets_procedural`` is the top-level asset package.
+ALLOWED: dict[str, set[str]] = {
+    "labels": set(),
+    "materials": set(),
+    "spec": set(),
+    "weather": set(),
+    "geometry": {"labels", "materials"},
+    "world": {"geometry", "spec"},
+    "assets_procedural": {"geometry", "labels", "materials"},
+    "layout": {"assets_procedural", "geometry", "labels", "materials", "spec", "world"},
+    "lidar": {"geometry", "labels", "spec", "world"},
+    "postfx": {"weather"},
+    "imaging": {"labels", "spec", "weather"},
+    "formats": {"geometry", "labels", "spec", "world"},
+    "previews": {"imaging", "labels", "weather", "world"},
+    "remission": {"formats", "labels", "materials", "spec"},
+    "stats": {"formats", "imaging", "labels", "previews", "weather"},
+    "scan_effects": {"labels", "remission", "spec", "weather"},
+    "fusion": {"formats", "geometry", "imaging", "labels", "stats", "world"},
+    "blender": {"geometry", "labels", "materials", "spec", "weather", "world"},
+    "jobs": {"blender", "formats", "geometry", "imaging", "labels", "layout", "lidar", "materials", "postfx", "previews",
+             "remission", "scan_effects", "spec", "stats", "weather", "world"},
+    "commands": {"formats", "fusion", "geometry", "imaging", "jobs", "labels", "layout", "lidar", "materials", "previews",
+                 "remission", "scan_effects", "spec", "stats", "weather", "world"},
+    "cli": {"commands"},
+}
+
+
+def _package(module: str) -> str:
+    parts = module.split(".")
+    if parts[0] == "assets_procedural":
+        return "assets_procedural"
+    return "generator" if len(parts) == 1 else parts[1]
+
+
+def _modules():
+    for path in sorted([*ROOT.glob("generator/**/*.py"), *ROOT.glob("assets_procedural/**/*.py")]):
+        rel = path.relative_to(ROOT).with_suffix("")
+        parts = list(rel.parts)
+        is_init = parts[-1] == "__init__"
+        if is_init:
+            parts = parts[:-1]
+        yield ".".join(parts), is_init, path
+
+
+def _imports(module: str, is_init: bool, path: Path) -> set[str]:
+    """Every module ``module`` imports (absolute names), at any nesting level."""
+    pkg = module if is_init else module.rsplit(".", 1)[0]
+    out = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            out.update(a.name for a in node.names)
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = pkg.split(".")[: len(pkg.split(".")) - (node.level - 1)]
+                target = ".".join(base + ([node.module] if node.module else []))
+            else:
+                target = node.module or ""
+            out.add(target)
+            out.update(f"{target}.{a.name}" for a in node.names)  # `from pkg import module`
+    return out
+
+
+@pytest.fixture(scope="module")
+def graph() -> dict[str, set[str]]:
+    """Module -> the project modules and packages it imports."""
+    g = {}
+    for module, is_init, path in _modules():
+        g[module] = {m for m in _imports(module, is_init, path) if m.split(".")[0] in ("generator", "assets_procedural")}
+    return g
+
+
+def _known(g: dict[str, set[str]], name: str) -> bool:
+    return name in g
+
+
+def test_every_package_is_in_the_layer_table(graph):
+    packages = {_package(m) for m in graph} - BASE
+    assert packages <= set(ALLOWED), f"add these packages to ALLOWED (and README): {sorted(packages - set(ALLOWED))}"
+
+
+def test_imports_follow_the_layer_table(graph):
+    bad = []
+    for module, targets in graph.items():
+        src = _package(module)
+        for t in targets:
+            if not _known(graph, t):
+                continue  # `from generator.x import name`: the name, not a module
+            dst = _package(t)
+            if dst == src or dst in BASE:
+                continue
+            if src in BASE:
+                bad.append(f"{module} (base) imports {t}")
+            elif dst not in ALLOWED[src]:
+                bad.append(f"{module} imports {t} ({src} -> {dst} is not in the layer table)")
+    assert not bad, "\n".join(sorted(bad))
+
+
+def test_the_layer_table_has_no_cycle():
+    state: dict[str, int] = defaultdict(int)
+
+    def visit(p: str, trail: list[str]) -> None:
+        if state[p] == 1:
+            raise AssertionError("cycle: " + " -> ".join(trail + [p]))
+        if state[p] == 2:
+            return
+        state[p] = 1
+        for q in ALLOWED.get(p, ()):
+            visit(q, trail + [p])
+        state[p] = 2
+
+    for p in ALLOWED:
+        visit(p, [])
+
+
+def test_the_blender_edge_calls_nothing_above_it(graph):
+    for module, targets in graph.items():
+        if _package(module) == "blender":
+            above = {t for t in targets if _package(t) in ("jobs", "commands", "cli", "layout")}
+            assert not above, f"{module} imports {sorted(above)}"
+
+
+def test_only_the_blender_edge_imports_bpy():
+    for module, is_init, path in _modules():
+        if module.startswith("generator.blender"):
+            continue
+        names = _imports(module, is_init, path)
+        assert not {n for n in names if n.split(".")[0] in ("bpy", "mathutils")}, f"{module} imports bpy"
+
+
+def test_only_the_placement_step_imports_assets(graph):
+    users = {m for m, targets in graph.items()
+             if _package(m) != "assets_procedural" and any(_package(t) == "assets_procedural" for t in targets)}
+    assert users == {"generator.layout.placement_core"}
+
+
+def test_modules_stay_small():
+    big = {str(p.relative_to(ROOT)): n for _, _, p in _modules()
+           if (n := len(p.read_text(encoding="utf-8").splitlines())) > 350}
+    assert not big, f"split these modules (over 350 lines): {big}"
