@@ -385,8 +385,9 @@ def test_ground_has_no_holes_out_to_the_horizon(default_spec, default_scene):
     within HORIZON_M of it; from every route point the ground's edge is HORIZON_M or more away
     (a camera 1.65 m up sees ground to within 0.05 degrees of the horizon)."""
     s = default_scene
-    stuff = s.face_instance == 0
     cls = s.face_class.astype(np.int64)
+    ground = [class_table().id(c) for c in ("road", "road_marking", "crosswalk", "curb", "sidewalk", "parking", "terrain")]
+    stuff = np.isin(cls, ground)
     grid = make_grid(default_spec)
     top, z = rasterize(s.vertices, s.faces[stuff], cls[stuff], np.asarray(grid.bounds), 2.0)
     assert (top >= 0).all(), f"{int((top < 0).sum())} holes in the town ground at 0.5 m"
@@ -502,3 +503,15 @@ def test_oriented_boxes_enclose_object_vertices(default_scene):
 def test_box_helper_sanity():
     box = OrientedBox((0.0, 0.0, 0.5), (4.0, 2.0, 1.0), np.pi / 2)
     assert point_box_distance(np.array([[0.0, 3.0], [2.0, 0.0], [0.0, 0.0]]), box).tolist() == pytest.approx([1.0, 1.0, 0.0])
+
+
+def test_instance_ids_go_to_things_only(default_scene):
+    """SemanticKITTI and Cityscapes panoptic conventions: things get unique ids 1..N, stuff 0."""
+    table = class_table()
+    ids = [o.instance_id for o in default_scene.objects if table[o.cls].thing]
+    assert ids and sorted(ids) == list(range(1, len(ids) + 1))
+    assert all(o.instance_id == 0 for o in default_scene.objects if not table[o.cls].thing)
+    stuff_faces = ~np.array([r.thing for r in table.rows])[default_scene.face_class]
+    assert (default_scene.face_instance[stuff_faces] == 0).all()
+    assert {table.names[c] for c in np.unique(default_scene.face_class[default_scene.face_instance > 0])} <= {
+        r.name for r in table.rows if r.thing}

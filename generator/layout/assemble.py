@@ -119,25 +119,31 @@ def _objects(grid: Grid, lots: list[Lot], placed: list[Placed], lib: Library):
         prototypes.setdefault(key, mesh)
         lo, hi = mesh.bounds()
         objects.append(SceneObject(len(objects), nm, kind, cls, 0, key, T, box_of(lo, hi, T)))
-    if len(placed) > MAX_INSTANCES:
-        raise LayoutError(f"{len(placed)} things exceed the {MAX_INSTANCES} instance ids of a uint16 label")
-    for k, p in enumerate(placed):
+    is_thing = [r.thing for r in class_table().rows]
+    n_things = sum(is_thing[class_table().id(p.cls)] for p in placed)
+    if n_things > MAX_INSTANCES:
+        raise LayoutError(f"{n_things} things exceed the {MAX_INSTANCES} instance ids of a uint16 label")
+    things = 0
+    for p in placed:
+        instance = 0
+        if is_thing[class_table().id(p.cls)]:  # instance ids for things only, as SemanticKITTI and Cityscapes
+            things += 1
+            instance = things
         if p.proto not in prototypes:
             mesh = lib.protos[p.proto].mesh
             prototypes[p.proto] = mesh
             hull = label_proxy(mesh)
             if hull is not None:
                 proxies[p.proto] = hull
-        objects.append(SceneObject(len(objects), name(p.kind), p.kind, p.cls, k + 1, p.proto, p.transform, p.box,
+        objects.append(SceneObject(len(objects), name(p.kind), p.kind, p.cls, instance, p.proto, p.transform, p.box,
                                    p.proto if p.proto in proxies else None, p.attrs))
     return prototypes, proxies, objects
 
 
 def verify_routes(paths: list[Path], grid: Grid, objects: list[SceneObject], limit: float) -> None:
     """Raise :class:`LayoutError` unless every route sample lies on driving-lane asphalt and keeps
-    ``limit`` metres (2D) from every thing's box."""
+    ``limit`` metres (2D) from the box of every placed object in ``objects``."""
     drive = grid.drivable_rects()
-    things = [o for o in objects if o.instance_id > 0]
     for path in paths:
         xy = path.points[:, :2]
         inside = ((xy[:, None, 0] >= drive[None, :, 0] - 1e-6) & (xy[:, None, 0] <= drive[None, :, 2] + 1e-6)
@@ -145,7 +151,7 @@ def verify_routes(paths: list[Path], grid: Grid, objects: list[SceneObject], lim
         if not inside.all():
             raise LayoutError(f"{path.name}: {int((~inside).sum())} samples off the driving lanes, e.g. {xy[~inside][0]}")
         keep = Keepout(xy, limit)
-        for o in things:
+        for o in objects:
             d = keep.distance(o.box)
             if d < limit:
                 raise LayoutError(f"{path.name}: {o.name} is {d:.2f} m from the route (< {limit:.2f} m)")
@@ -157,8 +163,8 @@ def build_scene(spec: SceneSpec) -> SceneModel:
     Returns
     -------
     SceneModel
-        Stuff objects first (instance id 0), then things with instance ids 1..N in placement
-        order; route 0 is the comb loop :class:`generator.world.rig.Rig` follows.
+        Ground pieces first, then placed objects in placement order; objects of thing classes
+        (``thing`` in ``classes.yaml``) get instance ids 1..N, stuff gets 0; route 0 is the comb loop :class:`generator.world.rig.Rig` follows.
 
     Raises
     ------
@@ -181,7 +187,7 @@ def build_scene(spec: SceneSpec) -> SceneModel:
         step(placer, spec, grid, lots, street)
         log.info("placed %d %s (%.2f s)", len(placer.placed) - n0, label, time.perf_counter() - t1)
     prototypes, proxies, objects = _objects(grid, lots, placer.placed, lib)
-    verify_routes(routes, grid, objects, limit - 1e-6)
+    verify_routes(routes, grid, objects[len(objects) - len(placer.placed):], limit - 1e-6)
     scene = SceneModel(spec.seed, spec.spec_hash, grid.bounds, prototypes, proxies, objects, routes)
     log.info("scene %s: %d objects, %d prototypes, %d proxies, built in %.2f s", spec.name, len(objects),
              len(prototypes), len(proxies), time.perf_counter() - t0)
