@@ -24,7 +24,8 @@ def cloud(n=20_000, seed=0):
 
 
 def test_seed002_preset_is_the_paper():
-    assert preset("seed002") == DomainGap(dropout=0.10, jitter_m=0.05, constant_intensity=1.0)
+    # the paper's intensity 1 on a 0-255 scale, on SemanticKITTI's [0, 1] scale
+    assert preset("seed002") == DomainGap(dropout=0.10, jitter_m=0.05, constant_intensity=1.0 / 255.0)
     with pytest.raises(UserError, match="unknown domain-gap preset 'x'; known: seed002, none"):
         preset("x")
 
@@ -85,7 +86,7 @@ def test_structured_points_keep_their_labels():
     pts["class"] = np.arange(1000) % 20
     pts["instance"] = np.arange(1000)
     out, rem, _ = apply_to_points(pts, np.zeros(1000, np.float32), PRESETS["seed002"], np.random.default_rng(0))
-    assert len(out) == 900 and np.all(rem == 1.0)
+    assert len(out) == 900 and np.all(rem == np.float32(1.0 / 255.0))
     src = out["instance"]  # the instance id says which input point each output is
     assert np.all(np.abs(out["x"] - pts["x"][src]) <= 0.05 + 1e-4)
     assert np.array_equal(out["class"], pts["class"][src])
@@ -103,9 +104,10 @@ def test_sequence_applies_the_gap_and_records_it(test_spec, tmp_path):
         cast = scan_meta["points_cast"]
         assert scan_meta["domain_gap"]["removed"] == round(0.1 * cast)
         assert len(rec.points) == cast - round(0.1 * cast) == scan_meta["points"]
-        assert np.all(rec.points[:, 3] == 1.0) and len(rec.semantic) == len(rec.points)
+        assert np.all(rec.points[:, 3] == np.float32(1.0 / 255.0)) and len(rec.semantic) == len(rec.points)
     on_disk = json.loads((tmp_path / "sequences" / "00" / "lidar_meta.json").read_text())
-    assert on_disk["scans"][0]["domain_gap"]["constant_intensity"] == 1.0
+    assert on_disk["scans"][0]["domain_gap"]["constant_intensity"] == 1.0 / 255.0
+    assert "1/255" in on_disk["scans"][0]["domain_gap"]["scale_note"]
 
 
 @pytest.mark.parametrize("extra, message", [
@@ -133,7 +135,7 @@ def test_command_line_options_reach_the_spec(test_spec):
                                                               "--jitter-m", "0.02", "--lidar-weather", "on"]))
     g = spec.lidar.domain_gap
     assert spec.lidar.intensity_model == "hybrid" and spec.lidar.weather.enabled is True
-    assert (g.enabled, g.dropout, g.jitter_m, g.constant_intensity) == (True, 0.1, 0.02, 1.0)
+    assert (g.enabled, g.dropout, g.jitter_m, g.constant_intensity) == (True, 0.1, 0.02, 1.0 / 255.0)
     assert spec.spec_hash != test_spec.spec_hash
     same = spec_with_processing_args(test_spec, p.parse_args([]))
     assert same == test_spec  # no options: the spec (and its hash) unchanged

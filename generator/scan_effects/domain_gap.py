@@ -10,7 +10,10 @@ LiDAR weather:
 3. **constant intensity**: every remission becomes ``constant_intensity`` (the paper's
    answer to CARLA's unrealistic intensities).
 
-The paper's preset (``seed002``) is 10 % removal, ±0.05 m, intensity 1.0. A part is off
+The paper's preset (``seed002``) is 10 % removal, ±0.05 m, intensity "1". The paper writes
+intensity on the sensor's 0-255 scale, where 1 is one of the most common values (poorly
+reflecting road); SemanticKITTI's remission is on [0, 1], so the preset writes 1/255
+(:data:`SEED002_INTENSITY`), not 1.0 (the maximum). The record says so (``scale_note``). A part is off
 when its value is 0 / 0 / None. Randomness comes only from the generator passed in
 (``stream(seed, "frame", k, "lidar_domain_gap")`` for frame ``k``).
 """
@@ -55,8 +58,13 @@ class DomainGap:
 
 
 #: Named presets; ``seed002`` reproduces the paper.
+#: Seed 002's constant intensity "1" on its 0-255 scale, written on SemanticKITTI's [0, 1] scale.
+SEED002_INTENSITY = 1.0 / 255.0
+SCALE_NOTE = ("remission is on SemanticKITTI's [0, 1] scale; seed 002's constant intensity 1 (of 0-255) "
+              "is written as 1/255")
+
 PRESETS: dict[str, DomainGap] = {
-    "seed002": DomainGap(dropout=0.10, jitter_m=0.05, constant_intensity=1.0),
+    "seed002": DomainGap(dropout=0.10, jitter_m=0.05, constant_intensity=SEED002_INTENSITY),
     "none": DomainGap(),
 }
 
@@ -111,7 +119,10 @@ def apply_domain_gap(xyz: np.ndarray, remission: np.ndarray, gap: DomainGap,
     rem = np.asarray(remission, np.float32)[keep]
     if gap.constant_intensity is not None:
         rem = np.full(len(keep), gap.constant_intensity, np.float32)
-    return keep, out, rem, {**gap.to_dict(), "points_in": int(n), "removed": int(k)}
+    info = {**gap.to_dict(), "points_in": int(n), "removed": int(k)}
+    if gap.constant_intensity is not None:
+        info["scale_note"] = SCALE_NOTE
+    return keep, out, rem, info
 
 
 def apply_to_points(points: np.ndarray, remission: np.ndarray, gap: DomainGap,
