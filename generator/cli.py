@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import logging
+import re
 import sys
 
 from generator import __version__
@@ -42,6 +43,32 @@ class OneLineParser(argparse.ArgumentParser):
         self.exit(EXIT_USAGE, f"{self.prog}: error: {message}\n")
 
 
+_ROLE = re.compile(r":([a-z]+):`~?([^`]+)`")
+_LITERAL = re.compile(r"``([^`]+)``")
+
+
+def plain(text: str | None) -> str | None:
+    """Help text without reST markup (``:func:`x``` -> ``x``, double backticks dropped)."""
+    if not text:
+        return text
+    def role(m: re.Match) -> str:  # a module keeps its dotted name, a function or class its own name
+        return m.group(2) if m.group(1) == "mod" else m.group(2).rsplit(".", 1)[-1]
+
+    return _LITERAL.sub(r"\1", _ROLE.sub(role, text))
+
+
+def _plain_help(parser: argparse.ArgumentParser) -> None:
+    """Strip reST markup from every description and option help of ``parser`` and its sub-commands."""
+    parser.description = plain(parser.description)
+    for action in parser._actions:
+        action.help = plain(action.help)
+        if isinstance(action, argparse._SubParsersAction):
+            for choice in action._choices_actions:
+                choice.help = plain(choice.help)
+            for sub in set(action.choices.values()):
+                _plain_help(sub)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = OneLineParser(prog="urbangen", description="Procedural urban scenes: labelled images and LiDAR from one geometry.")
     parser.add_argument("--version", action="version", version=f"urbangen {__version__}")
@@ -51,6 +78,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub.required = True
     for name in COMMANDS:
         importlib.import_module(f"generator.commands.{name}").register(sub)
+    _plain_help(parser)
     return parser
 
 
@@ -59,6 +87,8 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     level = logging.ERROR if args.quiet else (logging.WARNING, logging.INFO, logging.DEBUG)[min(args.verbose, 2)]
     logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s", stream=sys.stderr)
+    # progress lines (logged only when stderr is not a terminal; a terminal gets a bar) unless --quiet
+    logging.getLogger("urbangen.progress").setLevel(logging.ERROR if args.quiet else logging.INFO)
     try:
         return int(args.func(args) or 0)
     except UserError as e:

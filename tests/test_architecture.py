@@ -16,7 +16,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 
 #: Bottom of the house: imported by anything, import nothing of ours but each other.
-BASE = {"generator", "errors", "atomic", "rng", "safeload"}
+BASE = {"generator", "errors", "atomic", "rng", "safeload", "progress"}
 
 #: Package -> the packages it may import (besides BASE). ``generator`` is the package root
 #: (``__version__``); ``assets_procedural`` is the top-level asset package.
@@ -43,6 +43,7 @@ ALLOWED: dict[str, set[str]] = {
              "remission", "scan_effects", "spec", "stats", "weather", "world"},
     "commands": {"formats", "fusion", "geometry", "imaging", "jobs", "labels", "layout", "lidar", "materials", "previews",
                  "remission", "scan_effects", "spec", "stats", "weather", "world"},
+    "dataset": {"formats", "imaging", "labels"},
     "cli": {"commands"},
 }
 

@@ -76,8 +76,10 @@ def test_calib_from_the_rig_is_kitti_like(default_spec, tmp_path):
     np.testing.assert_allclose(tr[:3, :3], [[0, -1, 0], [0, 0, -1], [1, 0, 0]], atol=1e-12)
     np.testing.assert_allclose(tr[:3, 3], [0.0, -0.08, -0.27], atol=1e-12)  # lidar 8 cm above, 27 cm behind the camera
     k = rig.intrinsics(default_spec.sensors.camera.hfov_deg, 640, 360)
-    for key in ("P0", "P1", "P2", "P3"):
+    for key in ("P0", "P2"):  # the left camera (image_2) is the rectified reference
         np.testing.assert_array_equal(calib[key], np.hstack([k, np.zeros((3, 1))]))
+    for key in ("P1", "P3"):  # the right one, 0.54 m to its right: -fx * b in the last column, like KITTI
+        np.testing.assert_allclose(calib[key], np.hstack([k, [[-k[0, 0] * 0.54], [0.0], [0.0]]]), atol=1e-9)
     kitti_calib.write_calib(tmp_path / "calib.txt", calib)
     back = kitti_calib.read_calib(tmp_path / "calib.txt")
     assert list(back) == ["P0", "P1", "P2", "P3", "Tr"]

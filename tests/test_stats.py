@@ -145,10 +145,12 @@ def test_bad_input_is_one_line_exit_2_and_nothing_written(dataset, tmp_path, cap
     assert not out.exists()
 
 
-def test_report_is_deterministic_and_defaults_to_the_dataset_folder(dataset):
+def test_report_is_deterministic_and_defaults_to_the_stats_folder(dataset):
     root, _ = dataset
+    before = {p.name for p in root.iterdir()}
     assert main(["stats", str(root)]) == 0
-    first = {p.name: p.read_bytes() for p in root.iterdir() if p.is_file()}
+    first = {p.name: p.read_bytes() for p in (root / "stats").iterdir() if p.is_file()}
     assert set(first) == {"stats.md", "table1_pixels.csv", "table2_conditions.csv", "pixels_per_class.png"}
+    assert {p.name for p in root.iterdir()} == before | {"stats"}  # nothing else in the dataset root
     assert main(["stats", str(root)]) == 0
-    assert {p.name: p.read_bytes() for p in root.iterdir() if p.is_file()} == first
+    assert {p.name: p.read_bytes() for p in (root / "stats").iterdir() if p.is_file()} == first

@@ -15,10 +15,10 @@ import logging
 from pathlib import Path
 
 import numpy as np
-from tqdm import tqdm
 
 from generator.atomic import write_json, write_text
 from generator.errors import UserError
+from generator.progress import progress
 
 log = logging.getLogger(__name__)
 
@@ -62,7 +62,7 @@ def run(args) -> int:
     agree, raw = Agreement(), Agreement()
     maps = {"lidar": VoxelMap(args.voxel), "camera": VoxelMap(args.voxel)}
     overlay, best, exact, timed = None, -1, True, True
-    for frame in tqdm(ds, total=len(ds), desc="fuse", unit="frame", disable=None):
+    for frame in progress(ds, total=len(ds), desc="fuse", unit="frame"):
         fused = fuse_frame(frame, deskew, abs_tol, rel_tol)
         agree.add(fused)
         if deskew and frame.times is not None:
@@ -77,7 +77,7 @@ def run(args) -> int:
         if frame.index == overlay_k or (overlay_k is None and smeared > best):
             overlay, best = (frame.class_id, fused), smeared
     # scans without an image still go into the LiDAR-labelled map
-    for k in tqdm(ds.seq.frames, desc="map", unit="scan", disable=None):
+    for k in progress(ds.seq.frames, desc="map", unit="scan"):
         if k not in ds.frames:
             scan = ds.read_scan(k)
             maps["lidar"].add(P.transform(scan["pose"], deskewed(scan, deskew)), scan["native"])

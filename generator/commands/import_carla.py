@@ -14,7 +14,6 @@ import logging
 from pathlib import Path
 
 import numpy as np
-from tqdm import tqdm
 
 from generator import __version__
 from generator.world import rig
@@ -24,6 +23,7 @@ from generator.errors import UserError
 from generator.formats import carla_ply, kitti_calib, semantickitti as sk
 from generator.formats.label_config import count_raw_ids, merge_counts
 from generator.scan_effects.pipeline import ScanProcessing, process_scan
+from generator.progress import progress as progress_bar
 
 log = logging.getLogger(__name__)
 
@@ -96,7 +96,7 @@ def import_town(town: Path, out: Path, name: str, processing: ScanProcessing, se
     with staging(out, "import") as stage:
         seq = stage / name
         poses, times, counts, records, instances = [], [], {}, [], {}
-        for k, path in enumerate(tqdm(frames, desc=f"import-carla {name}", unit="scan", disable=None if progress else True)):
+        for k, path in enumerate(progress_bar(frames, desc=f"import-carla {name}", unit="scan", enabled=progress)):
             f = carla_ply.read_frame(path)
             pts = np.empty(len(f), IMPORT_DTYPE)
             for c in "xyz":

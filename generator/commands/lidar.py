@@ -28,7 +28,8 @@ def register(sub) -> None:
                        description=__doc__.split("\n\n")[1])
     p.add_argument("spec", help="scene spec JSON (e.g. scenes/default_town.json)")
     p.add_argument("--out", required=True, type=Path, help="dataset folder (sequences/NN/ is written inside)")
-    p.add_argument("--frames", type=int, default=10, help="number of scans (default 10)")
+    p.add_argument("--frames", type=int, default=10,
+                   help="number of scans (default 10, more than generate's 2 frames: scans are cheap, images are not)")
     p.add_argument("--sequence", default="00", help="sequence number, 00..99 (default 00)")
     p.add_argument("--threads", type=int, default=None, help="casting threads (default: all cores)")
     p.add_argument("--range-image", action="store_true", help="also save range/NNNNNN.npy (rings x columns, 0 = no return)")

@@ -43,7 +43,7 @@ def add_render_arguments(p, out_help: str, frames: int, variants: str) -> None:
 def register(sub) -> None:
     p = sub.add_parser("render", help="render RGB + label EXRs with metadata along the route",
                        description=__doc__.split("\n\n")[1])
-    add_render_arguments(p, "output folder", frames=4, variants="clear")
+    add_render_arguments(p, "output folder", frames=2, variants="clear")
     p.add_argument("--first", type=int, default=0, help="index of the first frame (default 0)")
     p.set_defaults(func=run)
 

@@ -26,7 +26,7 @@ def register(sub) -> None:
     p = sub.add_parser("stats", help="dataset statistics: pixels per class, images per weather x time of day",
                        description=__doc__.split("\n\n")[1])
     p.add_argument("dataset", type=Path, help="dataset folder (with images/*.json)")
-    p.add_argument("--out", type=Path, default=None, help="output folder (default: the dataset folder)")
+    p.add_argument("--out", type=Path, default=None, help="output folder (default: DIR/stats)")
     p.add_argument("--verify", action="store_true",
                    help="recompute pixel counts from the EXR masks; exit 1 listing the images that differ")
     p.set_defaults(func=run)
@@ -36,7 +36,7 @@ def run(args) -> int:
     root: Path = args.dataset
     if not root.is_dir():
         raise UserError(f"{root}: no such dataset folder")
-    out: Path = args.out if args.out is not None else root
+    out: Path = args.out if args.out is not None else root / "stats"
     if out.exists() and not out.is_dir():
         raise UserError(f"--out: {out} exists and is not a folder")
     sections, problems = [], []

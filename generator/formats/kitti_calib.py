@@ -2,16 +2,17 @@
 
 ``calib.txt`` (one ``KEY: 12 numbers`` line each, row-major 3x4):
 
-* ``P0`` .. ``P3``: projection matrices ``K [I | 0]`` of the rig camera, with ``K`` from
-  :meth:`generator.world.rig.Rig.K` (hfov of the spec, resolution of the render config).
-  urbangen renders ONE camera, which plays KITTI's cam0 and cam2 at once, so all four
-  matrices are equal with zero baselines: a KITTI tool projecting with ``P2 @ Tr`` lands
-  on urbangen's image. (Stereo tools dividing by the P1 baseline do not apply.) Pixel
-  convention of the rig: the origin is the top-left CORNER of the top-left pixel, so
-  ``floor(u), floor(v)`` is the pixel hit; for OpenCV's integer-centre convention
-  subtract 0.5 from ``cx, cy``.
-* ``Tr``: velodyne -> cam0 (``T_cam0_velo``), from the rig mounts WITHOUT the per-frame
-  camera jitter (:meth:`generator.world.rig.Rig.T_camera_lidar`).
+* ``P0`` .. ``P3``: projection matrices of the rectified KITTI stereo pair the sequence's
+  ``image_2/`` (left) and ``image_3/`` (right) come from (:meth:`generator.world.rig.Rig.stereo_projections`):
+  ``P2 = K [I | 0]``, ``P3 = K [I | (-b, 0, 0)]`` with the stereo baseline ``b`` (0.54 m by
+  default, as KITTI's). urbangen renders no grayscale pair, so ``P0 = P2`` and ``P1 = P3``.
+  ``K`` from the spec's hfov and the render config's resolution. Pixel convention of the
+  rig: the origin is the top-left CORNER of the top-left pixel, so ``floor(u), floor(v)`` is
+  the pixel hit; for OpenCV's integer-centre convention subtract 0.5 from ``cx, cy``.
+* ``Tr``: velodyne -> cam0 (= cam2, ``T_cam0_velo``), from the rig mounts: the stereo pair is
+  fixed (no jitter), so ``P2 @ Tr`` projects every scan into its ``image_2`` frame
+  (:meth:`generator.world.rig.Rig.T_camera_lidar`). The seed-003 images in ``images/``
+  carry a random jitter each; their exact transform is in their metadata.
   With the default KITTI-like mounts it is about ``R = [[0,-1,0],[0,0,-1],[1,0,0]]``,
   ``t = (0, -0.08, -0.27)`` m, like KITTI's own.
 
@@ -49,8 +50,7 @@ def kitti_calib(rig, width: int, height: int) -> dict[str, np.ndarray]:
     rig : generator.world.rig.Rig
         Camera intrinsics and the nominal (jitter-free) camera and LiDAR mounts.
     """
-    p = np.hstack([rig.K(width, height), np.zeros((3, 1))])
-    out = {f"P{i}": p.copy() for i in range(4)}
+    out = rig.stereo_projections(width, height)
     out["Tr"] = rig.T_camera_lidar()[:3]
     return out
 

@@ -43,6 +43,11 @@ class RenderJob:
         (time_of_day, weather) variants of every frame.
     scratch : str
         The worker's own scratch folder (Blender's temporary EXRs, ``blender.log``).
+    stereo : tuple of int
+        Scans whose KITTI stereo pair this worker renders into ``sequence_dir``
+        (:mod:`generator.jobs.stereo`).
+    sequence_dir : str
+        The LiDAR sequence folder the stereo pairs belong to.
     parent_pid : int
         Set by the local pool: the worker exits when its parent dies.
     """
@@ -53,20 +58,26 @@ class RenderJob:
     frames: tuple[int, ...]
     combos: tuple[tuple[str, str], ...]
     scratch: str
+    stereo: tuple[int, ...] = ()
+    sequence_dir: str = ""
     parent_pid: int = 0
 
 
-def make_jobs(spec, cfg, out: Path, frames: list[int], combos, workers: int) -> list[RenderJob]:
-    """Deal ``frames`` round-robin to ``workers`` jobs (fewer when there are fewer frames).
+def make_jobs(spec, cfg, out: Path, frames: list[int], combos, workers: int, stereo: list[int] = (),
+              sequence_dir: Path | None = None) -> list[RenderJob]:
+    """Deal the frames to render (``frames``: image variants, ``stereo``: stereo pairs) round-robin
+    to ``workers`` jobs (fewer when there is less work).
 
     With a render config that asks for all cores (``threads: 0``) and several local
     workers, each job gets its share of the machine's cores.
     """
-    parts = deal(list(frames), workers)
+    frames, stereo = set(frames), set(stereo)
+    parts = deal(sorted(frames | stereo), workers)
     if cfg.threads == 0 and len(parts) > 1:
         cfg = dataclasses.replace(cfg, threads=max(1, (os.cpu_count() or 1) // len(parts)))
-    return [RenderJob(spec, cfg, str(out), tuple(fr), tuple(tuple(c) for c in combos), str(scratch_dir(out, i)))
-            for i, fr in enumerate(parts)]
+    return [RenderJob(spec, cfg, str(out), tuple(k for k in part if k in frames), tuple(tuple(c) for c in combos),
+                      str(scratch_dir(out, i)), tuple(k for k in part if k in stereo), str(sequence_dir or ""))
+            for i, part in enumerate(parts)]
 
 
 def run_jobs(executor: str, jobs: list[RenderJob], total: int, on_frame=None, ray_address: str | None = None) -> PoolResult:

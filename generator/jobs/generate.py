@@ -5,8 +5,10 @@ Stages, each skipped when its output is already complete:
 1. LiDAR: one SemanticKITTI sequence (``lidar/sequences/NN``), every scan sharing its
    frame's weather draw (:func:`generator.weather.lidar_combination`). Cheap and
    byte-deterministic, so it is rewritten whole unless ``lidar_meta.json`` matches the plan.
-2. Images: every frame in every planned weather x time combination, on an executor
-   (local spawned processes or Ray); a frame is done when all its metadata JSONs exist.
+2. Images: every frame in every planned weather x time combination, and the KITTI stereo
+   pair of every ``sensors.stereo.every``-th scan (:mod:`generator.jobs.stereo`), on an
+   executor (local spawned processes or Ray); a frame is done when all its metadata JSONs
+   exist, a pair when its ``image_3`` PNG does.
 3. OpenLABEL per sequence, then statistics.
 
 The manifest is rewritten after every frame. Everything is written atomically, so a run
@@ -26,6 +28,7 @@ from generator.atomic import clean_temporaries
 from generator.jobs import manifest as mf
 from generator.jobs.executors import make_jobs, run_jobs
 from generator.jobs.plan import Plan
+from generator.jobs.stereo import pair_done, stereo_frames
 
 log = logging.getLogger(__name__)
 
@@ -108,16 +111,23 @@ def run_generate(spec, cfg, opts: GenerateOptions) -> dict:
     done = set(images_done(out, plan))
     manifest["finished"]["images"] = [n for k in plan.frames if k in done for n in plan.images_of(k)]
     todo = [k for k in plan.frames if k not in done]
-    if todo:
-        jobs = make_jobs(spec, cfg, out, todo, plan.combos, opts.workers)
+    seq_dir = out / "lidar" / "sequences" / plan.sequence
+    pairs = stereo_frames(spec, plan.frames)
+    manifest["finished"]["stereo"] = [k for k in pairs if pair_done(seq_dir, k)]
+    stereo_todo = [k for k in pairs if k not in manifest["finished"]["stereo"]]
+    if todo or stereo_todo:
+        jobs = make_jobs(spec, cfg, out, todo, plan.combos, opts.workers, stereo_todo, seq_dir)
 
-        def on_frame(index: int, payload: dict) -> None:
+        def on_frame(index, payload: dict) -> None:
             manifest["finished"]["images"] += list(payload["images"])
+            if "stereo" in payload:
+                manifest["finished"]["stereo"].append(payload["stereo"])
             mf.save(out, manifest)
 
-        res = run_jobs(opts.executor, jobs, len(todo), on_frame, opts.ray_address)
+        res = run_jobs(opts.executor, jobs, len(todo) + len(stereo_todo), on_frame, opts.ray_address)
         shutil.rmtree(out / ".scratch", ignore_errors=True)
         run.update(_render_figures(res, len(todo), len(plan.combos)))
+        run["stereo_pairs_rendered"] = len(stereo_todo)
 
     from generator.jobs.finish import write_openlabel, write_stats
 

@@ -24,7 +24,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from tqdm import tqdm
 
 from generator import __version__
 from generator.atomic import atomic_path, inside, write_json
@@ -40,6 +39,7 @@ from generator.remission.models import IntensityFn, intensity_fn_for_spec
 from generator.lidar.scan import Scanner
 from generator.lidar.sensors import Sensor, sensor_for_spec
 from generator.world.rig import Rig
+from generator.progress import progress as progress_bar
 
 log = logging.getLogger(__name__)
 
@@ -137,7 +137,7 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
     starts, n_points, counts, records = [], [], {}, []
     sweeps = []  # LiDAR world poses during each sweep (fusion de-skews with them)
     with Scanner(scene, sensor, threads=options.threads) as scanner:
-        for f in tqdm(frames, desc=f"lidar {name}", unit="scan", disable=None if progress else True):
+        for f in progress_bar(frames, desc=f"lidar {name}", unit="scan", enabled=progress):
             scan = scanner.sweep(rig, f.t, skew)
             pts, remission, record = process_scan(scan.points, processing, spec, f.index)
             scan = dataclasses.replace(scan, points=pts)  # xyz, range image and side files follow the processed points

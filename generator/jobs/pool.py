@@ -15,7 +15,8 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from tqdm import tqdm
+from generator.progress import progress
+
 
 log = logging.getLogger(__name__)
 
@@ -88,7 +89,7 @@ def follow(get, n_workers: int, total: int, desc: str, on_frame, failed) -> Pool
     Shared by the local pool and the Ray executor.
     """
     res = PoolResult()
-    with tqdm(total=total, desc=desc, unit="frame", disable=None, smoothing=0.1) as bar:
+    with progress(total=total, desc=desc, unit="frame") as bar:
         while len(res.done) < n_workers:
             try:
                 msg = get(timeout=1.0)

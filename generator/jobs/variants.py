@@ -11,6 +11,8 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
+import numpy as np
+
 from generator.postfx.fog import fog_image
 from generator.postfx.rain import rain_image
 from generator.jobs.images import write_image
@@ -46,6 +48,36 @@ def renders_needed(combos: list[tuple[str, str]]) -> list[tuple[str, bool]]:
     return sorted({(t, is_wet(k)) for t, k in combos}, key=lambda r: (r[0] != "day", r[1]))
 
 
+def weather_post(spec, frame_index: int, time_of_day: str, kind: str, rgb: np.ndarray, depth: np.ndarray,
+                 k: np.ndarray, stream_tag: tuple = ()) -> tuple[np.ndarray, dict]:
+    """Fog and rain of weather ``kind`` applied in post to one rendered image.
+
+    Parameters
+    ----------
+    rgb : (H, W, 3) float32
+        The rendered linear RGB (dry or wet render, as ``kind`` needs).
+    depth : (H, W) float32
+        Depth pass, metres along the ray (inf = sky).
+    k : (3, 3) float64
+        Camera intrinsics (rain streak lengths).
+    stream_tag : tuple
+        Extra names of the rain stream (another camera of the same frame draws its own drops).
+
+    Returns
+    -------
+    ((H, W, 3) float32, dict)
+        The image and the weather record of its metadata.
+    """
+    weather = draw_weather(spec, frame_index, kind)
+    img, params = rgb, weather.to_dict()
+    if has_fog(kind):
+        img, params["fog"] = fog_image(img, depth, weather.visibility_m, time_of_day)
+    if has_rain(kind):
+        g = stream(spec.seed, "frame", frame_index, "rain", time_of_day, kind, *stream_tag)
+        img, params["rain"] = rain_image(img, depth, weather.rain_rate_mmh, g, time_of_day, k=k)
+    return img, params
+
+
 def render_frame(renderer, spec, cfg, frame, out: Path, combos: list[tuple[str, str]]) -> dict[str, dict]:
     """Render and write every variant in ``combos`` of ``frame``.
 
@@ -66,16 +98,8 @@ def render_frame(renderer, spec, cfg, frame, out: Path, combos: list[tuple[str, 
         info.update({k: v for k, v in light.to_dict().items() if v is not None})
         rgb, rgb_s = renderer.render_rgb(seed=child_seed(spec.seed, "frame", frame.index, "cycles", tod, int(wet)))
         for kind in [k for t_, k in combos if t_ == tod and is_wet(k) == wet]:
-            weather = draw_weather(spec, frame.index, kind)
             t = time.perf_counter()
-            img, params = rgb, weather.to_dict()
-            if has_fog(kind):
-                img, fog_params = fog_image(img, labels.depth, weather.visibility_m, tod)
-                params["fog"] = fog_params
-            if has_rain(kind):
-                g = stream(spec.seed, "frame", frame.index, "rain", tod, kind)
-                img, rain_params = rain_image(img, labels.depth, weather.rain_rate_mmh, g, tod, k=renderer.k)
-                params["rain"] = rain_params
+            img, params = weather_post(spec, frame.index, tod, kind, rgb, labels.depth, renderer.k)
             post_s = time.perf_counter() - t
             secs = {"rgb_pass": rgb_s, "label_passes_shared": label_s, "post_fx": post_s}
             rendered = _Rendered(labels, info, secs)

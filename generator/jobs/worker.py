@@ -87,9 +87,18 @@ def _run(job, queue, scratch: Path) -> None:
     for n, index in enumerate(job.frames, 1):
         images = render_frame(renderer, spec, cfg, rig.frame(index), Path(job.out), job.combos)
         queue.put(("frame", index, {"images": images, "rss_mb": _rss_mb(), "frames_done": n}))
+    if job.stereo:
+        from generator.jobs.stereo import render_pair
+        from generator.lidar.sensors import sensor_for_spec
+
+        sensor = sensor_for_spec(spec)
+        for n, index in enumerate(job.stereo, len(job.frames) + 1):
+            secs = render_pair(renderer, spec, cfg, rig, sensor, index, Path(job.sequence_dir))
+            queue.put(("frame", ("stereo", index), {"images": {}, "stereo": index, "seconds": secs,
+                                                    "rss_mb": _rss_mb(), "frames_done": n}))
     cycles = renderer.cycles_seconds
     queue.put(("done", {
-        "pid": os.getpid(), "frames": len(job.frames), "max_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
+        "pid": os.getpid(), "frames": len(job.frames) + len(job.stereo), "max_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
         "rss_mb": _rss_mb(), "setup_s": layout_s + renderer.build_seconds, "frames_s": time.perf_counter() - t_start,
         "cycles_rgb_s": cycles["rgb"], "cycles_labels_s": cycles["labels"],
     }))

@@ -16,7 +16,6 @@ import time
 from collections import defaultdict
 
 import numpy as np
-from tqdm import tqdm
 
 from generator.geometry import Mesh, pose
 from generator.labels import class_table
@@ -31,6 +30,7 @@ from generator.layout.street_meshes import (intersection_road_mesh, intersection
 from generator.layout.streets import Grid, make_grid
 from generator.world.scene import OrientedBox, Path, SceneModel, SceneObject
 from generator.spec.model import SceneSpec
+from generator.progress import progress
 
 log = logging.getLogger(__name__)
 
@@ -182,7 +182,7 @@ def build_scene(spec: SceneSpec) -> SceneModel:
     street = ps.Street(grid)
     log.info("layout %s: %d x %d blocks, %d segments, %d lots", spec.name, len(grid.xs) - 1, len(grid.ys) - 1,
              len(grid.segments), len(lots))
-    for label, step in tqdm(STEPS, desc=f"layout {spec.name}", unit="step", disable=None, leave=False):
+    for label, step in progress(STEPS, desc=f"layout {spec.name}", unit="step", leave=False):
         n0, t1 = len(placer.placed), time.perf_counter()
         step(placer, spec, grid, lots, street)
         log.info("placed %d %s (%.2f s)", len(placer.placed) - n0, label, time.perf_counter() - t1)

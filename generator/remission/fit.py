@@ -25,13 +25,13 @@ from pathlib import Path
 
 import numpy as np
 import yaml
-from tqdm import tqdm
 
 from generator.atomic import write_text
 from generator.errors import UserError
 from generator.formats import semantickitti as sk
 from generator.labels import class_table
 from generator.remission.class_profiles import LABEL_SPACES, ClassStats, IntensityProfile
+from generator.progress import progress as progress_bar
 
 log = logging.getLogger(__name__)
 
@@ -155,7 +155,7 @@ def accumulate(root: str | Path, sequences: list[str] | None = None, progress: b
     seqs = [sk.Sequence(root, s) for s in names]  # opening validates every sequence before the long loop
     total = ClassMoments.empty()
     n_scans = n_points = 0
-    bar = tqdm(total=sum(len(s) for s in seqs), desc="intensity fit", unit="scan", disable=None if progress else True)
+    bar = progress_bar(total=sum(len(s) for s in seqs), desc="intensity fit", unit="scan", enabled=progress)
     with bar:
         for seq in seqs:
             for i in seq.frames:

@@ -85,9 +85,17 @@ class Lidar:
 
 
 @dataclass(frozen=True)
+class Stereo:
+    enabled: bool
+    baseline_m: float
+    every: int
+
+
+@dataclass(frozen=True)
 class Sensors:
     camera: Camera
     lidar: Lidar
+    stereo: Stereo
 
 
 @dataclass(frozen=True)

@@ -19,13 +19,13 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from tqdm import tqdm
 
 from generator.errors import UserError
 from generator.labels import class_table
 from generator.stats.chart import log_bar_chart
 from generator.stats.report import Figure, Section, Table
 from generator.weather import KINDS, TIMES
+from generator.progress import progress
 
 log = logging.getLogger(__name__)
 
@@ -138,7 +138,7 @@ def load(root: Path) -> ImageData | None:
     if not paths:
         raise UserError(f"{folder}: no image metadata (*.json) found")
     records = []
-    for p in tqdm(paths, desc="metadata", unit="img", disable=None, leave=False):
+    for p in progress(paths, desc="metadata", unit="img", leave=False):
         try:
             text = p.read_text(encoding="utf-8")
         except (OSError, UnicodeDecodeError) as e:
@@ -160,7 +160,7 @@ def verify(data: ImageData) -> list[str]:
 
     table = class_table()
     problems = []
-    for r in tqdm(data.records, desc="verify", unit="img", disable=None):
+    for r in progress(data.records, desc="verify", unit="img"):
         if r.exr is None:
             problems.append(f"{r.source}: files.exr is not given")
             continue

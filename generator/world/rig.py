@@ -133,6 +133,9 @@ class Rig:
         LiDAR mount (body axes: x forward, y left, z up).
     spacing_m : float
         Route distance between dataset frames, metres.
+    baseline_m : float
+        KITTI stereo pair: the right camera (``image_3``) sits this far right of the left one
+        (``image_2``), which is the nominal camera mount without jitter.
     trajectory : EgoTrajectory or None
         The ego's drive; ``None`` for a rig built without a scene (mounts only).
     """
@@ -144,6 +147,7 @@ class Rig:
     jitter_deg: tuple[float, float, float]
     T_ego_lidar: np.ndarray
     spacing_m: float
+    baseline_m: float = 0.54
     trajectory: EgoTrajectory | None = None
 
     @classmethod
@@ -153,7 +157,7 @@ class Rig:
         traj = EgoTrajectory(scene.paths[route], p.speed_mps) if scene is not None else None
         return cls(spec.seed, tuple(cam.xyz_m), tuple(cam.rpy_deg), cam.hfov_deg,
                    (p.yaw_jitter_deg, p.pitch_jitter_deg, p.roll_jitter_deg), mount(lidar.xyz_m, lidar.rpy_deg),
-                   p.spacing_m, traj)
+                   p.spacing_m, spec.sensors.stereo.baseline_m, traj)
 
     # -- mounts and intrinsics ---------------------------------------------------------------
     def T_ego_camera(self, jitter_rad=(0.0, 0.0, 0.0)) -> np.ndarray:
@@ -167,6 +171,30 @@ class Rig:
     def T_camera_lidar(self) -> np.ndarray:
         """(4, 4) LiDAR -> nominal camera (no jitter): KITTI's ``Tr`` (velodyne -> cam0)."""
         return invert(self.T_ego_camera()) @ self.T_ego_lidar
+
+    def T_ego_stereo(self, camera: int) -> np.ndarray:
+        """(4, 4) optical-frame pose of KITTI camera 2 (left) or 3 (right) in the ego frame.
+
+        Camera 2 is the nominal camera mount (no jitter) and the rectified reference frame;
+        camera 3 is ``baseline_m`` to its right, same orientation (a rectified pair).
+        """
+        if camera not in (2, 3):
+            raise ValueError(f"stereo camera must be 2 or 3, got {camera}")
+        shift = np.eye(4)
+        shift[0, 3] = self.baseline_m if camera == 3 else 0.0  # optical x points right
+        return self.T_ego_camera() @ shift
+
+    def stereo_projections(self, width: int, height: int) -> dict[str, np.ndarray]:
+        """KITTI ``P0``..``P3`` (3, 4) float64 of the rectified pair, camera 2 the reference.
+
+        ``P2 = P0 = K [I | 0]``; ``P3 = P1 = K [I | (-baseline, 0, 0)]`` (a point ``X`` in the
+        camera-2 frame lands in image 3 at ``P3 X``). urbangen renders no grayscale pair, so
+        cameras 0/1 coincide with 2/3.
+        """
+        k = self.K(width, height)
+        left = np.hstack([k, np.zeros((3, 1))])
+        right = np.hstack([k, (k @ np.array([-self.baseline_m, 0.0, 0.0]))[:, None]])
+        return {"P0": left, "P1": right.copy(), "P2": left.copy(), "P3": right}
 
     # -- time ---------------------------------------------------------------------------------
     def _drive(self) -> EgoTrajectory:

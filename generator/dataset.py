@@ -1,0 +1,179 @@
+"""Read a generated dataset in training code: numpy arrays, no framework.
+
+::
+
+    from generator.dataset import Dataset
+
+    ds = Dataset("dataset")
+    for name in ds.image_names():               # "000000_day_fog", ...
+        img = ds.image(name)                    # .rgb .class_id .instance .depth .meta
+    frame = ds.frame(0)                         # one call: every image variant, the scan, its boxes
+    scan = frame.scan                           # .xyz .remission .semantic .instance .pose .time
+
+Arrays and frames
+-----------------
+* ``ImageSample.rgb`` (H, W, 3) float32 linear RGB; ``class_id`` (H, W) uint8 native class
+  ids (:func:`ImageSample.labels` maps them to ``cityscapes``, ``semantickitti`` learning ids or
+  ``unified11``); ``instance`` (H, W) uint32 (0 for stuff); ``depth`` (H, W) float32 metres
+  along the ray (inf = sky); ``meta`` the image's metadata JSON (camera pose, intrinsics,
+  weather, lighting).
+* ``ScanSample.xyz`` (n, 3) float32 LiDAR frame (x forward, y left, z up), metres;
+  ``remission`` (n,) float32 in [0, 1]; ``semantic`` (n,) uint16 SemanticKITTI raw ids;
+  ``instance`` (n,) uint16; ``native`` (n,) uint8 native classes (urbangen side file, or None);
+  ``pose`` (4, 4) float64 LiDAR pose in the first scan's LiDAR frame; ``time`` seconds.
+* ``Box``: an OpenLABEL cuboid in the ego (``vehicle-iso8855``) frame of its frame: ``center``
+  (3,), ``quaternion`` (x, y, z, w), ``size`` (3,) metres, ``cls``, ``uid``, ``points``.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from generator.errors import UserError
+from generator.formats import semantickitti as sk
+from generator.formats.point_sidecars import NATIVE_DIR, read_sidecar
+from generator.imaging.exr import read_exr
+from generator.labels import class_table
+from generator.labels.sets import label_sets
+
+
+@dataclass
+class ImageSample:
+    """One image of ``images/`` (see the module docstring for shapes)."""
+
+    name: str
+    rgb: np.ndarray
+    class_id: np.ndarray
+    instance: np.ndarray
+    depth: np.ndarray
+    meta: dict
+
+    def labels(self, label_set: str = "native") -> np.ndarray:
+        """(H, W) class map in ``native``, ``cityscapes`` (label ids), ``semantickitti`` (learning ids) or ``unified11``."""
+        if label_set == "cityscapes":
+            return class_table().to_cityscapes[self.class_id]
+        sets = label_sets()
+        if label_set not in sets:
+            raise UserError(f"label set {label_set!r}: use native, cityscapes, {', '.join(s for s in sets if s != 'native')}")
+        return sets[label_set].from_native[self.class_id]
+
+
+@dataclass
+class Box:
+    """An OpenLABEL cuboid (ego frame of its frame)."""
+
+    uid: int
+    cls: str
+    center: np.ndarray
+    quaternion: np.ndarray
+    size: np.ndarray
+    points: int
+
+
+@dataclass
+class ScanSample:
+    """One LiDAR scan with labels, pose and time (see the module docstring for shapes)."""
+
+    index: int
+    xyz: np.ndarray
+    remission: np.ndarray
+    semantic: np.ndarray | None
+    instance: np.ndarray | None
+    native: np.ndarray | None
+    pose: np.ndarray | None
+    time: float | None
+
+
+@dataclass
+class FrameSample:
+    """Everything of frame ``index``: its image variants, its scan and its boxes."""
+
+    index: int
+    images: dict[str, ImageSample] = field(default_factory=dict)
+    scan: ScanSample | None = None
+    boxes: list[Box] = field(default_factory=list)
+
+
+class Dataset:
+    """A generated dataset folder (``urbangen generate``'s output).
+
+    Parameters
+    ----------
+    root : path-like
+    sequence : str
+        The LiDAR sequence whose scans and boxes :meth:`frame` returns (default ``00``).
+    """
+
+    def __init__(self, root: str | Path, sequence: str = "00"):
+        self.root = Path(root)
+        if not self.root.is_dir():
+            raise UserError(f"{self.root}: no such dataset folder")
+        self.sequence = sk.sequence_name(sequence)
+        lidar = self.root / "lidar"
+        has_seq = (lidar / "sequences" / self.sequence / "velodyne").is_dir()
+        self.seq = sk.Sequence(lidar, self.sequence) if has_seq else None
+        self._poses = self.seq.lidar_poses() if self.seq is not None else None
+        self._boxes = self._read_boxes(self.root / "openlabel" / f"{self.sequence}.json")
+
+    # -- images ------------------------------------------------------------------------------
+    def image_names(self, frame: int | None = None) -> list[str]:
+        """Image stems (``NNNNNN_<time>_<weather>``), sorted; only those of ``frame`` if given."""
+        names = sorted(p.stem for p in (self.root / "images").glob("[0-9]*.json"))
+        return [n for n in names if frame is None or int(n[:6]) == frame]
+
+    def image(self, name: str) -> ImageSample:
+        """The image ``name`` with its masks, instances, depth and metadata."""
+        exr, meta = self.root / "images" / f"{name}.exr", self.root / "images" / f"{name}.json"
+        if not exr.is_file() or not meta.is_file():
+            raise UserError(f"{exr}: no such image (with its .json)")
+        img = read_exr(exr)
+        return ImageSample(name, img.rgb, img.class_id, img.instance, img.depth, json.loads(meta.read_text("utf-8")))
+
+    # -- scans ---------------------------------------------------------------------------------
+    def scan_indices(self) -> list[int]:
+        return list(self.seq.frames) if self.seq is not None else []
+
+    def scan(self, index: int) -> ScanSample:
+        """Scan ``index`` of the sequence with its labels, native classes, pose and time."""
+        if self.seq is None:
+            raise UserError(f"{self.root / 'lidar'}: no sequence {self.sequence}")
+        rec = self.seq.read(index, True, self._poses)
+        native = read_sidecar(self.seq.dir, NATIVE_DIR, index, len(rec.points))
+        return ScanSample(index, rec.points[:, :3], rec.points[:, 3], rec.semantic, rec.instance, native, rec.pose,
+                          rec.time)
+
+    def boxes(self, index: int) -> list[Box]:
+        """The OpenLABEL cuboids of frame ``index`` (empty when the dataset has none)."""
+        return list(self._boxes.get(index, []))
+
+    def frame(self, index: int) -> FrameSample:
+        """Every image variant, the scan and the boxes of frame ``index``, in one call."""
+        out = FrameSample(index, {n: self.image(n) for n in self.image_names(index)})
+        if self.seq is not None and index in self.seq.frames:
+            out.scan = self.scan(index)
+        out.boxes = self.boxes(index)
+        return out
+
+    def __iter__(self):
+        frames = sorted({int(n[:6]) for n in self.image_names()} | set(self.scan_indices()))
+        for k in frames:
+            yield self.frame(k)
+
+    @staticmethod
+    def _read_boxes(path: Path) -> dict[int, list[Box]]:
+        if not path.is_file():
+            return {}
+        doc = json.loads(path.read_text("utf-8"))["openlabel"]
+        types = {uid: o["type"] for uid, o in doc.get("objects", {}).items()}
+        out: dict[int, list[Box]] = {}
+        for key, f in doc.get("frames", {}).items():
+            for uid, o in f.get("objects", {}).items():
+                data = o["object_data"]
+                v = np.asarray(data["cuboid"][0]["val"], np.float64)
+                n = int(data.get("num", [{"val": 0}])[0]["val"])
+                out.setdefault(int(key), []).append(Box(int(uid), types.get(uid, ""), v[:3], v[3:7], v[7:10], n))
+        return out
