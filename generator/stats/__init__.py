@@ -18,7 +18,7 @@ import importlib
 from types import ModuleType
 
 #: Statistics modules, in report order.
-SECTIONS = ("images",)
+SECTIONS = ("images", "class_mix")
 
 
 def section_modules() -> list[ModuleType]:
