@@ -27,6 +27,7 @@ COMMANDS = [
     "import_carla",
     "fuse",
     "eval",
+    "export",
     "openlabel",
     "render",
     "stats",
