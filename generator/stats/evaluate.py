@@ -247,7 +247,7 @@ def format_table(result: dict) -> str:
     lines.append(f"{'mIoU':<16} {'n/a' if miou is None else f'{100 * miou:8.2f}':>8}  over {result['evaluated_classes']} classes")
     if result["absent_classes"]:
         how = "counted as IoU 0 in the mean, as semantic-kitti-api does" if result["mean_over"] == "all" \
-            else "left out of the mean (--mean-over present)"
+            else "left out of the mean: --mean-over present"
         lines.append(f"absent from prediction and ground truth ({how}): {', '.join(result['absent_classes'])}")
     acc = result["accuracy"]
     lines.append(f"accuracy {'n/a' if acc is None else f'{100 * acc:.2f}'} %; ignored as ground truth: "
