@@ -28,6 +28,7 @@ COMMANDS = [
     "import_carla",
     "fuse",
     "eval",
+    "export",
     "openlabel",
     "render",
     "stats",

@@ -82,7 +82,7 @@ def test_convert_command_rewrites_labels_keeps_instances_and_copies_the_rest(tmp
     assert cfg["color_map"][1] == table.sk_colors_bgr[10] and cfg["color_map"][3] == table.sk_colors_bgr[40]
     assert cfg["learning_map"] == {i: i for i in range(12)} and cfg["learning_map_inv"] == {i: i for i in range(12)}
     assert cfg["learning_ignore"][0] is True and not any(cfg["learning_ignore"][i] for i in range(1, 12))
-    assert abs(sum(cfg["content"].values()) - 1) < 1e-9 and cfg["split"]["train"] == [0, 3]
+    assert abs(sum(cfg["content"].values()) - 1) < 1e-9 and cfg["split"]["valid"] == [0, 3]
     summary = json.loads((dst / "conversion.json").read_text())
     assert summary["scans"] == 5 and summary["labels"] == "unified11"
     assert not [p for p in dst.iterdir() if p.name.startswith(".tmp-")]

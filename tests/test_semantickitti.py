@@ -16,7 +16,7 @@ from generator.world.rig import Rig
 from generator.errors import UserError
 from generator.formats import kitti_calib
 from generator.formats import semantickitti as sk
-from generator.formats.label_config import label_config
+from generator.formats.label_config import label_config, merge_split
 from generator.formats.ply import read_ply, write_ply
 from generator.labels import class_table
 from generator.jobs.lidar_sequence import SequenceOptions, write_sequence
@@ -105,14 +105,14 @@ def test_camera_and_lidar_pose_conventions(rng):
 def test_label_config_matches_the_reference_format():
     ref = class_table().sk_config
     cfg = yaml.safe_load(__import__("generator.formats.label_config", fromlist=["x"]).format_label_config(
-        label_config({40: 30, 50: 10, 10: 0}, [0, 3])))
+        label_config({40: 30, 50: 10, 10: 0}, merge_split([0, 3]))))
     for section in ("labels", "color_map", "learning_map", "learning_map_inv", "learning_ignore"):
         assert cfg[section] == ref[section], section
     assert set(cfg["content"]) == set(ref["labels"])
     assert cfg["content"][40] == 0.75 and cfg["content"][50] == 0.25 and cfg["content"][10] == 0.0
-    assert cfg["split"]["train"] == [0, 3]
+    assert cfg["split"] == {"train": [], "valid": [0, 3], "test": []}  # semantic-kitti-api evaluates valid by default
     with pytest.raises(ValueError):
-        label_config({12345: 1}, [0])
+        label_config({12345: 1}, merge_split([0]))
 
 
 def test_ply_round_trip(tmp_path, rng):
@@ -176,7 +176,7 @@ def test_written_sequence_sizes_and_static_objects_stay_put(test_spec, tmp_path)
     assert seen[50] > 100 and seen[10] > 50
     cfg = yaml.safe_load((tmp_path / "semantic-kitti.yaml").read_text())
     assert abs(sum(cfg["content"].values()) - 1.0) < 1e-9 and cfg["content"][40] > 0.5
-    assert cfg["split"]["train"] == [5]
+    assert cfg["split"]["valid"] == [5]
 
 
 def test_same_seed_gives_identical_bytes(test_spec, tmp_path):

@@ -12,6 +12,7 @@ import logging
 
 from generator.commands.render import add_render_arguments, check_render_args
 from generator.errors import UserError
+from generator.formats.label_config import SPLITS
 from generator.jobs.generate import GenerateOptions, run_generate
 from generator.jobs.plan import make_plan
 
@@ -23,6 +24,9 @@ def register(sub) -> None:
                        description=__doc__.split("\n\n")[1])
     add_render_arguments(p, "dataset folder (created; a rerun resumes it)", frames=2, variants="all")
     p.add_argument("--sequence", default="00", help="SemanticKITTI sequence id of the scans (default 00)")
+    p.add_argument("--split", default=None, choices=SPLITS,
+                   help="split of the sequence in DIR/lidar/semantic-kitti.yaml: train, valid or test (default: "
+                        "the one it has there, else valid, what semantic-kitti-api evaluates without -s)")
     p.set_defaults(func=run)
 
 
@@ -33,6 +37,10 @@ def run(args) -> int:
     out = r.out
     plan = make_plan(args.frames, combos=r.combos, sequence=f"{int(args.sequence):02d}")
     run_rec = run_generate(r.spec, r.cfg, GenerateOptions(out, plan, args.workers, args.executor, args.ray_address))
+    if args.split:
+        from generator.jobs.lidar_sequence import write_dataset_label_config
+
+        write_dataset_label_config(out / "lidar", args.split, [plan.sequence])
     rate = run_rec.get("images_per_hour")
     print(f"dataset in {out}: {len(plan.frames)} frames x {len(plan.combos)} variants, LiDAR sequence {plan.sequence}"
           + (f"; {rate:.0f} images/hour" if rate else "; nothing left to render"))

@@ -3,7 +3,10 @@
 Builds the scene of SPEC and casts the spec's LiDAR (default: the KITTI HDL-64E) along
 route 0, one sweep per frame, writing a SemanticKITTI sequence to ``DIR/sequences/NN/``
 (velodyne/*.bin, labels/*.label, poses.txt, calib.txt, times.txt, lidar_meta.json), a
-bird's-eye PNG per scan in ``bev/``, and the dataset label config ``DIR/semantic-kitti.yaml``.
+bird's-eye PNG per scan in ``bev/``, and the dataset label config ``DIR/semantic-kitti.yaml``,
+whose split lists every sequence in DIR: --split puts this one under train, valid or test
+(default: the split it already has there, else valid, the split semantic-kitti-api evaluates
+without -s).
 """
 
 from __future__ import annotations
@@ -14,6 +17,7 @@ from pathlib import Path
 
 from generator.commands.intensity import add_processing_args, spec_with_processing_args
 from generator.errors import UserError
+from generator.formats.label_config import SPLITS
 from generator.formats.semantickitti import sequence_name
 from generator.remission.models import intensity_fn_for_spec
 from generator.lidar.sensors import sensor_for_spec
@@ -37,6 +41,9 @@ def register(sub) -> None:
     p.add_argument("--no-bev", action="store_true", help="skip the bird's-eye PNGs")
     p.add_argument("--render-config", default="preview",
                    help="render config (preset or YAML) whose resolution goes into calib.txt (default preview)")
+    p.add_argument("--split", default=None, choices=SPLITS,
+                   help="split of this sequence in DIR/semantic-kitti.yaml: train, valid or test "
+                        "(default: the one it has there, else valid)")
     add_processing_args(p, weather=True)
     p.set_defaults(func=run)
 
@@ -61,13 +68,15 @@ def run(args) -> int:
         raise UserError(f"--out: {out} is not writable")
 
     from generator.layout.assemble import build_scene
-    from generator.jobs.lidar_sequence import SequenceOptions, check_frames, write_sequence
+    from generator.jobs.lidar_sequence import SequenceOptions, check_frames, write_dataset_label_config, write_sequence
 
     scene = build_scene(spec)
     check_frames(scene, spec, args.frames)
     opts = SequenceOptions(frames=args.frames, sequence=name, threads=args.threads, range_image=args.range_image,
                            ply=args.ply, bev=not args.no_bev, resolution=(cfg.width, cfg.height), render_config=cfg.name)
     meta = write_sequence(scene, spec, out, opts, sensor=sensor, intensity_fn=intensity_fn)
+    if args.split:
+        write_dataset_label_config(out, args.split, [name])
     pts = meta["points_per_scan"]
     print(f"wrote {len(pts)} scans to {out / 'sequences' / name} ({sensor.name}, "
           f"{min(pts)}-{max(pts)} points per scan, remission: {meta['remission']['model']})")

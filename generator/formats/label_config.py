@@ -3,18 +3,33 @@
 Sections ``labels``, ``color_map`` (BGR), ``learning_map``, ``learning_map_inv`` and
 ``learning_ignore`` are the reference ones (``generator/labels/semantic-kitti.yaml``), so
 SemanticKITTI tools read an urbangen dataset unchanged. ``content`` (fraction of points
-per raw id) is computed from the labels actually written. ``split`` lists every sequence
-of the dataset under ``train`` (urbangen does not choose a split; edit it for yours).
+per raw id) is computed from the labels actually written.
+
+``split`` lists every sequence present in the dataset, each under exactly one of
+``train``, ``valid``, ``test`` (:func:`merge_split`): the split a command was asked for
+(``--split``), else the one the config on disk already gives it, else :data:`DEFAULT_SPLIT`
+= ``valid``, the split semantic-kitti-api's ``evaluate_semantics.py`` and
+``evaluate_panoptic.py`` evaluate when run without ``-s``; sequences no longer on disk are
+dropped (the api would look for their folders).
 """
 
 from __future__ import annotations
 
+import logging
 from pathlib import Path
 
 import numpy as np
+import yaml
 
 from generator.atomic import write_text
 from generator.labels import class_table
+
+log = logging.getLogger(__name__)
+
+#: The split names of the reference config, in its order.
+SPLITS = ("train", "valid", "test")
+#: Split of a sequence nobody assigned: what semantic-kitti-api evaluates by default (``-s valid``).
+DEFAULT_SPLIT = "valid"
 
 
 def count_raw_ids(semantic: np.ndarray) -> dict[int, int]:
@@ -32,8 +47,52 @@ def merge_counts(*counts: dict[int, int]) -> dict[int, int]:
     return out
 
 
-def label_config(counts: dict[int, int], sequences: list[int]) -> dict:
-    """The config as plain data: reference maps plus ``content`` from ``counts`` and ``split``.
+def read_split(path: str | Path) -> dict[str, list[int]]:
+    """The ``split`` section of a label config on disk (empty when the file is missing or unreadable)."""
+    path = Path(path)
+    if not path.is_file():
+        return {}
+    try:
+        split = (yaml.safe_load(path.read_text(encoding="utf-8")) or {}).get("split") or {}
+        return {part: [int(s) for s in (split.get(part) or [])] for part in SPLITS}
+    except (yaml.YAMLError, UnicodeDecodeError, AttributeError, TypeError, ValueError) as e:
+        log.warning("%s: split section not readable (%s); sequences get their --split or %s", path, e, DEFAULT_SPLIT)
+        return {}
+
+
+def merge_split(sequences: list[int], assigned: dict[int, str] | None = None,
+                previous: dict[str, list[int]] | None = None, default: str = DEFAULT_SPLIT) -> dict[str, list[int]]:
+    """Each of ``sequences`` under exactly one split.
+
+    Parameters
+    ----------
+    sequences : list of int
+        The sequences present in the dataset (only these are listed).
+    assigned : dict, optional
+        Sequence -> split for the sequences a command was asked to place (``--split``).
+    previous : dict, optional
+        The ``split`` section on disk (:func:`read_split`): kept for the other sequences.
+    default : str
+        Split of sequences neither assigned nor listed before.
+
+    Returns
+    -------
+    dict
+        ``{"train": [...], "valid": [...], "test": [...]}``, sorted sequence numbers.
+    """
+    assigned = {int(k): v for k, v in (assigned or {}).items()}
+    before = {int(s): part for part in SPLITS for s in (previous or {}).get(part, [])}
+    out: dict[str, list[int]] = {part: [] for part in SPLITS}
+    for s in sorted({int(s) for s in sequences}):
+        part = assigned.get(s) or before.get(s) or default
+        if part not in SPLITS:
+            raise ValueError(f"split must be one of {', '.join(SPLITS)}, got {part!r}")
+        out[part].append(s)
+    return out
+
+
+def label_config(counts: dict[int, int], split: dict[str, list[int]]) -> dict:
+    """The config as plain data: reference maps plus ``content`` from ``counts`` and ``split`` (:func:`merge_split`).
 
     Raises
     ------
@@ -54,7 +113,7 @@ def label_config(counts: dict[int, int], sequences: list[int]) -> dict:
         "learning_map": {int(k): int(v) for k, v in ref["learning_map"].items()},
         "learning_map_inv": {int(k): int(v) for k, v in ref["learning_map_inv"].items()},
         "learning_ignore": {int(k): bool(v) for k, v in ref["learning_ignore"].items()},
-        "split": {"train": sorted(int(s) for s in sequences), "valid": [], "test": []},
+        "split": {part: sorted(int(s) for s in split.get(part, [])) for part in SPLITS},
     }
 
 
@@ -80,15 +139,15 @@ def format_label_config(cfg: dict) -> str:
                 val = str(v)
             out.append(f"  {k}: {val}")
     out.append(f"split:{comments['split']}")
-    for part in ("train", "valid", "test"):
+    for part in SPLITS:
         seqs = cfg["split"][part]
         out.append(f"  {part}:" + ("" if seqs else " []"))
         out.extend(f"    - {s}" for s in seqs)
     return "\n".join(out) + "\n"
 
 
-def write_label_config(path: str | Path, counts: dict[int, int], sequences: list[int]) -> dict:
+def write_label_config(path: str | Path, counts: dict[int, int], split: dict[str, list[int]]) -> dict:
     """Write the config atomically and return it."""
-    cfg = label_config(counts, sequences)
+    cfg = label_config(counts, split)
     write_text(path, format_label_config(cfg))
     return cfg

@@ -8,7 +8,11 @@ The lookups are :mod:`generator.labels.sets`; this module rewrites whole dataset
 ``times.txt`` of each sequence, rewrites every ``.label`` with unified ids in the low 16
 bits (instance ids in the high 16 bits kept), and writes ``OUT/unified11.yaml`` (the
 unified label config in the layout of ``semantic-kitti.yaml``: labels, color_map (BGR),
-content, identity learning maps, 0 = unlabeled ignored, split) and ``OUT/conversion.json``.
+content of the sequences converted, identity learning maps, 0 = unlabeled ignored, split)
+and ``OUT/conversion.json``. ``split`` lists every sequence in OUT: the converted ones under
+``--split`` if given, else under the split ``IN/semantic-kitti.yaml`` gives them, else
+``valid`` (semantic-kitti-api's default); sequences already in OUT keep their split
+(:func:`generator.formats.label_config.merge_split`).
 Everything is staged in a temporary folder inside OUT and moved into place only once every
 scan has converted, so a bad input leaves OUT as it was.
 """
@@ -28,21 +32,23 @@ from generator import __version__
 from generator.atomic import staging, write_json, write_text
 from generator.errors import UserError
 from generator.formats import semantickitti as sk
-from generator.formats.label_config import count_raw_ids, format_label_config, merge_counts
+from generator.formats.label_config import SPLITS, count_raw_ids, format_label_config, merge_counts, merge_split, read_split
 from generator.labels import class_table
 from generator.labels.sets import semantickitti_to_unified
 
 log = logging.getLogger(__name__)
 
 COPIED_FILES = ("poses.txt", "calib.txt", "times.txt")
+SOURCE_CONFIG = "semantic-kitti.yaml"
 
 
 # -- target label configs ----------------------------------------------------------------
-def unified_label_config(counts: dict[int, int], sequences: list[int]) -> dict:
+def unified_label_config(counts: dict[int, int], split: dict[str, list[int]]) -> dict:
     """The unified set's label config as plain data (sections of ``semantic-kitti.yaml``).
 
     ``color_map`` (BGR) is the reference colour of each class's canonical raw id;
-    ``learning_map`` is the identity with 0 (unlabeled) ignored.
+    ``learning_map`` is the identity with 0 (unlabeled) ignored; ``split`` as given
+    (:func:`generator.formats.label_config.merge_split`).
     """
     table = class_table()
     names = table.unified_names
@@ -54,7 +60,7 @@ def unified_label_config(counts: dict[int, int], sequences: list[int]) -> dict:
         "learning_map": {u: u for u in names},
         "learning_map_inv": {u: u for u in names},
         "learning_ignore": {u: u == 0 for u in names},
-        "split": {"train": sorted(int(s) for s in sequences), "valid": [], "test": []},
+        "split": {part: sorted(int(s) for s in split.get(part, [])) for part in SPLITS},
     }
 
 
@@ -97,7 +103,7 @@ def pick_sequences(root: Path, sequences: list[str] | None) -> list[str]:
 
 
 def convert_dataset(src: str | Path, dst: str | Path, labels: str = "unified11", sequences: list[str] | None = None,
-                    progress: bool = True) -> dict:
+                    progress: bool = True, split: str | None = None) -> dict:
     """Rewrite the labels of a SemanticKITTI-layout dataset into another label set.
 
     Parameters
@@ -108,6 +114,9 @@ def convert_dataset(src: str | Path, dst: str | Path, labels: str = "unified11",
         A key of :data:`TARGETS`.
     sequences : list of str, optional
         Sequence numbers (default: every sequence with labels).
+    split : {"train", "valid", "test"}, optional
+        Split of the converted sequences in the written config (default: their split in
+        ``src/semantic-kitti.yaml``, else ``valid``).
 
     Returns
     -------
@@ -116,6 +125,8 @@ def convert_dataset(src: str | Path, dst: str | Path, labels: str = "unified11",
     """
     if labels not in TARGETS:
         raise UserError(f"--labels: unknown label set {labels!r}; known: {', '.join(TARGETS)}")
+    if split is not None and split not in SPLITS:
+        raise UserError(f"--split: must be one of {', '.join(SPLITS)}, got {split!r}")
     target = TARGETS[labels]
     src, dst = Path(src), Path(dst)
     if dst.exists() and not dst.is_dir():
@@ -150,7 +161,11 @@ def convert_dataset(src: str | Path, dst: str | Path, labels: str = "unified11",
         (dst / "sequences").mkdir(exist_ok=True)
         for n in names:
             (stage / "sequences" / n).rename(dst / "sequences" / n)
-    cfg = target.config(counts, [int(s) for s in names])  # content and split: the sequences of this run
+    source = {int(s): part for part, seqs in read_split(src / SOURCE_CONFIG).items() for s in seqs}
+    assigned = {int(n): split or source.get(int(n)) for n in names}
+    parts = merge_split([int(n) for n in sk.list_sequences(dst)], {k: v for k, v in assigned.items() if v},
+                        read_split(dst / target.config_name))
+    cfg = target.config(counts, parts)  # content: the sequences of this run; split: every sequence in dst
     write_text(dst / target.config_name, target.formatter(cfg))
     summary = {"generator": f"urbangen {__version__} convert", "source": str(src), "labels": labels,
                "mapping": "native -> SemanticKITTI raw (generator/labels/classes.yaml) -> unified "

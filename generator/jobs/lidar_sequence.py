@@ -179,8 +179,22 @@ def _remove_stale(seq: Path, n: int) -> None:
                 p.unlink()
 
 
-def write_dataset_label_config(out: str | Path) -> dict:
-    """(Re)write ``out/semantic-kitti.yaml`` with ``content`` summed over every sequence's metadata."""
+def write_dataset_label_config(out: str | Path, split: str | None = None, sequences: list[str] | None = None) -> dict:
+    """(Re)write ``out/semantic-kitti.yaml``: ``content`` summed over every sequence, ``split`` merged.
+
+    Parameters
+    ----------
+    out : path-like
+        Dataset root (``out/sequences/NN``).
+    split : {"train", "valid", "test"}, optional
+        Put ``sequences`` (default: every sequence) under this split; the other sequences keep
+        the split the config on disk gives them, new ones go to ``valid``
+        (:func:`generator.formats.label_config.merge_split`).
+    sequences : list of str, optional
+        The sequences ``split`` applies to.
+    """
+    from generator.formats.label_config import merge_split, read_split
+
     total: dict[int, int] = {}
     seqs = []
     for name in sk.list_sequences(out):
@@ -195,7 +209,9 @@ def write_dataset_label_config(out: str | Path) -> dict:
                     counts = merge_counts(counts, count_raw_ids(rec.semantic))
         total = merge_counts(total, counts)
         seqs.append(int(name))
-    return write_label_config(Path(out) / LABEL_CONFIG_NAME, total, seqs)
+    path = Path(out) / LABEL_CONFIG_NAME
+    assigned = {} if split is None else {int(s): split for s in (seqs if sequences is None else sequences)}
+    return write_label_config(path, total, merge_split(seqs, assigned, read_split(path)))
 
 
 def _metadata(scene, spec, sensor: Sensor, options: SequenceOptions, intensity_fn, n_points, counts) -> dict:
