@@ -55,7 +55,7 @@ def _sequence(dataset: Path) -> int:
 
 
 def run(args) -> int:
-    from tqdm import tqdm
+    from generator.progress import progress
 
     from generator.imaging.exr import read_exr
     from generator.previews.preview import tonemap
@@ -72,8 +72,8 @@ def run(args) -> int:
     planned = [(city_name(t, w), image_stem(city_name(t, w), seq, f)) for f, t, w in metas]
 
     def images() -> Iterator[CityscapesImage]:
-        for exr, (frame, time_of_day, weather) in tqdm(list(zip(exrs, metas)), desc="export cityscapes", unit="image",
-                                                                disable=None):
+        for exr, (frame, time_of_day, weather) in progress(list(zip(exrs, metas)), desc="export cityscapes",
+                                                           unit="image"):
             im = read_exr(exr)
             yield CityscapesImage(str(exr), city_name(time_of_day, weather), seq, frame, tonemap(im.rgb), im.class_id,
                                   im.instance)

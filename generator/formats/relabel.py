@@ -26,7 +26,6 @@ from pathlib import Path
 from typing import Callable
 
 import numpy as np
-from tqdm import tqdm
 
 from generator import __version__
 from generator.atomic import staging, write_json, write_text
@@ -35,6 +34,7 @@ from generator.formats import semantickitti as sk
 from generator.formats.label_config import SPLITS, count_raw_ids, format_label_config, merge_counts, merge_split, read_split
 from generator.labels import class_table
 from generator.labels.sets import semantickitti_to_unified
+from generator.progress import progress as progress_bar
 
 log = logging.getLogger(__name__)
 
@@ -140,7 +140,7 @@ def convert_dataset(src: str | Path, dst: str | Path, labels: str = "unified11",
             raise UserError(f"{dst / 'sequences' / n}: exists; remove it or choose another output folder")
     counts: dict[int, int] = {}
     with staging(dst, "convert") as stage:
-        bar = tqdm(total=sum(len(s) for s in seqs), desc=f"convert -> {labels}", unit="scan", disable=None if progress else True)
+        bar = progress_bar(total=sum(len(s) for s in seqs), desc=f"convert -> {labels}", unit="scan", enabled=progress)
         with bar:
             for seq in seqs:
                 out = stage / "sequences" / seq.dir.name

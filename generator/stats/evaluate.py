@@ -31,13 +31,13 @@ from pathlib import Path
 from typing import Iterator
 
 import numpy as np
-from tqdm import tqdm
 
 from generator.errors import UserError
 from generator.formats import semantickitti as sk
 from generator.formats.point_sidecars import NATIVE_DIR, read_sidecar
 from generator.labels.sets import LABEL_SET_NAMES as LABEL_SETS, LabelSet, label_sets
 from generator.stats.panoptic import MIN_POINTS, PanopticAccumulator, panoptic_result
+from generator.progress import progress as progress_bar
 
 IGNORE = 0
 #: Which classes the means average: every non-ignored class (the reference) or those present.
@@ -189,7 +189,7 @@ def evaluate_trees(pred_root: str | Path, gt_root: str | Path, labels: str = "un
     conf = np.zeros((n, n), np.int64)
     pan = PanopticAccumulator(n, (IGNORE,), min_points) if panoptic else None
     pairs = list(_pairs(Path(pred_root), Path(gt_root), sequences))
-    for gt_dir, pred_dir, i in tqdm(pairs, desc=f"eval {labels}", unit="scan", disable=None if progress else True):
+    for gt_dir, pred_dir, i in progress_bar(pairs, desc=f"eval {labels}", unit="scan", enabled=progress):
         gt_raw, gt_inst = sk.read_labels(gt_dir / "labels" / f"{i:06d}.label")
         pred_path = prediction_path(pred_dir, i)
         if not pred_path.is_file():
