@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from assets_procedural.parts import centred, disc_wheel, oriented_box, sweep
-from assets_procedural.two_wheelers import _draw, _xz
+from assets_procedural.two_wheelers import _draw, _xz, contact_anchors
 from generator.geometry import Mesh, box, loft, merge, polygon, pose, tube
 
 MOTO_STYLES = ("naked", "sport", "scooter")
@@ -41,7 +41,7 @@ def _motorcycle_parts(rng: np.random.Generator, style: str | None) -> tuple[list
     parts.append(disc_wheel(fa, R, tyre * 0.9, cls, spokes=spokes, width=2.0 * tyre))
     axis = _xz(90.0 - p["rake"])                              # steering axis, up and back
     head = fa + 0.04 * np.array([1.0, 0.0, 0.0]) + (0.72 if style != "scooter" else 0.78) * axis
-    seat_z, seat_x = p["seat"], 0.42 * wb - (0.05 if style == "scooter" else 0.0)
+    seat_z, seat_x = p["seat"], (0.3 if style == "scooter" else 0.42) * wb
     # front fork (two legs) and triple clamp
     for s in (1.0, -1.0):
         parts.append(tube(fa + s * 0.085 * y, head + s * 0.085 * y - 0.05 * axis, 0.028, cls,
@@ -63,29 +63,23 @@ def _motorcycle_parts(rng: np.random.Generator, style: str | None) -> tuple[list
     parts.append(tube(head - 0.02 * axis, bar_c, 0.02, cls, "pole_metal", sections=6))
     if style == "scooter":
         floor_z = 0.30
-        # front shield, floorboard, rear body over the engine, seat, front mudguard
-        sx = np.linspace(wb - 0.42, wb - 0.26, 4)
-        shield = []
-        for k, x in enumerate(sx):
-            zs = np.array([floor_z - 0.02, 0.55, 0.85, head[2] - 0.05])
-            w = np.array([0.2, 0.22, 0.2, 0.12])[k] * np.ones(1)
-            shield.append(np.array([[x, -w[0], zs[0]], [x, w[0], zs[0]], [x + 0.06, w[0], zs[3]], [x + 0.06, -w[0], zs[3]]]))
-        front = np.array([wb - 0.44, wb - 0.22])
+        # leg shield, floorboard, rear body over the engine, seat; room for the legs between them
+        front = np.array([seat_x + 0.62, seat_x + 0.82])
         ring = lambda x, w, z0, z1: np.array([[x, -w, z0], [x, w, z0], [x, w, z1], [x, -w, z1]])  # noqa: E731
         parts.append(loft(np.array([ring(front[0], 0.2, floor_z - 0.02, head[2] - 0.1),
                                     ring(front[1], 0.17, floor_z + 0.05, head[2] - 0.02)]), cls, "car_paint"))
-        parts.append(box((front[0] - seat_x + 0.05, 0.34, 0.06), cls, "rubber", ((front[0] + seat_x) / 2, 0.0, floor_z)))
+        parts.append(box((front[0] - seat_x, 0.34, 0.06), cls, "rubber", ((front[0] + seat_x) / 2, 0.0, floor_z)))
         body = []
-        for x, w, z0, z1 in ((seat_x + 0.22, 0.17, floor_z, seat_z - 0.08), (seat_x, 0.19, R + 0.08, seat_z - 0.06),
+        for x, w, z0, z1 in ((seat_x + 0.16, 0.15, floor_z + 0.03, seat_z - 0.1), (seat_x, 0.19, R + 0.08, seat_z - 0.06),
                              (-0.2, 0.16, R + 0.12, seat_z - 0.1), (-0.42, 0.08, R + 0.2, seat_z - 0.2)):
             body.append(ring(x, w, z0, z1))
         parts.append(loft(np.array(body), cls, "car_paint"))
-        parts.append(loft(np.array([ring(seat_x + 0.2, 0.14, seat_z - 0.1, seat_z - 0.02),
+        parts.append(loft(np.array([ring(seat_x + 0.18, 0.13, seat_z - 0.1, seat_z - 0.02),
                                     ring(seat_x, 0.17, seat_z - 0.1, seat_z), ring(-0.3, 0.12, seat_z - 0.1, seat_z - 0.03)]),
                           cls, "rubber"))
         parts.append(box((0.25, 0.14, 0.1), cls, "pole_metal", (0.1, -0.12, R + 0.02)))
         parts.append(tube(np.array([0.15, -0.12, 0.2]), np.array([-0.3, -0.15, 0.25]), 0.04, cls, "chrome", sections=6))
-        feet = [np.array([seat_x + 0.42, s * 0.12, floor_z + 0.03]) for s in (-1.0, 1.0)]
+        feet = [np.array([seat_x + 0.45, s * 0.12, floor_z + 0.03]) for s in (-1.0, 1.0)]
         light_f = np.array([front[0] + 0.22, 0.0, head[2] - 0.1])
         light_r = np.array([-0.44, 0.0, seat_z - 0.16])
     else:
@@ -122,7 +116,7 @@ def _motorcycle_parts(rng: np.random.Generator, style: str | None) -> tuple[list
                                      [-0.25, -0.2, R + 0.12]]), 0.045, cls, "chrome", 8))
         parts.append(sweep(np.array([fa + [-0.2, 0, 0.18], fa + [0.0, 0, R - 0.03], fa + [0.18, 0, R - 0.12]]),
                            (0.008, 0.07), cls, "car_paint", 6, binormal=(0, 1, 0)))
-        feet = [np.array([seat_x + 0.12, s * 0.2, R + 0.06]) for s in (-1.0, 1.0)]
+        feet = [np.array([seat_x + 0.12, s * (0.2 if style == "naked" else 0.23), R + 0.06]) for s in (-1.0, 1.0)]
         for f in feet:
             parts.append(tube(f - [0, np.sign(f[1]) * 0.1, 0], f + [0, np.sign(f[1]) * 0.04, 0], 0.012, cls, "pole_metal",
                               sections=6))
@@ -133,7 +127,7 @@ def _motorcycle_parts(rng: np.random.Generator, style: str | None) -> tuple[list
             for x, w, z0, z1 in ((head[0] + 0.2, 0.08, head[2] - 0.2, head[2] + 0.08),
                                  (head[0] + 0.05, 0.2, R + 0.05, head[2] + 0.12),
                                  (head[0] - 0.25, 0.23, R - 0.02, head[2] + 0.0),
-                                 (eng_c[0] - 0.15, 0.2, R - 0.05, seat_z - 0.15)):
+                                 (eng_c[0] - 0.15, 0.16, R - 0.05, seat_z - 0.15)):
                 a = np.linspace(0, 2 * np.pi, 10, endpoint=False)
                 fair.append(np.stack([np.full(10, x), w * np.cos(a), (z0 + z1) / 2 + (z1 - z0) / 2 * np.sin(a)], 1))
             parts.append(loft(np.array(fair), cls, "car_paint"))
@@ -169,7 +163,7 @@ def motorcycle(rng: np.random.Generator, style: str | None = None, lean_deg: flo
     """
     parts, info = _motorcycle_parts(rng, style)
     m = merge(parts)
-    m.anchors = {"headlight": info["headlight"][None], "taillight": info["taillight"][None]}
+    m.anchors = {"headlight": info["headlight"][None], "taillight": info["taillight"][None], **contact_anchors(info)}
     if lean_deg:
         m = m.transformed(pose(roll=np.radians(lean_deg)))
     return centred(m)

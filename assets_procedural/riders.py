@@ -22,7 +22,7 @@ import numpy as np
 from assets_procedural.motorcycles import _motorcycle_parts
 from assets_procedural.parts import centring, two_link
 from assets_procedural.person import _head
-from assets_procedural.two_wheelers import _bicycle_parts
+from assets_procedural.two_wheelers import _bicycle_parts, contact_anchors
 from generator.geometry import Mesh, box, icosphere, loft, merge, pose, resolve_ids, tube
 
 def _rot_to(d: np.ndarray) -> np.ndarray:
@@ -37,43 +37,59 @@ def _rot_to(d: np.ndarray) -> np.ndarray:
     return np.eye(3) + vx + vx @ vx / (1 + c)
 
 
-def _figure(rng: np.random.Generator, height: float, hip: np.ndarray, grips: list[np.ndarray],
-            feet: list[np.ndarray], foot_pitch: float, cls: str, helmet: bool) -> Mesh:
-    """A seated person: pelvis at ``hip``, hands on ``grips`` (right, left), shoes on ``feet``.
+def _rot_y(alpha: float) -> np.ndarray:
+    """3x3 rotation about +y: a torso leaning forward (toward +x) by ``alpha`` radians."""
+    c, s = np.cos(alpha), np.sin(alpha)
+    return np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
 
-    ``feet`` are the points under the balls of the feet (pedal or peg tops), (right, left).
-    The torso leans forward just enough for the arms to reach the grips.
+
+def _lean_for_reach(hip: np.ndarray, shoulder_local: np.ndarray, grip: np.ndarray, reach: float) -> float:
+    """Torso lean (radians, -5..75 degrees) that puts the shoulder ``reach`` metres from the grip."""
+    def gap(alpha):
+        return float(np.linalg.norm(grip - (hip + _rot_y(alpha) @ shoulder_local))) - reach
+
+    lo, hi = np.radians(-5), np.radians(75)
+    if gap(lo) <= 0:
+        return lo
+    if gap(hi) >= 0:
+        return hi
+    for _ in range(40):
+        mid = (lo + hi) / 2
+        lo, hi = (mid, hi) if gap(mid) > 0 else (lo, mid)
+    return (lo + hi) / 2
+
+
+#: torso rings of the seated figure: (height along the torso above the hip, half width, half depth) / body height
+TORSO = ((-0.035, 0.095, 0.06), (0.09, 0.078, 0.058), (0.19, 0.095, 0.066), (0.265, 0.11, 0.058), (0.305, 0.045, 0.04))
+
+
+def _figure(rng: np.random.Generator, height: float, seat: np.ndarray, hip_dx: float, grips: list[np.ndarray],
+            feet: list[np.ndarray], foot_pitch: float, cls: str, helmet: bool) -> Mesh:
+    """A seated person on the seat whose top centre is ``seat``: the pelvis rests on it (hip
+    joints ``hip_dx`` ahead of it), hands on ``grips`` (right, left), the balls of the feet on
+    ``feet`` (pedal or peg tops, right, left). The torso leans forward just enough for the arms
+    to reach the grips.
     """
     h = height
     g = float(rng.uniform(0.92, 1.12))
     short_sleeves = rng.random() < 0.3
-    arm_len = (0.175 + 0.15) * h
+    arm_reach = 0.9 * (0.175 + 0.15) * h + 0.035 * h
     sh_local = [np.array([0.0, s * 0.1 * h * g, 0.26 * h]) for s in (-1.0, 1.0)]
-
-    def rot(alpha):
-        c, s_ = np.cos(alpha), np.sin(alpha)
-        return np.array([[c, 0, s_], [0, 1, 0], [-s_, 0, c]])
-
-    def arm_gap(alpha):
-        sh = hip + rot(alpha) @ sh_local[1]
-        return float(np.linalg.norm(grips[1] - sh)) - 0.035 * h - 0.9 * arm_len
-
-    lo, hi = np.radians(-5), np.radians(75)
-    if arm_gap(lo) <= 0:
-        alpha = lo
-    elif arm_gap(hi) >= 0:
-        alpha = hi
-    else:
-        for _ in range(40):
-            mid = (lo + hi) / 2
-            lo, hi = (mid, hi) if arm_gap(mid) > 0 else (lo, mid)
-        alpha = (lo + hi) / 2
-    R = rot(alpha)
-    rings = []
     a = np.linspace(0, 2 * np.pi, 8, endpoint=False)
-    for z, hw, hd in ((-0.035, 0.095 * g, 0.06 * g), (0.09, 0.078 * g, 0.058 * g), (0.19, 0.095 * g, 0.066 * g),
-                      (0.265, 0.11 * g, 0.058 * g), (0.305, 0.045, 0.04)):
-        ring = np.stack([hd * h * np.cos(a), hw * h * np.sin(a), np.full(8, z * h)], 1)
+    hip = np.asarray(seat, float) + np.array([hip_dx, 0.0, 0.06 * h])
+    for _ in range(3):
+        # lean for the reach, then sit the lowest point of pelvis and thighs 3 mm above the seat
+        alpha = _lean_for_reach(hip, sh_local[1], grips[1], arm_reach)
+        z0, hw0, hd0 = TORSO[0]
+        pelvis = np.stack([hd0 * g * h * np.cos(a), hw0 * g * h * np.sin(a), np.full(8, z0 * h)], 1) @ _rot_y(alpha).T
+        low = min(float(pelvis[:, 2].min()), -0.045 * h * g)
+        hip[2] = seat[2] + 0.003 - low
+    R = _rot_y(alpha)
+    rot = _rot_y
+    rings = []
+    for z, hw, hd in TORSO:
+        gw = g if z < 0.3 else 1.0
+        ring = np.stack([hd * gw * h * np.cos(a), hw * gw * h * np.sin(a), np.full(8, z * h)], 1)
         rings.append(ring @ R.T + hip)
     parts = [loft(np.array(rings), cls, "clothing")]
     # head: person's head (built standing) moved onto the neck, tilted less than the torso
@@ -129,7 +145,7 @@ def _rider_height_for(info: dict) -> float:
     bb, saddle = info["bb"], info["saddle"]
     h = 1.75
     for _ in range(4):
-        hip = saddle + np.array([-0.02, 0.0, 0.042 * h])
+        hip = saddle + np.array([-0.02, 0.0, 0.057 * h])
         worst = 0.0
         for a in np.linspace(0, 2 * np.pi, 24, endpoint=False):
             pedal = bb + 0.17 * np.array([np.cos(a), 0.0, np.sin(a)])
@@ -167,17 +183,18 @@ def ridden(kind: str, rng: np.random.Generator, style: str | None = None,
     if kind == "bicyclist":
         parts, info = _bicycle_parts(rng, style)
         h = _rider_height_for(info) if height is None else float(height)
-        hip = info["saddle"] + np.array([-0.02, 0.0, 0.042 * h])
-        rider = _figure(rng, h, hip, info["grips"], info["pedals"], 0.3, "bicyclist", helmet=rng.random() < 0.5)
+        rider = _figure(rng, h, info["saddle"], -0.02, info["grips"], info["pedals"], 0.3, "bicyclist",
+                        helmet=rng.random() < 0.5)
         vehicle = merge(parts)
+        vehicle.anchors = contact_anchors(info)
     elif kind == "motorcyclist":
         parts, info = _motorcycle_parts(rng, style)
         h = float(rng.uniform(1.6, 1.9)) if height is None else float(height)
-        hip = info["saddle"] + np.array([0.0, 0.0, 0.045 * h])
         pitch = 0.05 if info["style"] == "scooter" else 0.15
-        rider = _figure(rng, h, hip, info["grips"], info["feet"], pitch, "motorcyclist", helmet=True)
+        rider = _figure(rng, h, info["saddle"], 0.0, info["grips"], info["feet"], pitch, "motorcyclist", helmet=True)
         vehicle = merge(parts)
-        vehicle.anchors = {"headlight": info["headlight"][None], "taillight": info["taillight"][None]}
+        vehicle.anchors = {"headlight": info["headlight"][None], "taillight": info["taillight"][None],
+                           **contact_anchors(info)}
     else:
         raise ValueError(f"ridden kind must be 'bicyclist' or 'motorcyclist', got {kind!r}")
     t = centring(vehicle)

@@ -115,8 +115,9 @@ def _bicycle_parts(rng: np.random.Generator, style: str | None) -> tuple[list[Me
     parts.append(box((0.05, 0.11, 0.03), cls, frame_mat, tuple(crown - 0.015 * hs_dir)))
     parts.append(tube(bb - 0.04 * y, bb + 0.04 * y, 0.022, cls, frame_mat, sections=6))
     # seat post and saddle
-    parts.append(tube(st_top, saddle_top - np.array([0.0, 0.0, 0.04]), 0.0135, cls, "chrome", sections=6))
-    parts.append(_saddle(saddle_top - np.array([0.02, 0.0, 0.025]), cls))
+    parts.append(tube(st_top, saddle_top - np.array([0.02, 0.0, 0.065]), 0.0135, cls, "chrome", sections=6))
+    saddle_top = saddle_top - np.array([0.02, 0.0, 0.025])      # the saddle's real top centre
+    parts.append(_saddle(saddle_top, cls))
     # stem and bars
     stem_top = ht_top + 0.05 * hs_dir
     if style == "city":
@@ -204,8 +205,18 @@ def bicycle(rng: np.random.Generator, style: str | None = None, lean_deg: float 
         Class ``bicycle``: 1.6-2.0 m long, 0.4-0.8 m wide (bars), 0.95-1.25 m high; open spoked
         wheels touching z = 0.
     """
-    parts, _ = _bicycle_parts(rng, style)
+    parts, info = _bicycle_parts(rng, style)
     m = merge(parts)
+    m.anchors = contact_anchors(info)
     if lean_deg:
         m = m.transformed(pose(roll=np.radians(lean_deg)))
     return centred(m)
+
+
+def contact_anchors(info: dict) -> dict[str, np.ndarray]:
+    """Where a rider touches the vehicle: ``"saddle"`` (1, 3) top centre of the saddle or seat,
+    ``"grips"`` (2, 3) and ``"footrests"`` (2, 3) (pedals or pegs), right (-y) first."""
+    feet = info["pedals"] if "pedals" in info else info["feet"]
+    return {"saddle": np.asarray(info["saddle"], float)[None], "grips": np.array(info["grips"], float),
+            "footrests": np.array(feet, float)}
+
