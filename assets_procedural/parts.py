@@ -101,7 +101,7 @@ def torus(center, axis, major: float, minor: float | tuple[float, float], cls: s
 
 
 def spoked_wheel(center, radius: float, tyre: float, cls: str, n_spokes: int = 16, rim: str = "chrome",
-                 spoke_radius: float = 0.0025, hub_width: float = 0.09, segments: int = 20,
+                 spoke_radius: float = 0.0025, hub_width: float = 0.09, segments: int = 16,
                  tyre_sides: int = 6) -> Mesh:
     """A bicycle wheel in the x-z plane: tyre torus, rim ring, hub and thin spokes, open between them.
 

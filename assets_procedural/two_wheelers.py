@@ -99,7 +99,7 @@ def _bicycle_parts(rng: np.random.Generator, style: str | None) -> tuple[list[Me
     parts.append(tube(crown - 0.01 * hs_dir, ht_top + 0.01 * hs_dir, tr * 1.3, cls, frame_mat, sections=6))
     if style == "city":   # step-through: one bent down tube from the head tube to the bottom bracket
         mid = bb + np.array([0.22, 0.0, 0.02])
-        parts.append(sweep(_bezier(ht_top - 0.05 * hs_dir, mid, bb + [0.03, 0, 0.03]), tr * 1.35, cls, frame_mat, 8))
+        parts.append(sweep(_bezier(ht_top - 0.05 * hs_dir, mid, bb + [0.03, 0, 0.03]), tr * 1.35, cls, frame_mat, 6))
         parts.append(sweep(_bezier(crown + 0.02 * hs_dir, mid + [0.05, 0, -0.08], bb + [0.06, 0, 0.0]), tr, cls,
                            frame_mat, 8))
     else:
@@ -170,7 +170,7 @@ def _bicycle_parts(rng: np.random.Generator, style: str | None) -> tuple[list[Me
         for c, a0, a1 in ((ra, np.radians(15), np.radians(175)), (fa, np.radians(10), np.radians(150))):
             path = c + (R + 0.025) * np.stack([np.cos(np.linspace(a0, a1, 8)), np.zeros(8),
                                                  np.sin(np.linspace(a0, a1, 8))], 1)
-            parts.append(sweep(path, (0.006, 0.028), cls, frame_mat, 6, binormal=(0, 1, 0)))
+            parts.append(sweep(path, (0.006, 0.028), cls, frame_mat, 4, binormal=(0, 1, 0)))
         rack_z = R + 0.08
         for side in (1.0, -1.0):
             parts.append(tube(ra + side * np.array([0.0, 0.07, 0.0]), np.array([-0.12, side * 0.07, rack_z]), 0.006,

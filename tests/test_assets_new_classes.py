@@ -83,7 +83,7 @@ SIZES = {
 }
 
 #: kind -> most triangles one asset may have (prototypes are instanced; keep them cheap)
-BUDGET = {"bicycle": 2400, "motorcycle": 2200, "bicyclist": 2800, "motorcyclist": 2700, "bus": 1500, "tram": 2600,
+BUDGET = {"bicycle": 2000, "motorcycle": 2200, "bicyclist": 2500, "motorcyclist": 2700, "bus": 1200, "tram": 2100,
           "rail_track": 800, "tram_rails": 100, "trailer": 800, "box_van": 900, "construction_vehicle": 600,
           "wall": 600, "traffic_island": 200, "median_strip": 200, "driveway_apron": 20, "gravel_patch": 100,
           "bench": 400, "bin": 250, "bollard": 200, "bike_rack": 1200, "bus_shelter": 400, "hydrant": 400,
@@ -353,7 +353,8 @@ def _hull_2d(p: np.ndarray) -> np.ndarray:
     def half(pts):
         out = []
         for q in pts:
-            while len(out) >= 2 and np.cross(out[-1] - out[-2], q - out[-2]) <= 0:
+            while len(out) >= 2 and ((out[-1][0] - out[-2][0]) * (q[1] - out[-2][1])
+                                     - (out[-1][1] - out[-2][1]) * (q[0] - out[-2][0])) <= 0:
                 out.pop()
             out.append(q)
         return out[:-1]
