@@ -15,6 +15,17 @@ from assets_procedural.fence import fence
 from generator.geometry import Mesh
 from assets_procedural.person import person
 from assets_procedural.street_furniture import lamp_post, traffic_light, traffic_sign
+from assets_procedural.ground_pieces import driveway_apron, gravel_patch, median_strip, traffic_island
+from assets_procedural.motorcycles import motorcycle
+from assets_procedural.riders import bicyclist, motorcyclist
+from assets_procedural.shelters import bus_shelter
+from assets_procedural.street_objects import advertising_column, bench, bike_rack, bollard, hydrant
+from assets_procedural.street_objects import bin as litter_bin
+from assets_procedural.tracks import rail_track, tram_rails
+from assets_procedural.transit import bus, tram
+from assets_procedural.utility_vehicles import box_van, construction_vehicle, trailer
+from assets_procedural.two_wheelers import bicycle
+from assets_procedural.walls import wall
 from assets_procedural.vegetation import bush, hedge, tree
 from assets_procedural.vehicle import car, truck
 
@@ -30,6 +41,30 @@ BUILDERS: dict[str, Callable[..., Mesh]] = {
     "car": car,
     "truck": truck,
     "person": person,
+    # issue 13: the rarer classes
+    "bicycle": bicycle,
+    "motorcycle": motorcycle,
+    "bicyclist": bicyclist,
+    "motorcyclist": motorcyclist,
+    "bus": bus,
+    "tram": tram,
+    "rail_track": rail_track,
+    "tram_rails": tram_rails,
+    "trailer": trailer,
+    "box_van": box_van,
+    "construction_vehicle": construction_vehicle,
+    "wall": wall,
+    "traffic_island": traffic_island,
+    "median_strip": median_strip,
+    "driveway_apron": driveway_apron,
+    "gravel_patch": gravel_patch,
+    "bench": bench,
+    "bin": litter_bin,
+    "bollard": bollard,
+    "bike_rack": bike_rack,
+    "bus_shelter": bus_shelter,
+    "hydrant": hydrant,
+    "advertising_column": advertising_column,
 }
 
 KINDS: tuple[str, ...] = tuple(BUILDERS)
@@ -47,6 +82,29 @@ MAIN_CLASS: dict[str, str] = {
     "car": "car",
     "truck": "truck",
     "person": "person",
+    "bicycle": "bicycle",
+    "motorcycle": "motorcycle",
+    "bicyclist": "bicyclist",
+    "motorcyclist": "motorcyclist",
+    "bus": "bus",
+    "tram": "on_rails",
+    "rail_track": "rail_track",
+    "tram_rails": "road",
+    "trailer": "other_vehicle",
+    "box_van": "truck",
+    "construction_vehicle": "other_vehicle",
+    "wall": "wall",
+    "traffic_island": "other_ground",
+    "median_strip": "other_ground",
+    "driveway_apron": "other_ground",
+    "gravel_patch": "other_ground",
+    "bench": "street_object",
+    "bin": "street_object",
+    "bollard": "street_object",
+    "bike_rack": "street_object",
+    "bus_shelter": "shelter",
+    "hydrant": "street_object",
+    "advertising_column": "street_object",
 }
 
 

@@ -30,7 +30,11 @@ def test_native_to_raw_to_unified_is_the_composition_for_every_class():
                 "crosswalk": "road", "curb": "sidewalk", "sidewalk": "sidewalk", "parking": "other-ground",
                 "terrain": "terrain", "building": "building", "fence": "fence", "vegetation": "vegetation",
                 "tree_trunk": "vegetation", "tree_crown": "vegetation", "pole": "pole", "traffic_light": "traffic-sign",
-                "traffic_sign": "traffic-sign", "unlabeled": "unlabeled", "sky": "unlabeled"}
+                "traffic_sign": "traffic-sign", "unlabeled": "unlabeled", "sky": "unlabeled",
+                "bicycle": "vehicle", "motorcycle": "vehicle", "bus": "vehicle", "on_rails": "vehicle",
+                "other_vehicle": "vehicle", "bicyclist": "person", "motorcyclist": "person", "wall": "fence",
+                "other_ground": "other-ground", "street_object": "unlabeled", "rail_track": "other-ground",
+                "shelter": "unlabeled"}
     assert {n: table.unified_names[int(u)] for n, u in zip(table.names, uni)} == expected
 
 

