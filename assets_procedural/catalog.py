@@ -13,11 +13,12 @@ import numpy as np
 from assets_procedural.building import building
 from assets_procedural.fence import fence
 from generator.geometry import Mesh
+from generator.labels import class_table
 from assets_procedural.person import person
 from assets_procedural.street_furniture import lamp_post, traffic_light, traffic_sign
 from assets_procedural.ground_pieces import driveway_apron, gravel_patch, median_strip, traffic_island
 from assets_procedural.motorcycles import motorcycle
-from assets_procedural.riders import bicyclist, motorcyclist
+from assets_procedural.riders import bicyclist, motorcyclist, ridden
 from assets_procedural.shelters import bus_shelter
 from assets_procedural.street_objects import advertising_column, bench, bike_rack, bollard, hydrant
 from assets_procedural.street_objects import bin as litter_bin
@@ -28,6 +29,19 @@ from assets_procedural.two_wheelers import bicycle
 from assets_procedural.walls import wall
 from assets_procedural.vegetation import bush, hedge, tree
 from assets_procedural.vehicle import car, truck
+
+def _ridden_vehicle(rider_kind: str, vehicle_class: str):
+    """Builder of the two-wheeler a ``rider_kind`` rides: the vehicle of :func:`ridden` from the same
+    generator state as the rider's own builder, its faces relabelled ``ridden_*`` (see classes.yaml)."""
+    def build_vehicle(rng: np.random.Generator, **params) -> Mesh:
+        _, vehicle = ridden(rider_kind, rng, **params)
+        table = class_table()
+        plain = table.id(vehicle_class.removeprefix("ridden_"))
+        vehicle.face_class = np.where(vehicle.face_class == plain, table.id(vehicle_class), vehicle.face_class).astype(
+            np.uint8)
+        return vehicle
+    return build_vehicle
+
 
 BUILDERS: dict[str, Callable[..., Mesh]] = {
     "building": building,
@@ -46,6 +60,8 @@ BUILDERS: dict[str, Callable[..., Mesh]] = {
     "motorcycle": motorcycle,
     "bicyclist": bicyclist,
     "motorcyclist": motorcyclist,
+    "ridden_bicycle": _ridden_vehicle("bicyclist", "ridden_bicycle"),
+    "ridden_motorcycle": _ridden_vehicle("motorcyclist", "ridden_motorcycle"),
     "bus": bus,
     "tram": tram,
     "rail_track": rail_track,
@@ -86,6 +102,8 @@ MAIN_CLASS: dict[str, str] = {
     "motorcycle": "motorcycle",
     "bicyclist": "bicyclist",
     "motorcyclist": "motorcyclist",
+    "ridden_bicycle": "ridden_bicycle",
+    "ridden_motorcycle": "ridden_motorcycle",
     "bus": "bus",
     "tram": "on_rails",
     "rail_track": "rail_track",

@@ -20,6 +20,7 @@ import numpy as np
 from generator.geometry import Mesh, pose
 from generator.labels import class_table
 from generator.layout import placement_lots as pl
+from generator.layout import placement_extras as px
 from generator.layout import placement_street as ps
 from generator.layout.lots import Lot, lot_ground_mesh, make_lots
 from generator.layout.outskirts import horizon_mesh
@@ -48,6 +49,15 @@ STEPS = (
     ("parked vehicles", lambda p, s, g, lots, st: ps.place_parked(p, s, st)),
     ("lane cars", lambda p, s, g, lots, st: ps.place_lane_cars(p, s, st)),
     ("people", lambda p, s, g, lots, st: ps.place_people(p, s, st)),
+    # families added later: placed last, each from its own stream, density 0 by default
+    ("street objects", lambda p, s, g, lots, st: px.place_street_objects(p, s, st)),
+    ("bike racks", lambda p, s, g, lots, st: px.place_bike_racks(p, s, st)),
+    ("two-wheelers", lambda p, s, g, lots, st: px.place_two_wheelers(p, s, st)),
+    ("bus stops", lambda p, s, g, lots, st: px.place_bus_stops(p, s, st)),
+    ("trams", lambda p, s, g, lots, st: px.place_trams(p, s, st)),
+    ("other vehicles", lambda p, s, g, lots, st: px.place_other_vehicles(p, s, st)),
+    ("riders", lambda p, s, g, lots, st: px.place_riders(p, s, st)),
+    ("lot extras", lambda p, s, g, lots, st: px.place_lot_extras(p, s, lots, st)),
 )
 
 

@@ -97,15 +97,18 @@ class Library:
         self.protos[key] = p
         return p
 
-    def variant(self, kind: str, i: int, params_fn=None, tag: str = "") -> Proto:
+    def variant(self, kind: str, i: int, params_fn=None, tag: str = "", stream_kind: str | None = None) -> Proto:
         """Variant ``i`` of an instanced kind; ``params_fn(g) -> dict`` draws its parameters first.
 
         ``tag`` names a separate family of variants of the same kind (e.g. street trees),
         keyed ``"<kind>_<tag>_v<i>"`` and built from the stream ``("assets", kind, tag, i)``.
+        ``stream_kind`` draws from another kind's stream instead: a rider and the bicycle it
+        rides are built from the same stream, so they fit each other.
         """
         key = f"{kind}_{tag}_v{i}" if tag else f"{kind}_v{i}"
         if key not in self.protos:
-            g = stream(self.seed, "assets", kind, tag, i) if tag else stream(self.seed, "assets", kind, i)
+            sk = stream_kind or kind
+            g = stream(self.seed, "assets", sk, tag, i) if tag else stream(self.seed, "assets", sk, i)
             self._make(key, kind, g, params_fn(g) if params_fn else {})
         return self.protos[key]
 

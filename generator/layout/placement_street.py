@@ -166,7 +166,7 @@ def _vehicle(placer: Placer, kind: str, i: int) -> Proto:
     return placer.lib.variant(kind, i % (N_CAR if kind == "car" else N_TRUCK))
 
 
-def _free_lane(placer: Placer, seg: Segment, v: float, u0: float, u1: float) -> bool:
+def free_lane(placer: Placer, seg: Segment, v: float, u0: float, u1: float) -> bool:
     """True if no route drives the lane whose centre is at ``v`` between ``u0`` and ``u1``."""
     tree = placer.keepout.tree
     if tree is None:
@@ -225,7 +225,7 @@ def place_lane_cars(placer: Placer, spec: SceneSpec, st: Street) -> None:
         for d in (1, -1):
             for k in range(grid.lanes):
                 v = -d * (k + 0.5) * grid.lane_w
-                if u1 > u0 and _free_lane(placer, seg, v, u0, u1):
+                if u1 > u0 and free_lane(placer, seg, v, u0, u1):
                     lanes.append((seg, d, v, u0, u1))
     if not lanes:
         return

@@ -48,6 +48,16 @@ class Density:
     signs_per_block: float
     lamp_spacing_m: float
     parks: float
+    street_objects_per_100m: float
+    bike_racks_per_block: float
+    parked_two_wheelers_per_100m: float
+    riders_per_km: float
+    bus_stops_per_km: float
+    trams: int
+    other_vehicles_per_100m: float
+    walls: float
+    driveways: float
+    gravel: float
 
 
 @dataclass(frozen=True)
