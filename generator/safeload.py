@@ -105,7 +105,10 @@ def printable(text: object, limit: int | None = None) -> str:
     str
         One line, safe to print on any terminal encoding (lone surrogates are escaped).
     """
-    s = str(text)
+    try:
+        s = str(text)
+    except ValueError:  # an integer too long to print
+        s = "<a very long integer>"
     if not s.isprintable():
         s = "".join(c if c.isprintable() else c.encode("unicode_escape", "backslashreplace").decode("ascii")
                     for c in s)
@@ -115,7 +118,20 @@ def printable(text: object, limit: int | None = None) -> str:
 
 
 def field_path(parts, prefix: str = "") -> str:
-    """Dotted field path of ``parts`` (``town.blocks_x``, ``lasers[3].ring``) after ``prefix``."""
+    """Dotted field path of ``parts``: ``town.blocks_x``, ``lasers[3].ring``.
+
+    Parameters
+    ----------
+    parts : iterable of str or int
+        Mapping keys (escaped with :func:`printable`, at most 64 characters) and list indices.
+    prefix : str, optional
+        Path the result continues.
+
+    Returns
+    -------
+    str
+        The path; empty for no parts and no prefix.
+    """
     out = prefix
     for p in parts:
         if isinstance(p, int) and not isinstance(p, bool):
@@ -298,9 +314,18 @@ def check_finite(obj: Any, source: str, field: str = "", *, max_depth: int | Non
     generator.errors.SpecError
         ``<file>: <field.path>: must be a finite number, got nan``, too deep, or too many values.
     """
-    stack: list[tuple[Any, tuple, int]] = [(obj, (), 0)]
+    # A path is a linked list (parent_path, key), so extending it is O(1) however deep the data.
+    stack: list[tuple[Any, tuple | None, int]] = [(obj, None, 0)]
     seen: set[int] = set()
     nodes = 0
+
+    def where(path) -> str:
+        parts = []
+        while path is not None:
+            path, key = path
+            parts.append(key)
+        return field_path(reversed(parts), field) or "(top level)"
+
     while stack:
         node, path, depth = stack.pop()
         nodes += 1
@@ -310,23 +335,23 @@ def check_finite(obj: Any, source: str, field: str = "", *, max_depth: int | Non
             continue
         if isinstance(node, (float, np.floating)):
             if not math.isfinite(node):
-                _fail(source, field_path(path, field) or "(top level)", f"must be a finite number, got {float(node)}")
+                _fail(source, where(path), f"must be a finite number, got {float(node)}")
         elif isinstance(node, (int, np.integer)):
             if abs(int(node)) > _FLOAT_MAX:
-                _fail(source, field_path(path, field) or "(top level)",
-                      f"must be a finite number, got an integer with {len(str(abs(int(node))))} digits")
+                digits = int((int(node).bit_length() - 1) * math.log10(2)) + 1  # str() refuses > 4300 digits
+                _fail(source, where(path), f"must be a finite number, got an integer with about {digits} digits")
         elif isinstance(node, (dict, list, tuple)):
             if id(node) in seen:
                 continue
             seen.add(id(node))
             if max_depth is not None and depth + 1 > max_depth:
-                _fail(source, field_path(path, field) or "(top level)", f"nested deeper than {max_depth} levels")
+                _fail(source, where(path), f"nested deeper than {max_depth} levels")
             if isinstance(node, dict):
                 nodes += len(node)  # the keys
                 items = node.items()
             else:
                 items = enumerate(node)
-            stack.extend((v, path + (k,), depth + 1) for k, v in reversed(list(items)))
+            stack.extend((v, (path, k), depth + 1) for k, v in reversed(list(items)))
 
 
 # --------------------------------------------------------------------------- JSON
@@ -687,7 +712,8 @@ def confined_path(base_dir: str | os.PathLike, relative: str | os.PathLike, sour
     base = os.path.realpath(base_dir)
     target = os.path.realpath(os.path.join(base, rel))
     if os.path.commonpath([base, target]) != base:
-        _fail(source, field, f"must stay inside the spec's folder ('..' and links leading out are refused), got {shown}")
+        _fail(source, field,
+              f"must stay inside the spec's folder ('..' and links leading out are refused), got {shown}")
     return Path(target)
 
 
@@ -789,6 +815,6 @@ def read_array(path: str | os.PathLike, dtype, record_bytes: int | None = None, 
     if finite and dt.kind == "f":
         bad = ~np.isfinite(arr)
         if bad.any():
-            first = int(np.flatnonzero(bad.reshape(len(arr), -1).any(axis=1))[0]) if per > 1 else int(np.flatnonzero(bad)[0])
+            first = int(np.flatnonzero(bad.reshape(len(arr), -1).any(axis=1))[0])
             _fail(src, field, f"record {first} is not finite")
     return arr
