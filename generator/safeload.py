@@ -283,7 +283,7 @@ def read_text(path: str | os.PathLike, *, source: str | None = None, field: str 
         text = data.decode("utf-8")
     except UnicodeDecodeError as e:
         _fail(src, field, f"not UTF-8 text (byte {e.start})")
-    return text[1:] if text.startswith("\ufeff") else text
+    return text.removeprefix("\ufeff")
 
 
 # --------------------------------------------------------------------------- parsed data

@@ -55,7 +55,8 @@ def default_scene(default_spec):
 # (1000 examples). ``HYPOTHESIS_PROFILE`` picks one by name, e.g.
 # ``HYPOTHESIS_PROFILE=thorough pytest tests/test_hostile_specs.py``.
 try:
-    from hypothesis import HealthCheck, settings as _hyp_settings
+    from hypothesis import HealthCheck
+    from hypothesis import settings as _hyp_settings
 except ImportError:  # hypothesis is in the test extra; only the property tests need it
     _hyp_settings = None
 if _hyp_settings is not None:

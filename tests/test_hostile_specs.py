@@ -30,11 +30,11 @@ import pytest
 import yaml
 
 hypothesis = pytest.importorskip("hypothesis")
-from hypothesis import HealthCheck, given, settings  # noqa: E402
-from hypothesis import strategies as st  # noqa: E402
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
-import generator.cli as cli  # noqa: E402
-from generator.spec import load_spec  # noqa: E402
+from generator import cli
+from generator.spec import load_spec
 
 ROOT = Path(__file__).resolve().parents[1]
 BASE_SPEC = load_spec(ROOT / "scenes" / "test_town.json").to_dict()  # every field, defaults filled in
@@ -248,9 +248,9 @@ def test_any_tree_as_a_spec(capsys, fmt, data):
         out = work / "out"
         rc, err = run_cli(capsys, ["-q", "lidar", str(spec), "--out", str(out), "--frames", "0"], work, out)
         assert rc == 2
-        assert (err.startswith(f"urbangen lidar: {spec}: ") or err.startswith("urbangen lidar: --frames: ")
-                or err.startswith(f"urbangen lidar: {work}/")  # a sensor file the (valid) spec names
-                or "intensity profile" in err), err
+        named = (f"urbangen lidar: {spec}: ", "urbangen lidar: --frames: ",
+                 f"urbangen lidar: {work}/")  # the last: a sensor file the (valid) spec names
+        assert err.startswith(named) or "intensity profile" in err, err
 
 
 @_cli_settings
@@ -267,7 +267,7 @@ def test_any_render_config(capsys, root, data):
                 "--frames", "0"]
         rc, err = run_cli(capsys, argv, work, out)
         assert rc == 2
-        assert err.startswith(f"urbangen render: {cfg}: ") or err.startswith("urbangen render: --frames: "), err
+        assert err.startswith((f"urbangen render: {cfg}: ", "urbangen render: --frames: ")), err
 
 
 def _sensor_text(data) -> str:
@@ -309,7 +309,7 @@ def test_sensor_file_in_a_spec(capsys, data, where):
         if where in ("../outside.yaml", "ABS", "link_out.yaml", "linkdir/outside.yaml", "a\u0000b"):
             assert err.startswith(f"urbangen lidar: {spec}: sensors.lidar.sensor_file: "), err
         else:
-            assert (err.startswith(f"urbangen lidar: {specs}") or err.startswith("urbangen lidar: --frames: ")), err
+            assert err.startswith((f"urbangen lidar: {specs}", "urbangen lidar: --frames: ")), err
 
 
 # -- fixed cases the properties might miss -------------------------------------------------------------------------
