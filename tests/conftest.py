@@ -48,3 +48,23 @@ def default_scene(default_spec):
     from generator.layout import build_scene
 
     return build_scene(default_spec)
+
+
+# Hypothesis profiles for the property tests: ``dev`` (default, 100 examples), ``ci`` (25
+# examples, derandomized; chosen when the ``CI`` environment variable is set) and ``thorough``
+# (1000 examples). ``HYPOTHESIS_PROFILE`` picks one by name, e.g.
+# ``HYPOTHESIS_PROFILE=thorough pytest tests/test_hostile_specs.py``.
+try:
+    from hypothesis import HealthCheck
+    from hypothesis import settings as _hyp_settings
+except ImportError:  # hypothesis is in the test extra; only the property tests need it
+    _hyp_settings = None
+if _hyp_settings is not None:
+    import os as _os
+
+    # No per-example deadline (a CLI run can take a second on a slow machine); the tests bound time themselves.
+    _common = {"deadline": None, "suppress_health_check": [HealthCheck.too_slow]}
+    _hyp_settings.register_profile("ci", max_examples=25, derandomize=True, database=None, **_common)
+    _hyp_settings.register_profile("dev", max_examples=100, **_common)
+    _hyp_settings.register_profile("thorough", max_examples=1000, **_common)
+    _hyp_settings.load_profile(_os.environ.get("HYPOTHESIS_PROFILE") or ("ci" if _os.environ.get("CI") else "dev"))

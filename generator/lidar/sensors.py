@@ -257,13 +257,21 @@ def sensor_for_spec(spec) -> Sensor:
     Parameters
     ----------
     spec : generator.spec.SceneSpec
+
+    Raises
+    ------
+    SpecError
+        ``sensor_file`` absolute or leading out of the spec's folder (``..``, a link), or
+        a bad sensor file; an unknown preset.
     """
     lidar = spec.sensors.lidar
     if lidar.sensor_file:
-        path = Path(lidar.sensor_file)
-        if not path.is_absolute():
-            path = Path(spec.source).parent / path if spec.source else path
-        return load_sensor(path, str(path))
+        from generator.safeload import confined_path
+
+        # A path inside a spec stays inside the spec's folder: no absolute path, no '..', no link out.
+        base = Path(spec.source).parent if spec.source else Path(".")
+        path = confined_path(base, lidar.sensor_file, spec.source or "spec", "sensors.lidar.sensor_file")
+        return load_sensor(path, str(base / lidar.sensor_file))
     try:
         return load_preset(lidar.preset)
     except SpecError as e:

@@ -1,6 +1,7 @@
 """Load JSON/YAML safely, validate against a JSON Schema, report one clear line.
 
-Every problem becomes a :class:`generator.errors.SpecError` whose message reads
+Files are read through :mod:`generator.safeload`. Every problem becomes a
+:class:`generator.errors.SpecError` whose message reads
 ``<file>: <field.path>: <reason>, got <value>``. Defaults declared in the schema are
 filled in after validation, so the schema is the single place defaults live.
 """
@@ -15,8 +16,8 @@ from pathlib import Path
 from typing import Any
 
 import jsonschema
-import yaml
 
+from generator import safeload
 from generator.errors import SpecError
 
 SCHEMA_DIR = Path(__file__).resolve().parent / "schemas"
@@ -29,21 +30,11 @@ def load_schema(name: str) -> dict:
         return json.load(f)
 
 
-def _no_duplicates(pairs: list[tuple[str, Any]]) -> dict:
-    out: dict = {}
-    for k, v in pairs:
-        if k in out:
-            raise ValueError(f"duplicate key {k!r}")
-        out[k] = v
-    return out
-
-
-def _reject_constant(name: str) -> None:
-    raise ValueError(f"{name} is not a valid JSON number")
-
-
 def read_document(path: str | Path, source: str | None = None) -> Any:
-    """Parse a JSON (``.json``) or YAML (other suffixes) file safely.
+    """Parse a JSON (``.json``) or YAML (other suffixes) file through :mod:`generator.safeload`.
+
+    The file must be a regular UTF-8 file within the size limit; duplicate keys, NaN/inf,
+    deep nesting and YAML alias bombs are refused.
 
     Parameters
     ----------
@@ -55,43 +46,25 @@ def read_document(path: str | Path, source: str | None = None) -> Any:
     Raises
     ------
     SpecError
-        Missing/unreadable file, or malformed content (with line and column).
+        Missing/unreadable/special file, or malformed content (with line and column, never
+        quoting the file), or a non-finite number (naming its field).
     """
     source = str(path) if source is None else source
-    p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise SpecError(source, "", "file not found") from None
-    except IsADirectoryError:
-        raise SpecError(source, "", "is a directory, expected a file") from None
-    except (OSError, UnicodeDecodeError) as e:
-        raise SpecError(source, "", f"cannot read: {e}") from None
-    if p.suffix.lower() == ".json":
-        try:
-            return json.loads(text, object_pairs_hook=_no_duplicates, parse_constant=_reject_constant)
-        except json.JSONDecodeError as e:
-            raise SpecError(source, "", f"invalid JSON at line {e.lineno} column {e.colno}: {e.msg}") from None
-        except ValueError as e:
-            raise SpecError(source, "", f"invalid JSON: {e}") from None
-    try:
-        return yaml.safe_load(text)
-    except yaml.YAMLError as e:
-        mark = getattr(e, "problem_mark", None)
-        where = f" at line {mark.line + 1} column {mark.column + 1}" if mark else ""
-        problem = getattr(e, "problem", None) or str(e).splitlines()[0]
-        raise SpecError(source, "", f"invalid YAML{where}: {problem}") from None
+    if Path(path).suffix.lower() == ".json":
+        return safeload.load_json(path, source=source)
+    return safeload.load_yaml(path, source=source)
 
 
 def _field_path(parts) -> str:
-    out = ""
-    for p in parts:
-        out += f"[{p}]" if isinstance(p, int) else (f".{p}" if out else str(p))
-    return out
+    # Keys come from the user's file: escaped and shortened so the message stays one line.
+    return safeload.field_path(parts)
 
 
 def _value(v: Any) -> str:
-    return json.dumps(v) if not isinstance(v, str) or len(v) < 80 else json.dumps(v[:77] + "...")
+    if isinstance(v, str):
+        return json.dumps(v) if len(v) < 80 else json.dumps(v[:77] + "...")
+    text = json.dumps(v, default=str)
+    return text if len(text) <= 80 else text[:77] + "..."
 
 
 _TYPE_WORDS = {"integer": "an integer", "number": "a number", "string": "a string", "boolean": "true or false",
