@@ -16,7 +16,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 
 #: Bottom of the house: imported by anything, import nothing of ours but each other.
-BASE = {"generator", "errors", "atomic", "rng", "safeload", "progress"}
+BASE = {"generator", "errors", "atomic", "rng", "safeload", "progress"}  # safeload is a package of its own
 
 #: Package -> the packages it may import (besides BASE). ``generator`` is the package root
 #: (``__version__``); ``assets_procedural`` is the top-level asset package.

@@ -34,7 +34,7 @@ def test_native_to_raw_to_unified_is_the_composition_for_every_class():
                 "bicycle": "vehicle", "motorcycle": "vehicle", "bus": "vehicle", "on_rails": "vehicle",
                 "other_vehicle": "vehicle", "bicyclist": "person", "motorcyclist": "person", "wall": "fence",
                 "other_ground": "other-ground", "street_object": "unlabeled", "rail_track": "other-ground",
-                "shelter": "unlabeled"}
+                "shelter": "unlabeled", "ridden_bicycle": "person", "ridden_motorcycle": "person"}
     assert {n: table.unified_names[int(u)] for n, u in zip(table.names, uni)} == expected
 
 

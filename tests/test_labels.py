@@ -24,10 +24,12 @@ EXPECTED = {
     "on_rails": (16, "vehicle", 31), "other_vehicle": (20, "vehicle", 30), "bicyclist": (31, "person", 25),
     "motorcyclist": (32, "person", 25), "wall": (51, "fence", 12), "other_ground": (49, "other-ground", 6),
     "street_object": (99, "unlabeled", 4), "rail_track": (49, "other-ground", 10), "shelter": (52, "unlabeled", 11),
+    # a ridden two-wheeler: SemanticKITTI counts it with its rider, Cityscapes as the vehicle
+    "ridden_bicycle": (31, "person", 33), "ridden_motorcycle": (32, "person", 32),
 }
 #: classes SemanticKITTI and Cityscapes give instance ids
 THINGS = {"car", "truck", "person", "bicycle", "motorcycle", "bus", "on_rails", "other_vehicle", "bicyclist",
-          "motorcyclist"}
+          "motorcyclist", "ridden_bicycle", "ridden_motorcycle"}
 
 
 def test_every_native_class_maps_everywhere():
