@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import logging
 
+from generator.commands.options import sequence_id
 from generator.commands.render import add_render_arguments, check_render_args
-from generator.errors import UserError
 from generator.formats.label_config import SPLITS
 from generator.jobs.generate import GenerateOptions, run_generate
 from generator.jobs.plan import make_plan
@@ -23,7 +23,8 @@ def register(sub) -> None:
     p = sub.add_parser("generate", help="the main job: images x weather + LiDAR + boxes + stats, resumable",
                        description=__doc__.split("\n\n")[1])
     add_render_arguments(p, "dataset folder (created; a rerun resumes it)", frames=2, variants="all")
-    p.add_argument("--sequence", default="00", help="SemanticKITTI sequence id of the scans (default 00)")
+    p.add_argument("--sequence", type=sequence_id, default="00",
+                   help="SemanticKITTI sequence id of the scans, 00..99 (default 00)")
     p.add_argument("--split", default=None, choices=SPLITS,
                    help="split of the sequence in DIR/lidar/semantic-kitti.yaml: train, valid or test (default: "
                         "the one it has there, else valid, what semantic-kitti-api evaluates without -s)")
@@ -32,10 +33,8 @@ def register(sub) -> None:
 
 def run(args) -> int:
     r = check_render_args(args)
-    if not (args.sequence.isdigit() and len(args.sequence) <= 2):
-        raise UserError(f"--sequence: must be a number 0..99 (e.g. 00), got {args.sequence!r}")
     out = r.out
-    plan = make_plan(args.frames, combos=r.combos, sequence=f"{int(args.sequence):02d}")
+    plan = make_plan(args.frames, combos=r.combos, sequence=args.sequence)
     run_rec = run_generate(r.spec, r.cfg, GenerateOptions(out, plan, args.workers, args.executor, args.ray_address))
     if args.split:
         from generator.jobs.lidar_sequence import write_dataset_label_config

@@ -11,13 +11,17 @@ from __future__ import annotations
 
 import logging
 import shutil
+from dataclasses import dataclass
 from pathlib import Path
 
-from dataclasses import dataclass
-
+from generator.atomic import TMP_PREFIX
+from generator.commands.options import Integer, path, text_path
+from generator.commands.preflight import output_dir
 from generator.errors import UserError
 from generator.jobs.executors import EXECUTORS, make_jobs, run_jobs
 from generator.jobs.images import image_name
+from generator.jobs.plan import (MAX_FRAME_INDEX, MAX_FRAMES, MAX_WORKERS, check_free_space, check_plan, check_workers,
+                                 image_bytes, make_plan)
 from generator.jobs.variants import parse_combos
 from generator.spec import load_spec
 from generator.spec.render import load_render_config
@@ -27,14 +31,17 @@ log = logging.getLogger(__name__)
 
 def add_render_arguments(p, out_help: str, frames: int, variants: str) -> None:
     """The options ``render`` and ``generate`` share (with their own defaults)."""
-    p.add_argument("spec", help="scene spec JSON (e.g. scenes/default_town.json)")
-    p.add_argument("--config", required=True, help="render config YAML or preset name (test, preview, paper)")
-    p.add_argument("--out", required=True, type=Path, help=out_help)
-    p.add_argument("--frames", type=int, default=frames, help=f"frames along the route (default {frames})")
+    p.add_argument("spec", type=text_path, help="scene spec JSON (e.g. scenes/default_town.json)")
+    p.add_argument("--config", required=True, type=text_path,
+                   help="render config YAML or preset name (test, preview, paper)")
+    p.add_argument("--out", required=True, type=path, help=out_help)
+    p.add_argument("--frames", type=Integer(1, MAX_FRAMES), default=frames,
+                   help=f"frames along the route, 1..{MAX_FRAMES} (default {frames})")
     p.add_argument("--variants", default=variants,
                    help=f"all (12 weather x time combinations per frame), clear (day, clear), or pairs like "
                         f"day:fog,night:rain (default {variants})")
-    p.add_argument("--workers", type=int, default=1, help="parallel Blender processes (default 1)")
+    p.add_argument("--workers", type=Integer(1, MAX_WORKERS), default=1,
+                   help="parallel Blender processes (default 1; local: at most one per core)")
     p.add_argument("--executor", default="local", choices=EXECUTORS,
                    help="where the render workers run: local (spawned processes, default) or ray")
     p.add_argument("--ray-address", default=None, help="address of an existing Ray cluster (default: start a local one)")
@@ -44,15 +51,9 @@ def register(sub) -> None:
     p = sub.add_parser("render", help="render RGB + label EXRs with metadata along the route",
                        description=__doc__.split("\n\n")[1])
     add_render_arguments(p, "output folder", frames=2, variants="clear")
-    p.add_argument("--first", type=int, default=0, help="index of the first frame (default 0)")
+    p.add_argument("--first", type=Integer(0, MAX_FRAME_INDEX), default=0,
+                   help="index of the first frame (default 0)")
     p.set_defaults(func=run)
-
-
-def positive(name: str, value: int, minimum: int = 1) -> int:
-    """Check an integer option; a bad one is a one-line user error."""
-    if value < minimum:
-        raise UserError(f"--{name}: must be an integer >= {minimum}, got {value}")
-    return value
 
 
 @dataclass(frozen=True)
@@ -69,30 +70,52 @@ def check_render_args(args) -> RenderArgs:
     """Load the spec and config and check the shared options; a bad one is a one-line user error."""
     spec = load_spec(args.spec)
     cfg = load_render_config(args.config)
-    positive("frames", args.frames)
-    positive("workers", args.workers)
-    out: Path = args.out
-    if out.exists() and not out.is_dir():
-        raise UserError(f"--out: {out} exists and is not a folder")
+    out = output_dir(args.out, "--out")
     try:
         combos = parse_combos(args.variants)
     except ValueError as e:
         raise UserError(f"--variants: {e}") from None
+    check_workers(args.workers, args.executor)
     return RenderArgs(spec, cfg, out, combos)
 
 
 def run(args) -> int:
+    from generator.labels import class_table
+
     r = check_render_args(args)
-    positive("first", args.first, 0)
-    out, combos = r.out, r.combos
-    todo = [k for k in range(args.first, args.first + args.frames)
-            if not all((out / "images" / f"{image_name(k, t, w)}.json").exists() for t, w in combos)]
+    out, combos, cfg = r.out, r.combos, r.cfg
+    plan = make_plan(args.frames, args.first, combos)
+    check_plan(plan)
+    todo = [k for k in plan.frames if not all((out / "images" / f"{n}.json").exists() for n in plan.images_of(k))]
     if not todo:
         log.info("all %d frames already rendered in %s", args.frames, out)
         return 0
-    jobs = make_jobs(r.spec, r.cfg, out, todo, combos, args.workers)
-    res = run_jobs(args.executor, jobs, len(todo), None, args.ray_address)
-    shutil.rmtree(out / ".scratch", ignore_errors=True)
+    n_images = len(todo) * len(combos)
+    per_image = image_bytes(cfg.width, cfg.height, cfg.exr_codec, len(class_table().names), cfg.preview)
+    check_free_space(out, n_images * per_image, f"{n_images} images at {cfg.width}x{cfg.height}")
+    created = not out.exists()
+    try:
+        jobs = make_jobs(r.spec, cfg, out, todo, combos, args.workers)
+        res = run_jobs(args.executor, jobs, len(todo), None, args.ray_address)
+    except BaseException:
+        _remove_unfinished(out, plan, created)
+        raise
+    finally:
+        shutil.rmtree(out / ".scratch", ignore_errors=True)
     n = sum(len(msg["images"]) for msg in res.frame_seconds.values())
     print(f"rendered {n} images of {len(res.frame_seconds)} frames into {out / 'images'} in {res.wall_s:.1f} s")
     return 0
+
+
+def _remove_unfinished(out: Path, plan, created: bool) -> None:
+    """After a failed run: drop the files of images without metadata (an image is done when its JSON
+    exists) and temporaries; a folder this run created and that holds no finished image goes too."""
+    images = out / "images"
+    for name in plan.images():
+        if not (images / f"{name}.json").exists():
+            for suffix in (".exr", "_preview.png"):
+                (images / f"{name}{suffix}").unlink(missing_ok=True)
+    for tmp in images.glob(f"{TMP_PREFIX}*") if images.is_dir() else ():
+        tmp.unlink(missing_ok=True)
+    if created and not any(images.glob("*.json")):
+        shutil.rmtree(out, ignore_errors=True)

@@ -11,6 +11,12 @@ Stages, each skipped when its output is already complete:
    exist, a pair when its ``image_3`` PNG does.
 3. OpenLABEL per sequence, then statistics.
 
+Before the first write, :func:`preflight` checks the whole run: the manifest of a folder
+being resumed (readable, same spec, config and sequence, the merged plan), the plan's
+size (:func:`generator.jobs.plan.check_plan`), the scene, sensor and intensity files the
+LiDAR stage reads, the route's room for the frames, and the disk the run will write against
+the free space at the output. A bad input therefore leaves no folder behind.
+
 The manifest is rewritten after every frame. Everything is written atomically, so a run
 killed at any moment resumes to exactly the files of an uninterrupted run.
 """
@@ -18,17 +24,20 @@ killed at any moment resumes to exactly the files of an uninterrupted run.
 from __future__ import annotations
 
 import dataclasses
-import json
 import logging
+import os
 import shutil
 import time
 from pathlib import Path
 
 from generator.atomic import clean_temporaries
+from generator.errors import SpecError, UserError
 from generator.jobs import manifest as mf
 from generator.jobs.executors import make_jobs, run_jobs
-from generator.jobs.plan import Plan
+from generator.jobs.plan import MAX_FRAME_INDEX, MAX_IMAGES, Plan, check_free_space, check_plan, image_bytes, scan_bytes
 from generator.jobs.stereo import pair_done, stereo_frames
+from generator.safeload import MAX_METADATA_BYTES, load_json
+from generator.weather import combinations
 
 log = logging.getLogger(__name__)
 
@@ -45,14 +54,16 @@ class GenerateOptions:
 
 
 def lidar_done(out: Path, plan: Plan, spec) -> bool:
+    """Whether ``lidar/sequences/NN`` is complete for this spec and plan (its metadata, read safely, says so)."""
     meta = out / "lidar" / "sequences" / plan.sequence / "lidar_meta.json"
-    if not meta.exists():
+    if not os.path.lexists(meta):
         return False
     try:
-        m = json.loads(meta.read_text())
-    except (json.JSONDecodeError, UnicodeDecodeError):
+        m = load_json(meta, max_bytes=MAX_METADATA_BYTES, max_nodes=1_000_000)
+    except UserError:  # damaged: it is cast again
         return False
-    return m.get("scene", {}).get("spec_hash") == spec.spec_hash and m.get("frames") == len(plan.frames)
+    scene = m.get("scene") if isinstance(m, dict) else None
+    return isinstance(scene, dict) and scene.get("spec_hash") == spec.spec_hash and m.get("frames") == len(plan.frames)
 
 
 def images_done(out: Path, plan: Plan) -> list[int]:
@@ -73,17 +84,87 @@ def write_lidar(spec, cfg, out: Path, plan: Plan, scene=None) -> dict:
     return meta
 
 
-def run_generate(spec, cfg, opts: GenerateOptions) -> dict:
-    """Plan, render, scan and write a dataset into ``opts.out``; return the run record."""
+@dataclasses.dataclass
+class Preflight:
+    """What :func:`preflight` found: the (merged) plan, the manifest to write, the built scene."""
+
+    plan: Plan
+    manifest: dict
+    scene: object
+
+
+def read_manifest(out: Path) -> dict | None:
+    """The manifest of a folder being resumed, or None; a damaged one is a one-line error naming the field."""
+    path = out / mf.NAME
+    if not os.path.lexists(path):
+        return None
+    src = str(path)
+    doc = load_json(path, source=src, max_bytes=MAX_METADATA_BYTES, max_nodes=8 * MAX_IMAGES + 100_000)
+
+    def need(obj, key, kind, where=""):
+        if not isinstance(obj, dict) or not isinstance(obj.get(key), kind):
+            raise SpecError(src, where + key, f"must be {kind.__name__ if isinstance(kind, type) else 'set'}; "
+                                              "use another --out or delete the folder")
+        return obj[key]
+
+    need(doc, "spec_hash", str)
+    need(need(doc, "render_config", dict), "config_hash", str, "render_config.")
+    plan = need(doc, "plan", dict)
+    frames, combos = need(plan, "frames", list, "plan."), need(plan, "combos", list, "plan.")
+    need(plan, "sequence", str, "plan.")
+    if not all(type(k) is int and 0 <= k <= MAX_FRAME_INDEX for k in frames) or len(frames) > MAX_IMAGES:
+        raise SpecError(src, "plan.frames", f"must be at most {MAX_IMAGES} frame numbers in 0..{MAX_FRAME_INDEX}")
+    valid = {tuple(c) for c in combinations()}
+    if not all(isinstance(c, list) and tuple(c) in valid for c in combos):
+        raise SpecError(src, "plan.combos", "must be [time_of_day, weather] pairs like [day, fog]")
+    finished = need(doc, "finished", dict)
+    if not isinstance(finished.get("images", []), list):
+        raise SpecError(src, "finished.images", "must be a list of image names")
+    if not isinstance(doc.get("runs", []), list):
+        raise SpecError(src, "runs", "must be a list")
+    return doc
+
+
+def preflight(spec, cfg, opts: GenerateOptions) -> Preflight:
+    """Check the whole run before anything is written (see the module docstring); a problem is one line."""
+    from generator.labels import class_table
+    from generator.layout.assemble import build_scene
+    from generator.jobs.lidar_sequence import check_frames
+    from generator.lidar.sensors import sensor_for_spec
+    from generator.remission.models import intensity_fn_for_spec
+    from generator.scan_effects.pipeline import processing_for_spec
+
     out, plan = Path(opts.out), opts.plan
-    t0 = time.perf_counter()
     new = mf.new_manifest(spec, cfg, plan, opts.executor)
-    old = mf.load(out)
+    old = read_manifest(out)
     manifest = new
     if old is not None:
         mf.check_compatible(old, new, out)
         manifest = mf.merge_plan(old, plan)
         plan = Plan.from_dict(manifest["plan"])
+    check_plan(plan)
+    sensor = sensor_for_spec(spec)  # every file the LiDAR stage reads, read now
+    processing_for_spec(spec, sensor, True, intensity_fn_for_spec(spec))
+    scene = build_scene(spec)
+    check_frames(scene, spec, len(plan.frames))
+    done = set(images_done(out, plan))
+    todo = [k for k in plan.frames if k not in done]
+    seq_dir = out / "lidar" / "sequences" / plan.sequence
+    pairs = [k for k in stereo_frames(spec, plan.frames) if not pair_done(seq_dir, k)]
+    per_image = image_bytes(cfg.width, cfg.height, cfg.exr_codec, len(class_table().names), cfg.preview)
+    need = (len(todo) * len(plan.combos) + 2 * len(pairs)) * per_image
+    scans = 0 if lidar_done(out, plan, spec) else len(plan.frames)
+    need += scans * scan_bytes(sensor.rays_per_sweep)
+    check_free_space(out, need, f"{len(todo) * len(plan.combos)} images and {len(pairs)} stereo pairs at "
+                                f"{cfg.width}x{cfg.height}, {scans} scans")
+    return Preflight(plan, manifest, scene)
+
+
+def run_generate(spec, cfg, opts: GenerateOptions) -> dict:
+    """Plan, render, scan and write a dataset into ``opts.out``; return the run record."""
+    t0 = time.perf_counter()
+    pre = preflight(spec, cfg, opts)
+    out, plan, manifest = Path(opts.out), pre.plan, pre.manifest
     out.mkdir(parents=True, exist_ok=True)
     removed = clean_temporaries(out)
     shutil.rmtree(out / ".scratch", ignore_errors=True)
@@ -91,7 +172,7 @@ def run_generate(spec, cfg, opts: GenerateOptions) -> dict:
         log.info("removed %d unfinished temporary files of an interrupted run", removed)
     run = {"started": time.strftime("%Y-%m-%dT%H:%M:%S%z"), "executor": opts.executor, "workers": opts.workers}
 
-    scenes: list = []
+    scenes: list = [pre.scene]
 
     def scene():
         """The spec's scene, built at most once in this process (LiDAR and OpenLABEL share it)."""
