@@ -100,18 +100,24 @@ def staging(out: str | os.PathLike, label: str) -> Iterator[Path]:
     """Yield a temporary folder inside ``out`` for building outputs that appear all at once.
 
     The caller builds files in the stage and moves them into ``out`` before leaving the
-    block. On any error the stage is removed, and ``out`` too when this call created it,
-    so a failed run leaves nothing behind; on success only the (emptied) stage is removed.
+    block. On any error the stage is removed, and ``out`` too when this call created it
+    (with any missing parents it created), so a failed run leaves nothing behind; on
+    success only the (emptied) stage is removed.
     """
     out = Path(out)
+    top = out  # the outermost folder this call creates (out's missing parents included), if any
+    while not top.parent.exists() and top.parent != top:
+        top = top.parent
     created = not out.exists()
-    out.mkdir(parents=True, exist_ok=True)
-    stage = Path(tempfile.mkdtemp(prefix=f"{TMP_PREFIX}{label}-", dir=out))
+    stage = None
     try:
+        out.mkdir(parents=True, exist_ok=True)
+        stage = Path(tempfile.mkdtemp(prefix=f"{TMP_PREFIX}{label}-", dir=out))
         yield stage
     except BaseException:
-        shutil.rmtree(stage, ignore_errors=True)
+        if stage is not None:
+            shutil.rmtree(stage, ignore_errors=True)
         if created:
-            shutil.rmtree(out, ignore_errors=True)
+            shutil.rmtree(top, ignore_errors=True)
         raise
     shutil.rmtree(stage, ignore_errors=True)

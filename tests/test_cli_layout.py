@@ -99,7 +99,7 @@ def test_missing_spec_file(tmp_path, capsys):
 def test_out_must_be_a_folder(tmp_path, capsys):
     out = _write(tmp_path, "taken", "")
     assert main(["layout", str(ROOT / "scenes" / "test_town.json"), "--out", str(out)]) == 2
-    assert capsys.readouterr().err == f"urbangen layout: {out}: --out must be a folder, got an existing file\n"
+    assert capsys.readouterr().err == f"urbangen layout: --out: {out}: exists and is a file, not a folder\n"
     assert out.read_text() == ""
 
 

@@ -7,8 +7,9 @@ process. Whatever the input, the command must end with exit 2 (or 0 when the mut
 happens to be valid), exactly one line on stderr naming the file, no traceback, nothing
 written, within a few seconds.
 
-Commands that would start real work on a valid input get an invalid option checked AFTER
-the files are loaded (``--frames 0``): every file is still read and validated first, and
+Commands that would start real work on a valid input get an output folder that is an
+existing file (``--out taken``), which is checked AFTER the files are loaded (options are
+checked when parsed, before any file): every file is still read and validated first, and
 the run stays bounded however the mutation turned out. One property runs ``layout``
 unmodified and accepts a valid result.
 
@@ -186,6 +187,13 @@ def mutated(draw, base, paths, fmt: str, values=TREES, max_mutations: int = 3, o
 # -- running the command line ------------------------------------------------------------------------------------
 
 
+def _taken(work: Path) -> Path:
+    """An existing file given as ``--out``: refused after the spec, config and sensor files are read."""
+    taken = work / "taken"
+    taken.write_text("")
+    return taken
+
+
 def _listing(folder: Path) -> set[str]:
     return {str(p.relative_to(folder)) for p in folder.rglob("*")}
 
@@ -246,9 +254,10 @@ def test_any_tree_as_a_spec(capsys, fmt, data):
         spec = work / f"spec.{fmt}"
         spec.write_text(text, encoding="utf-8")
         out = work / "out"
-        rc, err = run_cli(capsys, ["-q", "lidar", str(spec), "--out", str(out), "--frames", "0"], work, out)
+        argv = ["-q", "lidar", str(spec), "--out", str(_taken(work)), "--frames", "1"]
+        rc, err = run_cli(capsys, argv, work, out)
         assert rc == 2
-        named = (f"urbangen lidar: {spec}: ", "urbangen lidar: --frames: ",
+        named = (f"urbangen lidar: {spec}: ", "urbangen lidar: --out: ",
                  f"urbangen lidar: {work}/")  # the last: a sensor file the (valid) spec names
         assert err.startswith(named) or "intensity profile" in err, err
 
@@ -263,11 +272,11 @@ def test_any_render_config(capsys, root, data):
         cfg = work / "config.yaml"
         cfg.write_text(text, encoding="utf-8")
         out = work / "out"
-        argv = ["-q", "render", str(root / "scenes" / "test_town.json"), "--config", str(cfg), "--out", str(out),
-                "--frames", "0"]
+        argv = ["-q", "render", str(root / "scenes" / "test_town.json"), "--config", str(cfg), "--out",
+                str(_taken(work)), "--frames", "1"]
         rc, err = run_cli(capsys, argv, work, out)
         assert rc == 2
-        assert err.startswith((f"urbangen render: {cfg}: ", "urbangen render: --frames: ")), err
+        assert err.startswith((f"urbangen render: {cfg}: ", "urbangen render: --out: ")), err
 
 
 def _sensor_text(data) -> str:
@@ -303,13 +312,14 @@ def test_sensor_file_in_a_spec(capsys, data, where):
         spec = specs / "spec.json"
         spec.write_text(json.dumps(doc))
         out = work / "out"
-        rc, err = run_cli(capsys, ["-q", "lidar", str(spec), "--out", str(out), "--frames", "0"], work, out)
+        argv = ["-q", "lidar", str(spec), "--out", str(_taken(work)), "--frames", "1"]
+        rc, err = run_cli(capsys, argv, work, out)
         assert rc == 2
         assert SECRET not in err and "hunter2" not in err, err
         if where in ("../outside.yaml", "ABS", "link_out.yaml", "linkdir/outside.yaml", "a\u0000b"):
             assert err.startswith(f"urbangen lidar: {spec}: sensors.lidar.sensor_file: "), err
         else:
-            assert err.startswith((f"urbangen lidar: {specs}", "urbangen lidar: --frames: ")), err
+            assert err.startswith((f"urbangen lidar: {specs}", "urbangen lidar: --out: ")), err
 
 
 # -- fixed cases the properties might miss -------------------------------------------------------------------------

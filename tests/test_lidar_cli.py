@@ -39,10 +39,10 @@ def test_lidar_command_writes_a_sequence(root, tmp_path, capsys):
 
 
 @pytest.mark.parametrize("extra, message", [
-    (["--frames", "0"], "--frames: must be an integer >= 1"),
-    (["--sequence", "abc"], "sequence must be a number"),
-    (["--sequence", "123"], "--sequence: must be 00..99"),
-    (["--threads", "0"], "--threads: must be in 1..256"),
+    (["--frames", "0"], "--frames: must be an integer in 1..100000, got '0'"),
+    (["--sequence", "abc"], "--sequence: must be a sequence number 00..99, got 'abc'"),
+    (["--sequence", "123"], "--sequence: must be a sequence number 00..99, got '123'"),
+    (["--threads", "0"], "--threads: must be an integer in 1..256, got '0'"),
     (["--render-config", "nope"], "nope.yaml: file not found"),
 ])
 def test_bad_options_one_line_exit_2_nothing_written(root, tmp_path, capsys, extra, message):

@@ -12,27 +12,37 @@ twice: ``semantic_map_lidar.{ply,png}`` (every point, its ray-cast class) and
 from __future__ import annotations
 
 import logging
+import os
 from pathlib import Path
 
 import numpy as np
 
-from generator.atomic import write_json, write_text
+from generator.atomic import atomic_path, staging, write_json, write_text
+from generator.commands.options import Integer, Number, path, sequence_id
+from generator.commands.preflight import input_dir, output_dir
 from generator.errors import UserError
+from generator.jobs.plan import MAX_FRAME_INDEX
 from generator.progress import progress
 
 log = logging.getLogger(__name__)
+#: Voxel edges the semantic map takes: below 5 cm its 19-bit voxel indices reach only
+#: +-13 km and a map holds about one voxel per point anyway; above 50 m it says nothing.
+MIN_VOXEL_M, MAX_VOXEL_M = 0.05, 50.0
 
 
 def register(sub) -> None:
     p = sub.add_parser("fuse", help="project LiDAR into the images: label agreement report and 3D semantic map",
                        description=__doc__.split("\n\n")[1])
-    p.add_argument("dataset", type=Path, help="dataset folder with images/ and lidar/sequences/NN/")
-    p.add_argument("--sequence", default="00", help="LiDAR sequence (default 00)")
-    p.add_argument("--abs-tol", type=float, default=None, help="occlusion tolerance floor, metres (default 0.1)")
-    p.add_argument("--rel-tol", type=float, default=None, help="occlusion tolerance per metre of distance (default 0.01)")
-    p.add_argument("--voxel", type=float, default=0.2, help="semantic-map voxel edge, metres (default 0.2)")
+    p.add_argument("dataset", type=path, help="dataset folder with images/ and lidar/sequences/NN/")
+    p.add_argument("--sequence", type=sequence_id, default="00", help="LiDAR sequence, 00..99 (default 00)")
+    p.add_argument("--abs-tol", type=Number(0, 10), default=None,
+                   help="occlusion tolerance floor, metres, in [0, 10] (default 0.1)")
+    p.add_argument("--rel-tol", type=Number(0, 1), default=None,
+                   help="occlusion tolerance per metre of distance, in [0, 1] (default 0.01)")
+    p.add_argument("--voxel", type=Number(MIN_VOXEL_M, MAX_VOXEL_M), default=0.2,
+                   help=f"semantic-map voxel edge, metres, in [{MIN_VOXEL_M}, {MAX_VOXEL_M:g}] (default 0.2)")
     p.add_argument("--no-deskew", action="store_true", help="project the raw (motion-skewed) points")
-    p.add_argument("--overlay-frame", type=int, default=None,
+    p.add_argument("--overlay-frame", type=Integer(0, MAX_FRAME_INDEX), default=None,
                    help="frame drawn in agreement.png (default: the one where the occlusion test rejects most mislabelled points)")
     p.set_defaults(func=run)
 
@@ -43,18 +53,12 @@ def run(args) -> int:
     from generator.fusion.dataset import FusionDataset, deskewed
     from generator.fusion.report import markdown, report_png
     from generator.fusion.semantic_map import VoxelMap, write_map_ply, write_top_down
-    from generator.formats.semantickitti import sequence_name
 
-    abs_tol = P.ABS_TOL_M if args.abs_tol is None else args.abs_tol
+    abs_tol = P.ABS_TOL_M if args.abs_tol is None else args.abs_tol  # ranges checked when parsed
     rel_tol = P.REL_TOL if args.rel_tol is None else args.rel_tol
-    if not (0 <= abs_tol <= 10 and 0 <= rel_tol <= 1):
-        raise UserError(f"--abs-tol must be in [0, 10] m and --rel-tol in [0, 1], got {abs_tol}, {rel_tol}")
-    if args.voxel <= 0:
-        raise UserError(f"--voxel: must be > 0, got {args.voxel}")
-    root: Path = args.dataset
-    if not root.is_dir():
-        raise UserError(f"{root}: not a folder")
-    ds = FusionDataset(root, sequence_name(args.sequence))
+    root: Path = input_dir(args.dataset, what="dataset folder")
+    out = output_dir(root / "fusion", "")
+    ds = FusionDataset(root, args.sequence)
     overlay_k = args.overlay_frame
     if overlay_k is not None and overlay_k not in ds.frames:
         raise UserError(f"--overlay-frame: frame {overlay_k} has no image and scan (have {ds.frames[0]}..{ds.frames[-1]})")
@@ -93,29 +97,30 @@ def run(args) -> int:
     if raw.frames:
         report["without_deskew"] = {"agreement_native": raw.agreement("native", HEADLINE),
                                     "agreement_native_no_occlusion_test": raw.agreement("native", ("off",) + HEADLINE[1:])}
-    out = root / "fusion"
     text = markdown(report)
     if raw.frames:
         text += (f"\nWithout de-skew (raw skewed points), the headline agreement is "
                  f"{100 * report['without_deskew']['agreement_native']:.2f} % (native).\n")
-    write_json(out / "agreement.json", report)
-    write_text(out / "agreement.md", text)
-    from generator.atomic import atomic_path
-
-    with atomic_path(out / "agreement.png") as tmp:
-        report_png(report, *overlay).save(tmp, format="PNG")
     positions = {k: (ds.poses[k][:3, 3] if ds.poses is not None else np.zeros(3)) for k in ds.seq.frames}
     trajectory = {"lidar": np.array([positions[k] for k in ds.seq.frames]),
                   "camera": np.array([positions[k] for k in ds.frames])}
-    for name, vm in maps.items():
-        xyz, label, count = vm.voxels()
-        if not len(xyz):
-            log.warning("semantic map %s is empty", name)
-            continue
-        write_map_ply(out / f"semantic_map_{name}.ply", xyz, label, count,
-                      comment=f"urbangen semantic map ({name} labels), first LiDAR frame, voxel {args.voxel} m")
-        write_top_down(out / f"semantic_map_{name}.png", xyz, label, trajectory[name],
-                       title=f"{ds.seq.dir.name}: {name} labels, {len(ds.seq.frames) if name == 'lidar' else len(ds)} scans")
+    with staging(out, "fusion") as stage:  # every file written in full before any is moved into place
+        write_json(stage / "agreement.json", report)
+        write_text(stage / "agreement.md", text)
+        with atomic_path(stage / "agreement.png") as tmp:
+            report_png(report, *overlay).save(tmp, format="PNG")
+        for name, vm in maps.items():
+            xyz, label, count = vm.voxels()
+            if not len(xyz):
+                log.warning("semantic map %s is empty", name)
+                continue
+            write_map_ply(stage / f"semantic_map_{name}.ply", xyz, label, count,
+                          comment=f"urbangen semantic map ({name} labels), first LiDAR frame, voxel {args.voxel} m")
+            write_top_down(stage / f"semantic_map_{name}.png", xyz, label, trajectory[name],
+                           title=f"{ds.seq.dir.name}: {name} labels, "
+                                 f"{len(ds.seq.frames) if name == 'lidar' else len(ds)} scans")
+        for p in sorted(stage.iterdir()):
+            os.replace(p, out / p.name)
     print(text.split("\n\n## ")[0].splitlines()[-1].strip("*"))
     print(f"wrote {out}/agreement.{{md,json,png}} and semantic_map_{{lidar,camera}}.{{ply,png}}")
     return 0

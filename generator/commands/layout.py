@@ -11,12 +11,13 @@ from __future__ import annotations
 import argparse
 import io
 import logging
+import os
 import time
-from pathlib import Path
 
 from generator import __version__
-from generator.atomic import inside, write_bytes, write_json
-from generator.errors import UserError
+from generator.atomic import inside, staging, write_bytes, write_json
+from generator.commands.options import Number, path, text_path
+from generator.commands.preflight import output_dir
 from generator.spec import load_spec
 
 log = logging.getLogger("urbangen.layout")
@@ -25,9 +26,10 @@ log = logging.getLogger("urbangen.layout")
 def register(subparsers) -> None:
     p = subparsers.add_parser("layout", help="build the procedural town; write a map PNG, a GLB and a summary",
                               description=__doc__.splitlines()[0])
-    p.add_argument("spec", help="scene spec JSON (e.g. scenes/default_town.json)")
-    p.add_argument("--out", required=True, help="output folder (created if missing)")
-    p.add_argument("--ppm", type=float, default=None, help="map pixels per metre (default: 8, less for big towns)")
+    p.add_argument("spec", type=text_path, help="scene spec JSON (e.g. scenes/default_town.json)")
+    p.add_argument("--out", required=True, type=path, help="output folder (created if missing)")
+    p.add_argument("--ppm", type=Number(0.5, 20), default=None,
+                   help="map pixels per metre, in [0.5, 20] (default: 8, less for big towns)")
     p.set_defaults(func=run)
 
 
@@ -68,12 +70,8 @@ def run(args: argparse.Namespace) -> int:
     from generator.layout.assemble import build_scene
 
     spec = load_spec(args.spec)
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise UserError(f"{args.out}: --out must be a folder, got an existing file")
-    if args.ppm is not None and not 0.5 <= args.ppm <= 20:
-        raise UserError(f"--ppm: must be a number in [0.5, 20], got {args.ppm}")
-    files = {k: inside(out, f"{spec.name}{suffix}") for k, suffix in
+    out = output_dir(args.out, "--out")
+    files = {k: out / f"{spec.name}{suffix}" for k, suffix in
              (("map", "_map.png"), ("glb", ".glb"), ("summary", "_summary.json"))}
     t0 = time.perf_counter()
     log.info("building %s from %s", spec.name, args.spec)
@@ -86,9 +84,13 @@ def run(args: argparse.Namespace) -> int:
     log.info("exporting GLB")
     glb = scene_to_glb(scene)
     info = summary(scene, spec, build_s)
-    write_bytes(files["map"], png.getvalue())
-    write_bytes(files["glb"], glb)
-    write_json(files["summary"], info)
+    with staging(out, "layout") as stage:  # all three written in full before any is moved into place
+        staged = {k: inside(stage, p.name) for k, p in files.items()}
+        write_bytes(staged["map"], png.getvalue())
+        write_bytes(staged["glb"], glb)
+        write_json(staged["summary"], info)
+        for k, p in staged.items():
+            os.replace(p, files[k])
     t = info["totals"]
     log.info("wrote %s: %d objects, %d triangles, routes %s m", out, t["objects"], t["triangles"],
              ", ".join(f"{r['length_m']:.0f}" for r in info["routes"]))

@@ -13,12 +13,15 @@ from __future__ import annotations
 
 import logging
 import os
+import shutil
 from pathlib import Path
 
+from generator.atomic import staging
 from generator.commands.intensity import add_processing_args, spec_with_processing_args
-from generator.errors import UserError
+from generator.commands.options import Integer, path, sequence_id, text_path
+from generator.commands.preflight import output_dir
 from generator.formats.label_config import SPLITS
-from generator.formats.semantickitti import sequence_name
+from generator.jobs.plan import MAX_FRAMES, check_free_space, scan_bytes
 from generator.remission.models import intensity_fn_for_spec
 from generator.lidar.sensors import sensor_for_spec
 from generator.spec import load_spec
@@ -30,16 +33,17 @@ log = logging.getLogger(__name__)
 def register(sub) -> None:
     p = sub.add_parser("lidar", help="cast the virtual LiDAR along the route and write a SemanticKITTI sequence",
                        description=__doc__.split("\n\n")[1])
-    p.add_argument("spec", help="scene spec JSON (e.g. scenes/default_town.json)")
-    p.add_argument("--out", required=True, type=Path, help="dataset folder (sequences/NN/ is written inside)")
-    p.add_argument("--frames", type=int, default=10,
-                   help="number of scans (default 10, more than generate's 2 frames: scans are cheap, images are not)")
-    p.add_argument("--sequence", default="00", help="sequence number, 00..99 (default 00)")
-    p.add_argument("--threads", type=int, default=None, help="casting threads (default: all cores)")
+    p.add_argument("spec", type=text_path, help="scene spec JSON (e.g. scenes/default_town.json)")
+    p.add_argument("--out", required=True, type=path, help="dataset folder (sequences/NN/ is written inside)")
+    p.add_argument("--frames", type=Integer(1, MAX_FRAMES), default=10,
+                   help=f"number of scans, 1..{MAX_FRAMES} (default 10, more than generate's 2 frames: scans are "
+                        "cheap, images are not)")
+    p.add_argument("--sequence", type=sequence_id, default="00", help="sequence number, 00..99 (default 00)")
+    p.add_argument("--threads", type=Integer(1, 256), default=None, help="casting threads, 1..256 (default: all cores)")
     p.add_argument("--range-image", action="store_true", help="also save range/NNNNNN.npy (rings x columns, 0 = no return)")
     p.add_argument("--ply", action="store_true", help="also save ply/NNNNNN.ply per scan")
     p.add_argument("--no-bev", action="store_true", help="skip the bird's-eye PNGs")
-    p.add_argument("--render-config", default="preview",
+    p.add_argument("--render-config", type=text_path, default="preview",
                    help="render config (preset or YAML) whose resolution goes into calib.txt (default preview)")
     p.add_argument("--split", default=None, choices=SPLITS,
                    help="split of this sequence in DIR/semantic-kitti.yaml: train, valid or test "
@@ -54,18 +58,10 @@ def run(args) -> int:
     cfg = load_render_config(args.render_config)
     sensor = sensor_for_spec(spec)
     intensity_fn = intensity_fn_for_spec(spec)
-    name = sequence_name(args.sequence)
-    if len(name) > 2:
-        raise UserError(f"--sequence: must be 00..99, got {args.sequence!r}")
-    if args.frames < 1:
-        raise UserError(f"--frames: must be an integer >= 1, got {args.frames}")
-    if args.threads is not None and not 1 <= args.threads <= 256:
-        raise UserError(f"--threads: must be in 1..256, got {args.threads}")
-    out: Path = args.out
-    if out.exists() and not out.is_dir():
-        raise UserError(f"--out: {out} exists and is not a folder")
-    if out.exists() and not os.access(out, os.W_OK):
-        raise UserError(f"--out: {out} is not writable")
+    name: str = args.sequence
+    out: Path = output_dir(args.out, "--out")
+    extras = {"range_image": args.range_image, "ply": args.ply, "bev": not args.no_bev}
+    check_free_space(out, args.frames * scan_bytes(sensor.rays_per_sweep, **extras), f"{args.frames} scans")
 
     from generator.layout.assemble import build_scene
     from generator.jobs.lidar_sequence import SequenceOptions, check_frames, write_dataset_label_config, write_sequence
@@ -74,10 +70,29 @@ def run(args) -> int:
     check_frames(scene, spec, args.frames)
     opts = SequenceOptions(frames=args.frames, sequence=name, threads=args.threads, range_image=args.range_image,
                            ply=args.ply, bev=not args.no_bev, resolution=(cfg.width, cfg.height), render_config=cfg.name)
-    meta = write_sequence(scene, spec, out, opts, sensor=sensor, intensity_fn=intensity_fn)
-    if args.split:
-        write_dataset_label_config(out, args.split, [name])
+    # The sequence is cast into a stage inside DIR and moved into place whole: a failure (or Ctrl-C)
+    # leaves DIR as it was, and a rerun replaces an older sequence NN in one step.
+    with staging(out, "lidar") as stage:
+        meta = write_sequence(scene, spec, stage, opts, sensor=sensor, intensity_fn=intensity_fn)
+        _replace(stage / "sequences" / name, out / "sequences" / name, stage)
+    write_dataset_label_config(out, args.split, [name] if args.split else None)
     pts = meta["points_per_scan"]
     print(f"wrote {len(pts)} scans to {out / 'sequences' / name} ({sensor.name}, "
           f"{min(pts)}-{max(pts)} points per scan, remission: {meta['remission']['model']})")
     return 0
+
+
+def _replace(new: Path, dest: Path, stage: Path) -> None:
+    """Move the folder ``new`` to ``dest``; an older ``dest`` is moved aside into ``stage`` (removed with it)."""
+    dest.parent.mkdir(parents=True, exist_ok=True)
+    if os.path.lexists(dest):
+        old = stage / ".replaced"
+        os.replace(dest, old)
+        try:
+            os.replace(new, dest)
+        except BaseException:
+            os.replace(old, dest)
+            raise
+        shutil.rmtree(old, ignore_errors=True)
+    else:
+        os.replace(new, dest)

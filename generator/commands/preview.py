@@ -6,14 +6,18 @@
 
 from __future__ import annotations
 
+import os
 import re
 from pathlib import Path
 
 import numpy as np
 from PIL import Image
 
-from generator.atomic import atomic_path
+from generator.atomic import atomic_path, staging
+from generator.commands.options import integer_list, path
+from generator.commands.preflight import input_dir, output_dir
 from generator.errors import UserError
+from generator.jobs.plan import MAX_FRAME_INDEX
 from generator.previews.contact_sheet import variants_sheet
 from generator.imaging.exr import read_exr
 from generator.previews.preview import colorize, side_by_side, tonemap
@@ -33,8 +37,9 @@ def _height(panel: np.ndarray, h: int, smooth: bool) -> np.ndarray:
 def register(sub) -> None:
     p = sub.add_parser("preview", help="contact sheets per frame: RGB | masks | LiDAR bird's-eye; all variants",
                        description=__doc__.split("\n\n")[1].strip())
-    p.add_argument("dataset", type=Path, help="dataset folder")
-    p.add_argument("--frames", default=None, help="comma-separated frame numbers (default: all)")
+    p.add_argument("dataset", type=path, help="dataset folder")
+    p.add_argument("--frames", type=integer_list(0, MAX_FRAME_INDEX), default=None,
+                   help="comma-separated frame numbers (default: all)")
     p.set_defaults(func=run)
 
 
@@ -73,33 +78,40 @@ def _bev(root: Path, frame: int, size: int) -> np.ndarray | None:
 
 
 def run(args) -> int:
-    root: Path = args.dataset
+    root: Path = input_dir(args.dataset, what="dataset folder")
     if not (root / "images").is_dir():
         raise UserError(f"{root}: no images/ folder (is it a dataset from urbangen generate?)")
     frames = _frames(root)
-    if args.frames:
-        try:
-            wanted = [int(x) for x in args.frames.split(",")]
-        except ValueError:
-            raise UserError(f"--frames: expected comma-separated numbers, got {args.frames!r}") from None
-        missing = [k for k in wanted if k not in frames]
+    if args.frames is not None:
+        missing = [k for k in args.frames if k not in frames]
         if missing:
-            raise UserError(f"--frames: no images of frame(s) {missing} in {root / 'images'}")
-        frames = {k: frames[k] for k in wanted}
+            raise UserError(f"--frames: no images of frame(s) {', '.join(map(str, missing[:10]))}"
+                            f"{' ...' if len(missing) > 10 else ''} in {root / 'images'}")
+        frames = {k: frames[k] for k in args.frames}
     if not frames:
         raise UserError(f"{root / 'images'}: no images")
-    out = root / "preview"
-    for k, paths in frames.items():
-        pick = next((p for pref in PREFERRED for p in paths if p.stem.endswith(pref)), paths[0])
-        img = read_exr(pick)
-        h = max(img.class_id.shape[0], MIN_HEIGHT)
-        panels = [_height(tonemap(img.rgb), h, True), _height(colorize(img.class_id), h, False)]
-        bev = _bev(root, k, h)
-        if bev is not None:
-            panels.append(bev)
-        with atomic_path(out / f"{k:06d}.png", suffix=".png") as tmp:
-            Image.fromarray(side_by_side(panels)).save(tmp, format="PNG")
-        if len(paths) > 1:
-            variants_sheet(root / "images", k, out / f"{k:06d}_variants.png", scale=1.0 if img.rgb.shape[1] <= 320 else 0.5)
+    out = output_dir(root / "preview", "")
+    # Every sheet is made in a stage and moved into preview/ at the end: a bad EXR in the
+    # last frame leaves no sheets of the first ones behind.
+    with staging(out, "preview") as stage:
+        for k, paths in frames.items():
+            _sheets(root, k, paths, stage)
+        for p in sorted(stage.iterdir()):
+            os.replace(p, out / p.name)
     print(f"wrote {len(frames)} preview sheet(s) into {out}")
     return 0
+
+
+def _sheets(root: Path, k: int, paths: list[Path], out: Path) -> None:
+    """The contact sheet of frame ``k`` (and its variants sheet) into ``out``."""
+    pick = next((p for pref in PREFERRED for p in paths if p.stem.endswith(pref)), paths[0])
+    img = read_exr(pick)
+    h = max(img.class_id.shape[0], MIN_HEIGHT)
+    panels = [_height(tonemap(img.rgb), h, True), _height(colorize(img.class_id), h, False)]
+    bev = _bev(root, k, h)
+    if bev is not None:
+        panels.append(bev)
+    with atomic_path(out / f"{k:06d}.png", suffix=".png") as tmp:
+        Image.fromarray(side_by_side(panels)).save(tmp, format="PNG")
+    if len(paths) > 1:
+        variants_sheet(root / "images", k, out / f"{k:06d}_variants.png", scale=1.0 if img.rgb.shape[1] <= 320 else 0.5)

@@ -11,9 +11,13 @@ when they differ.
 from __future__ import annotations
 
 import logging
+import os
 import sys
 from pathlib import Path
 
+from generator.atomic import staging
+from generator.commands.options import path
+from generator.commands.preflight import input_dir, output_dir
 from generator.errors import UserError
 from generator.stats import section_modules
 from generator.stats.report import write_report
@@ -25,20 +29,16 @@ EXIT_MISMATCH = 1
 def register(sub) -> None:
     p = sub.add_parser("stats", help="dataset statistics: pixels per class, images per weather x time of day",
                        description=__doc__.split("\n\n")[1])
-    p.add_argument("dataset", type=Path, help="dataset folder (with images/*.json)")
-    p.add_argument("--out", type=Path, default=None, help="output folder (default: DIR/stats)")
+    p.add_argument("dataset", type=path, help="dataset folder (with images/*.json)")
+    p.add_argument("--out", type=path, default=None, help="output folder (default: DIR/stats)")
     p.add_argument("--verify", action="store_true",
                    help="recompute pixel counts from the EXR masks; exit 1 listing the images that differ")
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
-    root: Path = args.dataset
-    if not root.is_dir():
-        raise UserError(f"{root}: no such dataset folder")
-    out: Path = args.out if args.out is not None else root / "stats"
-    if out.exists() and not out.is_dir():
-        raise UserError(f"--out: {out} exists and is not a folder")
+    root: Path = input_dir(args.dataset, what="dataset folder")
+    out: Path = output_dir(args.out if args.out is not None else root / "stats", "--out")
     sections, problems = [], []
     for mod in section_modules():
         data = mod.load(root)
@@ -55,6 +55,10 @@ def run(args) -> int:
         print(f"urbangen stats: --verify: {len(problems)} image(s) disagree with their EXR; nothing written",
               file=sys.stderr)
         return EXIT_MISMATCH
-    paths = write_report(out, root, sections)
+    with staging(out, "stats") as stage:  # every file written in full before any is moved into place
+        staged = write_report(stage, root, sections)
+        paths = [out / p.name for p in staged]
+        for p, dest in zip(staged, paths):
+            os.replace(p, dest)
     print(f"wrote {', '.join(p.name for p in paths)} into {out}")
     return 0
