@@ -111,10 +111,10 @@ def test_sequence_applies_the_gap_and_records_it(test_spec, tmp_path):
 
 
 @pytest.mark.parametrize("extra, message", [
-    (["--dropout", "1.5"], "domain gap: dropout must be in [0, 1), got 1.5"),
-    (["--gap-intensity", "abc"], "--gap-intensity: expected a number in [0, 1] or 'none'"),
+    (["--dropout", "1.5"], "--dropout: must be a number in [0, 1), got '1.5'"),
+    (["--gap-intensity", "abc"], "--gap-intensity: must be a number in [0, 1] or 'none', got 'abc'"),
     (["--domain-gap", "off", "--dropout", "0.2"], "--domain-gap off contradicts"),
-    (["--constant-intensity", "3"], "lidar.constant_intensity: must be a number in [0, 1]"),
+    (["--constant-intensity", "3"], "--constant-intensity: must be a number in [0, 1], got '3'"),
 ])
 def test_lidar_command_processing_options_errors(root, tmp_path, capsys, monkeypatch, extra, message):
     import generator.cli as cli

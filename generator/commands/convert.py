@@ -11,21 +11,23 @@ without -s).
 
 from __future__ import annotations
 
-from pathlib import Path
+import os
 
-from generator.commands.intensity import parse_sequences
-from generator.errors import UserError
+from generator.commands.options import path, sequence_list
+from generator.commands.preflight import input_dir, output_dir
 from generator.formats.label_config import SPLITS
 from generator.formats.relabel import TARGETS, convert_dataset
+from generator.jobs.plan import check_free_space
 
 
 def register(sub) -> None:
     p = sub.add_parser("convert", help="relabel a SemanticKITTI-layout dataset into the unified 11 classes",
                        description=__doc__.split("\n\n")[1])
-    p.add_argument("input", type=Path, help="dataset root (holds sequences/NN)")
-    p.add_argument("output", type=Path, help="output dataset root")
+    p.add_argument("input", type=path, help="dataset root (holds sequences/NN)")
+    p.add_argument("output", type=path, help="output dataset root")
     p.add_argument("--labels", required=True, choices=tuple(TARGETS), help="target label set")
-    p.add_argument("--sequences", default=None, help="comma-separated sequence numbers (default: all with labels)")
+    p.add_argument("--sequences", type=sequence_list, default=None,
+                   help="comma-separated sequence numbers (default: all with labels)")
     p.add_argument("--split", default=None, choices=SPLITS,
                    help="split of the converted sequences in the written config: train, valid or test "
                         "(default: their split in IN/semantic-kitti.yaml, else valid)")
@@ -33,10 +35,28 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    if not args.input.is_dir():
-        raise UserError(f"{args.input}: dataset folder not found")
-    summary = convert_dataset(args.input, args.output, args.labels, parse_sequences(args.sequences),
-                               split=args.split)
+    input_dir(args.input, what="dataset folder")
+    output_dir(args.output, "OUT")
+    check_free_space(args.output, _input_bytes(args.input, args.sequences), "a copy of the scans and labels",
+                     flag="OUT")
+    summary = convert_dataset(args.input, args.output, args.labels, args.sequences, split=args.split)
     print(f"converted {summary['scans']} scans of sequences {', '.join(summary['sequences'])} to {args.labels} "
           f"-> {args.output} ({summary['config']})")
     return 0
+
+
+def _input_bytes(root, sequences: list[str] | None) -> int:
+    """Bytes of the scans and labels a conversion copies (what it writes, give or take the text files)."""
+    total = 0
+    base = root / "sequences"
+    try:
+        names = sequences if sequences is not None else (
+            [p.name for p in base.iterdir() if p.name.isdigit()] if base.is_dir() else [])
+        for name in names:
+            for sub in ("velodyne", "labels"):
+                folder = base / name / sub
+                if folder.is_dir():
+                    total += sum(e.stat().st_size for e in os.scandir(folder) if e.is_file())
+    except OSError:  # an estimate; the reader names the file that is wrong
+        pass
+    return total

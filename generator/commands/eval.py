@@ -15,10 +15,12 @@ is written as JSON (default PRED/eval_<labels>.json).
 
 from __future__ import annotations
 
-from pathlib import Path
-
 from generator.atomic import write_json
-from generator.errors import UserError
+from generator.commands.options import Integer, path, sequence_id
+from generator.commands.preflight import input_dir, output_file
+
+#: Largest --min-points (a segment of more points than a scan holds never counts).
+MAX_MIN_POINTS = 10_000_000
 
 
 def register(sub) -> None:
@@ -27,36 +29,36 @@ def register(sub) -> None:
 
     p = sub.add_parser("eval", help="IoU per class and mIoU (and PQ) of predicted labels against ground truth",
                        description=__doc__.split("\n\n")[1])
-    p.add_argument("--pred", required=True, type=Path,
+    p.add_argument("--pred", required=True, type=path,
                    help="prediction root (sequences/NN/predictions/ or sequences/NN/labels/)")
-    p.add_argument("--gt", required=True, type=Path, help="ground-truth root (sequences/NN/labels/)")
+    p.add_argument("--gt", required=True, type=path, help="ground-truth root (sequences/NN/labels/)")
     p.add_argument("--labels", default="unified11", choices=LABEL_SETS,
                    help="label set: unified11, semantickitti or native (default unified11; native needs "
                         "native_labels/ in both trees)")
-    p.add_argument("--sequences", nargs="+", default=None, help="sequences to evaluate (default: all of --gt)")
+    p.add_argument("--sequences", nargs="+", type=sequence_id, default=None,
+                   help="sequences to evaluate, 00..99 (default: all of --gt)")
     p.add_argument("--mean-over", default="all", choices=MEAN_OVER,
                    help="classes the means average: all (every class but 0, absent ones as 0; the reference, "
                         "default) or present (only classes in prediction or ground truth)")
     p.add_argument("--panoptic", action="store_true", help="also panoptic quality: PQ, SQ, RQ per class and mean")
-    p.add_argument("--min-points", type=int, default=MIN_POINTS,
-                   help=f"panoptic: smallest unmatched segment counted as FP/FN (default {MIN_POINTS}, as the reference)")
-    p.add_argument("--json", type=Path, default=None, help="result file (default PRED/eval_<labels>.json)")
+    p.add_argument("--min-points", type=Integer(1, MAX_MIN_POINTS), default=MIN_POINTS,
+                   help=f"panoptic: smallest unmatched segment counted as FP/FN, 1..{MAX_MIN_POINTS} "
+                        f"(default {MIN_POINTS}, as the reference)")
+    p.add_argument("--json", type=path, default=None, help="result file (default PRED/eval_<labels>.json)")
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
-    from generator.formats.semantickitti import sequence_name
     from generator.stats.evaluate import evaluate_trees, format_table
     from generator.stats.panoptic import format_panoptic
 
-    for flag, path in (("--pred", args.pred), ("--gt", args.gt)):
-        if not path.is_dir():
-            raise UserError(f"{flag}: {path} is not a folder")
-    seqs = None if args.sequences is None else [sequence_name(s) for s in args.sequences]
+    for flag, folder in (("--pred", args.pred), ("--gt", args.gt)):
+        input_dir(folder, flag)
+    out = output_file(args.json or args.pred / f"eval_{args.labels}.json", "--json")
+    seqs = None if args.sequences is None else list(dict.fromkeys(args.sequences))
     result = evaluate_trees(args.pred, args.gt, args.labels, seqs, mean_over=args.mean_over,
                             panoptic=args.panoptic, min_points=args.min_points)
     result["pred"], result["gt"] = str(args.pred), str(args.gt)
-    out = args.json or args.pred / f"eval_{args.labels}.json"
     write_json(out, result)
     print(format_table(result))
     if args.panoptic:

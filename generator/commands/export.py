@@ -12,11 +12,16 @@ evaluation looks. Nothing is written on error; existing files are never overwrit
 
 from __future__ import annotations
 
-import json
+import os
 from pathlib import Path
 from typing import Iterator
 
+from generator.commands.options import path
+from generator.commands.preflight import input_dir, output_dir
 from generator.errors import UserError
+from generator.jobs.plan import MAX_FRAME_INDEX, check_free_space
+from generator.safeload import MAX_METADATA_BYTES, load_json, printable
+from generator.weather import combinations
 from generator.formats.cityscapes import DEFAULT_SPLIT, SPLITS, CityscapesImage, city_name, export, image_stem
 
 FORMATS = ("cityscapes",)
@@ -26,8 +31,8 @@ def register(sub) -> None:
     p = sub.add_parser("export", help="write a dataset's images in the Cityscapes layout",
                        description=__doc__.split("\n\n")[1])
     p.add_argument("format", choices=FORMATS, help="target layout: cityscapes")
-    p.add_argument("dataset", type=Path, help="generated dataset (holds images/*.exr)")
-    p.add_argument("out", type=Path, help="export root (leftImg8bit/ and gtFine/ are written inside)")
+    p.add_argument("dataset", type=path, help="generated dataset (holds images/*.exr)")
+    p.add_argument("out", type=path, help="export root (leftImg8bit/ and gtFine/ are written inside)")
     p.add_argument("--split", default=DEFAULT_SPLIT, choices=SPLITS,
                    help=f"split folder: train, val or test (default {DEFAULT_SPLIT}, what cityscapesScripts evaluates)")
     p.set_defaults(func=run)
@@ -35,22 +40,28 @@ def register(sub) -> None:
 
 def _metadata(exr: Path) -> tuple[int, str, str]:
     path = exr.with_suffix(".json")
+    if not os.path.lexists(path):
+        raise UserError(f"{path}: missing (every image needs its metadata JSON)")
+    meta = load_json(path, max_bytes=MAX_METADATA_BYTES, max_nodes=100_000)
     try:
-        meta = json.loads(path.read_text(encoding="utf-8"))
-        return int(meta["frame"]), str(meta["time_of_day"]), str(meta["weather"]["kind"])
-    except FileNotFoundError:
-        raise UserError(f"{path}: missing (every image needs its metadata JSON)") from None
-    except (json.JSONDecodeError, UnicodeDecodeError, KeyError, TypeError, ValueError) as e:
-        raise UserError(f"{path}: not image metadata (frame, time_of_day, weather.kind): {e}") from None
+        frame, tod, kind = meta["frame"], meta["time_of_day"], meta["weather"]["kind"]
+    except (KeyError, TypeError):
+        raise UserError(f"{path}: not image metadata (needs frame, time_of_day, weather.kind)") from None
+    if type(frame) is not int or not 0 <= frame <= MAX_FRAME_INDEX:
+        raise UserError(f"{path}: frame: must be an integer in 0..{MAX_FRAME_INDEX}")
+    if not (isinstance(tod, str) and isinstance(kind, str) and (tod, kind) in set(combinations())):  # they name folders: known words only
+        raise UserError(f"{path}: time_of_day, weather.kind: must be one of the 12 known combinations "
+                        f"(day/night x {', '.join(sorted({w for _, w in combinations()}))})")
+    return frame, tod, kind
 
 
 def _sequence(dataset: Path) -> int:
-    from generator.jobs.manifest import load
-
-    manifest = load(dataset) or {}
-    seq = str(manifest.get("plan", {}).get("sequence", "0"))
-    if not seq.isdigit():
-        raise UserError(f"{dataset / 'manifest.json'}: plan.sequence must be a number, got {seq!r}")
+    path = dataset / "manifest.json"
+    manifest = load_json(path, max_bytes=MAX_METADATA_BYTES, max_nodes=10_000_000) if os.path.lexists(path) else {}
+    plan = manifest.get("plan", {}) if isinstance(manifest, dict) else {}
+    seq = str(plan.get("sequence", "0") if isinstance(plan, dict) else "?")
+    if not (seq.isascii() and seq.isdigit() and len(seq) <= 4):
+        raise UserError(f"{path}: plan.sequence must be a number, got {printable(seq, 40)!r}")
     return int(seq)
 
 
@@ -60,13 +71,15 @@ def run(args) -> int:
     from generator.imaging.exr import read_exr
     from generator.previews.preview import tonemap
 
-    if not args.dataset.is_dir():
-        raise UserError(f"{args.dataset}: dataset folder not found")
+    input_dir(args.dataset, what="dataset folder")
+    output_dir(args.out, "OUT")
     exrs = sorted((args.dataset / "images").glob("*.exr"))
     if not exrs:
         raise UserError(f"{args.dataset / 'images'}: no .exr images to export")
     if args.out.resolve() == args.dataset.resolve():
         raise UserError(f"{args.out}: output must differ from the dataset folder")
+    # five PNGs per image: about half the size of its EXR (RGB 8-bit, label ids compress well)
+    check_free_space(args.out, sum(p.stat().st_size for p in exrs) // 2, f"{len(exrs)} images", flag="OUT")
     seq = _sequence(args.dataset)
     metas = [_metadata(p) for p in exrs]
     planned = [(city_name(t, w), image_stem(city_name(t, w), seq, f)) for f, t, w in metas]

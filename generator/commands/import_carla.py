@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import logging
+import os
 from pathlib import Path
 
 import numpy as np
@@ -19,9 +20,12 @@ from generator import __version__
 from generator.world import rig
 from generator.atomic import staging, write_json
 from generator.commands.intensity import add_processing_args, gap_from_args, intensity_fn_from_args
+from generator.commands.options import Integer, path, sequence_id
+from generator.commands.preflight import input_dir, output_dir
 from generator.errors import UserError
 from generator.formats import carla_ply, kitti_calib, semantickitti as sk
 from generator.formats.label_config import count_raw_ids, merge_counts
+from generator.jobs.plan import MAX_FRAMES, check_free_space
 from generator.scan_effects.pipeline import ScanProcessing, process_scan
 from generator.progress import progress as progress_bar
 
@@ -38,21 +42,21 @@ PERIOD_S = 0.1
 def register(sub) -> None:
     p = sub.add_parser("import-carla", help="convert a KITTI-CARLA town (CARLA semantic-LiDAR PLY) to a SemanticKITTI sequence",
                        description=__doc__.split("\n\n")[1])
-    p.add_argument("town", type=Path, help="KITTI-CARLA town folder (TownNN with generated/frames/*.ply)")
-    p.add_argument("output", type=Path, help="dataset root; the sequence goes to OUT/sequences/NN")
-    p.add_argument("--sequence", required=True, help="sequence number, e.g. 22")
-    p.add_argument("--seed", type=int, default=0, help="seed of the intensity and domain-gap draws (default 0)")
-    p.add_argument("--frames", type=int, default=None, help="import only the first N frames")
+    p.add_argument("town", type=path, help="KITTI-CARLA town folder (TownNN with generated/frames/*.ply)")
+    p.add_argument("output", type=path, help="dataset root; the sequence goes to OUT/sequences/NN")
+    p.add_argument("--sequence", required=True, type=sequence_id, help="sequence number 00..99, e.g. 22")
+    p.add_argument("--seed", type=Integer(0, 2**63 - 1), default=0,
+                   help="seed of the intensity and domain-gap draws, >= 0 (default 0)")
+    p.add_argument("--frames", type=Integer(1, MAX_FRAMES), default=None,
+                   help=f"import only the first N frames, 1..{MAX_FRAMES}")
     add_processing_args(p)
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
-    name = sk.sequence_name(args.sequence)
-    if args.seed < 0:
-        raise UserError(f"--seed: must be >= 0, got {args.seed}")
-    if args.frames is not None and args.frames < 1:
-        raise UserError(f"--frames: must be >= 1, got {args.frames}")
+    name = args.sequence
+    input_dir(args.town, what="town folder")
+    output_dir(args.output, "OUT")
     fn = intensity_fn_from_args(args, default="class_normal")
     processing = ScanProcessing(fn, gap_from_args(args), None)
     meta = import_town(args.town, args.output, name, processing, args.seed, args.frames)
@@ -88,11 +92,13 @@ def import_town(town: Path, out: Path, name: str, processing: ScanProcessing, se
     frames, pose_file = carla_ply.find_town(town)
     frames = frames[:max_frames] if max_frames else frames
     dest = out / "sequences" / name
-    if dest.exists():
+    if os.path.lexists(dest):
         raise UserError(f"{dest}: exists; remove it or choose another --sequence")
     if out.exists() and not out.is_dir():
         raise UserError(f"{out}: exists and is not a folder")
     poses_all, pose_times = carla_ply.read_pose_file(pose_file) if pose_file else (None, None)
+    # what it writes: about the size of the PLY frames (16 + 4 bytes per point against their 24-28)
+    check_free_space(out, sum(_size(p) for p in frames), f"{len(frames)} scans", flag="OUT")
     with staging(out, "import") as stage:
         seq = stage / name
         poses, times, counts, records, instances = [], [], {}, [], {}
@@ -136,6 +142,13 @@ def import_town(town: Path, out: Path, name: str, processing: ScanProcessing, se
         seq.rename(dest)
     _label_config(out)
     return meta
+
+
+def _size(path: Path) -> int:
+    try:
+        return path.stat().st_size
+    except OSError:  # an estimate; the reader names the file that is wrong
+        return 0
 
 
 def _metadata(town, frames, pose_file, name, processing, seed, records, counts, instances) -> dict:
