@@ -36,24 +36,27 @@ def write_image(out: Path, frame, spec, cfg, renderer, rendered, time_of_day: st
     folder = inside(out, "images")
     lab = rendered.labels
     rgb = rendered.rgb if rgb is None else rgb
+    files = {"exr": f"{name}.exr", **({"preview": f"{name}_preview.png"} if cfg.preview else {})}
+    # The metadata is built and checked first: a record that does not match its schema
+    # (a bug) stops here, before the EXR or the preview exist.
+    planned = {**secs, "exr_write": 0.0, **({"preview": 0.0} if cfg.preview else {})}
+    record = image_metadata(image=name, files=files, frame=frame, k=renderer.k, width=cfg.width, height=cfg.height,
+                            hfov_deg=spec.sensors.camera.hfov_deg, class_id=lab.class_id, time_of_day=time_of_day,
+                            weather=weather, lighting=rendered.lighting, spec=spec, render_cfg=cfg,
+                            device=renderer.device, timings=planned, blender_version=renderer.blender_version)
+    problems = validate_metadata(record)
+    if problems:
+        raise RuntimeError(f"metadata of {name} does not match its schema: {problems[0]}")
     t = time.perf_counter()
     write_exr(folder / f"{name}.exr", LabelledImage(rgb, lab.class_id, lab.instance, lab.depth,
                                                      {"urbangen.image": name}), cfg.exr_codec)
     secs["exr_write"] = time.perf_counter() - t
-    files = {"exr": f"{name}.exr"}
     if cfg.preview:
         t = time.perf_counter()
         write_preview(folder / f"{name}_preview.png", rgb, lab.class_id, lab.depth)
         secs["preview"] = time.perf_counter() - t
-        files["preview"] = f"{name}_preview.png"
     t = time.perf_counter()
-    record = image_metadata(image=name, files=files, frame=frame, k=renderer.k, width=cfg.width, height=cfg.height,
-                            hfov_deg=spec.sensors.camera.hfov_deg, class_id=lab.class_id, time_of_day=time_of_day,
-                            weather=weather, lighting=rendered.lighting, spec=spec, render_cfg=cfg,
-                            device=renderer.device, timings=secs, blender_version=renderer.blender_version)
-    problems = validate_metadata(record)
-    if problems:
-        raise RuntimeError(f"metadata of {name} does not match its schema: {problems[0]}")
-    write_json(folder / f"{name}.json", record)
+    record["timings_s"] = {key: round(float(v), 4) for key, v in secs.items()}
+    write_json(folder / f"{name}.json", record)  # last: an image with metadata is complete
     secs["metadata"] = time.perf_counter() - t
     return name, secs
