@@ -145,8 +145,6 @@ def preflight(spec, cfg, opts: GenerateOptions) -> Preflight:
     check_plan(plan)
     sensor = sensor_for_spec(spec)  # every file the LiDAR stage reads, read now
     processing_for_spec(spec, sensor, True, intensity_fn_for_spec(spec))
-    scene = build_scene(spec)
-    check_frames(scene, spec, len(plan.frames))
     done = set(images_done(out, plan))
     todo = [k for k in plan.frames if k not in done]
     seq_dir = out / "lidar" / "sequences" / plan.sequence
@@ -157,6 +155,8 @@ def preflight(spec, cfg, opts: GenerateOptions) -> Preflight:
     need += scans * scan_bytes(sensor.rays_per_sweep)
     check_free_space(out, need, f"{len(todo) * len(plan.combos)} images and {len(pairs)} stereo pairs at "
                                 f"{cfg.width}x{cfg.height}, {scans} scans")
+    scene = build_scene(spec)  # the one expensive check, last
+    check_frames(scene, spec, len(plan.frames))
     return Preflight(plan, manifest, scene)
 
 
