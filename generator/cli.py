@@ -109,7 +109,18 @@ def build_parser() -> argparse.ArgumentParser:
     for name in COMMANDS:
         importlib.import_module(f"generator.commands.{name}").register(sub)
     _plain_help(parser)
+    _name_leaves(parser)
     return parser
+
+
+def _name_leaves(parser: argparse.ArgumentParser) -> None:
+    """Every runnable (sub-)command records its name (``urbangen intensity fit``) for its messages."""
+    subs = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
+    if not subs:
+        parser.set_defaults(command_name=parser.prog)
+    for action in subs:
+        for sub in set(action.choices.values()):
+            _name_leaves(sub)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -124,7 +135,7 @@ def main(argv: list[str] | None = None) -> int:
     logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s", stream=sys.stderr)
     # progress lines (logged only when stderr is not a terminal; a terminal gets a bar) unless --quiet
     logging.getLogger("urbangen.progress").setLevel(logging.ERROR if args.quiet else logging.INFO)
-    name = f"urbangen {args.command}"
+    name = getattr(args, "command_name", f"urbangen {args.command}")
     try:
         return int(args.func(args) or 0)
     except UserError as e:
