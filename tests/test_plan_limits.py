@@ -142,3 +142,19 @@ def test_a_resumed_plan_is_checked_merged(tmp_path, capsys):
     err = capsys.readouterr().err
     assert rc == 2 and "40000 frames x 3 variants = 120000 images planned" in err, err
     assert sorted(p.name for p in out.iterdir()) == before
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["--ray-address", "127.0.0.1:6379"], "--ray-address: only with --executor ray"),
+    (["--executor", "ray", "--ray-address", "127.0.0.1:1"], "--ray-address: cannot reach 127.0.0.1:1"),
+    (["--executor", "ray", "--ray-address", "ray://x:99999"], "--ray-address: expected host:port or ray://host:port"),
+])
+def test_a_ray_cluster_that_cannot_answer_is_found_before_any_work(tmp_path, capsys, extra, message):
+    """ray.init on an address nobody listens at waits for minutes: refused in seconds instead."""
+    import importlib.util
+
+    if "ray" in extra and importlib.util.find_spec("ray") is None:
+        message = "--executor ray needs Ray"
+    out = tmp_path / "ds"
+    err = _refused(capsys, ["render", SPEC, "--config", "test", "--out", str(out), *extra], out)
+    assert message in err, err

@@ -43,7 +43,12 @@ _REASONS = {
 
 def os_reason(e: OSError) -> str:
     """A short reason for an :class:`OSError` (no file content, just what the system said)."""
-    return _REASONS.get(e.errno, (e.strerror or type(e).__name__).lower())
+    if e.errno in _REASONS:
+        return _REASONS[e.errno]
+    if e.strerror:
+        return e.strerror.lower()
+    text = str(e).strip().splitlines()  # an OSError of a library (Ray's ConnectionError): its own words
+    return printable(text[0], 300) if text else type(e).__name__
 
 
 _ATOMIC_TMP = re.compile(re.escape(TMP_PREFIX) + r"(.+)\.[A-Za-z0-9_]{8}(?:\.[^./]*)?")

@@ -10,13 +10,14 @@ exists are skipped (rerun = resume).
 from __future__ import annotations
 
 import logging
+import re
 import shutil
 from dataclasses import dataclass
 from pathlib import Path
 
 from generator.atomic import TMP_PREFIX
-from generator.commands.options import Integer, path, text_path
-from generator.commands.preflight import output_dir
+from generator.commands.options import Integer, path, shown, text_path
+from generator.commands.preflight import os_reason, output_dir
 from generator.errors import UserError
 from generator.jobs.executors import EXECUTORS, make_jobs, run_jobs
 from generator.jobs.images import image_name
@@ -76,7 +77,35 @@ def check_render_args(args) -> RenderArgs:
     except ValueError as e:
         raise UserError(f"--variants: {e}") from None
     check_workers(args.workers, args.executor)
+    if args.executor == "ray":
+        check_ray(args.ray_address)
+    elif args.ray_address is not None:
+        raise UserError("--ray-address: only with --executor ray")
     return RenderArgs(spec, cfg, out, combos)
+
+
+def check_ray(address: str | None, timeout_s: float = 3.0) -> None:
+    """Ray is installed and the cluster at ``address`` (``host:port`` or ``ray://host:port``) answers.
+
+    ``ray.init`` on an address nobody listens at waits for minutes; this is found in seconds,
+    before anything is written. ``auto`` (Ray's own lookup) is left to Ray.
+    """
+    import importlib.util
+    import socket
+
+    if importlib.util.find_spec("ray") is None:
+        raise UserError("--executor ray needs Ray: pip install 'urbangen[ray]' (or pip install 'ray>=2.9,<3')")
+    if address is None or address == "auto":
+        return
+    m = re.fullmatch(r"(?:ray://)?(\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9_.-]{1,253}):([0-9]{1,5})", address)
+    if not m or not 1 <= int(m.group(2)) <= 65535:
+        raise UserError(f"--ray-address: expected host:port or ray://host:port (or auto), got {shown(address)}")
+    host, port = m.group(1).strip("[]"), int(m.group(2))
+    try:
+        socket.create_connection((host, port), timeout=timeout_s).close()
+    except OSError as e:
+        reason = "no answer" if isinstance(e, TimeoutError) else os_reason(e)
+        raise UserError(f"--ray-address: cannot reach {host}:{port} ({reason})") from None
 
 
 def run(args) -> int:
