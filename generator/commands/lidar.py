@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import logging
 import os
-import shutil
 from pathlib import Path
 
 from generator.atomic import staging
@@ -70,11 +69,11 @@ def run(args) -> int:
     check_frames(scene, spec, args.frames)
     opts = SequenceOptions(frames=args.frames, sequence=name, threads=args.threads, range_image=args.range_image,
                            ply=args.ply, bev=not args.no_bev, resolution=(cfg.width, cfg.height), render_config=cfg.name)
-    # The sequence is cast into a stage inside DIR and moved into place whole: a failure (or Ctrl-C)
-    # leaves DIR as it was, and a rerun replaces an older sequence NN in one step.
+    # The sequence is cast into a stage inside DIR and moved into place when complete: a failure
+    # (or Ctrl-C) while casting and writing leaves DIR as it was.
     with staging(out, "lidar") as stage:
         meta = write_sequence(scene, spec, stage, opts, sensor=sensor, intensity_fn=intensity_fn)
-        _replace(stage / "sequences" / name, out / "sequences" / name, stage)
+        _move_in(stage / "sequences" / name, out / "sequences" / name, args.frames)
     write_dataset_label_config(out, args.split, [name] if args.split else None)
     pts = meta["points_per_scan"]
     print(f"wrote {len(pts)} scans to {out / 'sequences' / name} ({sensor.name}, "
@@ -82,17 +81,19 @@ def run(args) -> int:
     return 0
 
 
-def _replace(new: Path, dest: Path, stage: Path) -> None:
-    """Move the folder ``new`` to ``dest``; an older ``dest`` is moved aside into ``stage`` (removed with it)."""
+def _move_in(new: Path, dest: Path, frames: int) -> None:
+    """Move the finished sequence ``new`` to ``dest``: in one rename when ``dest`` is new, else file by
+    file over the older run's files (renames only: no space needed), keeping what this command does not
+    write (a generate dataset's stereo pairs) and dropping scans beyond ``frames``, as a rerun always did."""
+    from generator.jobs.lidar_sequence import _remove_stale
+
     dest.parent.mkdir(parents=True, exist_ok=True)
-    if os.path.lexists(dest):
-        old = stage / ".replaced"
-        os.replace(dest, old)
-        try:
-            os.replace(new, dest)
-        except BaseException:
-            os.replace(old, dest)
-            raise
-        shutil.rmtree(old, ignore_errors=True)
-    else:
+    if not os.path.lexists(dest):
         os.replace(new, dest)
+        return
+    for folder, _, files in os.walk(new):
+        target = dest / Path(folder).relative_to(new)
+        target.mkdir(parents=True, exist_ok=True)
+        for name in files:
+            os.replace(Path(folder) / name, target / name)
+    _remove_stale(dest, frames)

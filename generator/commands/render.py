@@ -140,11 +140,14 @@ def _remove_unfinished(out: Path, plan, created: bool) -> None:
     """After a failed run: drop the files of images without metadata (an image is done when its JSON
     exists) and temporaries; a folder this run created and that holds no finished image goes too."""
     images = out / "images"
-    for name in plan.images():
-        if not (images / f"{name}.json").exists():
-            for suffix in (".exr", "_preview.png"):
-                (images / f"{name}{suffix}").unlink(missing_ok=True)
-    for tmp in images.glob(f"{TMP_PREFIX}*") if images.is_dir() else ():
-        tmp.unlink(missing_ok=True)
-    if created and not any(images.glob("*.json")):
-        shutil.rmtree(out, ignore_errors=True)
+    try:
+        for name in plan.images():
+            if not (images / f"{name}.json").exists():
+                for suffix in (".exr", "_preview.png"):
+                    (images / f"{name}{suffix}").unlink(missing_ok=True)
+        for tmp in images.glob(f"{TMP_PREFIX}*") if images.is_dir() else ():
+            tmp.unlink(missing_ok=True)
+        if created and not any(images.glob("*.json")):
+            shutil.rmtree(out, ignore_errors=True)
+    except OSError as e:  # the failure being reported matters more than this cleanup
+        log.warning("could not remove the unfinished images of the failed run: %s", e)

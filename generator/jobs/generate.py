@@ -103,8 +103,9 @@ def read_manifest(out: Path) -> dict | None:
 
     def need(obj, key, kind, where=""):
         if not isinstance(obj, dict) or not isinstance(obj.get(key), kind):
-            raise SpecError(src, where + key, f"must be {kind.__name__ if isinstance(kind, type) else 'set'}; "
-                                              "use another --out or delete the folder")
+            what = {str: "text", dict: "a mapping", list: "a list"}[kind]
+            raise SpecError(src, where + key, f"must be {what} (not a manifest urbangen wrote; use another --out "
+                                              "or delete the folder)")
         return obj[key]
 
     need(doc, "spec_hash", str)
