@@ -60,8 +60,7 @@ class OneLineParser(argparse.ArgumentParser):
     """An argument parser whose errors are one line (``urbangen CMD: --opt: reason``) and exit code 2."""
 
     def error(self, message: str):  # noqa: D102 - argparse API
-        if message.startswith("argument "):
-            message = message[len("argument "):]
+        message = message.removeprefix("argument ")
         self.exit(EXIT_USAGE, f"{self.prog}: {printable(message, MAX_MESSAGE_CHARS)}\n")
 
     def _get_values(self, action, arg_strings):  # noqa: D102 - argparse API

@@ -24,7 +24,7 @@ SPEC = str(ROOT / "scenes" / "test_town.json")
 @pytest.fixture
 def cached_scene(monkeypatch, test_scene):
     """``build_scene`` returns the session's test town (layout tests need a scene, not a fresh one)."""
-    import generator.layout.assemble as assemble
+    from generator.layout import assemble
 
     monkeypatch.setattr(assemble, "build_scene", lambda spec: test_scene)
 
@@ -32,14 +32,14 @@ def cached_scene(monkeypatch, test_scene):
 def _run(capsys, argv):
     capsys.readouterr()
     rc = cli.main(argv)
-    out, err = capsys.readouterr()
+    _, err = capsys.readouterr()
     assert "Traceback" not in err or "-v" in argv, err
     return rc, err
 
 
 def _fail_second_write(monkeypatch, exc: BaseException):
     """Make the layout command's second file write raise ``exc`` after the first succeeded."""
-    import generator.commands.layout as layout
+    from generator.commands import layout
 
     real, calls = layout.write_bytes, []
 
@@ -69,7 +69,7 @@ def test_a_write_refused_by_the_system_is_one_line_and_leaves_nothing(tmp_path, 
 
 
 def test_a_stage_that_cannot_be_made_leaves_nothing(tmp_path, capsys, monkeypatch, cached_scene):
-    import generator.atomic as atomic
+    from generator import atomic
 
     def forbidden(prefix, dir):
         raise PermissionError(errno.EACCES, "Permission denied", dir)
@@ -139,10 +139,10 @@ def test_openlabel_refuses_a_target_that_is_not_a_file(tmp_path, capsys):
 
 @pytest.mark.parametrize("manifest, field", [
     ("[1, 2]", "spec_hash"),
-    ('{"spec_hash": "x", "render_config": {"config_hash": "y"}, "plan": {"frames": [0, -1], "combos": [], '
-     '"sequence": "00"}, "finished": {}}', "plan.frames"),
-    ('{"spec_hash": "x", "render_config": {"config_hash": "y"}, "plan": {"frames": [0], "combos": [["day", "../x"]], '
-     '"sequence": "00"}, "finished": {}}', "plan.combos"),
+    (('{"spec_hash": "x", "render_config": {"config_hash": "y"}, "plan": {"frames": [0, -1], "combos": [], '
+      '"sequence": "00"}, "finished": {}}'), "plan.frames"),
+    (('{"spec_hash": "x", "render_config": {"config_hash": "y"}, "plan": {"frames": [0], "combos": [["day", "../x"]], '
+      '"sequence": "00"}, "finished": {}}'), "plan.combos"),
     ('{"spec_hash": NaN}', "NaN"),
     ("FIFO", "named pipe"),
 ])
@@ -168,3 +168,42 @@ def test_generate_resumed_with_another_spec_is_refused_before_writing(tmp_path, 
     rc, err = _run(capsys, ["generate", SPEC, "--config", "test", "--out", str(out), "--frames", "1"])
     assert rc == 2 and "made from another spec" in err
     assert sorted(p.name for p in out.iterdir()) == ["manifest.json"]
+
+
+# -- lidar: cast in a stage, moved in when complete ----------------------------------------------------------------
+
+
+def _tree(root: Path) -> dict[str, bytes]:
+    return {str(p.relative_to(root)): p.read_bytes() for p in sorted(root.rglob("*")) if p.is_file()}
+
+
+def test_lidar_failing_mid_sequence_leaves_the_older_run_as_it_was(tmp_path, capsys, monkeypatch, cached_scene):
+    from generator.formats import semantickitti as sk
+
+    out = tmp_path / "ds"
+
+    def argv(frames: int) -> list[str]:
+        return ["-q", "lidar", SPEC, "--out", str(out), "--frames", str(frames), "--no-bev", "--threads", "2"]
+
+    assert _run(capsys, argv(2))[0] == 0
+    extra = out / "sequences" / "00" / "image_2" / "000000.png"  # a generate dataset's stereo image
+    extra.parent.mkdir()
+    extra.write_bytes(b"png")
+    before = _tree(out)
+    real, calls = sk.write_labels, []
+
+    def full_disk(path, *a):
+        calls.append(path)
+        if len(calls) == 2:
+            raise OSError(errno.ENOSPC, "No space left on device", str(path))
+        real(path, *a)
+
+    monkeypatch.setattr(sk, "write_labels", full_disk)
+    rc, err = _run(capsys, argv(3))
+    assert rc == 2 and err == f"urbangen lidar: {out}: no space left on device\n", err
+    assert _tree(out) == before  # no stage, no half sequence, nothing replaced
+    monkeypatch.setattr(sk, "write_labels", real)
+    assert _run(capsys, argv(1))[0] == 0  # a shorter rerun
+    seq = out / "sequences" / "00"
+    assert sorted(p.name for p in (seq / "velodyne").iterdir()) == ["000000.bin"]
+    assert extra.read_bytes() == b"png" and not list(out.glob(".tmp-*"))

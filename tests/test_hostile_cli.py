@@ -149,7 +149,7 @@ def run_refused(capsys, argv: list[str], work: Path) -> str:
     t0 = time.perf_counter()
     rc = cli.main(argv)
     elapsed = time.perf_counter() - t0
-    out, err = capsys.readouterr()
+    _, err = capsys.readouterr()
     assert "Traceback" not in err, err
     assert rc == 2, (rc, argv[:8], err)
     assert err.endswith("\n") and err.count("\n") == 1, err

@@ -94,6 +94,6 @@ def run(args: argparse.Namespace) -> int:
     t = info["totals"]
     log.info("wrote %s: %d objects, %d triangles, routes %s m", out, t["objects"], t["triangles"],
              ", ".join(f"{r['length_m']:.0f}" for r in info["routes"]))
-    for path in files.values():
-        print(path)
+    for written in files.values():
+        print(written)
     return 0

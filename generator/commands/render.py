@@ -20,7 +20,6 @@ from generator.commands.options import Integer, path, shown, text_path
 from generator.commands.preflight import os_reason, output_dir
 from generator.errors import UserError
 from generator.jobs.executors import EXECUTORS, make_jobs, run_jobs
-from generator.jobs.images import image_name
 from generator.jobs.plan import (MAX_FRAME_INDEX, MAX_FRAMES, MAX_WORKERS, check_free_space, check_plan, check_workers,
                                  image_bytes, make_plan)
 from generator.jobs.variants import parse_combos
