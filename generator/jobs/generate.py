@@ -58,8 +58,9 @@ def lidar_done(out: Path, plan: Plan, spec) -> bool:
     meta = out / "lidar" / "sequences" / plan.sequence / "lidar_meta.json"
     if not os.path.lexists(meta):
         return False
+    n = len(plan.frames)  # the metadata grows with the scans (~2 KB and ~200 values each): budget by the plan
     try:
-        m = load_json(meta, max_bytes=MAX_METADATA_BYTES, max_nodes=1_000_000)
+        m = load_json(meta, max_bytes=MAX_METADATA_BYTES + n * 16 * 1024, max_nodes=100_000 + n * 2_000)
     except UserError:  # damaged: it is cast again
         return False
     scene = m.get("scene") if isinstance(m, dict) else None
