@@ -22,10 +22,10 @@ Exposure. The camera meters the scene it sees, ``m = metered * 2**radiance_scale
 ``ev = AE_STRENGTH * log2(REFERENCE_LUMINANCE / m) + ev_comp`` and gets it clamped to
 ``[EV_MIN, ev_max]``; the factor on the rendered radiance is
 ``E = KEY / REFERENCE_LUMINANCE * 2**(ev + radiance_scale_ev)``. EV 0 is the exposure of a
-clear day (log-average luminance :data:`REFERENCE_LUMINANCE`), so a clear day's mid grey
-lands on :data:`KEY`. The camera may darken a bright scene a lot (fog: about -1.9 EV) but
-brighten a dark one only up to ``ev_max`` (exposure time and gain run out), so night stays
-dark and a foggy day does not wash out.
+clear day (metered luminance :data:`REFERENCE_LUMINANCE`), so a clear day's mid grey lands on
+:data:`KEY`. The camera may darken a bright scene a lot (the default town's day fog: -1.4 EV)
+but brighten a dark one only up to ``ev_max`` (exposure time and gain run out): the renders'
+night (+1.7..1.9 EV, gain 3..4) stays dark and a foggy day does not wash out.
 
 Gain. Up to ``EV_BASE_GAIN`` the camera changes its exposure time at base gain (G = 1);
 above it, it raises the gain, ``G = 2**(ev - EV_BASE_GAIN)``. Photo-electrons behind an output
