@@ -89,6 +89,39 @@ def render_time(passes: dict, w: int, h: int) -> tuple[float | None, str]:
     return None, "no dataset"
 
 
+def bench_resolution(rgb: np.ndarray, depth: np.ndarray, render: tuple[float | None, str], repeat: int) -> None:
+    """Print the table of one resolution."""
+    h, w = depth.shape
+    p = cm.draw_params(stream(0, "frame", 0, "camera_model", "day", "clear"), "day")
+    expo = cm.meter(rgb, p)
+    out, rec = cm.apply_camera(rgb, p, np.random.default_rng(0))
+    vig = np.float32(expo["exposure"]) * cm.vignetting_map(h, w, p.vignetting)
+    rows = [
+        ("baseline: copy", timed(lambda: rgb.copy(), repeat)),
+        ("baseline: tonemap (8-bit, model off)", timed(lambda: tonemap(rgb), repeat)),
+        ("baseline: fog post", timed(lambda: fog_image(rgb, depth, 150.0, "day"), repeat)),
+        ("  meter", timed(lambda: cm.meter(rgb, p), repeat)),
+        ("  psf", timed(lambda: cm.psf(rgb, p.psf_share), repeat)),
+        ("  chromatic aberration", timed(lambda: cm.chromatic_aberration(rgb, p.ca_scale), repeat)),
+        ("  vignetting x exposure", timed(lambda: rgb * (np.float32(expo["exposure"])
+                                                      * cm.vignetting_map(h, w, p.vignetting))[..., None], repeat)),
+        ("  noise", timed(lambda: cm.sensor_noise(rgb * vig[..., None], expo["gain"], p.full_well_e, p.read_noise_e,
+                                                   np.random.default_rng(0)), repeat)),
+        ("  crf to 8-bit", timed(lambda: crf_8bit(out, rec["crf"]), repeat)),
+    ]
+    model = timed(lambda: crf_8bit(cm.apply_camera(rgb, p, np.random.default_rng(0))[0], rec["crf"]), repeat)
+    rows.append(("camera model total (apply_camera + crf)", model))
+    secs, how = render
+    print(f"\n{w}x{h}   RGB render: {f'{secs:.1f} s ({how})' if secs else how}")
+    print(f"{'stage':42s} {'ms':>9s} {'% of render':>12s}")
+    for name, s in rows:
+        share = f"{100 * s / secs:11.2f}%" if secs else f"{'-':>12s}"
+        print(f"{name:42s} {1000 * s:9.1f} {share}")
+    if secs:
+        extra = model - rows[1][1]
+        print(f"{'model minus the tonemap it replaces':42s} {1000 * extra:9.1f} {100 * extra / secs:11.2f}%")
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("datasets", nargs="*", type=Path, help="dataset folders with images/*.json (rgb_pass timings)")
@@ -98,35 +131,7 @@ def main(argv=None) -> int:
     print(f"source: {'dataset day image' if image else 'synthetic street'}; repeat {args.repeat} (median)")
     for w, h in RESOLUTIONS:
         rgb, depth = (resize(image[0], h, w), resize(image[1], h, w)) if image else synthetic(h, w)
-        g = stream(0, "frame", 0, "camera_model", "day", "clear")
-        p = cm.draw_params(g, "day")
-        expo = cm.meter(rgb, p)
-        out, rec = cm.apply_camera(rgb, p, np.random.default_rng(0))
-        rows = [
-            ("baseline: copy", timed(lambda: rgb.copy(), args.repeat)),
-            ("baseline: tonemap (8-bit, model off)", timed(lambda: tonemap(rgb), args.repeat)),
-            ("baseline: fog post", timed(lambda: fog_image(rgb, depth, 150.0, "day"), args.repeat)),
-            ("  meter", timed(lambda: cm.meter(rgb, p), args.repeat)),
-            ("  psf", timed(lambda: cm.psf(rgb, p.psf_share), args.repeat)),
-            ("  chromatic aberration", timed(lambda: cm.chromatic_aberration(rgb, p.ca_scale), args.repeat)),
-            ("  vignetting x exposure", timed(lambda: rgb * (np.float32(expo["exposure"])
-                                                          * cm.vignetting_map(h, w, p.vignetting))[..., None],
-                                              args.repeat)),
-            ("  noise", timed(lambda: cm.sensor_noise(rgb, expo["gain"], p.full_well_e, p.read_noise_e,
-                                                       np.random.default_rng(0)), args.repeat)),
-            ("  crf to 8-bit", timed(lambda: crf_8bit(out, rec["crf"]), args.repeat)),
-        ]
-        model = timed(lambda: crf_8bit(cm.apply_camera(rgb, p, np.random.default_rng(0))[0], rec["crf"]), args.repeat)
-        rows.append(("camera model total (apply_camera + crf)", model))
-        render, how = render_time(passes, w, h)
-        print(f"\n{w}x{h}   RGB render: {'%.1f s (%s)' % (render, how) if render else how}")
-        print(f"{'stage':42s} {'ms':>9s} {'% of render':>12s}")
-        for name, s in rows:
-            share = f"{100 * s / render:11.2f}%" if render else f"{'-':>12s}"
-            print(f"{name:42s} {1000 * s:9.1f} {share}")
-        if render:
-            extra = model - timed(lambda: tonemap(rgb), args.repeat)
-            print(f"{'model minus the tonemap it replaces':42s} {1000 * extra:9.1f} {100 * extra / render:11.2f}%")
+        bench_resolution(rgb, depth, render_time(passes, w, h), args.repeat)
     return 0
 
 

@@ -8,6 +8,7 @@ RGB)), then one Blender render of a day and a night (``-m blender``).
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import json
 
 import numpy as np
@@ -28,9 +29,9 @@ NIGHT_RATIO_LINEAR = 0.35
 
 def _params(**kw) -> cm.CameraParams:
     """A camera with every effect off (override what a test looks at)."""
-    base = dict(time_of_day="day", radiance_scale_ev=0.0, ev_comp=0.0, ev_max=2.0, psf_share=0.0, vignetting=0.0,
-                ca_scale=0.0, full_well_e=1e12, read_noise_e=0.0,
-                crf={"contrast": 1.3, "shoulder": 0.98, "white": 10.0, "mid_in": 0.18, "mid_out": 0.18})
+    base = {"time_of_day": "day", "radiance_scale_ev": 0.0, "ev_comp": 0.0, "ev_max": 2.0, "psf_share": 0.0,
+            "vignetting": 0.0, "ca_scale": 0.0, "full_well_e": 1e12, "read_noise_e": 0.0,
+            "crf": {"contrast": 1.3, "shoulder": 0.98, "white": 10.0, "mid_in": 0.18, "mid_out": 0.18}}
     return cm.CameraParams(**{**base, **kw})
 
 
@@ -154,9 +155,9 @@ def test_noise_variance_grows_as_exposure_falls():
     p = _params(full_well_e=8000.0, read_noise_e=4.0)
     rel = []
     for L in (0.64, 0.16, 0.04, 0.01):
-        out, rec = cm.apply_camera(np.full((200, 200, 3), L, np.float32), p, np.random.default_rng(1))
+        out, _ = cm.apply_camera(np.full((200, 200, 3), L, np.float32), p, np.random.default_rng(1))
         rel.append(float(out.var() / out.mean() ** 2))
-    assert all(a < b for a, b in zip(rel, rel[1:])), rel
+    assert all(a < b for a, b in itertools.pairwise(rel)), rel
     # The photon + read noise model: var = G s / Q + (G r / Q)^2 at any output level s.
     s, gain = np.full((400, 400), 0.2, np.float32), 4.0
     noisy = cm.sensor_noise(s, gain, 8000.0, 4.0, np.random.default_rng(2))
@@ -307,11 +308,11 @@ def test_off_is_bit_identical_to_no_camera_model(written, test_spec, tod, kind):
     assert display_rgb(post, None).tobytes() == tonemap(post).tobytes()
 
 
-def test_off_keeps_the_config_hash_of_a_config_without_the_switch(tmp_path):
+def test_off_keeps_the_config_hash_of_a_config_without_the_switch(tmp_path, root):
     from generator.spec.render import load_render_config
 
-    text = (cm.__file__.rsplit("/generator/", 1)[0] + "/render_configs/test.yaml")
-    lines = [ln for ln in open(text).read().splitlines() if not ln.startswith("camera_model")]
+    text = (root / "render_configs" / "test.yaml").read_text()
+    lines = [ln for ln in text.splitlines() if not ln.startswith("camera_model")]
     (tmp_path / "old.yaml").write_text("\n".join(lines) + "\n")
     old, new = load_render_config(tmp_path / "old.yaml"), load_render_config("test")
     assert old.camera_model is False and new.config_hash == old.config_hash
