@@ -33,7 +33,7 @@ ALLOWED: dict[str, set[str]] = {
     "postfx": {"weather"},
     "imaging": {"labels", "spec", "weather"},
     "formats": {"geometry", "labels", "spec", "world"},
-    "previews": {"imaging", "labels", "weather", "world"},
+    "previews": {"imaging", "labels", "postfx", "weather", "world"},
     "remission": {"formats", "labels", "materials", "spec"},
     "stats": {"formats", "imaging", "labels", "previews", "weather"},
     "scan_effects": {"labels", "remission", "spec", "weather"},

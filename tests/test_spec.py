@@ -62,6 +62,13 @@ BAD = [
     ({"lidar": {"intensity_model": "foo"}}, "lidar.intensity_model: must be one of"),
     ({"town": 5}, "town: must be an object, got 5"),
     ({"paths": {"speed_mps": 0}}, "paths.speed_mps: must be a number in (0, 40]"),
+    # the newer street families (issue 13) and the stereo stream (issue 15)
+    ({"density": {"riders_per_km": -1}}, "density.riders_per_km: must be a number in [0, 200], got -1"),
+    ({"density": {"trams": 1.5}}, "density.trams: must be an integer in [0, 20], got 1.5"),
+    ({"density": {"walls": 2}}, "density.walls: must be a number in [0, 1], got 2"),
+    ({"density": {"street_objects_per_100m": "many"}}, "density.street_objects_per_100m: must be a number"),
+    ({"sensors": {"stereo": {"baseline_m": 0}}}, "sensors.stereo.baseline_m: must be a number in [0.05, 2.0], got 0"),
+    ({"sensors": {"stereo": {"every": 0}}}, "sensors.stereo.every: must be an integer in [1, 1000], got 0"),
 ]
 
 

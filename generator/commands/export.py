@@ -2,7 +2,8 @@
 
 Writes the images of a generated dataset (DIR/images/*.exr and their metadata JSON) in the
 Cityscapes layout under OUT: leftImg8bit/<split>/<city>/<city>_<seq>_<frame>_leftImg8bit.png
-(the preview's tone mapping, 8-bit sRGB) and gtFine/<split>/<city>/..._gtFine_labelIds.png,
+(8-bit sRGB as the preview shows it: the camera model's response curve, or the
+fixed tone mapping for images made without the model) and gtFine/<split>/<city>/..._gtFine_labelIds.png,
 _instanceIds.png (label id x 1000 + k for person, rider and vehicles), _labelTrainIds.png and
 _color.png. The weather x time variant of an image is its city (urbangen-day-clear,
 urbangen-night-rain-fog, ...), so the 12 variants of a frame keep distinct names; <seq> is the
@@ -69,7 +70,7 @@ def run(args) -> int:
     from generator.progress import progress
 
     from generator.imaging.exr import read_exr
-    from generator.previews.preview import tonemap
+    from generator.previews.preview import camera_model_of, display_rgb
 
     input_dir(args.dataset, what="dataset folder")
     output_dir(args.out, "OUT")
@@ -88,8 +89,8 @@ def run(args) -> int:
         for exr, (frame, time_of_day, weather) in progress(list(zip(exrs, metas)), desc="export cityscapes",
                                                            unit="image"):
             im = read_exr(exr)
-            yield CityscapesImage(str(exr), city_name(time_of_day, weather), seq, frame, tonemap(im.rgb), im.class_id,
-                                  im.instance)
+            yield CityscapesImage(str(exr), city_name(time_of_day, weather), seq, frame,
+                                  display_rgb(im.rgb, camera_model_of(exr)), im.class_id, im.instance)
 
     written = export(images(), args.out, args.split, planned)
     cities = sorted({c for c, _ in planned})

@@ -20,7 +20,7 @@ from generator.errors import UserError
 from generator.jobs.plan import MAX_FRAME_INDEX
 from generator.previews.contact_sheet import variants_sheet
 from generator.imaging.exr import read_exr
-from generator.previews.preview import colorize, side_by_side, tonemap
+from generator.previews.preview import camera_model_of, colorize, display_rgb, side_by_side
 from generator.labels import class_table
 
 PREFERRED = ("day_clear", "night_clear")
@@ -107,7 +107,7 @@ def _sheets(root: Path, k: int, paths: list[Path], out: Path) -> None:
     pick = next((p for pref in PREFERRED for p in paths if p.stem.endswith(pref)), paths[0])
     img = read_exr(pick)
     h = max(img.class_id.shape[0], MIN_HEIGHT)
-    panels = [_height(tonemap(img.rgb), h, True), _height(colorize(img.class_id), h, False)]
+    panels = [_height(display_rgb(img.rgb, camera_model_of(pick)), h, True), _height(colorize(img.class_id), h, False)]
     bev = _bev(root, k, h)
     if bev is not None:
         panels.append(bev)

@@ -48,7 +48,7 @@ def run(args) -> int:
             problems += mod.verify(data)
         sections.append(mod.section(data))
     if not sections:
-        raise UserError(f"{root}: no dataset found (expected images/*.json)")
+        raise UserError(f"{root}: no dataset found (expected images/*.json or LiDAR sequences)")
     if problems:
         for line in problems:
             print(f"urbangen stats: {line}", file=sys.stderr)

@@ -23,6 +23,12 @@ def resolve_ids(cls: str | int, material: str | int) -> tuple[int, int]:
     return c, m
 
 
+_UNIT_BOX_VERTICES = np.array([[0, 0, 0], [0, 0, 1], [0, 1, 0], [0, 1, 1], [1, 0, 0], [1, 0, 1], [1, 1, 0], [1, 1, 1]],
+                              np.float64)
+_UNIT_BOX_FACES = np.array([[1, 3, 0], [4, 1, 0], [0, 3, 2], [2, 4, 0], [1, 7, 3], [5, 1, 4], [5, 7, 1], [3, 7, 2],
+                            [6, 4, 2], [2, 7, 6], [6, 5, 4], [7, 5, 6]], np.int64)
+
+
 def box(size: tuple[float, float, float], cls: str | int, material: str | int,
         center: tuple[float, float, float] = (0.0, 0.0, 0.0), bottom: bool = True) -> Mesh:
     """An axis-aligned box of ``size`` (x, y, z) metres centred on ``center``.
@@ -30,13 +36,16 @@ def box(size: tuple[float, float, float], cls: str | int, material: str | int,
     ``bottom=False`` leaves out the two bottom triangles (boxes resting on the ground
     need no hidden floor).
     """
-    tm = trimesh.creation.box(extents=size)
-    faces = tm.faces
+    # trimesh's unit box, vertex and face order kept (towns built before stay byte-identical),
+    # without building a Trimesh (normals, caches): the town builds ~15k boxes
+    vertices = _UNIT_BOX_VERTICES - 0.5
+    vertices *= np.asarray(size, dtype=np.float64)
+    faces = _UNIT_BOX_FACES
     if not bottom:
-        centroids_z = tm.vertices[faces].mean(1)[:, 2]
+        centroids_z = vertices[faces].mean(1)[:, 2]
         faces = faces[centroids_z > -size[2] / 2 + 1e-9]
     c, m = resolve_ids(cls, material)
-    return Mesh(tm.vertices + np.asarray(center, float), faces, c, m)
+    return Mesh(vertices + np.asarray(center, float), faces, c, m)
 
 
 def slab(x0: float, y0: float, x1: float, y1: float, z0: float, z1: float, cls: str | int,

@@ -62,7 +62,7 @@ def class_pixels(class_id: np.ndarray) -> dict[str, int]:
 
 def image_metadata(*, image: str, files: dict, frame, k: np.ndarray, width: int, height: int, hfov_deg: float,
                    class_id: np.ndarray, time_of_day: str, weather: dict, lighting: dict, spec, render_cfg,
-                   device: str, timings: dict, blender_version: str | None) -> dict:
+                   device: str, timings: dict, blender_version: str | None, camera_model: dict | None = None) -> dict:
     """The metadata record of one image.
 
     Parameters
@@ -72,10 +72,13 @@ def image_metadata(*, image: str, files: dict, frame, k: np.ndarray, width: int,
         Intrinsics.
     class_id : (H, W) uint8
         The label map (masks) of the image.
+    camera_model : dict, optional
+        The camera model's record (:func:`generator.postfx.camera.apply_camera`); None when
+        the model is off, and then the record has no ``camera_model`` section (as before it).
     """
     T = frame.T_world_camera
     jit = frame.camera_jitter
-    return {
+    record = {
         "metadata_version": METADATA_VERSION,
         "image": image,
         "files": files,
@@ -105,6 +108,9 @@ def image_metadata(*, image: str, files: dict, frame, k: np.ndarray, width: int,
         "timings_s": {key: round(float(v), 4) for key, v in timings.items()},
         "software": software_versions(blender_version),
     }
+    if camera_model is not None:
+        record["camera_model"] = camera_model
+    return record
 
 
 def validate_metadata(record: dict) -> list[str]:

@@ -23,8 +23,12 @@ def image_name(frame_index: int, time_of_day: str = "day", weather: str = "clear
 
 
 def write_image(out: Path, frame, spec, cfg, renderer, rendered, time_of_day: str, weather: dict,
-                rgb=None, name: str | None = None) -> tuple[str, dict]:
+                rgb=None, name: str | None = None, camera: dict | None = None) -> tuple[str, dict]:
     """Write one image variant (``rgb`` overrides the rendered RGB, e.g. after fog in post).
+
+    ``camera`` is the camera model's record (:func:`generator.jobs.variants.camera_post`):
+    it goes into the metadata, and the preview shows the camera's 8-bit output; None (the
+    model off) writes the files as before the model existed.
 
     Returns
     -------
@@ -43,7 +47,8 @@ def write_image(out: Path, frame, spec, cfg, renderer, rendered, time_of_day: st
     record = image_metadata(image=name, files=files, frame=frame, k=renderer.k, width=cfg.width, height=cfg.height,
                             hfov_deg=spec.sensors.camera.hfov_deg, class_id=lab.class_id, time_of_day=time_of_day,
                             weather=weather, lighting=rendered.lighting, spec=spec, render_cfg=cfg,
-                            device=renderer.device, timings=planned, blender_version=renderer.blender_version)
+                            device=renderer.device, timings=planned, blender_version=renderer.blender_version,
+                            camera_model=camera)
     problems = validate_metadata(record)
     if problems:
         raise RuntimeError(f"metadata of {name} does not match its schema: {problems[0]}")
@@ -53,7 +58,7 @@ def write_image(out: Path, frame, spec, cfg, renderer, rendered, time_of_day: st
     secs["exr_write"] = time.perf_counter() - t
     if cfg.preview:
         t = time.perf_counter()
-        write_preview(folder / f"{name}_preview.png", rgb, lab.class_id, lab.depth)
+        write_preview(folder / f"{name}_preview.png", rgb, lab.class_id, lab.depth, camera_model=camera)
         secs["preview"] = time.perf_counter() - t
     t = time.perf_counter()
     record["timings_s"] = {key: round(float(v), 4) for key, v in secs.items()}

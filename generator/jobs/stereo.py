@@ -10,8 +10,14 @@ camera 3 ``baseline_m`` to its right, no jitter), so ``P2 @ Tr`` of the sequence
 ``semantic_2/NNNNNN.png``      Cityscapes label id per pixel, uint8 (KITTI semantics layout)
 ``passes_2/NNNNNN.exr``        the dataset EXR: linear RGB, one mask per native class,
                                depth (metres along the ray) and instance ids
-``passes_2/NNNNNN.json``       exposure time, camera pose (world), intrinsics, weather
+``passes_2/NNNNNN.json``       exposure time, camera pose (world), intrinsics, weather (and
+                               the camera model's record when it is on)
 ============================== ===========================================================
+
+Camera model (render config ``camera_model: true``): both cameras of the pair are one camera
+model (one draw from ``("frame", k, "camera_model", time, weather, "stereo")``), exposed as the
+left camera meters (a synchronised rig), each with its own sensor noise; ``image_2|3`` are the
+response curve of their EXR RGB. Off: the fixed tone mapping, as before.
 
 Exposure: KITTI triggers its cameras when the spinning LiDAR faces forward; here the pair
 is exposed at the sweep start plus the firing time of the column looking along +x
@@ -30,9 +36,9 @@ from PIL import Image
 
 from generator.atomic import atomic_path, write_json
 from generator.imaging.exr import LabelledImage, write_exr
-from generator.jobs.variants import weather_post
+from generator.jobs.variants import camera_post, weather_post
 from generator.labels import class_table
-from generator.previews.preview import tonemap
+from generator.previews.preview import display_rgb
 from generator.rng import child_seed
 from generator.weather import draw_lighting, frame_wetness, is_wet, lidar_combination
 
@@ -97,24 +103,31 @@ def render_pair(renderer, spec, cfg, rig, sensor, index: int, seq_dir: Path) -> 
     lighting = renderer.set_conditions(light, wetness, puddles)
     to_cs = class_table().to_cityscapes
     stem = f"{index:06d}"
-    images = {}
+    images, exposure = {}, None
     for cam in CAMERAS:
         T_world_camera = T_world_ego @ rig.T_ego_stereo(cam)
         renderer.place_camera(T_world_camera)
         labels = renderer.render_labels()
         rgb, _ = renderer.render_rgb(seed=child_seed(spec.seed, "frame", index, "stereo", cam))
         img, weather = weather_post(spec, index, tod, kind, rgb, labels.depth, renderer.k, ("stereo", cam))
+        img, camera = camera_post(spec, cfg, index, tod, kind, img, ("stereo",), (cam,), exposure)
+        if camera is not None:
+            camera["exposure_from"] = f"image_{CAMERAS[0]}"
+            exposure = camera["exposure"]
         write_exr(seq_dir / f"passes_{cam}" / f"{stem}.exr",
                   LabelledImage(img, labels.class_id, labels.instance, labels.depth,
                                 {"urbangen.image": f"image_{cam}/{stem}"}), cfg.exr_codec)
-        write_json(seq_dir / f"passes_{cam}" / f"{stem}.json", {
+        record = {
             "image": f"image_{cam}/{stem}.png", "camera": cam, "scan": index, "time_s": t_exp,
             "exposure_offset_s": t_exp - rig.frame(index).t, "T_world_camera": T_world_camera.tolist(),
             "K": renderer.k.tolist(), "width": cfg.width, "height": cfg.height, "time_of_day": tod,
             "weather": weather, "lighting": {k: v for k, v in lighting.items() if k != "light_objects"},
-            "seed": spec.seed, "spec_hash": spec.spec_hash})
+            "seed": spec.seed, "spec_hash": spec.spec_hash}
+        if camera is not None:
+            record["camera_model"] = camera
+        write_json(seq_dir / f"passes_{cam}" / f"{stem}.json", record)
         _png(seq_dir / f"semantic_{cam}" / f"{stem}.png", to_cs[labels.class_id])
-        images[cam] = tonemap(img)
+        images[cam] = display_rgb(img, camera)
     for cam in CAMERAS:  # the images last: image_3 present means the pair is complete
         _png(seq_dir / f"image_{cam}" / f"{stem}.png", images[cam])
     return {"stereo_s": time.perf_counter() - t0}

@@ -2,8 +2,10 @@
 
 Per frame: the label passes once (masks, instances and depth are shared by every
 variant); one RGB render per (time of day, dry | wet); then fog and rain in
-post-processing from the depth pass (seed 003 Sec. III.A). The 12 combinations of
-Table II therefore cost 4 RGB renders, and a frame's variants differ only in RGB.
+post-processing from the depth pass (seed 003 Sec. III.A), then the camera model when the
+render config turns it on (:func:`camera_post`: the camera sees the foggy, rainy scene). The
+12 combinations of Table II therefore cost 4 RGB renders, and a frame's variants differ only
+in RGB.
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from generator.postfx.camera import apply_camera, draw_params
 from generator.postfx.fog import fog_image
 from generator.postfx.rain import rain_image
 from generator.jobs.images import write_image
@@ -78,6 +81,39 @@ def weather_post(spec, frame_index: int, time_of_day: str, kind: str, rgb: np.nd
     return img, params
 
 
+def camera_post(spec, cfg, frame_index: int, time_of_day: str, kind: str, rgb: np.ndarray,
+                stream_tag: tuple = (), noise_tag: tuple = (), exposure: dict | None = None) -> tuple[np.ndarray, dict | None]:
+    """The camera model (:mod:`generator.postfx.camera`) on one image after its fog and rain.
+
+    Off (``cfg.camera_model`` false) it returns ``rgb`` itself and None: the image is written
+    exactly as before the model existed.
+
+    Parameters
+    ----------
+    rgb : (H, W, 3) float32
+        Linear radiance after :func:`weather_post`.
+    stream_tag : tuple
+        Extra names of the camera's stream (``("stereo",)``: both cameras of a pair share one camera).
+    noise_tag : tuple
+        Extra names of a separate noise stream (each camera of a pair has its own sensor noise).
+    exposure : dict, optional
+        Use this exposure (a record's ``exposure``) instead of metering: a stereo pair is exposed
+        as its left camera meters.
+
+    Returns
+    -------
+    ((H, W, 3) float32, dict or None)
+        The EXR RGB and the ``camera_model`` section of the image's metadata (None when off).
+    """
+    if not cfg.camera_model:
+        return rgb, None
+    g = stream(spec.seed, "frame", frame_index, "camera_model", time_of_day, kind, *stream_tag)
+    params = draw_params(g, time_of_day)
+    if noise_tag:
+        g = stream(spec.seed, "frame", frame_index, "camera_model", time_of_day, kind, *stream_tag, *noise_tag, "noise")
+    return apply_camera(rgb, params, g, exposure)
+
+
 def render_frame(renderer, spec, cfg, frame, out: Path, combos: list[tuple[str, str]]) -> dict[str, dict]:
     """Render and write every variant in ``combos`` of ``frame``.
 
@@ -102,8 +138,12 @@ def render_frame(renderer, spec, cfg, frame, out: Path, combos: list[tuple[str, 
             img, params = weather_post(spec, frame.index, tod, kind, rgb, labels.depth, renderer.k)
             post_s = time.perf_counter() - t
             secs = {"rgb_pass": rgb_s, "label_passes_shared": label_s, "post_fx": post_s}
+            t = time.perf_counter()
+            img, camera = camera_post(spec, cfg, frame.index, tod, kind, img)
+            if camera is not None:
+                secs["camera_model"] = time.perf_counter() - t
             rendered = _Rendered(labels, info, secs)
-            name, written = write_image(out, frame, spec, cfg, renderer, rendered, tod, params, rgb=img)
+            name, written = write_image(out, frame, spec, cfg, renderer, rendered, tod, params, rgb=img, camera=camera)
             timings[name] = written
     return timings
 

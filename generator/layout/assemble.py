@@ -47,6 +47,8 @@ STEPS = (
     ("traffic signs", lambda p, s, g, lots, st: ps.place_signs(p, s, st)),
     ("lot greenery", lambda p, s, g, lots, st: pl.place_lot_greenery(p, s, lots, g.curb_h)),
     ("parked vehicles", lambda p, s, g, lots, st: ps.place_parked(p, s, st)),
+    # trams need a whole free lane: before the lane cars (a no-op at the default trams = 0)
+    ("trams", lambda p, s, g, lots, st: px.place_trams(p, s, st)),
     ("lane cars", lambda p, s, g, lots, st: ps.place_lane_cars(p, s, st)),
     ("people", lambda p, s, g, lots, st: ps.place_people(p, s, st)),
     # families added later: placed last, each from its own stream, density 0 by default
@@ -54,7 +56,6 @@ STEPS = (
     ("bike racks", lambda p, s, g, lots, st: px.place_bike_racks(p, s, st)),
     ("two-wheelers", lambda p, s, g, lots, st: px.place_two_wheelers(p, s, st)),
     ("bus stops", lambda p, s, g, lots, st: px.place_bus_stops(p, s, st)),
-    ("trams", lambda p, s, g, lots, st: px.place_trams(p, s, st)),
     ("other vehicles", lambda p, s, g, lots, st: px.place_other_vehicles(p, s, st)),
     ("riders", lambda p, s, g, lots, st: px.place_riders(p, s, st)),
     ("lot extras", lambda p, s, g, lots, st: px.place_lot_extras(p, s, lots, st)),

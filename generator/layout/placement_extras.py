@@ -236,10 +236,16 @@ def place_other_vehicles(placer: Placer, spec: SceneSpec, st: Street) -> None:
                              {"color": vehicle_color(g), "placement": "parked" if fits else "lane"}, pad=0.2)
 
 
+def _in_rects(x: float, y: float, rects: np.ndarray, pad: float = 1.0) -> bool:
+    return bool(((x > rects[:, 0] - pad) & (x < rects[:, 2] + pad) & (y > rects[:, 1] - pad)
+                 & (y < rects[:, 3] + pad)).any())
+
+
 def place_lot_extras(placer: Placer, spec: SceneSpec, lots: list[Lot], st: Street) -> None:
     """Walls along bare lot fronts, driveway aprons across the sidewalk, gravel in parks and yards."""
     dens = spec.density
     g = stream(spec.seed, "layout", "lot_extras")
+    lanes = st.grid.drivable_rects()
     for lot in lots:
         if dens.walls > 0 and g.random() < dens.walls:
             length = lot.width - 1.0
@@ -255,7 +261,9 @@ def place_lot_extras(placer: Placer, spec: SceneSpec, lots: list[Lot], st: Stree
             if depth < grid.parking_w:
                 a = float(np.clip(lot.entrance_a + g.uniform(2.5, 4.0), -lot.width / 2 + 3, lot.width / 2 - 3))
                 b = -(grid.corridor_half - grid.road_half) - depth / 2
-                placer.try_place(apron, *lot.to_world([(a, b)])[0], 0.0, lot.yaw - np.pi / 2, {"lot": lot.index})
+                x, y = lot.to_world([(a, b)])[0]
+                if not _in_rects(x, y, lanes):  # not where turning cars run at the segment ends
+                    placer.try_place(apron, x, y, 0.0, lot.yaw - np.pi / 2, {"lot": lot.index})
         if lot.use in ("park", "yard") and dens.gravel > 0 and g.random() < dens.gravel:
             patch = placer.lib.variant("gravel_patch", int(g.integers(N_VAR)))
             a, b = g.uniform(-lot.width / 4, lot.width / 4), g.uniform(lot.depth / 4, 3 * lot.depth / 4)

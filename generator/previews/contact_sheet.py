@@ -9,7 +9,7 @@ from PIL import Image, ImageDraw
 
 from generator.atomic import atomic_path
 from generator.imaging.exr import read_exr
-from generator.previews.preview import colorize, tonemap
+from generator.previews.preview import camera_model_of, colorize, display_rgb
 from generator.weather import KINDS, TIMES
 
 
@@ -42,7 +42,7 @@ def variants_sheet(images_dir: str | Path, frame: int, out_png: str | Path, scal
             img = read_exr(path)
             if label_tile is None:
                 label_tile = _caption(colorize(img.class_id), "labels (shared by all variants)")
-            tiles.append(_caption(tonemap(img.rgb), f"{tod} / {kind}"))
+            tiles.append(_caption(display_rgb(img.rgb, camera_model_of(path)), f"{tod} / {kind}"))
             names.append(name)
         rows.append(tiles)
     if not names:

@@ -1,7 +1,13 @@
-"""Preview PNGs: tone-mapped RGB beside the colourised labels (and optional extra panels)."""
+"""Preview PNGs: tone-mapped RGB beside the colourised labels (and optional extra panels).
+
+Every 8-bit view of an image's RGB goes through :func:`display_rgb`: the camera's response
+curve when the camera model made the image (its metadata has a ``camera_model`` section),
+else the fixed-exposure :func:`tonemap` every image had before the model.
+"""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -9,6 +15,7 @@ from PIL import Image, ImageDraw
 
 from generator.atomic import atomic_path
 from generator.labels import class_table
+from generator.postfx.camera_crf import crf_8bit
 
 EXPOSURE = 1.6
 
@@ -22,6 +29,32 @@ def tonemap(rgb: np.ndarray, exposure: float = EXPOSURE) -> np.ndarray:
     x = x / (1.0 + x)
     srgb = np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1 / 2.4) - 0.055)
     return (np.clip(srgb, 0, 1) * 255 + 0.5).astype(np.uint8)
+
+
+def display_rgb(rgb: np.ndarray, camera_model: dict | None = None) -> np.ndarray:
+    """(H, W, 3) linear RGB -> uint8 sRGB as the image's camera shows it.
+
+    Parameters
+    ----------
+    rgb : (H, W, 3) float
+        The EXR RGB (or the array written into it).
+    camera_model : dict, optional
+        The image metadata's ``camera_model`` section: its response curve maps the (already
+        exposed) RGB. None or absent (the model off, or a dataset from before it): :func:`tonemap`.
+    """
+    if camera_model and camera_model.get("enabled"):
+        return crf_8bit(rgb, camera_model["crf"])
+    return tonemap(rgb)
+
+
+def camera_model_of(exr_path: str | Path) -> dict | None:
+    """The ``camera_model`` section of the metadata JSON beside an EXR (None without one)."""
+    p = Path(exr_path).with_suffix(".json")
+    try:
+        meta = json.loads(p.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return meta.get("camera_model") if isinstance(meta, dict) else None
 
 
 def colorize(class_id: np.ndarray) -> np.ndarray:
@@ -60,9 +93,10 @@ def legend(class_ids: np.ndarray, width: int) -> np.ndarray:
     return np.asarray(img)
 
 
-def write_preview(path: str | Path, rgb: np.ndarray, class_id: np.ndarray, depth: np.ndarray | None = None) -> None:
-    """Write RGB | labels (| depth) with a class legend below, atomically, as PNG."""
-    panels = [tonemap(rgb), colorize(class_id)]
+def write_preview(path: str | Path, rgb: np.ndarray, class_id: np.ndarray, depth: np.ndarray | None = None,
+                  camera_model: dict | None = None) -> None:
+    """Write RGB | labels (| depth) with a class legend below, atomically, as PNG (RGB: :func:`display_rgb`)."""
+    panels = [display_rgb(rgb, camera_model), colorize(class_id)]
     if depth is not None:
         panels.append(depth_panel(depth))
     top = side_by_side(panels)

@@ -31,6 +31,7 @@ class RenderConfig:
     persistent_data: bool
     exr_codec: str
     preview: bool
+    camera_model: bool = False
     source: str = ""
     config_hash: str = ""
 
@@ -46,6 +47,8 @@ class RenderConfig:
         d = dataclasses.asdict(self)
         d.pop("source")
         d.pop("config_hash")
+        if not d["camera_model"]:  # off = as every config before the model: same hash, same records
+            d.pop("camera_model")
         d["resolution"] = list(d["resolution"])
         return d
 

@@ -84,8 +84,9 @@ def load(root: Path) -> MixData | None:
     """Point and pixel counts of the dataset at ``root`` (None when it has neither scans nor images)."""
     root = Path(root)
     points, scans = np.zeros(20, np.int64), 0
-    if (root / "lidar" / "sequences").is_dir():
-        points, scans = count_points(root / "lidar")
+    lidar = root / "lidar" if (root / "lidar" / "sequences").is_dir() else root  # a dataset, or a lidar-only output
+    if (lidar / "sequences").is_dir():
+        points, scans = count_points(lidar)
     pixels, images = np.zeros(256, np.int64), 0
     data = image_stats.load(root)  # the images section's parse of the metadata (classes_present)
     if data is not None:
