@@ -103,10 +103,13 @@ def test_a_bug_is_one_line_exit_70_with_the_traceback_in_a_log(tmp_path, capsys,
     assert rc == 70 and "Traceback" in err and err.rstrip("\n").splitlines()[-1].startswith("urbangen layout: internal")
 
 
-def test_argv_and_messages_with_undecodable_bytes_stay_one_line(tmp_path, capsys):
-    bad = str(tmp_path) + "/\udcff\x1b[2J\nnext"  # what Python makes of invalid UTF-8 in argv, plus controls
-    rc, err = _run(capsys, ["validate", bad])
+def test_argv_and_messages_with_undecodable_bytes_stay_one_line(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    rc, err = _run(capsys, ["validate", "\udcff\x1b[2J\nnext"])  # invalid UTF-8 in argv, as Python sees it
     assert rc == 2 and err.count("\n") == 1 and "\\udcff" in err and "\\x1b" in err and "\\n" in err, err
+    assert "must be a UTF-8 path" in err
+    rc, err = _run(capsys, ["validate", "\x1b[2J\nnext"])  # controls are fine in a name, escaped in messages
+    assert rc == 2 and err == "urbangen validate: \\x1b[2J\\nnext: dataset folder not found\n", err
 
 
 # -- OpenLABEL: whose file may be replaced ----------------------------------------------------------------------

@@ -187,7 +187,7 @@ def test_hostile_numeric_options(capsys, tmp_path_factory, name, flag, action, d
 # -- hostile paths ---------------------------------------------------------------------------------------------
 
 #: Path kinds refused for every role (made inside the example's folder; see :func:`_make`).
-ALWAYS_BAD = ["fifo", "loop", "through_file", "empty", "long", "long_name", "dangling"]
+ALWAYS_BAD = ["fifo", "loop", "through_file", "empty", "long", "long_name", "dangling", "not_utf8"]
 BAD_FOR = {
     "in_file": ALWAYS_BAD + ["missing", "folder", "device"],
     "in_dir": ALWAYS_BAD + ["missing", "file", "device", "empty_folder"],
@@ -245,6 +245,10 @@ def _make(kind: str, work: Path) -> str | None:
         return ""
     if kind == "long":
         return str(junk) + "/" + ("d" * 200 + "/") * 30 + "x"  # 6000 characters
+    if kind == "not_utf8":  # what Python makes of a file name with bytes that are not UTF-8
+        p = os.fsencode(junk) + b"/caf\xe9"
+        os.mkdir(p)
+        return os.fsdecode(p)
     if kind == "long_name":
         return str(junk / ("n" * 300))
     raise AssertionError(kind)

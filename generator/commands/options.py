@@ -145,13 +145,18 @@ def integer_list(lo: int, hi: int):
 
 def path(text: str) -> Path:
     """A path named on the command line: not empty (``''`` would silently mean the working
-    directory), no NUL byte, at most :data:`MAX_PATH_CHARS` characters."""
+    directory), no NUL byte, at most :data:`MAX_PATH_CHARS` characters, valid UTF-8."""
     if not text:
         raise argparse.ArgumentTypeError("must be a path, got an empty string")
     if "\0" in text:
         raise argparse.ArgumentTypeError(f"must be a path, got one with a NUL byte: {shown(text)}")
     if len(text) > MAX_PATH_CHARS:
         raise argparse.ArgumentTypeError(f"path too long ({len(text)} characters; at most {MAX_PATH_CHARS})")
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:  # bytes that are not UTF-8 (Python keeps them as lone surrogates)
+        raise argparse.ArgumentTypeError(f"must be a UTF-8 path (urbangen records paths in its JSON, YAML and "
+                                         f"Markdown outputs), got {shown(text)}") from None
     return Path(text)
 
 
