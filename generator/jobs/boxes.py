@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import logging
+import os
 from pathlib import Path
 
 import numpy as np
@@ -59,6 +60,18 @@ def _sensor(meta: dict, source: str) -> dict:
     return out
 
 
+def _output(root: Path, name: str) -> Path:
+    """``root/openlabel/NN.json``, refusing an ``openlabel`` that is not a folder inside the dataset."""
+    folder = root / "openlabel"
+    try:
+        out = inside(root, "openlabel", f"{name}.json")
+    except (ValueError, RuntimeError, OSError):  # a link leading out, or a loop
+        out = None
+    if out is None or (os.path.lexists(folder) and not folder.is_dir()) or out.is_dir():
+        raise UserError(f"{folder}: must be a folder inside the dataset (not a file, FIFO or link leading out)")
+    return out
+
+
 def write_sequence_openlabel(spec, root: Path, sequence: str = "00", classes=DEFAULT_CLASSES,
                              min_points: int | None = None, scene=None) -> tuple[Path, dict]:
     """Write ``root/openlabel/NN.json`` for ``root/lidar/sequences/NN`` cast from ``spec``.
@@ -80,6 +93,7 @@ def write_sequence_openlabel(spec, root: Path, sequence: str = "00", classes=DEF
     min_points = spec.labels.openlabel_min_points if min_points is None else min_points
     root = Path(root)
     name = sk.sequence_name(sequence)
+    out = _output(root, name)  # where it goes is checked before any work
     seq = sk.Sequence(root / "lidar", name)
     meta_path = seq.dir / "lidar_meta.json"
     meta = md.load_metadata(meta_path)
@@ -122,10 +136,6 @@ def write_sequence_openlabel(spec, root: Path, sequence: str = "00", classes=DEF
                           min_points=min_points, T_ego_lidar=rig.T_ego_lidar,
                           T_ego_camera_nominal=rig.T_ego_camera(), K=K, width=w, height=h,
                           streams=streams, frame_uris=frame_uris, info=info)
-    try:
-        out = inside(root, "openlabel", f"{name}.json")
-    except (ValueError, RuntimeError, OSError):  # openlabel/ is a link leading out, or a loop
-        raise UserError(f"{root / 'openlabel'}: must be a folder inside the dataset (a link leads elsewhere)") from None
     try:
         write_openlabel(out, doc)
     except ValueError as e:  # a bug, not a user error: say so loudly
