@@ -75,6 +75,21 @@ def check_links(root: Path) -> list[str]:
     return problems
 
 
+#: Entries that must be folders when present (``NN`` stands for every sequence).
+FOLDERS = ("images", "lidar", "lidar/sequences", "openlabel", "lidar/sequences/NN", "lidar/sequences/NN/velodyne",
+           "lidar/sequences/NN/labels",
+           "lidar/sequences/NN/native_labels", "lidar/sequences/NN/point_times")
+
+
+def check_layout(root: Path) -> list[str]:
+    """Entries of the dataset layout that exist but are not folders (a file, a FIFO, a broken link)."""
+    seqs = root / "lidar" / "sequences"
+    names = sorted(p.name for p in seqs.iterdir() if p.name.isdigit()) if seqs.is_dir() else []
+    paths = [root / f for f in FOLDERS if "NN" not in f]
+    paths += [root / f.replace("NN", n) for f in FOLDERS if "NN" in f for n in names]
+    return [f"{rel(p, root)}: must be a folder" for p in paths if os.path.lexists(p) and not p.is_dir()]
+
+
 def _image_meta(meta: dict, meta_path: Path, root: Path, img) -> list[str]:
     """What the readers use beyond the schema: pinhole K of the image's size, rigid pose, the EXR beside it."""
     src = rel(meta_path, root)
@@ -170,7 +185,7 @@ def check_manifest(root: Path) -> list[str]:
 
 def validate_dataset(root: Path) -> tuple[list[str], dict]:
     """Every problem of the dataset at ``root`` and how many items were checked."""
-    links = check_links(root)
+    links = check_links(root) + check_layout(root)
     images, n_img = check_images(root)
     lidar, n_scan = check_lidar(root)
     openlabel, n_ol = check_openlabel(root)
