@@ -35,6 +35,7 @@ import yaml
 from generator import safeload
 from generator.errors import SpecError, UserError
 from generator.formats.kitti_calib import rigid_problem
+from generator.formats.semantickitti import MAX_POINT_M, MAX_TRANSLATION_M
 from generator.labels import class_table
 
 TAG_FILE = Path(__file__).resolve().with_name("carla_semantic_tags.yaml")
@@ -160,6 +161,8 @@ def read_frame(path: str | Path) -> np.ndarray:
             out[dest] = np.nan
         elif not np.isfinite(col).all():
             _bad(path, f"{_ALIASES.get(key, (key,))[0]}: has NaN or infinite values")
+        elif key in "xyz" and col.size and np.abs(col).max() > MAX_POINT_M:
+            _bad(path, f"{key}: a coordinate beyond {MAX_POINT_M:.0f} m from the sensor")
         else:
             out[dest] = col
     for key, dest in (("semantic", "tag"), ("instance", "instance")):
@@ -240,6 +243,8 @@ def read_pose_file(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
         problem = rigid_problem(np.array(vals[:12]).reshape(3, 4))
         if problem:
             raise SpecError(src, f"line {i}", f"pose {problem}")
+        if max(abs(vals[3]), abs(vals[7]), abs(vals[11])) > MAX_TRANSLATION_M:
+            raise SpecError(src, f"line {i}", f"translation beyond {MAX_TRANSLATION_M:.0f} m from the first pose")
         rows.append(vals + [np.nan] * (13 - len(vals)))
     if not rows:
         raise SpecError(src, "", "no poses")

@@ -140,7 +140,7 @@ def rigid_problem(T: np.ndarray, tol: float = RIGID_TOL) -> str | None:
     r = np.asarray(T, np.float64)[:3, :3]
     if not np.isfinite(r).all():
         return "is not finite"
-    if np.abs(r @ r.T - np.eye(3)).max() > tol or abs(np.linalg.det(r) - 1.0) > tol:
+    if np.abs(r).max() > 1 + tol or np.abs(r @ r.T - np.eye(3)).max() > tol or abs(np.linalg.det(r) - 1.0) > tol:
         return "rotation part is not a rotation (not orthonormal with determinant +1)"
     return None
 

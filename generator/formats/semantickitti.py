@@ -95,9 +95,22 @@ def write_times(path: str | Path, times: np.ndarray) -> None:
 # pose line, one per time line, finite numbers), one ``UserError`` line naming the file.
 
 
+#: Farthest coordinate a scan point may have, metres from the sensor (LiDARs reach a few hundred).
+MAX_POINT_M = 10_000.0
+#: Farthest a pose in ``poses.txt`` may be from the first one, metres: with points within
+#: :data:`MAX_POINT_M` the whole map stays within the reach of the semantic map's voxel keys.
+MAX_TRANSLATION_M = 40_000.0
+
+
 def read_scan(path: str | Path) -> np.ndarray:
-    """(n, 4) float32 (x, y, z, remission) of a ``.bin`` file (every value finite)."""
-    return safeload.read_array(path, "<f4", 16, finite=True).astype(np.float32, copy=False)
+    """(n, 4) float32 (x, y, z, remission) of a ``.bin`` file: every value finite, coordinates within
+    :data:`MAX_POINT_M` of the sensor."""
+    pts = safeload.read_array(path, "<f4", 16, finite=True).astype(np.float32, copy=False)
+    if pts.size and np.abs(pts[:, :3]).max() > MAX_POINT_M:
+        first = int(np.flatnonzero((np.abs(pts[:, :3]) > MAX_POINT_M).any(axis=1))[0])
+        raise UserError(f"{safeload.printable(path)}: record {first}: a coordinate beyond {MAX_POINT_M:.0f} m "
+                        "from the sensor")
+    return pts
 
 
 def read_labels(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
@@ -126,8 +139,13 @@ def _known_raw_ids() -> np.ndarray:
 
 
 def read_poses(path: str | Path) -> np.ndarray:
-    """(n, 4, 4) float64 poses of a KITTI ``poses.txt`` (12 finite numbers per line)."""
+    """(n, 4, 4) float64 poses of a KITTI ``poses.txt`` (12 finite numbers per line, translations
+    within :data:`MAX_TRANSLATION_M`)."""
     rows = safeload.read_matrix_rows(path, 12)
+    far = np.flatnonzero(np.abs(rows[:, [3, 7, 11]]).max(axis=1) > MAX_TRANSLATION_M)
+    if far.size:
+        raise UserError(f"{safeload.printable(path)}: line {int(far[0]) + 1}: translation beyond "
+                        f"{MAX_TRANSLATION_M:.0f} m from the first pose")
     out = np.repeat(np.eye(4)[None], len(rows), 0)
     out[:, :3, :4] = rows.reshape(-1, 3, 4)
     return out

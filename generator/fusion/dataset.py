@@ -18,7 +18,6 @@ import numpy as np
 from generator.world import rig
 from generator.errors import SpecError, UserError
 from generator.formats import semantickitti as sk
-from generator.formats.kitti_calib import rigid_problem
 from generator.formats.point_sidecars import NATIVE_DIR, TIMES_DIR, read_sidecar
 from generator.imaging import meta_fields as md
 from generator.imaging.exr import read_exr
@@ -113,7 +112,7 @@ def read_image_meta(meta_path: Path) -> tuple[dict, np.ndarray, np.ndarray]:
     """(metadata, T_world_camera (4, 4), K (3, 3)) of one image, every field fusion uses checked."""
     meta = md.load_metadata(meta_path)
     T = md.matrix(meta, "camera.T_world_camera", (4, 4), str(meta_path))
-    problem = rigid_problem(T)
+    problem = md.rigid_problem(T)
     if problem:
         raise SpecError(str(meta_path), "camera.T_world_camera", problem)
     K, _, _ = md.intrinsics(meta, str(meta_path))
@@ -182,7 +181,7 @@ class FusionDataset:
         xyz = md.matrix(self.meta, "mount.lidar_xyz_m", (3,), source)
         rpy = md.matrix(self.meta, "mount.lidar_rpy_deg", (3,), source)
         ego = md.matrix(image_meta, "ego.T_world_ego", (4, 4), str(self.images.get(k, "image metadata")))
-        problem = rigid_problem(ego)
+        problem = md.rigid_problem(ego)
         if problem:
             raise SpecError(str(self.images.get(k, "image metadata")), "ego.T_world_ego", problem)
         start = ego @ rig.mount(xyz, rpy)

@@ -22,6 +22,8 @@ from generator.errors import SpecError
 #: Values a dataset metadata JSON may hold (an image's has ~300; a sequence's ``lidar_meta.json``
 #: and an OpenLABEL file grow with their frames). The byte limit is ``safeload.MAX_METADATA_BYTES``.
 MAX_METADATA_NODES = 5_000_000
+#: Farthest a world pose in metadata may be from the world origin, metres.
+MAX_WORLD_M = 1e7
 #: Largest image side a metadata file may declare.
 MAX_IMAGE_SIDE = 65535
 _REQUIRED = object()
@@ -196,9 +198,13 @@ def sweep_poses(meta: dict, source: str) -> list[tuple[np.ndarray, np.ndarray]]:
 
 
 def rigid_problem(T: np.ndarray, tol: float = 1e-3) -> str | None:
-    """Why a (4, 4) pose read from metadata is not rigid, or None (the same test as
-    :func:`generator.formats.kitti_calib.rigid_problem`, which this layer cannot import)."""
-    r = np.asarray(T, np.float64)[:3, :3]
-    if np.abs(r @ r.T - np.eye(3)).max() > tol or abs(np.linalg.det(r) - 1.0) > tol:
+    """Why a (4, 4) world pose read from metadata is not rigid or is beyond :data:`MAX_WORLD_M`, or
+    None (the rotation test of :func:`generator.formats.kitti_calib.rigid_problem`, which this layer
+    cannot import)."""
+    T = np.asarray(T, np.float64)
+    r = T[:3, :3]
+    if np.abs(r).max() > 1 + tol or np.abs(r @ r.T - np.eye(3)).max() > tol or abs(np.linalg.det(r) - 1.0) > tol:
         return "rotation part is not a rotation (not orthonormal with determinant +1)"
+    if np.abs(T[:3, 3]).max() > MAX_WORLD_M or not np.array_equal(T[3], [0.0, 0.0, 0.0, 1.0]):
+        return f"must be a rigid transform [[R, t], [0, 0, 0, 1]] with |t| within {MAX_WORLD_M:.0e} m"
     return None
