@@ -27,7 +27,7 @@ import numpy as np
 from generator import safeload
 from generator.atomic import write_bytes, write_text
 from generator.errors import UserError
-from generator.formats.kitti_calib import lidar_poses, read_calib, tr_matrix
+from generator.formats.kitti_calib import lidar_poses, read_calib, rigid_problem, tr_matrix
 from generator.labels import class_table
 
 __all__ = [
@@ -139,13 +139,17 @@ def _known_raw_ids() -> np.ndarray:
 
 
 def read_poses(path: str | Path) -> np.ndarray:
-    """(n, 4, 4) float64 poses of a KITTI ``poses.txt`` (12 finite numbers per line, translations
+    """(n, 4, 4) float64 poses of a KITTI ``poses.txt`` (12 finite numbers per line, rigid, translations
     within :data:`MAX_TRANSLATION_M`)."""
     rows = safeload.read_matrix_rows(path, 12)
     far = np.flatnonzero(np.abs(rows[:, [3, 7, 11]]).max(axis=1) > MAX_TRANSLATION_M)
     if far.size:
         raise UserError(f"{safeload.printable(path)}: line {int(far[0]) + 1}: translation beyond "
                         f"{MAX_TRANSLATION_M:.0f} m from the first pose")
+    for i, row in enumerate(rows):
+        problem = rigid_problem(row.reshape(3, 4))
+        if problem:
+            raise UserError(f"{safeload.printable(path)}: line {i + 1}: pose {problem}")
     out = np.repeat(np.eye(4)[None], len(rows), 0)
     out[:, :3, :4] = rows.reshape(-1, 3, 4)
     return out
