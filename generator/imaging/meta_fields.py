@@ -125,13 +125,15 @@ def intrinsics(doc: dict, source: str) -> tuple[np.ndarray, int, int]:
     return K, width, height
 
 
-def exr_path(doc: dict, meta_path: str | Path, source: str | None = None) -> Path:
+def exr_path(doc: dict, meta_path: str | Path, source: str | None = None, must_exist: bool = True) -> Path:
     """The EXR an image's metadata names (``files.exr``), which must lie beside the metadata file.
 
     Raises
     ------
     generator.errors.SpecError
-        Not a string, empty, absolute, or leading out of the metadata's folder (``..``, a link).
+        Not a string, empty, absolute, leading out of the metadata's folder (``..``, a link),
+        or (``must_exist``) naming nothing there. The name itself is never repeated: it is
+        the file's content until it is known to name a file of the dataset.
     """
     src = str(meta_path) if source is None else source
     rel = field(doc, "files.exr", src)
@@ -142,6 +144,8 @@ def exr_path(doc: dict, meta_path: str | Path, source: str | None = None) -> Pat
     if os.path.isabs(rel) or os.path.commonpath([base, target]) != base:
         raise SpecError(src, "files.exr", "must name a file in the metadata's own folder (no absolute path, "
                                           "no '..', no link leading out)")
+    if must_exist and not os.path.lexists(os.path.join(base, rel)):
+        raise SpecError(src, "files.exr", "names no file beside the metadata")
     return Path(meta_path).parent / rel
 
 

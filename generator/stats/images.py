@@ -110,7 +110,8 @@ def parse_record(path: Path, rec: object) -> ImageRecord:
             raise _bad(path, f"classes_present.{name}: must be a pixel count (integer in [0, {MAX_PIXELS}]), "
                              f"got {md.kind_of(count) if not isinstance(count, int) else count}")
         pixels[table.id(name)] = count
-    exr = md.exr_path(rec, path) if isinstance(md.field(rec, "files.exr", str(path), None), str) else None
+    exr = md.exr_path(rec, path, must_exist=False) if isinstance(md.field(rec, "files.exr", str(path), None), str) \
+        else None
     intr = (rec.get("camera") or {}).get("intrinsics") if isinstance(rec.get("camera"), dict) else None
     size = None
     if isinstance(intr, dict) and "width" in intr and "height" in intr:
@@ -162,7 +163,7 @@ def verify(data: ImageData) -> list[str]:
             problems.append(f"{printable(r.source)}: files.exr is not given")
             continue
         if not os.path.lexists(r.exr):
-            problems.append(f"{r.name}: EXR {printable(r.exr)} is missing")
+            problems.append(f"{r.name}: files.exr names no file beside the metadata")
             continue
         try:
             class_id = read_exr(r.exr).class_id
