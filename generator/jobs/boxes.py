@@ -34,9 +34,10 @@ def _camera(root: Path, seq, meta: dict, meta_source: str) -> tuple[np.ndarray, 
     if seq.calib is None or "calib" not in meta:
         raise UserError(f"{seq.dir}: no image metadata and no calib.txt/lidar_meta.json to read the camera from")
     res = md.field(meta, "calib.resolution", meta_source)
-    if not (isinstance(res, list) and len(res) == 2):
-        raise SpecError(meta_source, "calib.resolution", "must be [width, height]")
-    w, h = (md.integer({"v": v}, "v", meta_source, 1, md.MAX_IMAGE_SIDE) for v in res)
+    if not (isinstance(res, list) and len(res) == 2 and all(
+            isinstance(v, int) and not isinstance(v, bool) and 1 <= v <= md.MAX_IMAGE_SIDE for v in res)):
+        raise SpecError(meta_source, "calib.resolution", f"must be [width, height] in pixels, 1..{md.MAX_IMAGE_SIDE}")
+    w, h = res
     P2 = np.asarray(seq.calib.get("P2", np.zeros(0)), np.float64)
     if P2.shape != (3, 4):
         raise UserError(f"{seq.dir / 'calib.txt'}: P2: needs 12 numbers")
