@@ -30,6 +30,7 @@ import io
 import os
 import re
 import sys
+import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -114,6 +115,17 @@ def write_exr(path: str | Path, image: LabelledImage, codec: str = "zip") -> Non
             f.write(str(tmp))
 
 
+_quiet = threading.Lock()
+_quiet_state = {"depth": 0, "saved": []}
+
+
+def _c_flush() -> None:
+    try:
+        ctypes.CDLL(None).fflush(None)
+    except (OSError, AttributeError, TypeError):  # no C library handle on this platform
+        pass
+
+
 @contextlib.contextmanager
 def _c_output_silenced():
     """Send fds 1 and 2 to /dev/null while OpenEXR's C core runs.
@@ -122,35 +134,43 @@ def _c_output_silenced():
     "Warning: Exception raised reading pixel data") straight to the process's stdout and
     stderr, bypassing Python; the reader turns the failure into one UserError instead.
     C stdio buffers are flushed before the fds are restored so nothing leaks out later.
+    Threads reading EXRs at once share one redirection (the first in saves the fds, the
+    last out restores them); other output of the process during a read is dropped.
     """
-    for stream in (sys.stdout, sys.stderr):
-        try:
-            stream.flush()
-        except (AttributeError, OSError, ValueError):
-            pass
-    saved = []
-    try:
-        devnull = os.open(os.devnull, os.O_WRONLY)
-    except OSError:
-        yield
-        return
-    try:
-        for fd in (1, 2):
+    with _quiet:
+        if _quiet_state["depth"] == 0:
+            for stream in (sys.stdout, sys.stderr):
+                try:
+                    stream.flush()
+                except (AttributeError, OSError, ValueError):
+                    pass
+            _c_flush()
             try:
-                saved.append((fd, os.dup(fd)))
-                os.dup2(devnull, fd)
+                devnull = os.open(os.devnull, os.O_WRONLY)
             except OSError:
-                pass
+                devnull = None
+            saved = []
+            if devnull is not None:
+                for fd in (1, 2):
+                    try:
+                        saved.append((fd, os.dup(fd)))
+                        os.dup2(devnull, fd)
+                    except OSError:
+                        pass
+                os.close(devnull)
+            _quiet_state["saved"] = saved
+        _quiet_state["depth"] += 1
+    try:
         yield
     finally:
-        try:
-            ctypes.CDLL(None).fflush(None)
-        except (OSError, AttributeError):
-            pass
-        for fd, copy in saved:
-            os.dup2(copy, fd)
-            os.close(copy)
-        os.close(devnull)
+        with _quiet:
+            _quiet_state["depth"] -= 1
+            if _quiet_state["depth"] == 0:
+                _c_flush()
+                for fd, copy in _quiet_state["saved"]:
+                    os.dup2(copy, fd)
+                    os.close(copy)
+                _quiet_state["saved"] = []
 
 
 def _open(data: bytes, path, header_only: bool):
