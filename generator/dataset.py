@@ -27,18 +27,20 @@ Arrays and frames
 
 from __future__ import annotations
 
-import json
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from generator.errors import UserError
+from generator.errors import SpecError, UserError
 from generator.formats import semantickitti as sk
 from generator.formats.point_sidecars import NATIVE_DIR, read_sidecar
+from generator.imaging import meta_fields as md
 from generator.imaging.exr import read_exr
 from generator.labels import class_table
 from generator.labels.sets import label_sets
+from generator.safeload import printable
 
 
 @dataclass
@@ -122,16 +124,16 @@ class Dataset:
     # -- images ------------------------------------------------------------------------------
     def image_names(self, frame: int | None = None) -> list[str]:
         """Image stems (``NNNNNN_<time>_<weather>``), sorted; only those of ``frame`` if given."""
-        names = sorted(p.stem for p in (self.root / "images").glob("[0-9]*.json"))
+        names = sorted(p.stem for p in (self.root / "images").glob("[0-9][0-9][0-9][0-9][0-9][0-9]*.json"))
         return [n for n in names if frame is None or int(n[:6]) == frame]
 
     def image(self, name: str) -> ImageSample:
         """The image ``name`` with its masks, instances, depth and metadata."""
         exr, meta = self.root / "images" / f"{name}.exr", self.root / "images" / f"{name}.json"
-        if not exr.is_file() or not meta.is_file():
+        if not os.path.lexists(exr) or not os.path.lexists(meta):
             raise UserError(f"{exr}: no such image (with its .json)")
         img = read_exr(exr)
-        return ImageSample(name, img.rgb, img.class_id, img.instance, img.depth, json.loads(meta.read_text("utf-8")))
+        return ImageSample(name, img.rgb, img.class_id, img.instance, img.depth, md.load_metadata(meta))
 
     # -- scans ---------------------------------------------------------------------------------
     def scan_indices(self) -> list[int]:
@@ -142,6 +144,8 @@ class Dataset:
         if self.seq is None:
             raise UserError(f"{self.root / 'lidar'}: no sequence {self.sequence}")
         rec = self.seq.read(index, True, self._poses)
+        if rec.semantic is not None:
+            sk.check_raw_ids(rec.semantic, self.seq.label_path(index))
         native = read_sidecar(self.seq.dir, NATIVE_DIR, index, len(rec.points))
         return ScanSample(index, rec.points[:, :3], rec.points[:, 3], rec.semantic, rec.instance, native, rec.pose,
                           rec.time)
@@ -165,15 +169,39 @@ class Dataset:
 
     @staticmethod
     def _read_boxes(path: Path) -> dict[int, list[Box]]:
-        if not path.is_file():
+        """The cuboids of an OpenLABEL file by frame, every field used type-checked (one-line errors)."""
+        if not os.path.lexists(path):
             return {}
-        doc = json.loads(path.read_text("utf-8"))["openlabel"]
-        types = {uid: o["type"] for uid, o in doc.get("objects", {}).items()}
+        src = str(path)
+        doc = md.load_metadata(path)
+        objects = _mapping(md.field(doc, "openlabel.objects", src, default={}), src, "openlabel.objects")
+        frames = _mapping(md.field(doc, "openlabel.frames", src, default={}), src, "openlabel.frames")
+        types = {uid: o.get("type") if isinstance(o, dict) and isinstance(o.get("type"), str) else ""
+                 for uid, o in objects.items()}
         out: dict[int, list[Box]] = {}
-        for key, f in doc.get("frames", {}).items():
-            for uid, o in f.get("objects", {}).items():
-                data = o["object_data"]
-                v = np.asarray(data["cuboid"][0]["val"], np.float64)
-                n = int(data.get("num", [{"val": 0}])[0]["val"])
+        for key, f in frames.items():
+            where = f"openlabel.frames.{printable(key, 32)}"
+            if not (key.isascii() and key.isdigit() and len(key) <= 9):
+                raise SpecError(src, where, "frame keys must be frame numbers")
+            objs = _mapping(md.field(_mapping(f, src, where), "objects", src, default={}, prefix=where), src,
+                            f"{where}.objects")
+            for uid, o in objs.items():
+                at = f"{where}.objects.{printable(uid, 32)}"
+                if not (uid.isascii() and uid.isdigit() and len(uid) <= 9):
+                    raise SpecError(src, at, "object keys must be instance ids")
+                data = _mapping(md.field(_mapping(o, src, at), "object_data", src, prefix=at), src, f"{at}.object_data")
+                cuboids = md.field(data, "cuboid", src, prefix=f"{at}.object_data")
+                if not (isinstance(cuboids, list) and cuboids and isinstance(cuboids[0], dict)):
+                    raise SpecError(src, f"{at}.object_data.cuboid", "must be a list of cuboid objects")
+                v = md.matrix(cuboids[0], "val", (10,), src, prefix=f"{at}.object_data.cuboid[0]")
+                nums = data.get("num", [{"val": 0}])
+                n = md.integer(nums[0] if isinstance(nums, list) and nums and isinstance(nums[0], dict) else {},
+                               "val", src, 0, 2**32)
                 out.setdefault(int(key), []).append(Box(int(uid), types.get(uid, ""), v[:3], v[3:7], v[7:10], n))
         return out
+
+
+def _mapping(value, source: str, where: str) -> dict:
+    if not isinstance(value, dict):
+        raise SpecError(source, where, f"must be an object, got {md.kind_of(value)}")
+    return value

@@ -99,7 +99,7 @@ def test_raw_entry_takes_precedence_over_unified():
 
 
 @pytest.mark.parametrize("doc, message", [
-    ({"unified": {"roads": {"mean": 0.3, "std": 0.1}}}, "unknown class 'roads'"),
+    ({"unified": {"roads": {"mean": 0.3, "std": 0.1}}}, "unified.roads: unknown class"),
     ({"unified": {"road": {"mean": 0.3, "std": -0.1}}}, "std >= 0"),
     ({"unified": {"road": {"mean": 0.3}}}, "mapping with mean and std"),
     ({"semantickitti": {"forty": {"mean": 0.3, "std": 0.1}}}, "raw ids"),

@@ -53,9 +53,9 @@ def test_scan_and_label_files_round_trip(tmp_path, rng):
 
 def test_reader_errors_name_the_file(tmp_path):
     (tmp_path / "bad.bin").write_bytes(b"\0" * 18)
-    with pytest.raises(UserError, match=r"bad\.bin: size 18 bytes is not a multiple of 16"):
+    with pytest.raises(UserError, match=r"bad\.bin: size 18 bytes is not a multiple of the record size \(16 bytes\)"):
         sk.read_scan(tmp_path / "bad.bin")
-    with pytest.raises(UserError, match=r"missing\.label: label file not found"):
+    with pytest.raises(UserError, match=r"missing\.label: file not found"):
         sk.read_labels(tmp_path / "missing.label")
     (tmp_path / "poses.txt").write_text("1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0 0 1 0 0 0 0 1\n")
     with pytest.raises(UserError, match=r"poses\.txt: line 2: expected 12 numbers, got 11"):

@@ -28,11 +28,14 @@ from pathlib import Path
 
 import numpy as np
 
+from generator import safeload
 from generator.geometry.transforms import invert
 from generator.atomic import write_text
-from generator.errors import UserError
+from generator.errors import SpecError, UserError
 
 CALIB_KEYS = ("P0", "P1", "P2", "P3", "Tr")
+#: Tolerance of :func:`rigid_problem` on ``R R^T - I`` and ``det R - 1``.
+RIGID_TOL = 1e-3
 
 
 def homogeneous(m: np.ndarray) -> np.ndarray:
@@ -70,7 +73,8 @@ def write_calib(path: str | Path, calib: dict[str, np.ndarray]) -> None:
 
 
 def read_calib(path: str | Path) -> dict[str, np.ndarray]:
-    """Read a KITTI ``calib.txt``.
+    """Read a KITTI ``calib.txt`` (through :mod:`generator.safeload`: a regular UTF-8 file within the
+    table size limit).
 
     Returns
     -------
@@ -81,34 +85,64 @@ def read_calib(path: str | Path) -> dict[str, np.ndarray]:
     Raises
     ------
     UserError
-        Missing file, a line without ``KEY:``, or non-numeric values (naming file and line).
+        Missing or special file, a line without ``KEY:``, a key twice, non-numeric or
+        non-finite values, or a ``P0``..``P3``/``Tr`` entry without 12 numbers (naming file
+        and line, never quoting it).
     """
-    p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as e:
-        raise UserError(f"{p}: cannot read calibration: {e}") from None
+    src = str(path)
+    text = safeload.read_text(path, source=src, max_bytes=safeload.MAX_TABLE_BYTES)
     out: dict[str, np.ndarray] = {}
     for n, line in enumerate(text.splitlines(), 1):
         if not line.strip():
             continue
         key, sep, rest = line.partition(":")
-        if not sep:
-            raise UserError(f"{p}: line {n}: expected 'KEY: numbers', got {line[:40]!r}")
+        key = key.strip()
+        if not sep or not key or len(key) > 32 or not key.replace("_", "").isalnum() or not key.isascii():
+            raise SpecError(src, f"line {n}", "expected 'KEY: numbers' (a short name, a colon, then numbers)")
+        if key in out:
+            raise SpecError(src, f"line {n}", f"{key}: given twice")
         try:
             vals = np.array([float(v) for v in rest.split()], np.float64)
         except ValueError:
-            raise UserError(f"{p}: line {n}: {key.strip()}: values must be numbers") from None
-        out[key.strip()] = vals.reshape(3, 4) if vals.size == 12 else (vals.reshape(3, 3) if vals.size == 9 else vals)
+            raise SpecError(src, f"line {n}", f"{key}: values must be numbers") from None
+        if not np.isfinite(vals).all():
+            raise SpecError(src, f"line {n}", f"{key}: values must be finite numbers")
+        if key in CALIB_KEYS + ("Tr_velo_to_cam",) and vals.size != 12:
+            raise SpecError(src, f"line {n}", f"{key}: expected 12 numbers (a 3x4 matrix), got {vals.size}")
+        out[key] = vals.reshape(3, 4) if vals.size == 12 else (vals.reshape(3, 3) if vals.size == 9 else vals)
     return out
 
 
 def tr_matrix(calib: dict[str, np.ndarray], source: str = "calib.txt") -> np.ndarray:
-    """(4, 4) ``Tr`` (velodyne -> cam0) from a parsed calib (``Tr`` or ``Tr_velo_to_cam``)."""
+    """(4, 4) ``Tr`` (velodyne -> cam0) from a parsed calib (``Tr`` or ``Tr_velo_to_cam``).
+
+    Raises
+    ------
+    UserError
+        No such entry, or its rotation part is not a rotation (the transform must be rigid).
+    """
     for key in ("Tr", "Tr_velo_to_cam"):
         if key in calib and np.size(calib[key]) == 12:
-            return homogeneous(calib[key])
+            tr = homogeneous(calib[key])
+            problem = rigid_problem(tr)
+            if problem:
+                raise UserError(f"{source}: {key}: {problem}")
+            return tr
     raise UserError(f"{source}: no 'Tr' (velodyne to camera) entry with 12 numbers")
+
+
+def rigid_problem(T: np.ndarray, tol: float = RIGID_TOL) -> str | None:
+    """Why a (4, 4) or (3, 4) transform is not rigid (rotation part not orthonormal with det +1), or None.
+
+    ``tol`` bounds ``|R R^T - I|`` elementwise and ``|det R - 1|``: loose enough for poses
+    printed with a few digits, tight enough to catch a scale, a shear or garbage.
+    """
+    r = np.asarray(T, np.float64)[:3, :3]
+    if not np.isfinite(r).all():
+        return "is not finite"
+    if np.abs(r).max() > 1 + tol or np.abs(r @ r.T - np.eye(3)).max() > tol or abs(np.linalg.det(r) - 1.0) > tol:
+        return "rotation part is not a rotation (not orthonormal with determinant +1)"
+    return None
 
 
 def camera_poses(T_world_velo: np.ndarray, tr: np.ndarray) -> np.ndarray:

@@ -16,12 +16,14 @@ dropped (the api would look for their folders).
 from __future__ import annotations
 
 import logging
+import os
 from pathlib import Path
 
 import numpy as np
-import yaml
 
+from generator import safeload
 from generator.atomic import write_text
+from generator.errors import SpecError, UserError
 from generator.labels import class_table
 
 log = logging.getLogger(__name__)
@@ -30,6 +32,8 @@ log = logging.getLogger(__name__)
 SPLITS = ("train", "valid", "test")
 #: Split of a sequence nobody assigned: what semantic-kitti-api evaluates by default (``-s valid``).
 DEFAULT_SPLIT = "valid"
+#: Values a label config may hold (the reference has ~700; content and maps of 65536 ids at most).
+MAX_CONFIG_NODES = 1_000_000
 
 
 def count_raw_ids(semantic: np.ndarray) -> dict[int, int]:
@@ -48,15 +52,30 @@ def merge_counts(*counts: dict[int, int]) -> dict[int, int]:
 
 
 def read_split(path: str | Path) -> dict[str, list[int]]:
-    """The ``split`` section of a label config on disk (empty when the file is missing or unreadable)."""
+    """The ``split`` section of a label config on disk (empty when the file is missing or unreadable).
+
+    Read through :mod:`generator.safeload` (size limit, strict YAML, no aliases beyond a
+    small budget); a config that cannot be read or whose split is malformed is logged as
+    one line (never quoting the file) and treated as having no split.
+    """
     path = Path(path)
-    if not path.is_file():
+    if not os.path.lexists(path):
         return {}
     try:
-        split = (yaml.safe_load(path.read_text(encoding="utf-8")) or {}).get("split") or {}
-        return {part: [int(s) for s in (split.get(part) or [])] for part in SPLITS}
-    except (yaml.YAMLError, UnicodeDecodeError, AttributeError, TypeError, ValueError) as e:
-        log.warning("%s: split section not readable (%s); sequences get their --split or %s", path, e, DEFAULT_SPLIT)
+        doc = safeload.load_yaml(path, string_keys=False, max_nodes=MAX_CONFIG_NODES)
+        split = (doc.get("split") if isinstance(doc, dict) else None) or {}
+        if not isinstance(split, dict):
+            raise SpecError(str(path), "split", "must be a mapping of train, valid, test to sequence lists")
+        out = {}
+        for part in SPLITS:
+            seqs = split.get(part) or []
+            if not isinstance(seqs, list) or not all(isinstance(s, int) and not isinstance(s, bool)
+                                                     and 0 <= s <= 9999 for s in seqs):
+                raise SpecError(str(path), f"split.{part}", "must be a list of sequence numbers 0..9999")
+            out[part] = list(seqs)
+        return out
+    except UserError as e:
+        log.warning("%s; sequences get their --split or %s", e, DEFAULT_SPLIT)
         return {}
 
 

@@ -63,13 +63,19 @@ def load_schema() -> dict:
     return json.loads(SCHEMA_PATH.read_text(encoding="utf-8"))
 
 
-def validate_openlabel(doc: dict) -> list[str]:
-    """Problems of ``doc`` against the OpenLABEL 1.0.0 schema (empty when valid)."""
+def openlabel_errors(doc: dict):
+    """The ``jsonschema`` errors of ``doc`` against the OpenLABEL 1.0.0 schema (an iterator)."""
     import jsonschema
 
     schema = load_schema()
-    v = jsonschema.validators.validator_for(schema)(schema)
-    return [f"{'/'.join(str(p) for p in e.absolute_path) or '(root)'}: {e.message}" for e in v.iter_errors(doc)]
+    return jsonschema.validators.validator_for(schema)(schema).iter_errors(doc)
+
+
+def validate_openlabel(doc: dict) -> list[str]:
+    """Problems of ``doc`` against the OpenLABEL 1.0.0 schema (empty when valid). The messages are
+    ``jsonschema``'s, which quote values: for documents we write; user files go through
+    :func:`openlabel_errors` and a message that names only the field."""
+    return [f"{'/'.join(str(p) for p in e.absolute_path) or '(root)'}: {e.message}" for e in openlabel_errors(doc)]
 
 
 def _m(T: np.ndarray) -> dict:

@@ -7,10 +7,12 @@ Vertex properties: ``float x, y, z`` (sensor frame, metres), ``float intensity``
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
 
+from generator import safeload
 from generator.atomic import write_bytes
 from generator.errors import UserError
 
@@ -40,14 +42,26 @@ def write_ply(path: str | Path, xyz, intensity, semantic, instance, rgb, comment
 
 
 def read_ply(path: str | Path) -> np.ndarray:
-    """Read a file written by :func:`write_ply` back as a (n,) :data:`PLY_DTYPE` array."""
-    data = Path(path).read_bytes()
-    end = data.find(b"end_header\n")
+    """Read a file written by :func:`write_ply` back as a (n,) :data:`PLY_DTYPE` array.
+
+    Read through :mod:`generator.safeload` (a regular file within the array size limit).
+
+    Raises
+    ------
+    UserError
+        Not a PLY of this layout, or a vertex count that disagrees with the data (one line,
+        never quoting the file).
+    """
+    data = safeload.read_bytes(path, max_bytes=safeload.MAX_ARRAY_BYTES)
+    end = data.find(b"end_header\n", 0, 64 * 1024)
+    where = safeload.printable(path)
     if not data.startswith(b"ply\n") or end < 0:
-        raise UserError(f"{path}: not a PLY file")
-    header = data[:end].decode("ascii").splitlines()
-    n = next(int(h.split()[2]) for h in header if h.startswith("element vertex"))
+        raise UserError(f"{where}: not a PLY file")
+    counts = [h.split()[2:] for h in data[:end].decode("ascii", "replace").splitlines() if h.startswith("element vertex")]
+    if len(counts) != 1 or len(counts[0]) != 1 or not re.fullmatch(r"[0-9]{1,12}", counts[0][0]):
+        raise UserError(f"{where}: PLY header needs one 'element vertex <count>' line with a count >= 0")
+    n = int(counts[0][0])
     body = data[end + len(b"end_header\n"):]
     if len(body) != n * PLY_DTYPE.itemsize:
-        raise UserError(f"{path}: {len(body)} bytes of vertex data for {n} vertices of {PLY_DTYPE.itemsize} bytes")
+        raise UserError(f"{where}: {len(body)} bytes of vertex data for {n} vertices of {PLY_DTYPE.itemsize} bytes")
     return np.frombuffer(body, PLY_DTYPE)

@@ -19,12 +19,15 @@ elsewhere lack them; readers return None then.
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
 
+from generator import safeload
 from generator.atomic import write_bytes
 from generator.errors import UserError
+from generator.labels import class_table
 
 TIMES_DIR = "point_times"
 NATIVE_DIR = "native_labels"
@@ -55,15 +58,24 @@ def write_point_sidecars(seq_dir: str | Path, stem: str, times: np.ndarray, nati
 def read_sidecar(seq_dir: str | Path, folder: str, index: int, n_points: int) -> np.ndarray | None:
     """(n,) array of side file ``folder`` for scan ``index``, or None when the file does not exist.
 
+    Read through :mod:`generator.safeload` (a regular file, whole records); firing times must
+    be finite, native ids within the class table.
+
     Raises
     ------
     UserError
-        When its length disagrees with the scan's ``n_points``.
+        When it cannot be read (a folder, a FIFO, a symlink loop...), its length disagrees
+        with the scan's ``n_points``, or its values are out of range.
     """
     path = Path(seq_dir) / folder / f"{index:06d}.bin"
-    if not path.is_file():
+    if not os.path.lexists(path):
         return None
-    values = np.fromfile(path, dtype=SIDECARS[folder])
+    values = safeload.read_array(path, SIDECARS[folder], finite=True)
     if len(values) != n_points:
         raise UserError(f"{path}: {len(values)} values but the scan has {n_points} points")
+    if folder == NATIVE_DIR:
+        n_classes = len(class_table())
+        if values.size and int(values.max()) >= n_classes:
+            raise UserError(f"{path}: native class id {int(values.max())} is not in the class table "
+                            f"(0..{n_classes - 1}, generator/labels/classes.yaml)")
     return values

@@ -20,15 +20,15 @@ scan has converted, so a bad input leaves OUT as it was.
 from __future__ import annotations
 
 import logging
-import shutil
+import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
 import numpy as np
 
-from generator import __version__
-from generator.atomic import staging, write_json, write_text
+from generator import __version__, safeload
+from generator.atomic import staging, write_bytes, write_json, write_text
 from generator.errors import UserError
 from generator.formats import semantickitti as sk
 from generator.formats.label_config import SPLITS, count_raw_ids, format_label_config, merge_counts, merge_split, read_split
@@ -131,7 +131,7 @@ def convert_dataset(src: str | Path, dst: str | Path, labels: str = "unified11",
     src, dst = Path(src), Path(dst)
     if dst.exists() and not dst.is_dir():
         raise UserError(f"{dst}: exists and is not a folder")
-    if dst.resolve() == src.resolve():
+    if os.path.realpath(dst) == os.path.realpath(src):
         raise UserError(f"{dst}: output must differ from the input dataset")
     names = pick_sequences(src, sequences)
     seqs = [sk.Sequence(src, n) for n in names]  # validates folders, poses/times lengths
@@ -145,17 +145,14 @@ def convert_dataset(src: str | Path, dst: str | Path, labels: str = "unified11",
             for seq in seqs:
                 out = stage / "sequences" / seq.dir.name
                 (out / "velodyne").mkdir(parents=True)
-                for f in COPIED_FILES:
-                    if (seq.dir / f).is_file():
-                        shutil.copyfile(seq.dir / f, out / f)
+                for f in COPIED_FILES:  # already parsed and checked by sk.Sequence; copied as read
+                    if os.path.lexists(seq.dir / f):
+                        write_bytes(out / f, safeload.read_bytes(seq.dir / f, max_bytes=safeload.MAX_TABLE_BYTES))
                 for i in seq.frames:
-                    sem, inst = sk.read_labels(seq.label_path(i))
-                    n_pts = seq.scan_path(i).stat().st_size // 16
-                    if len(sem) != n_pts:
-                        raise UserError(f"{seq.label_path(i)}: {len(sem)} labels but {seq.scan_path(i)} has {n_pts} points")
+                    pts, sem, inst = seq.read_labelled(i)  # whole 16-byte finite points, one label each
                     new = target.relabel(sem, str(seq.label_path(i)))
                     sk.write_labels(out / "labels" / seq.label_path(i).name, new, inst)
-                    shutil.copyfile(seq.scan_path(i), out / "velodyne" / seq.scan_path(i).name)
+                    write_bytes(out / "velodyne" / seq.scan_path(i).name, pts.astype("<f4").tobytes())
                     counts = merge_counts(counts, count_raw_ids(new))
                     bar.update()
         (dst / "sequences").mkdir(exist_ok=True)

@@ -16,6 +16,7 @@ Every write is atomic (:mod:`generator.atomic`). Every read problem is a
 
 from __future__ import annotations
 
+import functools
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -23,13 +24,15 @@ from typing import Iterator
 
 import numpy as np
 
+from generator import safeload
 from generator.atomic import write_bytes, write_text
 from generator.errors import UserError
-from generator.formats.kitti_calib import lidar_poses, read_calib, tr_matrix
+from generator.formats.kitti_calib import lidar_poses, read_calib, rigid_problem, tr_matrix
+from generator.labels import class_table
 
 __all__ = [
     "encode_labels", "decode_labels", "write_scan", "write_labels", "write_poses", "write_times",
-    "read_scan", "read_labels", "read_poses", "read_times", "read_calib", "sequence_name", "sequence_dir",
+    "read_scan", "read_labels", "read_poses", "read_times", "read_calib", "check_raw_ids", "sequence_name", "sequence_dir",
     "list_sequences", "Sequence", "ScanRecord", "iter_sequence",
 ]
 
@@ -87,57 +90,79 @@ def write_times(path: str | Path, times: np.ndarray) -> None:
 
 
 # -- reading ----------------------------------------------------------------------------------
-def _read_raw(path: Path, dtype: str, row: int, what: str) -> np.ndarray:
-    try:
-        size = os.path.getsize(path)
-    except OSError:
-        raise UserError(f"{path}: {what} file not found") from None
-    itemsize = np.dtype(dtype).itemsize * row
-    if size % itemsize:
-        raise UserError(f"{path}: size {size} bytes is not a multiple of {itemsize} ({what}); truncated or not a {what} file")
-    return np.fromfile(path, dtype=dtype)
+# Every reader goes through :mod:`generator.safeload`: regular files only, size limits, and the
+# shapes of the format checked at the border (16-byte points, 4-byte labels, 12 numbers per
+# pose line, one per time line, finite numbers), one ``UserError`` line naming the file.
+
+
+#: Farthest coordinate a scan point may have, metres from the sensor (LiDARs reach a few hundred).
+MAX_POINT_M = 10_000.0
+#: Farthest a pose in ``poses.txt`` may be from the first one, metres: with points within
+#: :data:`MAX_POINT_M` the whole map stays within the reach of the semantic map's voxel keys.
+MAX_TRANSLATION_M = 40_000.0
 
 
 def read_scan(path: str | Path) -> np.ndarray:
-    """(n, 4) float32 (x, y, z, remission) of a ``.bin`` file."""
-    return _read_raw(Path(path), "<f4", 4, "scan").reshape(-1, 4).astype(np.float32, copy=False)
+    """(n, 4) float32 (x, y, z, remission) of a ``.bin`` file: every value finite, coordinates within
+    :data:`MAX_POINT_M` of the sensor."""
+    pts = safeload.read_array(path, "<f4", 16, finite=True).astype(np.float32, copy=False)
+    if pts.size and np.abs(pts[:, :3]).max() > MAX_POINT_M:
+        first = int(np.flatnonzero((np.abs(pts[:, :3]) > MAX_POINT_M).any(axis=1))[0])
+        raise UserError(f"{safeload.printable(path)}: record {first}: a coordinate beyond {MAX_POINT_M:.0f} m "
+                        "from the sensor")
+    return pts
 
 
 def read_labels(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
     """(semantic uint16, instance uint16) of a ``.label`` file."""
-    return decode_labels(_read_raw(Path(path), "<u4", 1, "label"))
+    return decode_labels(safeload.read_array(path, "<u4"))
 
 
-def _read_rows(path: Path, width: int, what: str) -> np.ndarray:
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as e:
-        raise UserError(f"{path}: cannot read {what}: {e}") from None
-    rows = []
-    for n, line in enumerate(text.splitlines(), 1):
-        if not line.strip():
-            continue
-        try:
-            vals = [float(v) for v in line.split()]
-        except ValueError:
-            raise UserError(f"{path}: line {n}: values must be numbers") from None
-        if len(vals) != width:
-            raise UserError(f"{path}: line {n}: expected {width} numbers, got {len(vals)}")
-        rows.append(vals)
-    return np.array(rows, np.float64).reshape(-1, width)
+def check_raw_ids(semantic: np.ndarray, source: str | Path) -> None:
+    """Refuse SemanticKITTI raw ids that the label table does not know.
+
+    Raises
+    ------
+    UserError
+        ``<file>: label ids [..] are not in the SemanticKITTI label table``.
+    """
+    bad = np.setdiff1d(np.unique(np.asarray(semantic)), _known_raw_ids())
+    if bad.size:
+        shown = ", ".join(str(int(v)) for v in bad[:8]) + (", ..." if bad.size > 8 else "")
+        raise UserError(f"{safeload.printable(source)}: label ids [{shown}] are not in the SemanticKITTI "
+                        "label table (generator/labels/semantic-kitti.yaml)")
+
+
+@functools.cache
+def _known_raw_ids() -> np.ndarray:
+    return np.array(sorted(class_table().sk_labels), np.int64)
 
 
 def read_poses(path: str | Path) -> np.ndarray:
-    """(n, 4, 4) float64 poses of a KITTI ``poses.txt``."""
-    rows = _read_rows(Path(path), 12, "poses")
+    """(n, 4, 4) float64 poses of a KITTI ``poses.txt`` (12 finite numbers per line, rigid, translations
+    within :data:`MAX_TRANSLATION_M`)."""
+    rows = safeload.read_matrix_rows(path, 12)
+    far = np.flatnonzero(np.abs(rows[:, [3, 7, 11]]).max(axis=1) > MAX_TRANSLATION_M)
+    if far.size:
+        raise UserError(f"{safeload.printable(path)}: line {int(far[0]) + 1}: translation beyond "
+                        f"{MAX_TRANSLATION_M:.0f} m from the first pose")
+    for i, row in enumerate(rows):
+        problem = rigid_problem(row.reshape(3, 4))
+        if problem:
+            raise UserError(f"{safeload.printable(path)}: line {i + 1}: pose {problem}")
     out = np.repeat(np.eye(4)[None], len(rows), 0)
     out[:, :3, :4] = rows.reshape(-1, 3, 4)
     return out
 
 
 def read_times(path: str | Path) -> np.ndarray:
-    """(n,) float64 seconds of a KITTI ``times.txt``."""
-    return _read_rows(Path(path), 1, "times")[:, 0]
+    """(n,) float64 seconds of a KITTI ``times.txt`` (one finite number per line)."""
+    return safeload.read_matrix_rows(path, 1)[:, 0]
+
+
+def _present(path: Path) -> bool:
+    """Whether anything is at ``path`` (a dangling link or a FIFO too: reading it then says what is wrong)."""
+    return os.path.lexists(path)
 
 
 # -- sequences ---------------------------------------------------------------------------------
@@ -200,13 +225,14 @@ class Sequence:
         stems = [p.stem for p in self.velodyne.glob("*.bin")]
         bad = [s for s in stems if not s.isdigit()]
         if bad:
-            raise UserError(f"{self.velodyne / (bad[0] + '.bin')}: scan names must be frame numbers like 000000.bin")
+            raise UserError(f"{safeload.printable(self.velodyne / (bad[0] + '.bin'))}: scan names must be frame "
+                            "numbers like 000000.bin")
         self.frames: list[int] = sorted(int(s) for s in stems)
         self._stem = {int(s): s for s in stems}
         self.has_labels = self.labels_dir.is_dir()
-        self.times = read_times(self.dir / "times.txt") if (self.dir / "times.txt").is_file() else None
-        self.calib = read_calib(self.dir / "calib.txt") if (self.dir / "calib.txt").is_file() else None
-        self.cam_poses = read_poses(self.dir / "poses.txt") if (self.dir / "poses.txt").is_file() else None
+        self.times = read_times(self.dir / "times.txt") if _present(self.dir / "times.txt") else None
+        self.calib = read_calib(self.dir / "calib.txt") if _present(self.dir / "calib.txt") else None
+        self.cam_poses = read_poses(self.dir / "poses.txt") if _present(self.dir / "poses.txt") else None
         for name, arr in (("times.txt", self.times), ("poses.txt", self.cam_poses)):
             if arr is not None and self.frames and len(arr) <= max(self.frames):
                 raise UserError(f"{self.dir / name}: {len(arr)} lines but scans go up to frame {max(self.frames)}")
@@ -232,14 +258,26 @@ class Sequence:
             return None
         return lidar_poses(self.cam_poses, tr_matrix(self.calib, str(self.dir / "calib.txt")))
 
+    def read_labelled(self, index: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(points (n, 4) float32, semantic (n,) uint16, instance (n,) uint16) of frame ``index``.
+
+        Raises
+        ------
+        UserError
+            A bad scan or label file, or a label count that differs from the point count.
+        """
+        pts = read_scan(self.scan_path(index))
+        sem, inst = read_labels(self.label_path(index))
+        if len(sem) != len(pts):
+            raise UserError(f"{self.label_path(index)}: {len(sem)} labels but {self.scan_path(index)} has {len(pts)} points")
+        return pts, sem, inst
+
     def read(self, index: int, labels: bool = True, _poses: np.ndarray | None = None) -> ScanRecord:
         """The scan, labels (unless ``labels=False``), pose and time of frame ``index``."""
-        pts = read_scan(self.scan_path(index))
-        sem = inst = None
         if labels and self.has_labels:
-            sem, inst = read_labels(self.label_path(index))
-            if len(sem) != len(pts):
-                raise UserError(f"{self.label_path(index)}: {len(sem)} labels but {self.scan_path(index)} has {len(pts)} points")
+            pts, sem, inst = self.read_labelled(index)
+        else:
+            pts, sem, inst = read_scan(self.scan_path(index)), None, None
         poses = self.lidar_poses() if _poses is None else _poses
         return ScanRecord(index, pts, sem, inst, None if poses is None else poses[index],
                           None if self.times is None else float(self.times[index]))

@@ -7,8 +7,8 @@ pose, so one variant per frame is read (``day_clear`` when present, else the fir
 
 from __future__ import annotations
 
-import json
 import logging
+import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Iterator
@@ -16,9 +16,10 @@ from typing import Iterator
 import numpy as np
 
 from generator.world import rig
-from generator.errors import UserError
+from generator.errors import SpecError, UserError
 from generator.formats import semantickitti as sk
 from generator.formats.point_sidecars import NATIVE_DIR, TIMES_DIR, read_sidecar
+from generator.imaging import meta_fields as md
 from generator.imaging.exr import read_exr
 from generator.labels import class_table
 
@@ -99,7 +100,7 @@ def frame_images(root: Path) -> dict[int, Path]:
     out: dict[int, Path] = {}
     for p in sorted(folder.glob("*.json")):
         stem = p.stem.split("_", 1)[0]
-        if not stem.isdigit():
+        if not (stem.isascii() and stem.isdigit() and len(stem) <= 9):
             continue
         k = int(stem)
         if k not in out or p.stem.endswith("_day_clear"):
@@ -107,17 +108,21 @@ def frame_images(root: Path) -> dict[int, Path]:
     return out
 
 
+def read_image_meta(meta_path: Path) -> tuple[dict, np.ndarray, np.ndarray]:
+    """(metadata, T_world_camera (4, 4), K (3, 3)) of one image, every field fusion uses checked."""
+    meta = md.load_metadata(meta_path)
+    T = md.matrix(meta, "camera.T_world_camera", (4, 4), str(meta_path))
+    problem = md.rigid_problem(T)
+    if problem:
+        raise SpecError(str(meta_path), "camera.T_world_camera", problem)
+    K, _, _ = md.intrinsics(meta, str(meta_path))
+    return meta, T, K
+
+
 def read_image(meta_path: Path) -> tuple[dict, object]:
     """Metadata dict and :class:`generator.imaging.exr.LabelledImage` of one image."""
-    try:
-        meta = json.loads(meta_path.read_text(encoding="utf-8"))
-        exr = meta_path.parent / meta["files"]["exr"]
-        cam = meta["camera"]
-        np.asarray(cam["T_world_camera"], np.float64).reshape(4, 4)
-        np.asarray(cam["intrinsics"]["K"], np.float64).reshape(3, 3)
-    except (OSError, ValueError, KeyError, TypeError) as e:
-        raise UserError(f"{meta_path}: not an image metadata file ({type(e).__name__}: {e})") from None
-    return meta, read_exr(exr)
+    meta, _, _ = read_image_meta(meta_path)
+    return meta, read_exr(md.exr_path(meta, meta_path))
 
 
 class FusionDataset:
@@ -129,15 +134,25 @@ class FusionDataset:
         Dataset folder with ``images/`` and ``lidar/sequences/NN/``.
     sequence : str
         Sequence name (default ``00``).
+
+    Raises
+    ------
+    UserError
+        Anything the readers refuse, or a sequence without ``poses.txt`` and ``calib.txt``
+        (without poses every scan would be stacked at the origin of the map).
     """
 
     def __init__(self, root: str | Path, sequence: str = "00"):
         self.root = Path(root)
         self.images = frame_images(self.root)
         self.seq = sk.Sequence(self.root / "lidar", sequence)
-        self.meta = self._lidar_meta()
-        #: (n, 4, 4) LiDAR poses in the first LiDAR frame (poses.txt + calib.txt), or None
+        self.meta, self.sweeps = self._lidar_meta()
+        #: (n, 4, 4) LiDAR poses in the first LiDAR frame (poses.txt + calib.txt)
         self.poses = self.seq.lidar_poses()
+        if self.poses is None:
+            missing = [n for n in ("poses.txt", "calib.txt") if not os.path.lexists(self.seq.dir / n)]
+            raise UserError(f"{self.seq.dir}: {' and '.join(missing)} missing; fusion places every scan with its "
+                            "pose (without them every scan would stack at the origin)")
         self.frames = [k for k in self.seq.frames if k in self.images]
         if not self.frames:
             raise UserError(f"{self.root}: no frame has both an image in images/ and a scan in {self.seq.velodyne}")
@@ -145,28 +160,31 @@ class FusionDataset:
         if missing:
             log.warning("%d scans without an image (first: %06d): left out", len(missing), missing[0])
 
-    def _lidar_meta(self) -> dict:
+    def _lidar_meta(self) -> tuple[dict, list]:
         path = self.seq.dir / META_NAME
-        if not path.is_file():
-            return {}
-        try:
-            return json.loads(path.read_text(encoding="utf-8"))
-        except (OSError, ValueError) as e:
-            raise UserError(f"{path}: cannot read ({e})") from None
+        if not os.path.lexists(path):
+            return {}, []
+        meta = md.load_metadata(path)
+        return meta, md.sweep_poses(meta, str(path))
 
     def _lidar_poses(self, k: int, image_meta: dict | None) -> tuple[np.ndarray, np.ndarray]:
         """(sweep_times (k,), sweep_poses (k, 4, 4)) of scan ``k``."""
-        sweeps = self.meta.get("sweep_poses_world") or {}
-        frames = sweeps.get("frames", [])
-        if k < len(frames):
-            return np.asarray(frames[k]["t_s"], np.float64), np.asarray(frames[k]["T_world_lidar"], np.float64)
-        mount = self.meta.get("mount")
+        if k < len(self.sweeps):
+            return self.sweeps[k]
+        source = str(self.seq.dir / META_NAME)
+        mount = md.field(self.meta, "mount", source, default=None)
         if image_meta is None and k in self.images:
-            image_meta = json.loads(self.images[k].read_text(encoding="utf-8"))
+            image_meta = md.load_metadata(self.images[k])
         if not mount or image_meta is None:
             raise UserError(f"{self.seq.dir / META_NAME}: needs 'sweep_poses_world' (or 'mount' and an image) "
                             f"to place scan {k:06d} of the LiDAR")
-        start = np.asarray(image_meta["ego"]["T_world_ego"], np.float64) @ rig.mount(mount["lidar_xyz_m"], mount["lidar_rpy_deg"])
+        xyz = md.matrix(self.meta, "mount.lidar_xyz_m", (3,), source)
+        rpy = md.matrix(self.meta, "mount.lidar_rpy_deg", (3,), source)
+        ego = md.matrix(image_meta, "ego.T_world_ego", (4, 4), str(self.images.get(k, "image metadata")))
+        problem = md.rigid_problem(ego)
+        if problem:
+            raise SpecError(str(self.images.get(k, "image metadata")), "ego.T_world_ego", problem)
+        start = ego @ rig.mount(xyz, rpy)
         log.warning("%s: no sweep poses for scan %06d; it is projected without de-skew", self.seq.dir, k)
         return np.zeros(1), start[None]
 
@@ -180,22 +198,22 @@ class FusionDataset:
         rec = self.seq.read(k, True, self.poses)
         if rec.semantic is None:
             raise UserError(f"{self.seq.labels_dir}: missing (fusion needs labelled scans)")
+        sk.check_raw_ids(rec.semantic, self.seq.label_path(k))
         native = read_sidecar(self.seq.dir, NATIVE_DIR, k, len(rec.points))
         times = read_sidecar(self.seq.dir, TIMES_DIR, k, len(rec.points))
         sweep_times, sweep_poses = self._lidar_poses(k, image_meta)
         return dict(xyz=rec.points[:, :3], semantic=rec.semantic, instance=rec.instance,
                     native=native if native is not None else native_from_raw(rec.semantic),
                     native_exact=native is not None, times=times, T_world_lidar_start=sweep_poses[0],
-                    sweep_times=sweep_times, sweep_poses=sweep_poses,
-                    pose=rec.pose if rec.pose is not None else np.eye(4))
+                    sweep_times=sweep_times, sweep_poses=sweep_poses, pose=rec.pose)
 
     def read(self, k: int) -> FusionFrame:
         """Frame ``k`` (must be in :attr:`frames`)."""
-        meta, img = read_image(self.images[k])
-        cam = meta["camera"]
-        return FusionFrame(index=k, image_name=meta.get("image", self.images[k].stem), class_id=img.class_id,
-                           depth=img.depth, K=np.asarray(cam["intrinsics"]["K"], np.float64),
-                           T_world_camera=np.asarray(cam["T_world_camera"], np.float64), **self.read_scan(k, meta))
+        meta, T, K = read_image_meta(self.images[k])
+        img = read_exr(md.exr_path(meta, self.images[k]))
+        name = meta.get("image") if isinstance(meta.get("image"), str) else self.images[k].stem
+        return FusionFrame(index=k, image_name=name, class_id=img.class_id, depth=img.depth, K=K, T_world_camera=T,
+                           **self.read_scan(k, meta))
 
     def __iter__(self) -> Iterator[FusionFrame]:
         for k in self.frames:

@@ -26,6 +26,14 @@ from generator.imaging.exr import read_exr
 from generator.labels import class_table
 
 
+def _p2(calib: dict, source: Path) -> np.ndarray:
+    """(3, 4) ``P2 = K [I | t]`` of a parsed calib, refusing anything else (it is solved for ``t``)."""
+    P2 = np.asarray(calib.get("P2", np.zeros(0)), np.float64)
+    if P2.shape != (3, 4) or not (P2[0, 0] > 0 and P2[1, 1] > 0 and P2[1, 0] == 0 and np.array_equal(P2[2, :3], [0, 0, 1])):
+        raise UserError(f"{source}: P2: needs 12 numbers forming K [I | t] (a pinhole K with fx, fy > 0)")
+    return P2
+
+
 def scan_agreement(seq_dir: Path, index: int, calib: dict) -> dict:
     """Counts for scan ``index``: ``{"counted", "agree", "projected", "points"}``."""
     xyz = sk.read_scan(seq_dir / "velodyne" / f"{index:06d}.bin")[:, :3].astype(np.float64)
@@ -34,7 +42,7 @@ def scan_agreement(seq_dir: Path, index: int, calib: dict) -> dict:
         raise UserError(f"{seq_dir / NATIVE_DIR}: no native labels for scan {index:06d}")
     img = read_exr(seq_dir / "passes_2" / f"{index:06d}.exr")
     h, w = img.class_id.shape
-    P2 = np.asarray(calib["P2"], np.float64)
+    P2 = _p2(calib, seq_dir / "calib.txt")
     K, t = P2[:, :3], np.linalg.solve(P2[:, :3], P2[:, 3])  # P2 = K [I | t]
     T = kitti_calib.homogeneous(np.c_[np.eye(3), t]) @ kitti_calib.tr_matrix(calib)
     proj = P.project(P.transform(T, xyz), K, w, h)

@@ -17,17 +17,21 @@ sequences carry ``native_labels/`` side files, so their maps keep every native c
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
 from generator.atomic import atomic_path, write_bytes
+from generator.errors import UserError
 from generator.labels import class_table
 
-LABEL_BITS = 5  # native ids < 32
-AXIS_BITS = 19  # 3 * 19 + 5 = 62 bits: +-262k voxels per axis
+LABEL_BITS = 6  # native ids < 64 (the class table has 34)
+AXIS_BITS = 19  # 3 * 19 + 6 = 63 bits: +-262k voxels per axis, keys stay positive int64
 _OFFSET = 1 << (AXIS_BITS - 1)
+#: Voxel edges accepted, metres.
+MIN_VOXEL_M, MAX_VOXEL_M = 0.001, 1000.0
 
 
 class VoxelMap:
@@ -37,26 +41,39 @@ class VoxelMap:
     ----------
     voxel_m : float
         Voxel edge, metres.
+
+    Raises
+    ------
+    UserError
+        A voxel edge that is not a finite number in [:data:`MIN_VOXEL_M`, :data:`MAX_VOXEL_M`]
+        (it comes from the command line's ``--voxel``).
     """
 
     def __init__(self, voxel_m: float = 0.2):
-        if voxel_m <= 0:
-            raise ValueError(f"voxel size must be > 0, got {voxel_m}")
-        self.voxel_m = float(voxel_m)
+        try:
+            v = float(voxel_m)
+        except (TypeError, ValueError):
+            v = math.nan
+        if not (math.isfinite(v) and MIN_VOXEL_M <= v <= MAX_VOXEL_M):
+            raise UserError(f"--voxel: the voxel edge must be a finite number in [{MIN_VOXEL_M}, {MAX_VOXEL_M}] m, "
+                            f"got {voxel_m}")
+        self.voxel_m = v
         self._key = np.zeros(0, np.int64)  # voxel << LABEL_BITS | label
         self._count = np.zeros(0, np.int64)
         self._sum = np.zeros((0, 3), np.float64)
         self.points = 0
 
     def add(self, xyz: np.ndarray, labels: np.ndarray) -> None:
-        """Count (n, 3) float points (map frame, metres) with (n,) native labels (< 32)."""
+        """Count (n, 3) float points (map frame, metres) with (n,) native labels (< 64)."""
         xyz = np.asarray(xyz, np.float64).reshape(-1, 3)
         labels = np.asarray(labels, np.int64)
         if labels.size and (labels.min() < 0 or labels.max() >= 1 << LABEL_BITS):
             raise ValueError(f"labels must be in 0..{(1 << LABEL_BITS) - 1}")
+        reach = (_OFFSET - 1) * self.voxel_m
+        if xyz.size and not (np.isfinite(xyz).all() and np.abs(xyz).max() < reach):
+            raise UserError(f"semantic map: points farther than {reach:.0f} m from the first scan "
+                            "(poses.txt, calib.txt or the scans hold far-off values; or choose a larger --voxel)")
         idx = np.floor(xyz / self.voxel_m).astype(np.int64) + _OFFSET
-        if idx.size and (idx.min() < 0 or idx.max() >= 1 << AXIS_BITS):
-            raise ValueError(f"points farther than {_OFFSET * self.voxel_m:.0f} m from the map origin")
         key = (((idx[:, 0] << AXIS_BITS | idx[:, 1]) << AXIS_BITS | idx[:, 2]) << LABEL_BITS) | labels
         self._merge(key, np.ones(len(key), np.int64), xyz)
         self.points += len(key)

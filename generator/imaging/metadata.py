@@ -14,6 +14,7 @@ import numpy as np
 
 from generator import __version__
 from generator.imaging.exr import DEPTH_DEFINITION
+from generator.imaging.meta_fields import schema_message
 from generator.labels import class_table
 from generator.spec.validate import load_schema
 
@@ -114,8 +115,9 @@ def image_metadata(*, image: str, files: dict, frame, k: np.ndarray, width: int,
 
 
 def validate_metadata(record: dict) -> list[str]:
-    """Problems of a metadata record against its schema (empty when valid)."""
+    """Problems of a metadata record against its schema (empty when valid); one line each, naming
+    the field and never the value (:func:`schema_message`)."""
     import jsonschema
 
     v = jsonschema.Draft202012Validator(load_schema("metadata"))
-    return [f"{'.'.join(str(p) for p in e.absolute_path) or '(top level)'}: {e.message}" for e in v.iter_errors(record)]
+    return [schema_message(e) for e in v.iter_errors(record)]

@@ -2,33 +2,75 @@
 
 from __future__ import annotations
 
-import json
+import logging
+import os
 from pathlib import Path
 
 import numpy as np
 
 from generator.atomic import inside
-from generator.errors import UserError
+from generator.errors import SpecError, UserError
 from generator.formats import semantickitti as sk
 from generator.formats.openlabel import build_openlabel, write_openlabel
+from generator.imaging import meta_fields as md
+from generator.safeload import printable
 from generator.world.rig import Rig
+
+log = logging.getLogger(__name__)
 
 DEFAULT_CLASSES = ("car", "truck", "person")
 
 
-def _camera(root: Path, seq, meta: dict, spec) -> tuple[np.ndarray, int, int, str]:
+def _camera(root: Path, seq, meta: dict, meta_source: str) -> tuple[np.ndarray, int, int, str]:
     """Intrinsics from the first image's metadata, else from calib.txt and the sequence metadata."""
     images = sorted((root / "images").glob("*.json")) if (root / "images").is_dir() else []
     for p in images:
         try:
-            cam = json.loads(p.read_text(encoding="utf-8"))["camera"]["intrinsics"]
-            return np.asarray(cam["K"], np.float64), int(cam["width"]), int(cam["height"]), f"metadata of {p.name}"
-        except (OSError, ValueError, KeyError):
+            K, w, h = md.intrinsics(md.load_metadata(p), str(p))
+        except UserError as e:  # another JSON in images/, or a damaged one: the next may do
+            log.warning("%s; intrinsics not read from it", e)
             continue
+        return K, w, h, f"metadata of {printable(p.name)}"
     if seq.calib is None or "calib" not in meta:
         raise UserError(f"{seq.dir}: no image metadata and no calib.txt/lidar_meta.json to read the camera from")
-    w, h = meta["calib"]["resolution"]
-    return np.asarray(seq.calib["P2"], np.float64)[:, :3], int(w), int(h), "calib.txt P2"
+    res = md.field(meta, "calib.resolution", meta_source)
+    if not (isinstance(res, list) and len(res) == 2 and all(
+            isinstance(v, int) and not isinstance(v, bool) and 1 <= v <= md.MAX_IMAGE_SIDE for v in res)):
+        raise SpecError(meta_source, "calib.resolution", f"must be [width, height] in pixels, 1..{md.MAX_IMAGE_SIDE}")
+    w, h = res
+    P2 = np.asarray(seq.calib.get("P2", np.zeros(0)), np.float64)
+    if P2.shape != (3, 4):
+        raise UserError(f"{seq.dir / 'calib.txt'}: P2: needs 12 numbers")
+    return P2[:, :3], w, h, "calib.txt P2"
+
+
+def _sensor(meta: dict, source: str) -> dict:
+    """The ``sensor`` fields of ``lidar_meta.json`` the OpenLABEL streams copy, type-checked."""
+    out = {}
+    for key in ("model", "name"):
+        out[key] = md.field(meta, f"sensor.{key}", source)
+        if not isinstance(out[key], str):
+            raise SpecError(source, f"sensor.{key}", f"must be a string, got {md.kind_of(out[key])}")
+    out["lasers"] = md.integer(meta, "sensor.lasers", source, 1, 100_000)
+    out["rotation_hz"] = float(md.matrix(meta, "sensor.rotation_hz", (), source))
+    out["range_m"] = md.matrix(meta, "sensor.range_m", (2,), source).tolist()
+    skew = md.field(meta, "motion_skew", source, default=False)
+    if not isinstance(skew, bool):
+        raise SpecError(source, "motion_skew", f"must be true or false, got {md.kind_of(skew)}")
+    out["motion_skew"] = skew
+    return out
+
+
+def _output(root: Path, name: str) -> Path:
+    """``root/openlabel/NN.json``, refusing an ``openlabel`` that is not a folder inside the dataset."""
+    folder = root / "openlabel"
+    try:
+        out = inside(root, "openlabel", f"{name}.json")
+    except (ValueError, RuntimeError, OSError):  # a link leading out, or a loop
+        out = None
+    if out is None or (os.path.lexists(folder) and not folder.is_dir()) or out.is_dir():
+        raise UserError(f"{folder}: must be a folder inside the dataset (not a file, FIFO or link leading out)")
+    return out
 
 
 def write_sequence_openlabel(spec, root: Path, sequence: str = "00", classes=DEFAULT_CLASSES,
@@ -52,39 +94,39 @@ def write_sequence_openlabel(spec, root: Path, sequence: str = "00", classes=DEF
     min_points = spec.labels.openlabel_min_points if min_points is None else min_points
     root = Path(root)
     name = sk.sequence_name(sequence)
+    out = _output(root, name)  # where it goes is checked before any work
     seq = sk.Sequence(root / "lidar", name)
     meta_path = seq.dir / "lidar_meta.json"
-    try:
-        meta = json.loads(meta_path.read_text(encoding="utf-8"))
-    except (OSError, ValueError) as e:
-        raise UserError(f"{meta_path}: cannot read ({e}); the sequence must come from urbangen lidar") from None
-    if meta.get("scene", {}).get("spec_hash") != spec.spec_hash:
+    meta = md.load_metadata(meta_path)
+    src = str(meta_path)
+    if md.field(meta, "scene.spec_hash", src, default=None) != spec.spec_hash:
         raise UserError(f"{meta_path}: cast from another spec (spec_hash differs from {spec.source})")
     if not seq.has_labels or not seq.frames:
         raise UserError(f"{seq.dir}: needs scans with labels")
     if seq.times is None:
         raise UserError(f"{seq.dir / 'times.txt'}: missing")
+    sensor = _sensor(meta, src)
     if scene is None:
         from generator.layout.assemble import build_scene
 
         scene = build_scene(spec)
-    route = int(meta["scene"].get("route", 0))
+    route = md.integer(meta, "scene.route", src, 0, max(len(scene.paths) - 1, 0), default=0)
     rig = Rig.from_spec(spec, scene, route)
     frames = [rig.frame(k) for k in seq.frames]
     counts = []
     for k in seq.frames:
-        _, inst = sk.read_labels(seq.label_path(k))
+        _, _, inst = seq.read_labelled(k)  # whole scan and labels, one label per point
         c = np.bincount(inst)
         counts.append({int(i): int(c[i]) for i in np.flatnonzero(c) if i > 0})
     objects = [o for o in scene.objects if o.cls in classes and o.instance_id > 0]
-    K, w, h, k_src = _camera(root, seq, meta, spec)
+    K, w, h, k_src = _camera(root, seq, meta, src)
     cam = spec.sensors.camera
     streams = {
         "camera": {"uri": "images/", "description": f"rig camera, hfov {cam.hfov_deg} deg, intrinsics from {k_src}"},
         "lidar": {"uri": f"lidar/sequences/{name}/velodyne/",
-                  "description": f"{meta['sensor']['model']} ({meta['sensor']['name']}), {meta['sensor']['rotation_hz']} Hz",
-                  "stream_properties": {"lasers": meta["sensor"]["lasers"], "range_m": meta["sensor"]["range_m"],
-                                        "motion_skew": meta.get("motion_skew", False)}},
+                  "description": f"{sensor['model']} ({sensor['name']}), {sensor['rotation_hz']} Hz",
+                  "stream_properties": {"lasers": sensor["lasers"], "range_m": sensor["range_m"],
+                                        "motion_skew": sensor["motion_skew"]}},
     }
     info = {"scene": spec.name, "seed": spec.seed, "spec_hash": spec.spec_hash, "sequence": name, "route": route,
             "classes": list(classes)}
@@ -95,7 +137,6 @@ def write_sequence_openlabel(spec, root: Path, sequence: str = "00", classes=DEF
                           min_points=min_points, T_ego_lidar=rig.T_ego_lidar,
                           T_ego_camera_nominal=rig.T_ego_camera(), K=K, width=w, height=h,
                           streams=streams, frame_uris=frame_uris, info=info)
-    out = inside(root, "openlabel", f"{name}.json")
     try:
         write_openlabel(out, doc)
     except ValueError as e:  # a bug, not a user error: say so loudly

@@ -1,39 +1,113 @@
 """Check a dataset folder file by file and list every problem found.
 
 Each check returns a list of ``"<path>: <problem>"`` lines; an empty list means valid.
-Images: EXR channels present, masks binary / exclusive / complete, class list, finite
-RGB, metadata against its schema and against the masks, every EXR with its JSON.
-LiDAR: ``.bin`` / ``.label`` sizes, labels in the label table, poses, times and calib.
-OpenLABEL: every file against the 1.0 schema. Manifest: every planned item present.
+Every file is read through :mod:`generator.safeload` (regular files, size limits, strict
+UTF-8 and JSON, finite numbers) and no check raises: a file that cannot be read is a
+problem like any other, and no line quotes a file's content.
+
+* Links: no symlink leads out of the dataset, none is a loop or dangling; no FIFO, socket
+  or device inside it.
+* Images: EXR channels present, masks binary / exclusive / complete, class names known,
+  finite RGB, depth >= 0; metadata against its schema (types of every field), then what
+  the readers use (pinhole K, rigid camera pose, the EXR beside it), and against the masks;
+  every EXR with its JSON.
+* LiDAR (:mod:`generator.jobs.validate_lidar`): scans, labels (ids in the label table,
+  one per point), side files, poses (finite, rigid, one per scan), times (finite,
+  increasing), calib, ``lidar_meta.json``.
+* OpenLABEL: every file against the 1.0 schema. Manifest: every planned item present.
 """
 
 from __future__ import annotations
 
-import json
+import errno
+import os
+import re
+import stat
 from pathlib import Path
 
 import numpy as np
 
 from generator.errors import UserError
+from generator.imaging import meta_fields as md
 from generator.imaging.exr import read_exr
 from generator.imaging.metadata import class_pixels, validate_metadata
+from generator.jobs.validate_lidar import check_lidar, reason, rel
 from generator.labels import class_table
 
-
-def _rel(path: Path, root: Path) -> str:
-    try:
-        return str(path.relative_to(root))
-    except ValueError:
-        return str(path)
+#: OpenLABEL schema problems listed per file at most.
+MAX_SCHEMA_PROBLEMS = 20
+#: Planned items a manifest may list (frames x variants).
+MAX_PLAN_ITEMS = 1_000_000
+_NAME = re.compile(r"[a-z][a-z_]{0,31}")
 
 
 def _read_json(path: Path, root: Path, problems: list[str]):
-    """Parsed JSON of ``path``, or None after recording why it cannot be read."""
+    """Parsed metadata JSON of ``path``, or None after recording why it cannot be read."""
     try:
-        return json.loads(path.read_text())
-    except (json.JSONDecodeError, UnicodeDecodeError) as e:
-        problems.append(f"{_rel(path, root)}: invalid JSON ({e})")
+        return md.load_metadata(path, rel(path, root))
+    except UserError as e:
+        problems.append(str(e))
         return None
+
+
+def check_links(root: Path) -> list[str]:
+    """Symlinks leading out of ``root``, symlink loops, dangling links and special files inside it."""
+    base = os.path.realpath(root)
+    problems = []
+    for folder, dirs, files in os.walk(root, onerror=lambda e: problems.append(
+            f"{rel(Path(e.filename or root), root)}: cannot list ({e.strerror or type(e).__name__})")):
+        for name in sorted(dirs + files):
+            p = Path(folder) / name
+            try:
+                mode = os.lstat(p).st_mode
+            except OSError:
+                continue
+            if stat.S_ISLNK(mode):
+                try:
+                    os.stat(p)
+                except OSError as e:
+                    problems.append(f"{rel(p, root)}: symlink {'loop' if e.errno == errno.ELOOP else 'to nothing'}")
+                    continue
+                if os.path.commonpath([base, os.path.realpath(p)]) != base:
+                    problems.append(f"{rel(p, root)}: symlink leading out of the dataset")
+            elif not (stat.S_ISREG(mode) or stat.S_ISDIR(mode)):
+                problems.append(f"{rel(p, root)}: not a regular file (a FIFO, socket or device)")
+    return problems
+
+
+#: Entries that must be folders when present (``NN`` stands for every sequence).
+FOLDERS = ("images", "lidar", "lidar/sequences", "openlabel", "lidar/sequences/NN", "lidar/sequences/NN/velodyne",
+           "lidar/sequences/NN/labels",
+           "lidar/sequences/NN/native_labels", "lidar/sequences/NN/point_times")
+
+
+def check_layout(root: Path) -> list[str]:
+    """Entries of the dataset layout that exist but are not folders (a file, a FIFO, a broken link)."""
+    seqs = root / "lidar" / "sequences"
+    names = sorted(p.name for p in seqs.iterdir() if p.name.isdigit()) if seqs.is_dir() else []
+    paths = [root / f for f in FOLDERS if "NN" not in f]
+    paths += [root / f.replace("NN", n) for f in FOLDERS if "NN" in f for n in names]
+    return [f"{rel(p, root)}: must be a folder" for p in paths if os.path.lexists(p) and not p.is_dir()]
+
+
+def _image_meta(meta: dict, meta_path: Path, root: Path, img) -> list[str]:
+    """What the readers use beyond the schema: pinhole K of the image's size, rigid pose, the EXR beside it."""
+    src = rel(meta_path, root)
+    problems = []
+    try:
+        _, w, h = md.intrinsics(meta, src)
+        if (w, h) != (img.class_id.shape[1], img.class_id.shape[0]):
+            problems.append(f"{src}: intrinsics size {w}x{h} differs from the image "
+                            f"{img.class_id.shape[1]}x{img.class_id.shape[0]}")
+        problem = md.rigid_problem(md.matrix(meta, "camera.T_world_camera", (4, 4), src))
+        if problem:
+            problems.append(f"{src}: camera.T_world_camera: {problem}")
+        md.exr_path(meta, meta_path, src)
+    except UserError as e:
+        problems.append(str(e))
+    if meta.get("classes_present") != class_pixels(img.class_id):
+        problems.append(f"{src}: classes_present disagrees with the masks of the EXR")
+    return problems
 
 
 def check_images(root: Path) -> tuple[list[str], int]:
@@ -43,90 +117,35 @@ def check_images(root: Path) -> tuple[list[str], int]:
     exrs = sorted(folder.glob("*.exr"))
     jsons = sorted(p for p in folder.glob("*.json"))
     for stem in sorted({p.stem for p in jsons} - {p.stem for p in exrs}):
-        problems.append(f"{_rel(folder / stem, root)}.json: metadata without its EXR")
+        problems.append(f"{rel(folder / stem, root)}.json: metadata without its EXR")
+    names = class_table().names
     for exr in exrs:
-        rel = _rel(exr, root)
+        r = rel(exr, root)
         try:
             img = read_exr(exr)
         except UserError as e:
-            problems.append(f"{rel}: {str(e).split(': ', 1)[-1]}")
+            problems.append(f"{r}: {reason(e, exr)}")
             continue
-        classes = img.header.get("urbangen.classes", "")
-        if classes.split(",") != class_table().names:
-            problems.append(f"{rel}: class list in the header differs from the class table")
+        if str(img.header.get("urbangen.classes", ",".join(names))).split(",") != names:
+            problems.append(f"{r}: class list in the header differs from the class table")
         if not np.isfinite(img.rgb).all():
-            problems.append(f"{rel}: RGB holds NaN or inf")
+            problems.append(f"{r}: RGB holds NaN or inf")
         if (img.depth < 0).any() or np.isnan(img.depth).any():
-            problems.append(f"{rel}: depth holds negative or NaN values")
+            problems.append(f"{r}: depth holds negative or NaN values")
         meta_path = exr.with_suffix(".json")
-        if not meta_path.exists():
-            problems.append(f"{rel}: no metadata JSON beside it")
+        if not os.path.lexists(meta_path):
+            problems.append(f"{r}: no metadata JSON beside it")
             continue
         meta = _read_json(meta_path, root, problems)
         if meta is None:
             continue
-        problems += [f"{_rel(meta_path, root)}: {p}" for p in validate_metadata(meta)]
-        if isinstance(meta, dict) and meta.get("classes_present") not in (None, class_pixels(img.class_id)):
-            problems.append(f"{_rel(meta_path, root)}: classes_present disagrees with the masks of the EXR")
-        w, h = img.class_id.shape[1], img.class_id.shape[0]
-        intr = meta.get("camera", {}).get("intrinsics", {}) if isinstance(meta, dict) else {}
-        if intr and (intr.get("width"), intr.get("height")) != (w, h):
-            problems.append(f"{_rel(meta_path, root)}: intrinsics size {intr.get('width')}x{intr.get('height')} "
-                            f"differs from the image {w}x{h}")
+        schema = [f"{rel(meta_path, root)}: {p}" for p in validate_metadata(meta)]
+        problems += schema if schema else _image_meta(meta, meta_path, root, img)
     return problems, len(exrs)
 
 
-def check_lidar(root: Path) -> tuple[list[str], int]:
-    """Problems of every sequence under ``root/lidar`` and the number of scans checked."""
-    from generator.formats import kitti_calib
-    from generator.formats.semantickitti import list_sequences, read_labels, read_poses, read_times
-
-    lidar = root / "lidar"
-    if not (lidar / "sequences").is_dir():
-        return [], 0
-    known = set(class_table().sk_labels)
-    problems, n = [], 0
-    for name in list_sequences(lidar):
-        seq = lidar / "sequences" / name
-        bins = sorted((seq / "velodyne").glob("*.bin"))
-        n += len(bins)
-        for b in bins:
-            lab = seq / "labels" / (b.stem + ".label")
-            size = b.stat().st_size
-            if size % 16:
-                problems.append(f"{_rel(b, root)}: size {size} is not a multiple of 16 bytes (x, y, z, remission float32)")
-                continue
-            if not lab.exists():
-                problems.append(f"{_rel(b, root)}: no labels/{b.stem}.label")
-                continue
-            if lab.stat().st_size != size // 4:
-                problems.append(f"{_rel(lab, root)}: {lab.stat().st_size // 4} labels for {size // 16} points")
-                continue
-            sem, _ = read_labels(lab)
-            bad = sorted(set(np.unique(sem).tolist()) - known)
-            if bad:
-                problems.append(f"{_rel(lab, root)}: label ids {bad} are not in the label table")
-        for fname, reader in (("poses.txt", read_poses), ("times.txt", read_times)):
-            p = seq / fname
-            try:
-                rows = len(reader(p))
-            except (UserError, OSError) as e:
-                problems.append(f"{_rel(p, root)}: {str(e).split(': ', 1)[-1]}")
-                continue
-            if rows != len(bins):
-                problems.append(f"{_rel(p, root)}: {rows} rows for {len(bins)} scans")
-        try:
-            calib = kitti_calib.read_calib(seq / "calib.txt")
-            missing = [k for k in ("P0", "P1", "P2", "P3", "Tr") if k not in calib]
-            if missing:
-                problems.append(f"{_rel(seq / 'calib.txt', root)}: missing {', '.join(missing)}")
-        except (UserError, OSError, ValueError) as e:
-            problems.append(f"{_rel(seq / 'calib.txt', root)}: {str(e).split(': ', 1)[-1]}")
-    return problems, n
-
-
 def check_openlabel(root: Path) -> tuple[list[str], int]:
-    from generator.formats.openlabel import validate_openlabel
+    from generator.formats.openlabel import openlabel_errors
 
     files = sorted((root / "openlabel").glob("*.json"))
     problems = []
@@ -134,19 +153,31 @@ def check_openlabel(root: Path) -> tuple[list[str], int]:
         doc = _read_json(f, root, problems)
         if doc is None:
             continue
-        problems += [f"{_rel(f, root)}: {p}" for p in validate_openlabel(doc)]
+        errors = [md.schema_message(e) for e in openlabel_errors(doc)]
+        problems += [f"{rel(f, root)}: {p}" for p in errors[:MAX_SCHEMA_PROBLEMS]]
+        if len(errors) > MAX_SCHEMA_PROBLEMS:
+            problems.append(f"{rel(f, root)}: and {len(errors) - MAX_SCHEMA_PROBLEMS} more schema problems")
     return problems, len(files)
 
 
 def check_manifest(root: Path) -> list[str]:
     p = root / "manifest.json"
-    if not p.exists():
+    if not os.path.lexists(p):
         return []
-    try:
-        m = json.loads(p.read_text())
-        frames, combos = m["plan"]["frames"], m["plan"]["combos"]
-    except (json.JSONDecodeError, KeyError, TypeError, UnicodeDecodeError) as e:
-        return [f"manifest.json: unreadable ({e})"]
+    problems: list[str] = []
+    m = _read_json(p, root, problems)
+    if m is None:
+        return problems
+    plan = m.get("plan") if isinstance(m.get("plan"), dict) else {}
+    frames, combos = plan.get("frames"), plan.get("combos")
+    if not (isinstance(frames, list) and all(isinstance(k, int) and not isinstance(k, bool) and 0 <= k < 10**6
+                                             for k in frames)):
+        return ["manifest.json: plan.frames: must be a list of frame numbers"]
+    if not (isinstance(combos, list) and all(isinstance(c, list) and len(c) == 2 and all(
+            isinstance(x, str) and _NAME.fullmatch(x) for x in c) for c in combos)):
+        return ["manifest.json: plan.combos: must be a list of [time_of_day, weather] names"]
+    if len(frames) * len(combos) > MAX_PLAN_ITEMS:
+        return [f"manifest.json: plan: more than {MAX_PLAN_ITEMS} planned images"]
     missing = [f"{k:06d}_{t}_{w}" for k in frames for t, w in combos
                if not (root / "images" / f"{k:06d}_{t}_{w}.json").exists()]
     return [f"manifest.json: planned image {n} is missing" for n in missing]
@@ -154,7 +185,9 @@ def check_manifest(root: Path) -> list[str]:
 
 def validate_dataset(root: Path) -> tuple[list[str], dict]:
     """Every problem of the dataset at ``root`` and how many items were checked."""
+    links = check_links(root) + check_layout(root)
     images, n_img = check_images(root)
     lidar, n_scan = check_lidar(root)
     openlabel, n_ol = check_openlabel(root)
-    return images + lidar + openlabel + check_manifest(root), {"images": n_img, "scans": n_scan, "openlabel": n_ol}
+    return (links + images + lidar + openlabel + check_manifest(root),
+            {"images": n_img, "scans": n_scan, "openlabel": n_ol})

@@ -10,12 +10,13 @@ from __future__ import annotations
 
 import logging
 import math
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import yaml
 
+from generator import safeload
 from generator.errors import SpecError, UserError
 from generator.labels import class_table
 
@@ -116,20 +117,19 @@ class IntensityProfile:
 def _stats(value, where: str) -> ClassStats:
     if not isinstance(value, dict) or "mean" not in value or "std" not in value:
         raise UserError(f"{where}: must be a mapping with mean and std")
-    try:
-        mean, std = float(value["mean"]), float(value["std"])
-    except (TypeError, ValueError):
-        raise UserError(f"{where}: mean and std must be numbers") from None
+    if not all(isinstance(value[k], (int, float)) and not isinstance(value[k], bool) for k in ("mean", "std")):
+        raise UserError(f"{where}: mean and std must be numbers")
+    mean, std = float(value["mean"]), float(value["std"])
     if not (math.isfinite(mean) and math.isfinite(std)) or std < 0:
         raise UserError(f"{where}: needs a finite mean and a finite std >= 0, got mean={mean}, std={std}")
     count = value.get("count")
-    if count is not None and (not isinstance(count, int) or count < 0):
-        raise UserError(f"{where}: count must be a non-negative integer or null, got {count!r}")
+    if count is not None and (not isinstance(count, int) or isinstance(count, bool) or count < 0):
+        raise UserError(f"{where}: count must be a non-negative integer or null")
     return ClassStats(mean, std, count)
 
 
 def parse_profile(doc, source: str) -> IntensityProfile:
-    """Validate a profile document (``yaml.safe_load`` output) read from ``source``."""
+    """Validate a profile document (:func:`generator.safeload.load_yaml` output) read from ``source``."""
     if not isinstance(doc, dict):
         raise UserError(f"{source}: an intensity profile must be a YAML mapping")
     known = set(class_table().unified_names.values())
@@ -141,28 +141,28 @@ def parse_profile(doc, source: str) -> IntensityProfile:
     unified = {}
     for name, v in unified_doc.items():
         if name not in known:
-            raise UserError(f"{source}: unified: unknown class {name!r}; known: {', '.join(sorted(known))}")
+            raise UserError(f"{source}: unified.{safeload.printable(name, 64)}: unknown class; "
+                            f"known: {', '.join(sorted(known))}")
         unified[name] = _stats(v, f"{source}: unified.{name}")
     raw = {}
     for k, v in raw_doc.items():
-        if not isinstance(k, int) or not 0 <= k <= 0xFFFF:
-            raise UserError(f"{source}: semantickitti: keys must be raw ids 0..65535, got {k!r}")
+        if not isinstance(k, int) or isinstance(k, bool) or not 0 <= k <= 0xFFFF:
+            raise UserError(f"{source}: semantickitti.{safeload.printable(k, 64)}: keys must be raw ids 0..65535")
         raw[k] = _stats(v, f"{source}: semantickitti.{k}")
     pooled = _stats(doc["pooled"], f"{source}: pooled") if doc.get("pooled") is not None else None
-    return IntensityProfile(str(doc.get("name", Path(source).stem)), str(doc.get("source", "")), unified, raw, pooled,
-                            source)
+    name, origin = doc.get("name", Path(source).stem), doc.get("source", "")
+    if not isinstance(name, str) or not isinstance(origin, str):
+        raise UserError(f"{source}: name and source must be strings")
+    return IntensityProfile(name, origin, unified, raw, pooled, source)
 
 
 def load_profile(path: str | Path, name: str | None = None) -> IntensityProfile:
-    """Read a profile YAML (``UserError`` naming the file on any problem); ``name`` replaces the path in records."""
-    path = Path(path)
-    try:
-        doc = yaml.safe_load(path.read_text(encoding="utf-8"))
-    except OSError as e:
-        raise UserError(f"{path}: cannot read intensity profile: {e.strerror or e}") from None
-    except yaml.YAMLError as e:
-        raise UserError(f"{path}: not valid YAML: {str(e).splitlines()[0]}") from None
-    return parse_profile(doc, name or str(path))
+    """Read a profile YAML through :mod:`generator.safeload` (a regular UTF-8 file within the YAML
+    limit, strict YAML, finite numbers); ``UserError`` naming the file on any problem, never
+    quoting it. ``name`` replaces the path in records and messages."""
+    source = name or str(path)
+    doc = safeload.load_yaml(path, source=source, string_keys=False)
+    return parse_profile(doc, source)
 
 
 def shipped_profiles() -> list[str]:
@@ -171,22 +171,72 @@ def shipped_profiles() -> list[str]:
 
 
 def resolve_profile(value: str | None, base: str | Path | None = None) -> IntensityProfile:
-    """A shipped profile by name (None = :data:`DEFAULT_PROFILE`) or a file path (relative to ``base``)."""
+    """A shipped profile by name (None = :data:`DEFAULT_PROFILE`) or a file path (relative to ``base``).
+
+    The path is taken as given (a path the user typed on the command line); a path written in
+    a spec goes through :func:`profile_for_spec`, which keeps it inside the spec's folder.
+    """
     value = value or DEFAULT_PROFILE
     if value in shipped_profiles():
         return load_profile(PROFILE_DIR / f"{value}.yaml", f"generator/remission/profiles/{value}.yaml")
     path = Path(value)
     if not path.is_absolute() and base is not None:
         path = Path(base) / path
-    if not path.is_file():
-        raise UserError(f"{value}: intensity profile not found (not a file, nor one of {', '.join(shipped_profiles())})")
+    if not os.path.lexists(path):
+        raise UserError(f"{safeload.printable(value, 200)}: intensity profile not found "
+                        f"(not a file, nor one of {', '.join(shipped_profiles())})")
     return load_profile(path)
 
 
-def profile_for_spec(spec) -> IntensityProfile:
-    """The spec's ``lidar.intensity_profile`` (a shipped name or a path relative to the spec file)."""
+def _written_in_spec_file(spec) -> bool:
+    """Whether ``spec.lidar.intensity_profile`` is what the spec FILE says.
+
+    A command line option (``--intensity-profile``) is applied by rewriting the spec, so a
+    value that differs from the file's came from the user's command line: it is not confined
+    to the spec's folder. A spec file that cannot be re-read counts as the source (confined).
+    """
+    from generator.spec.validate import read_document
+
+    try:
+        doc = read_document(spec.source)
+    except UserError:
+        return True
+    lidar = doc.get("lidar") if isinstance(doc, dict) else None
+    return not isinstance(lidar, dict) or lidar.get("intensity_profile") == spec.lidar.intensity_profile
+
+
+def profile_for_spec(spec, command_line: str | None = None) -> IntensityProfile:
+    """The spec's ``lidar.intensity_profile``: a shipped name, or a path relative to the spec file
+    that must stay inside the spec's folder (no absolute path, no ``..``, no link leading out).
+
+    Parameters
+    ----------
+    spec : generator.spec.SceneSpec
+    command_line : str, optional
+        A profile the user named on the command line: used instead, taken as given (not
+        confined), relative paths against the working directory.
+
+    Raises
+    ------
+    SpecError
+        ``<spec>: lidar.intensity_profile: <reason>`` for a path leading out of the spec's
+        folder or a missing profile; a bad profile file is named itself.
+    """
+    if command_line is not None:
+        return resolve_profile(command_line)
+    value = spec.lidar.intensity_profile
+    source = spec.source or "spec"
+    if value and value not in shipped_profiles() and spec.source and _written_in_spec_file(spec):
+        base = Path(spec.source).parent
+        path = safeload.confined_path(base, value, source, "lidar.intensity_profile")
+        if not os.path.lexists(path):
+            raise SpecError(source, "lidar.intensity_profile", f"{safeload.printable(value, 200)}: intensity profile "
+                            f"not found (not a file beside the spec, nor one of {', '.join(shipped_profiles())})")
+        return load_profile(path, str(base / value))
     base = Path(spec.source).parent if spec.source else None
     try:
-        return resolve_profile(spec.lidar.intensity_profile, base)
+        return resolve_profile(value, base)
+    except SpecError:
+        raise
     except UserError as e:
-        raise SpecError(spec.source or "spec", "lidar.intensity_profile", str(e)) from None
+        raise SpecError(source, "lidar.intensity_profile", str(e)) from None

@@ -19,13 +19,13 @@ their size does not depend on the number of scans either.
 from __future__ import annotations
 
 import logging
-import os
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import yaml
 
+from generator import safeload
 from generator.atomic import write_text
 from generator.errors import UserError
 from generator.formats import semantickitti as sk
@@ -129,17 +129,11 @@ def read_semantic_remission(scan_path: Path, label_path: Path) -> tuple[np.ndarr
     UserError
         Bad sizes, a label/point count mismatch or non-finite remission (naming the file).
     """
-    pts = sk.read_scan(scan_path)
-    if not os.path.isfile(label_path):
-        raise UserError(f"{label_path}: label file not found")
-    size = os.path.getsize(label_path)
-    if size != 4 * len(pts):
-        raise UserError(f"{label_path}: {size // 4} labels but {scan_path} has {len(pts)} points")
-    sem = np.fromfile(label_path, "<u4").view("<u2")[::2]  # little-endian: low 16 bits first
-    rem = pts[:, 3]
-    if not np.isfinite(rem).all():
-        raise UserError(f"{scan_path}: remission has NaN or infinite values")
-    return sem, rem
+    pts = sk.read_scan(scan_path)  # whole points, every value finite
+    labels = safeload.read_array(label_path, "<u4")
+    if len(labels) != len(pts):
+        raise UserError(f"{label_path}: {len(labels)} labels but {scan_path} has {len(pts)} points")
+    return labels.view("<u2")[::2], pts[:, 3]  # little-endian: the low 16 bits first
 
 
 def accumulate(root: str | Path, sequences: list[str] | None = None, progress: bool = True) -> tuple[ClassMoments, dict]:

@@ -195,18 +195,25 @@ def constant(value: float = 0.5) -> IntensityFn:
     return fn
 
 
-#: Factories by spec name; each takes the spec and returns an :data:`IntensityFn`.
+#: Factories by spec name; each takes the spec (and a command-line profile, or None) and returns an
+#: :data:`IntensityFn`.
 #: ``class_normal``, ``physical`` and ``hybrid`` live in :mod:`generator.remission.models`.
-INTENSITY_MODELS: dict[str, Callable[[object], IntensityFn]] = {
-    "constant": lambda spec: constant(spec.lidar.constant_intensity),
-    "class_normal": lambda spec: class_normal(profile_for_spec(spec)),
-    "physical": lambda spec: physical(),
-    "hybrid": lambda spec: hybrid(profile_for_spec(spec)),
+INTENSITY_MODELS: dict[str, Callable[..., IntensityFn]] = {
+    "constant": lambda spec, profile=None: constant(spec.lidar.constant_intensity),
+    "class_normal": lambda spec, profile=None: class_normal(profile_for_spec(spec, profile)),
+    "physical": lambda spec, profile=None: physical(),
+    "hybrid": lambda spec, profile=None: hybrid(profile_for_spec(spec, profile)),
 }
 
 
-def intensity_fn_for_spec(spec) -> IntensityFn:
+def intensity_fn_for_spec(spec, command_line_profile: str | None = None) -> IntensityFn:
     """The intensity function ``spec.lidar.intensity_model`` names.
+
+    Parameters
+    ----------
+    command_line_profile : str, optional
+        A profile named on the command line (a shipped name or a path taken as given),
+        used instead of ``spec.lidar.intensity_profile`` (which stays inside the spec's folder).
 
     Raises
     ------
@@ -214,11 +221,10 @@ def intensity_fn_for_spec(spec) -> IntensityFn:
         If the model is not available (yet).
     """
     name = spec.lidar.intensity_model
-    try:
-        return INTENSITY_MODELS[name](spec)
-    except KeyError:
+    if name not in INTENSITY_MODELS:
         raise SpecError(spec.source or "spec", "lidar.intensity_model",
-                        f"{name!r} is not available in this version (available: {', '.join(INTENSITY_MODELS)})") from None
+                        f"{name!r} is not available in this version (available: {', '.join(INTENSITY_MODELS)})")
+    return INTENSITY_MODELS[name](spec, command_line_profile)
 
 
 #: Every model name, in the order the spec's enum lists them.

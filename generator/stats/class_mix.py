@@ -75,6 +75,7 @@ def count_points(lidar_root: Path) -> tuple[np.ndarray, int]:
             continue
         for k in seq.frames:
             sem, _ = sk.read_labels(seq.label_path(k))
+            sk.check_raw_ids(sem, seq.label_path(k))
             counts += np.bincount(lut[sem], minlength=20)[:20]
             scans += 1
     return counts, scans

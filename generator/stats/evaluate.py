@@ -26,6 +26,7 @@ Label sets (:data:`LABEL_SETS`): ``unified11`` (seed 000's 11 classes, from the 
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Iterator
@@ -123,9 +124,19 @@ def _read_native(seq: Path, index: int, raw: np.ndarray) -> np.ndarray:
     return native.astype(np.int64)
 
 
-def read_ids(ls: LabelSet, seq: Path, index: int, raw: np.ndarray) -> np.ndarray:
-    """(n,) int64 ids in label set ``ls`` of scan ``index``: from its raw ids, or its native side file."""
-    return _read_native(seq, index, raw) if ls.from_raw is None else ls.from_raw[raw]
+def read_ids(ls: LabelSet, seq: Path, index: int, raw: np.ndarray, source: str | Path = "labels") -> np.ndarray:
+    """(n,) int64 ids in label set ``ls`` of scan ``index``: from its raw ids, or its native side file.
+
+    Raises
+    ------
+    UserError
+        A raw id the SemanticKITTI label table does not know (``source`` names the file), or a
+        native side file that is missing or holds ids outside the class table.
+    """
+    if ls.from_raw is None:
+        return _read_native(seq, index, raw)
+    sk.check_raw_ids(raw, source)
+    return ls.from_raw[raw]
 
 
 def prediction_path(pred_dir: Path, index: int) -> Path:
@@ -192,12 +203,13 @@ def evaluate_trees(pred_root: str | Path, gt_root: str | Path, labels: str = "un
     for gt_dir, pred_dir, i in progress_bar(pairs, desc=f"eval {labels}", unit="scan", enabled=progress):
         gt_raw, gt_inst = sk.read_labels(gt_dir / "labels" / f"{i:06d}.label")
         pred_path = prediction_path(pred_dir, i)
-        if not pred_path.is_file():
+        if not os.path.lexists(pred_path):
             raise UserError(f"{pred_path}: missing prediction (ground truth has {gt_dir.name}/{i:06d})")
         pred_raw, pred_inst = sk.read_labels(pred_path)
         if len(pred_raw) != len(gt_raw):
             raise UserError(f"{pred_path}: {len(pred_raw)} labels but the ground truth has {len(gt_raw)} points")
-        gt_ids, pred_ids = read_ids(ls, gt_dir, i, gt_raw), read_ids(ls, pred_dir, i, pred_raw)
+        gt_ids = read_ids(ls, gt_dir, i, gt_raw, gt_dir / "labels" / f"{i:06d}.label")
+        pred_ids = read_ids(ls, pred_dir, i, pred_raw, pred_path)
         conf += confusion(pred_ids, gt_ids, n)
         if pan is not None:
             pan.add(pred_ids, sk.encode_labels(pred_raw, pred_inst), gt_ids, sk.encode_labels(gt_raw, gt_inst))

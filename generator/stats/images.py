@@ -13,15 +13,17 @@ average is over all images of the dataset (as in seed 003: total / number of ima
 
 from __future__ import annotations
 
-import json
 import logging
+import os
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from generator.errors import UserError
+from generator.imaging import meta_fields as md
 from generator.labels import class_table
+from generator.safeload import printable
 from generator.stats.chart import log_bar_chart
 from generator.stats.report import Figure, Section, Table
 from generator.weather import KINDS, TIMES
@@ -34,6 +36,8 @@ KIND_TITLES = {"clear": "Clear", "fog": "Fog", "rain": "Rain", "rain_fog": "Rain
                "wet_fog": "Wet & fog"}
 TIME_TITLES = {"day": "Day", "night": "Night"}
 CHART = "pixels_per_class.png"
+#: Most pixels one class may claim in one image (a 65535 x 65535 image).
+MAX_PIXELS = 65535 * 65535
 
 
 @dataclass(frozen=True)
@@ -79,24 +83,21 @@ class ImageData:
 
 
 def _bad(path: Path, reason: str) -> UserError:
-    return UserError(f"{path}: {reason}")
+    return UserError(f"{printable(path)}: {reason}")
 
 
-def parse_record(path: Path, text: str) -> ImageRecord:
-    """One metadata JSON -> :class:`ImageRecord`; a malformed file is a one-line UserError."""
-    try:
-        rec = json.loads(text)
-    except json.JSONDecodeError as e:
-        raise _bad(path, f"not valid JSON ({e.msg} at line {e.lineno} column {e.colno})") from None
+def parse_record(path: Path, rec: object) -> ImageRecord:
+    """One parsed metadata JSON -> :class:`ImageRecord`; a malformed record is a one-line UserError
+    (naming the field, never quoting the file)."""
     if not isinstance(rec, dict):
         raise _bad(path, "metadata must be a JSON object")
     tod = rec.get("time_of_day")
     if tod not in TIMES:
-        raise _bad(path, f"time_of_day: must be one of {', '.join(TIMES)}, got {tod!r}")
+        raise _bad(path, f"time_of_day: must be one of {', '.join(TIMES)}, got {md.kind_of(tod)}")
     weather = rec.get("weather")
     kind = weather.get("kind") if isinstance(weather, dict) else None
     if kind not in KINDS:
-        raise _bad(path, f"weather.kind: must be one of {', '.join(KINDS)}, got {kind!r}")
+        raise _bad(path, f"weather.kind: must be one of {', '.join(KINDS)}, got {md.kind_of(kind)}")
     present = rec.get("classes_present")
     if not isinstance(present, dict) or not present:
         raise _bad(path, "classes_present: must be a non-empty object {class name: pixel count}")
@@ -104,22 +105,23 @@ def parse_record(path: Path, text: str) -> ImageRecord:
     pixels = np.zeros(len(table), np.int64)
     for name, count in present.items():
         if name not in table.names:
-            raise _bad(path, f"classes_present.{name}: unknown class; known: {', '.join(table.names)}")
-        if not isinstance(count, int) or isinstance(count, bool) or count < 0:
-            raise _bad(path, f"classes_present.{name}: must be a pixel count (integer >= 0), got {count!r}")
+            raise _bad(path, f"classes_present.{printable(name, 64)}: unknown class; known: {', '.join(table.names)}")
+        if not isinstance(count, int) or isinstance(count, bool) or not 0 <= count <= MAX_PIXELS:
+            raise _bad(path, f"classes_present.{name}: must be a pixel count (integer in [0, {MAX_PIXELS}]), "
+                             f"got {md.kind_of(count) if not isinstance(count, int) else count}")
         pixels[table.id(name)] = count
-    files = rec.get("files")
-    exr = files.get("exr") if isinstance(files, dict) else None
+    exr = md.exr_path(rec, path, must_exist=False) if isinstance(md.field(rec, "files.exr", str(path), None), str) \
+        else None
     intr = (rec.get("camera") or {}).get("intrinsics") if isinstance(rec.get("camera"), dict) else None
     size = None
-    if isinstance(intr, dict) and isinstance(intr.get("width"), int) and isinstance(intr.get("height"), int):
-        size = intr["width"] * intr["height"]
-    name = rec.get("image") if isinstance(rec.get("image"), str) else path.stem
-    return ImageRecord(name, path, path.parent / exr if isinstance(exr, str) else None, tod, kind, pixels, size)
+    if isinstance(intr, dict) and "width" in intr and "height" in intr:
+        size = (md.integer(rec, "camera.intrinsics.width", str(path), 1, md.MAX_IMAGE_SIDE)
+                * md.integer(rec, "camera.intrinsics.height", str(path), 1, md.MAX_IMAGE_SIDE))
+    return ImageRecord(printable(path.stem, 200), path, exr, tod, kind, pixels, size)
 
 
 def load(root: Path) -> ImageData | None:
-    """Read every ``root/images/*.json``.
+    """Read every ``root/images/*.json`` (through :mod:`generator.safeload`, the metadata limits).
 
     Returns
     -------
@@ -139,11 +141,7 @@ def load(root: Path) -> ImageData | None:
         raise UserError(f"{folder}: no image metadata (*.json) found")
     records = []
     for p in progress(paths, desc="metadata", unit="img", leave=False):
-        try:
-            text = p.read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError) as e:
-            raise _bad(p, f"cannot read ({e})") from None
-        records.append(parse_record(p, text))
+        records.append(parse_record(p, md.load_metadata(p)))
     return ImageData(root, records)
 
 
@@ -162,10 +160,10 @@ def verify(data: ImageData) -> list[str]:
     problems = []
     for r in progress(data.records, desc="verify", unit="img"):
         if r.exr is None:
-            problems.append(f"{r.source}: files.exr is not given")
+            problems.append(f"{printable(r.source)}: files.exr is not given")
             continue
-        if not r.exr.is_file():
-            problems.append(f"{r.name}: EXR {r.exr} is missing")
+        if not os.path.lexists(r.exr):
+            problems.append(f"{r.name}: files.exr names no file beside the metadata")
             continue
         try:
             class_id = read_exr(r.exr).class_id
