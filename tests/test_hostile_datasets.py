@@ -645,14 +645,16 @@ def test_intensity_profiles_stay_in_the_spec_folder_unless_given_on_the_command_
         spec = specs / "spec.json"
         spec.write_text(json.dumps({"name": "t", "seed": 1, "town": {"blocks_x": 1, "blocks_y": 1},
                                     "lidar": {"intensity_model": "class_normal", "intensity_profile": profile_in_spec}}))
-        argv = ["lidar", str(spec), "--out", str(tmp_path / "out"), "--frames", "0", *extra]
+        blocker = tmp_path / "out_is_a_file"  # every check on the inputs runs first, then --out stops the run
+        blocker.write_text("x")
+        argv = ["lidar", str(spec), "--out", str(blocker), *extra]
         return run(capfd, argv, tmp_path, {2})[1]
 
     for where in (str(tmp_path / "outside.yaml"), "../outside.yaml"):
         assert "lidar.intensity_profile: must" in lidar(where)
     assert "latin1.yaml: not UTF-8 text" in lidar("latin1.yaml")
     assert "secret.yaml: invalid YAML at line 4" in lidar("secret.yaml")
-    # the same file named on the command line is the user's choice: accepted, the run stops at --frames
-    assert "--frames" in lidar("semantickitti_table3", "--intensity-profile", str(tmp_path / "outside.yaml"))
+    # the same file named on the command line is the user's choice: accepted, the run stops at --out
+    assert "--out" in lidar("semantickitti_table3", "--intensity-profile", str(tmp_path / "outside.yaml"))
     err = lidar("semantickitti_table3", "--intensity-profile", str(specs / "latin1.yaml"))
     assert "latin1.yaml: not UTF-8 text" in err, err
