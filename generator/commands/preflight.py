@@ -138,13 +138,20 @@ def _writable_ancestor(path: Path, flag: str) -> None:
         _fail(flag, path, f"cannot create it: {printable(parent, 200)} is not writable")
 
 
+def _creatable(path: Path, flag: str, st) -> bool:
+    """True when ``path`` does not exist yet (``st`` is None) and could be created; fails otherwise."""
+    if st is not None:
+        return False
+    if os.path.islink(path):
+        _fail(flag, path, "is a symbolic link to nothing")
+    _writable_ancestor(path, flag)
+    return True
+
+
 def output_dir(path: Path, flag: str) -> Path:
     """A folder to write into: an existing writable folder, or a new one that can be created."""
     st = _stat(path, flag)
-    if st is None:
-        if os.path.islink(path):
-            _fail(flag, path, "is a symbolic link to nothing")
-        _writable_ancestor(path, flag)
+    if _creatable(path, flag, st):
         return path
     if not stat.S_ISDIR(st.st_mode):
         _fail(flag, path, f"exists and is {_kind(st.st_mode)}, not a folder")
@@ -156,10 +163,7 @@ def output_dir(path: Path, flag: str) -> Path:
 def output_file(path: Path, flag: str) -> Path:
     """A file to (re)write: a regular file, or a new one whose folder exists or can be created."""
     st = _stat(path, flag)
-    if st is None:
-        if os.path.islink(path):
-            _fail(flag, path, "is a symbolic link to nothing")
-        _writable_ancestor(path, flag)
+    if _creatable(path, flag, st):
         return path
     if not stat.S_ISREG(st.st_mode):
         _fail(flag, path, f"exists and is {_kind(st.st_mode)}; an output file must be a regular file or new")
