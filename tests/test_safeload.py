@@ -66,7 +66,7 @@ def test_source_and_field_name_the_file(tmp_path):
 
 
 def test_directory(tmp_path):
-    _refused(safeload.read_bytes, tmp_path, match="is a directory")
+    _refused(safeload.read_bytes, tmp_path, match="is a folder, expected a regular file")
 
 
 @pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs FIFOs")

@@ -19,7 +19,7 @@ from pathlib import Path
 
 from generator.atomic import TMP_PREFIX
 from generator.errors import UserError
-from generator.safeload import printable
+from generator.safeload import file_kind, printable
 
 #: Longest file name component most file systems take (bytes).
 NAME_MAX = 255
@@ -76,20 +76,6 @@ def describe_os_error(e: OSError) -> str:
     return f"{where}: {os_reason(e)}" if where else os_reason(e)
 
 
-def _kind(mode: int) -> str:
-    if stat.S_ISDIR(mode):
-        return "a folder"
-    if stat.S_ISREG(mode):
-        return "a file"
-    if stat.S_ISFIFO(mode):
-        return "a named pipe (FIFO)"
-    if stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
-        return "a device"
-    if stat.S_ISSOCK(mode):
-        return "a socket"
-    return "not a regular file"
-
-
 def _fail(flag: str, path, reason: str):
     head = f"{flag}: " if flag else ""
     raise UserError(f"{head}{printable(path, 300)}: {reason}")
@@ -115,7 +101,7 @@ def input_dir(path: Path, flag: str = "", what: str = "folder") -> Path:
     if st is None:
         _fail(flag, path, f"{what} not found")
     if not stat.S_ISDIR(st.st_mode):
-        _fail(flag, path, f"is {_kind(st.st_mode)}, expected a {what}")
+        _fail(flag, path, f"is {file_kind(st.st_mode)}, expected a {what}")
     if not os.access(path, os.R_OK | os.X_OK):
         _fail(flag, path, "permission denied")
     return path
@@ -133,7 +119,7 @@ def _writable_ancestor(path: Path, flag: str) -> None:
             break
         parent = parent.parent
     if not stat.S_ISDIR(st.st_mode):
-        _fail(flag, path, f"{printable(parent, 200)} is {_kind(st.st_mode)}, not a folder")
+        _fail(flag, path, f"{printable(parent, 200)} is {file_kind(st.st_mode)}, not a folder")
     if not os.access(parent, os.W_OK | os.X_OK):
         _fail(flag, path, f"cannot create it: {printable(parent, 200)} is not writable")
 
@@ -154,7 +140,7 @@ def output_dir(path: Path, flag: str) -> Path:
     if _creatable(path, flag, st):
         return path
     if not stat.S_ISDIR(st.st_mode):
-        _fail(flag, path, f"exists and is {_kind(st.st_mode)}, not a folder")
+        _fail(flag, path, f"exists and is {file_kind(st.st_mode)}, not a folder")
     if not os.access(path, os.W_OK | os.X_OK):
         _fail(flag, path, "folder is not writable")
     return path
@@ -166,7 +152,7 @@ def output_file(path: Path, flag: str) -> Path:
     if _creatable(path, flag, st):
         return path
     if not stat.S_ISREG(st.st_mode):
-        _fail(flag, path, f"exists and is {_kind(st.st_mode)}; an output file must be a regular file or new")
+        _fail(flag, path, f"exists and is {file_kind(st.st_mode)}; an output file must be a regular file or new")
     if not os.access(path.parent if str(path.parent) else Path("."), os.W_OK | os.X_OK):
         _fail(flag, path, "its folder is not writable")
     return path

@@ -94,19 +94,18 @@ def _os_reason(e: OSError) -> str:
     return _OS_REASONS.get(e.errno, f"cannot read ({e.strerror or type(e).__name__})")
 
 
+def file_kind(mode: int) -> str:
+    """What a ``st_mode`` is, in words for a message: ``a folder``, ``a file``, ``a named pipe (FIFO)``..."""
+    for test, words in ((stat.S_ISDIR, "a folder"), (stat.S_ISREG, "a file"), (stat.S_ISFIFO, "a named pipe (FIFO)"),
+                        (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
+                        (stat.S_ISSOCK, "a socket")):
+        if test(mode):
+            return words
+    return "not a regular file"
+
+
 def _kind_problem(mode: int) -> str | None:
-    if stat.S_ISREG(mode):
-        return None
-    if stat.S_ISDIR(mode):
-        return "is a directory, expected a file"
-    if stat.S_ISFIFO(mode):
-        return "is a named pipe (FIFO), expected a regular file"
-    if stat.S_ISCHR(mode):
-        return "is a character device, expected a regular file"
-    if stat.S_ISBLK(mode):
-        return "is a block device, expected a regular file"
-    if stat.S_ISSOCK(mode):
-        return "is a socket, expected a regular file"
-    return "is not a regular file"
+    """None for a regular file, else why it cannot be read as one."""
+    return None if stat.S_ISREG(mode) else f"is {file_kind(mode)}, expected a regular file"
 
 
