@@ -260,6 +260,16 @@ class Placer:
         boxes = world_boxes(proto.bands, T, pad)
         if self.occ.hits(boxes):
             return False
+        self._accept(proto, T, box, boxes, attrs)
+        return True
+
+    def place_on(self, proto: Proto, x: float, y: float, z: float, yaw: float, attrs: dict | None = None) -> None:
+        """Place ``proto`` without the keep-out and occupancy tests: for what rests on an object
+        placed (and tested) just before, under the same transform (a rider on its bicycle, rails
+        under their tram). Its boxes still enter the occupancy."""
+        T = pose(x, y, z, yaw)
+        self._accept(proto, T, oriented_box(proto, T), world_boxes(proto.bands, T), attrs)
+
+    def _accept(self, proto: Proto, T: np.ndarray, box: OrientedBox, boxes: np.ndarray, attrs: dict | None) -> None:
         self.occ.add(boxes)
         self.placed.append(Placed(proto.kind, self.lib.main_class(proto.kind), proto.key, T, box, dict(attrs or {})))
-        return True

@@ -149,17 +149,7 @@ def place_riders(placer: Placer, spec: SceneSpec, st: Street) -> None:
         x, y = _at(seg, u, v, vehicle, traffic)
         color = vehicle_color(g)
         if placer.try_place(vehicle, x, y, 0.0, traffic, {"color": color, "placement": "ridden"}, pad=0.3):
-            placer.placed.append(_same_place(placer, rider, x, y, traffic, {"color": clothing_color(g)}))
-
-
-def _same_place(placer: Placer, proto: Proto, x: float, y: float, yaw: float, attrs: dict):
-    """A rider on its vehicle: placed without an occupancy test (it sits on the vehicle by design)."""
-    from generator.geometry import pose
-    from generator.layout.placement_core import Placed, oriented_box, world_boxes
-
-    T = pose(x, y, 0.0, yaw)
-    placer.occ.add(world_boxes(proto.bands, T))
-    return Placed(proto.kind, placer.lib.main_class(proto.kind), proto.key, T, oriented_box(proto, T), dict(attrs))
+            placer.place_on(rider, x, y, 0.0, traffic, {"color": clothing_color(g)})
 
 
 def place_bus_stops(placer: Placer, spec: SceneSpec, st: Street) -> None:
@@ -211,7 +201,7 @@ def place_trams(placer: Placer, spec: SceneSpec, st: Street) -> None:
             continue
         rails = placer.lib.unique("tram_rails", length=float(u1 - u0))
         x, y = seg.to_world((u0 + u1) / 2, v)[0]
-        placer.placed.append(_same_place(placer, rails, x, y, traffic, {}))
+        placer.place_on(rails, x, y, 0.0, traffic)
 
 
 def place_other_vehicles(placer: Placer, spec: SceneSpec, st: Street) -> None:
