@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from assets_procedural.parts import centred, disc_wheel, oriented_box, sweep
-from assets_procedural.two_wheelers import _draw, _xz, contact_anchors
+from assets_procedural.two_wheelers import _style_params, _xz, contact_anchors
 from generator.geometry import Mesh, box, loft, merge, polygon, pose, tube
 
 MOTO_STYLES = ("naked", "sport", "scooter")
@@ -26,11 +26,7 @@ MOTO = {
 
 def _motorcycle_parts(rng: np.random.Generator, style: str | None) -> tuple[list[Mesh], dict]:
     """Motorcycle meshes in a raw frame (rear axle at x = 0, tyres on z = 0) and its contact points."""
-    if style is None:
-        style = str(rng.choice(MOTO_STYLES))
-    if style not in MOTO:
-        raise ValueError(f"motorcycle style must be one of {MOTO_STYLES}, got {style!r}")
-    p = _draw(rng, MOTO[style])
+    style, p = _style_params(rng, style, MOTO, "motorcycle")
     cls = "motorcycle"
     R, wb, tyre = p["R"], p["wb"], p["tyre"]
     ra, fa = np.array([0.0, 0.0, R]), np.array([wb, 0.0, R])

@@ -34,6 +34,16 @@ def _draw(rng: np.random.Generator, spec: dict) -> dict:
     return {k: float(rng.uniform(*v)) if isinstance(v, tuple) else v for k, v in spec.items()}
 
 
+def _style_params(rng: np.random.Generator, style: str | None, table: dict, what: str) -> tuple[str, dict]:
+    """The style (drawn when None, checked otherwise) and its parameters drawn from ``table[style]``."""
+    styles = tuple(table)
+    if style is None:
+        style = str(rng.choice(styles))
+    if style not in table:
+        raise ValueError(f"{what} style must be one of {styles}, got {style!r}")
+    return style, _draw(rng, table[style])
+
+
 def _xz(angle_deg: float) -> np.ndarray:
     """Unit vector in the x-z plane pointing up and back at ``angle_deg`` from the ground (frame tubes)."""
     a = np.radians(angle_deg)
@@ -62,11 +72,7 @@ def _saddle(top_centre: np.ndarray, cls: str, length: float = 0.27, width: float
 
 def _bicycle_parts(rng: np.random.Generator, style: str | None) -> tuple[list[Mesh], dict]:
     """Bicycle meshes in a raw frame (rear axle at x = 0, wheels on z = 0) and its contact points."""
-    if style is None:
-        style = str(rng.choice(BIKE_STYLES))
-    if style not in BIKE:
-        raise ValueError(f"bicycle style must be one of {BIKE_STYLES}, got {style!r}")
-    p = _draw(rng, BIKE[style])
+    style, p = _style_params(rng, style, BIKE, "bicycle")
     cls = "bicycle"
     R, wb, tr = p["R"], p["wb"], p["tube"]
     crank_phase = float(rng.uniform(0, 2 * np.pi))

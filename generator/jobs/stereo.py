@@ -96,7 +96,8 @@ def render_pair(renderer, spec, cfg, rig, sensor, index: int, seq_dir: Path) -> 
     """
     t0 = time.perf_counter()
     tod, kind = lidar_combination(index)
-    t_exp = rig.frame(index).t + exposure_offset(sensor, spec.sensors.lidar.motion_skew)
+    t_scan = rig.frame(index).t  # the sweep start of scan ``index``
+    t_exp = t_scan + exposure_offset(sensor, spec.sensors.lidar.motion_skew)
     T_world_ego = rig.T_world_ego(t_exp)[0]
     light = draw_lighting(spec, index, tod)
     wetness, puddles = frame_wetness(spec, index) if is_wet(kind) else (0.0, 0.0)
@@ -119,7 +120,7 @@ def render_pair(renderer, spec, cfg, rig, sensor, index: int, seq_dir: Path) -> 
                                 {"urbangen.image": f"image_{cam}/{stem}"}), cfg.exr_codec)
         record = {
             "image": f"image_{cam}/{stem}.png", "camera": cam, "scan": index, "time_s": t_exp,
-            "exposure_offset_s": t_exp - rig.frame(index).t, "T_world_camera": T_world_camera.tolist(),
+            "exposure_offset_s": t_exp - t_scan, "T_world_camera": T_world_camera.tolist(),
             "K": renderer.k.tolist(), "width": cfg.width, "height": cfg.height, "time_of_day": tod,
             "weather": weather, "lighting": {k: v for k, v in lighting.items() if k != "light_objects"},
             "seed": spec.seed, "spec_hash": spec.spec_hash}
