@@ -79,6 +79,26 @@ class Paths:
 
 
 @dataclass(frozen=True)
+class Traffic:
+    cars_per_km: float
+    trucks_per_km: float
+    buses_per_km: float
+    other_vehicles_per_km: float
+    cyclists_per_km: float
+    motorcyclists_per_km: float
+    pedestrians_per_100m: float
+    standing_pedestrians_per_100m: float
+    speed_limit_mps: float
+    pedestrian_speed_mps: float
+    ego_stop_probability: float
+
+    @property
+    def enabled(self) -> bool:
+        """Whether anything moves besides the ego (all densities 0: the frozen town)."""
+        return any(v > 0 for k, v in dataclasses.asdict(self).items() if k.endswith(("_per_km", "_per_100m")))
+
+
+@dataclass(frozen=True)
 class Camera:
     hfov_deg: float
     xyz_m: Vec3
@@ -164,6 +184,7 @@ class SceneSpec:
     density: Density
     heights: Heights
     paths: Paths
+    traffic: Traffic
     sensors: Sensors
     weather: Weather
     lidar: LidarProcessing

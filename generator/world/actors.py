@@ -1,0 +1,256 @@
+"""The world in time: the static town plus actors whose poses are functions of time.
+
+Every sensor asks the same question -- :meth:`World.T_world_actor` at its own instant -- so
+the camera and the LiDAR can never disagree about where a car was. Pure numpy.
+
+A :class:`Track` is a mover's pose sampled every ``dt`` seconds from ``t0``; between samples
+position and heading are linear in time (the heading along the shorter arc), so a pose is
+exact for any instant and velocity is piecewise constant. Velocity and acceleration reported
+to users (OpenLABEL, metadata) are central differences of the samples, the same numbers a
+finite difference of cuboid centres gives.
+
+Frames: world frame (z up, metres); an actor's local frame has x forward, y left, z up,
+origin on the ground under the reference point of its prototype (as static objects).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from generator.geometry import Mesh
+from generator.world.scene import OrientedBox, SceneModel
+
+#: An actor faster than this at an instant is *moving* there (SemanticKITTI moving-* ids,
+#: OpenLABEL ``moving``); a pedestrian standing or a car waiting at a stop line is not.
+MOVING_THRESHOLD_MPS = 0.3
+
+
+@dataclass(frozen=True)
+class Track:
+    """A pose sampled every ``dt`` seconds.
+
+    Attributes
+    ----------
+    t0 : float
+        Time of the first sample, seconds.
+    dt : float
+        Sample spacing, seconds.
+    xyz : (T, 3) float64
+        Positions of the local origin, world frame, metres.
+    yaw : (T,) float64
+        Heading, radians, unwrapped (continuous from sample to sample).
+    """
+
+    t0: float
+    dt: float
+    xyz: np.ndarray
+    yaw: np.ndarray
+
+    @property
+    def t1(self) -> float:
+        """Time of the last sample."""
+        return self.t0 + self.dt * (len(self.yaw) - 1)
+
+    def _where(self, t) -> tuple[np.ndarray, np.ndarray]:
+        x = (np.atleast_1d(np.asarray(t, np.float64)) - self.t0) / self.dt
+        x = np.clip(x, 0.0, len(self.yaw) - 1.0)
+        i = np.minimum(np.floor(x).astype(np.int64), len(self.yaw) - 2) if len(self.yaw) > 1 else np.zeros(len(x), np.int64)
+        return i, x - i
+
+    def position(self, t) -> np.ndarray:
+        """(k, 3) float64 positions at time(s) ``t`` (clamped to the sampled span)."""
+        if len(self.yaw) == 1:
+            return np.repeat(self.xyz[:1], np.size(t), 0)
+        i, f = self._where(t)
+        return self.xyz[i] * (1 - f[:, None]) + self.xyz[i + 1] * f[:, None]
+
+    def heading(self, t) -> np.ndarray:
+        """(k,) float64 headings at time(s) ``t``, radians (unwrapped)."""
+        if len(self.yaw) == 1:
+            return np.repeat(self.yaw[:1], np.size(t))
+        i, f = self._where(t)
+        return self.yaw[i] * (1 - f) + self.yaw[i + 1] * f
+
+    def pose(self, t) -> np.ndarray:
+        """(k, 4, 4) float64 ``T_world_actor`` at time(s) ``t``."""
+        p, h = self.position(t), self.heading(t)
+        out = np.repeat(np.eye(4)[None], len(h), 0)
+        c, s = np.cos(h), np.sin(h)
+        out[:, 0, 0], out[:, 0, 1], out[:, 1, 0], out[:, 1, 1] = c, -s, s, c
+        out[:, :3, 3] = p
+        return out
+
+    def velocity(self, t, h: float | None = None) -> np.ndarray:
+        """(k, 3) float64 velocity, central difference over ``+-h`` seconds (default ``dt``), m/s."""
+        h = self.dt if h is None else h
+        t = np.atleast_1d(np.asarray(t, np.float64))
+        return (self.position(t + h) - self.position(t - h)) / (2 * h)
+
+    def acceleration(self, t, h: float | None = None) -> np.ndarray:
+        """(k, 3) float64 acceleration, second central difference over ``+-h`` seconds, m/s^2."""
+        h = self.dt if h is None else h
+        t = np.atleast_1d(np.asarray(t, np.float64))
+        return (self.position(t + h) - 2 * self.position(t) + self.position(t - h)) / (h * h)
+
+    def speed(self, t) -> np.ndarray:
+        """(k,) float64 speed, m/s."""
+        return np.linalg.norm(self.velocity(t)[:, :2], axis=1)
+
+
+@dataclass
+class Actor:
+    """One mover: a prototype mesh under a pose that changes with time.
+
+    Attributes
+    ----------
+    uid : int
+        Stable id for the whole sequence (0..n-1, the position in :attr:`World.actors`).
+    name : str
+        Unique, e.g. ``"actor_car_0003"``.
+    kind : str
+        ``"car"``, ``"truck"``, ``"bus"``, ``"ridden_bicycle"``, ``"person"`` ...
+    cls : str
+        Main native class (a ridden bicycle's is ``bicyclist``).
+    instance_id : int
+        Instance id, unique in the world (after the static town's), the same in every sweep.
+    prototype : str
+        Key into :attr:`World.prototypes`.
+    size : (3,) float
+        Box length, width, height, metres.
+    box_center : (3,) float
+        Box centre in the local frame, metres.
+    track : Track
+    proxy : str or None
+        Key into :attr:`World.proxies`.
+    attrs : dict
+        Renderer parameters (``color``...).
+    """
+
+    uid: int
+    name: str
+    kind: str
+    cls: str
+    instance_id: int
+    prototype: str
+    size: tuple[float, float, float]
+    box_center: tuple[float, float, float]
+    track: Track
+    proxy: str | None = None
+    attrs: dict = field(default_factory=dict)
+
+    def box(self, t: float) -> OrientedBox:
+        """The actor's oriented box at time ``t``, world frame."""
+        T = self.track.pose(t)[0]
+        c = T[:3, :3] @ np.asarray(self.box_center) + T[:3, 3]
+        return OrientedBox(tuple(float(v) for v in c), tuple(float(v) for v in self.size),
+                           float(self.track.heading(t)[0]))
+
+
+@dataclass
+class World:
+    """The static town, the actors and the ego's drive: everything at any time.
+
+    Attributes
+    ----------
+    scene : SceneModel
+        The static town (one BVH for the LiDAR, one Blender scene).
+    actors : list of Actor
+        Empty for a frozen town (``traffic`` densities all 0).
+    prototypes, proxies : dict of str to Mesh
+        Actor meshes (local frames) and their label proxies.
+    ego : object
+        The ego's trajectory: ``T_world_ego(t) -> (k, 4, 4)`` and ``knot_offsets(t0, period)``
+        (:class:`generator.world.trajectory.EgoTrajectory` or :class:`TrackTrajectory`).
+    duration_s : float
+        Seconds of simulated time from 0 (poses beyond it are held).
+    """
+
+    scene: SceneModel
+    actors: list[Actor]
+    prototypes: dict[str, Mesh]
+    proxies: dict[str, Mesh]
+    ego: object
+    duration_s: float
+
+    def T_world_actor(self, t: float) -> np.ndarray:
+        """(n, 4, 4) float64 pose of every actor at time ``t`` (seconds)."""
+        if not self.actors:
+            return np.zeros((0, 4, 4))
+        return np.stack([a.track.pose(t)[0] for a in self.actors])
+
+    def velocities(self, t: float) -> np.ndarray:
+        """(n, 3) float64 actor velocities at ``t``, m/s."""
+        return np.array([a.track.velocity(t)[0] for a in self.actors]).reshape(-1, 3)
+
+    def accelerations(self, t: float) -> np.ndarray:
+        """(n, 3) float64 actor accelerations at ``t``, m/s^2."""
+        return np.array([a.track.acceleration(t)[0] for a in self.actors]).reshape(-1, 3)
+
+    def moving(self, t: float) -> np.ndarray:
+        """(n,) bool: which actors move faster than :data:`MOVING_THRESHOLD_MPS` at ``t``."""
+        v = self.velocities(t)
+        return np.linalg.norm(v[:, :2], axis=1) > MOVING_THRESHOLD_MPS
+
+    def boxes(self, t: float) -> list[OrientedBox]:
+        """Every actor's box at ``t``."""
+        return [a.box(t) for a in self.actors]
+
+    def actor_of_instance(self) -> dict[int, Actor]:
+        """Instance id -> actor."""
+        return {a.instance_id: a for a in self.actors}
+
+
+@dataclass(frozen=True)
+class TrackTrajectory:
+    """The ego's drive as a sampled track (traffic on): the ego is one of the movers.
+
+    Same interface as :class:`generator.world.trajectory.EgoTrajectory`.
+
+    Attributes
+    ----------
+    track : Track
+        Pose of the ego frame's origin (ISO 8855: x forward, y left, z up).
+    distance : (T,) float64
+        Distance driven at each sample, metres (non-decreasing: the ego may stop).
+    """
+
+    track: Track
+    distance: np.ndarray
+
+    def T_world_ego(self, t) -> np.ndarray:
+        """(k, 4, 4) float64 ego poses at time(s) ``t``."""
+        return self.track.pose(t)
+
+    def knot_offsets(self, t0: float, period_s: float) -> np.ndarray:
+        """(k,) float64: 0, the track samples inside ``(t0, t0 + period)`` as offsets, ``period``.
+
+        The pose is linear between samples, so poses at these offsets rebuild any instant exactly.
+        """
+        tr = self.track
+        k = np.arange(int(np.floor((t0 - tr.t0) / tr.dt)), int(np.ceil((t0 + period_s - tr.t0) / tr.dt)) + 1)
+        times = tr.t0 + k * tr.dt - t0
+        inner = times[(times > 0) & (times < period_s) & (k > 0) & (k < len(tr.yaw) - 1)]
+        return np.unique(np.r_[0.0, inner, period_s])
+
+    def time_at_distance(self, s: float) -> float:
+        """First time the ego has driven ``s`` metres (linear between samples)."""
+        d, tr = self.distance, self.track
+        i = int(np.searchsorted(d, s, side="left"))
+        if i <= 0:
+            return tr.t0
+        if i >= len(d):
+            return tr.t1
+        f = (s - d[i - 1]) / max(d[i] - d[i - 1], 1e-12)
+        return tr.t0 + (i - 1 + f) * tr.dt
+
+    @property
+    def speed_mps(self) -> float:
+        """Mean speed over the drive (for messages), m/s."""
+        return float(self.distance[-1] / max(self.track.t1 - self.track.t0, 1e-9))
+
+
+def frozen_world(scene: SceneModel, ego) -> World:
+    """A world without actors (traffic off): the static town and the ego's drive."""
+    return World(scene, [], {}, {}, ego, float("inf"))
