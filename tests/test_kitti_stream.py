@@ -10,7 +10,7 @@ from generator.cli import main
 from generator.formats import kitti_calib
 from generator.fusion.kitti_stream import sequence_agreement
 from generator.imaging.exr import read_exr
-from generator.jobs.stereo import files_of
+from generator.jobs.stereo import files_of, stereo_frames
 
 pytestmark = pytest.mark.blender
 
@@ -24,8 +24,12 @@ def sequence(tmp_path_factory, root):
     return out / "lidar" / "sequences" / "00"
 
 
-def test_every_scan_has_a_stereo_pair(sequence):
-    for k in (0, 1):
+def test_every_tenth_sweep_has_a_stereo_pair(sequence, test_spec):
+    sweeps = sorted(int(p.stem) for p in (sequence / "velodyne").glob("*.bin"))
+    pairs = stereo_frames(test_spec, sweeps)
+    assert pairs == [j for j in sweeps if j % test_spec.sensors.stereo.every == 0] and pairs
+    assert not any(p.exists() for j in set(sweeps) - set(pairs) for p in files_of(sequence, j))
+    for k in pairs:
         assert all(p.is_file() for p in files_of(sequence, k))
         left, right = (np.asarray(Image.open(sequence / f"image_{c}" / f"{k:06d}.png")) for c in (2, 3))
         assert left.dtype == np.uint8 and left.shape == right.shape and left.shape[2] == 3
