@@ -152,3 +152,20 @@ def test_track_interpolates_between_samples():
     assert np.allclose(tr.position(0.25), [[0.5, 0, 0]])
     assert np.allclose(tr.heading(0.75), [np.pi / 4])
     assert np.allclose(tr.velocity(0.5, h=0.25), [[3.0, 0, 0]])
+
+
+@pytest.mark.parametrize("command", [["lidar", "--frames", "3"], ["generate", "--config", "test", "--frames", "2"],
+                                     ["render", "--config", "test", "--frames", "2"]])
+def test_a_traffic_spec_the_sensors_cannot_show_yet_is_one_line_and_writes_nothing(tmp_path, capsys, command):
+    """Until the LiDAR casts actors and the renderer poses them, a traffic spec is refused before any write."""
+    import json
+
+    from generator.cli import main
+
+    spec = tmp_path / "s.json"
+    spec.write_text(json.dumps({"name": "t", "seed": 1, "town": {"blocks_x": 1, "blocks_y": 1, "block_size_m": 36,
+                                                                  "block_size_jitter_m": 0}, "traffic": {"cars_per_km": 5}}))
+    out = tmp_path / "out"
+    assert main([command[0], str(spec), "--out", str(out), *command[1:]]) == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert "s.json: traffic: moving" in err and not out.exists()

@@ -121,6 +121,13 @@ def check_sweeps(scene, spec, n: int, route: int = 0) -> None:
                         f"{spec.paths.speed_mps}: room for {int(seconds / SWEEP_PERIOD_S) + 1} sweeps, asked for {n}")
 
 
+def check_castable(spec, world) -> None:
+    """Refuse (one line) a world with actors while the scanner cannot cast them, before anything is written."""
+    if world is not None and world.actors and "world" not in inspect.signature(Scanner).parameters:
+        raise SpecError(spec.source, "traffic", "moving vehicles are not cast by the LiDAR in this version; set every "
+                        "traffic density to 0")
+
+
 def world_for(spec, scene, sweeps: int, distance_m: float = 0.0):
     """The world (:func:`generator.traffic.build.build_world`) covering ``sweeps`` 10 Hz sweeps."""
     from generator.traffic.build import build_world
@@ -167,9 +174,7 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
     starts, n_points, counts, records = [], [], {}, []
     sweeps = []  # LiDAR world poses during each sweep (fusion de-skews with them)
     actors = world.actors if world is not None else []
-    if actors and "world" not in inspect.signature(Scanner).parameters:
-        raise SpecError(spec.source, "traffic", "moving vehicles are not cast by the LiDAR in this version; set every "
-                        "traffic density to 0")
+    check_castable(spec, world)
     with Scanner(scene, sensor, threads=options.threads, **({"world": world} if actors else {})) as scanner:
         for j in progress_bar(range(options.frames), desc=f"lidar {name}", unit="scan", enabled=progress):
             t_j = times[j]
