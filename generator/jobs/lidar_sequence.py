@@ -96,12 +96,16 @@ class SequenceOptions:
     image_frames: tuple = ()
 
 
-def check_frames(scene, spec, n: int, route: int = 0) -> None:
-    """Refuse more image frames than fit on an open route (a loop wraps)."""
+def _check_route(scene, spec, n: int, route: int) -> None:
     if n < 1:
         raise UserError(f"--frames must be >= 1, got {n}")
     if route >= len(scene.paths):
         raise UserError(f"{spec.source}: the scene has no route {route}")
+
+
+def check_frames(scene, spec, n: int, route: int = 0) -> None:
+    """Refuse more image frames than fit on an open route (a loop wraps)."""
+    _check_route(scene, spec, n, route)
     fits = Rig.from_spec(spec, scene, route).max_frames()
     if not scene.paths[route].closed and n > fits:
         raise UserError(f"{spec.source}: route {route} fits {fits} frames at "
@@ -110,10 +114,7 @@ def check_frames(scene, spec, n: int, route: int = 0) -> None:
 
 def check_sweeps(scene, spec, n: int, route: int = 0) -> None:
     """Refuse more 10 Hz sweeps than the ego can drive on an open route (a loop wraps)."""
-    if n < 1:
-        raise UserError(f"--frames must be >= 1, got {n}")
-    if route >= len(scene.paths):
-        raise UserError(f"{spec.source}: the scene has no route {route}")
+    _check_route(scene, spec, n, route)
     path = scene.paths[route]
     seconds = path.length() / spec.paths.speed_mps
     if not path.closed and (n - 1) * SWEEP_PERIOD_S > seconds:

@@ -36,14 +36,14 @@ WARMUP_S = 20.0
 MAX_DRIVE_S = 900.0
 SPACING_M = 6.0       #: lanes hold at most one vehicle per (length + this), for the capacity check
 EGO_SIZE_M = (4.6, 1.9)
-# spec field -> (asset kind, variants, speed factor of the limit, max acceleration m/s^2)
+# spec field -> (asset kind, variants, speed factor of the limit, max acceleration m/s^2, nominal length m)
 KINDS = {
-    "cars_per_km": ("car", 6, (0.8, 1.0), 2.0),
-    "trucks_per_km": ("truck", 3, (0.7, 0.85), 1.2),
-    "buses_per_km": ("bus", 4, (0.7, 0.85), 1.0),
-    "other_vehicles_per_km": ("construction_vehicle", 4, (0.5, 0.7), 1.0),
-    "cyclists_per_km": ("bicyclist", 4, (0.35, 0.55), 1.0),
-    "motorcyclists_per_km": ("motorcyclist", 4, (0.8, 1.0), 2.5),
+    "cars_per_km": ("car", 6, (0.8, 1.0), 2.0, 4.6),
+    "trucks_per_km": ("truck", 3, (0.7, 0.85), 1.2, 8.0),
+    "buses_per_km": ("bus", 4, (0.7, 0.85), 1.0, 12.0),
+    "other_vehicles_per_km": ("construction_vehicle", 4, (0.5, 0.7), 1.0, 7.0),
+    "cyclists_per_km": ("bicyclist", 4, (0.35, 0.55), 1.0, 1.8),
+    "motorcyclists_per_km": ("motorcyclist", 4, (0.8, 1.0), 2.5, 2.2),
 }
 
 
@@ -214,10 +214,10 @@ def _drive(spec, graph, signals, lib, blocked, crossing, duration_s, distance_m)
     ego.route_pos = 1
     vehicles, movers = [ego], []
     km = sum(e.length for e in free) / 1000.0
-    _check_capacity(spec, lib, km)
+    _check_capacity(spec)
     g = stream(spec.seed, "traffic", "vehicles")
     taken: dict[int, list] = {route[0]: [(0.0, EGO_SIZE_M[0])]}
-    for field_name, (kind, n_var, speed, a_max) in KINDS.items():
+    for field_name, (kind, n_var, speed, a_max, _) in KINDS.items():
         for _ in range(round(getattr(tr, field_name) * km)):
             proto = _proto(lib, kind, int(g.integers(n_var)))
             length, width = float(proto.hi[0] - proto.lo[0]), float(proto.hi[1] - proto.lo[1])
@@ -261,13 +261,12 @@ def _drive(spec, graph, signals, lib, blocked, crossing, duration_s, distance_m)
     return movers, ego_track, np.asarray(dist)
 
 
-def _check_capacity(spec, lib, km: float) -> None:
+def _check_capacity(spec) -> None:
     tr = spec.traffic
-    lengths = {"cars_per_km": 4.6, "trucks_per_km": 8.0, "buses_per_km": 12.0, "other_vehicles_per_km": 7.0,
-               "cyclists_per_km": 1.8, "motorcyclists_per_km": 2.2}
-    used = sum(getattr(tr, f) * (lengths[f] + SPACING_M) for f in KINDS)   # metres of lane per km
+    need = {f: getattr(tr, f) * (k[4] + SPACING_M) for f, k in KINDS.items()}   # metres of lane per km
+    used = sum(need.values())
     if used > 1000.0:
-        worst = max(KINDS, key=lambda f: getattr(tr, f) * (lengths[f] + SPACING_M))
+        worst = max(need, key=need.get)
         raise SpecError(spec.source, f"traffic.{worst}", f"the vehicles asked for need {used / 1000:.2f} km of "
                         "lane per km of lane (all kinds together, with safe gaps); lower the densities")
 

@@ -133,18 +133,8 @@ class LaneGraph:
         return len(self.edges) - 1
 
     def _connector_path(self, node, x: int, y: int, k: int) -> Path:
-        c0 = self.grid.node_xy(node)
-        a, b = -ARM_DIRS[x], ARM_DIRS[y]
-        right_a, right_b = np.array([a[1], -a[0]]), np.array([b[1], -b[0]])
-        o = (k + 0.5) * self.grid.lane_w
-        t_in, t_out = c0 - self.entry_m * a + o * right_a, c0 + self.entry_m * b + o * right_b
-        sign = float(np.sign(a[0] * b[1] - a[1] * b[0]))
-        name = f"conn_{node[0]}_{node[1]}_{x}{y}_{k}"
-        if sign == 0:
-            return _line(t_in, t_out, name)
-        r = self.entry_m - o if sign < 0 else self.entry_m + o
-        centre = t_in + r * sign * np.array([-a[1], a[0]])
-        return _arc(centre, r, float(np.arctan2(a[1], a[0])), sign, name)
+        return connector_path(self.grid.node_xy(node), self.entry_m, self.grid.lane_w, x, y, k,
+                              f"conn_{node[0]}_{node[1]}_{x}{y}_{k}")
 
     def _link(self) -> None:
         for (node, x, y, k), ci in self.connector.items():
@@ -175,9 +165,25 @@ class LaneGraph:
         return self.stop_m - self.entry_m
 
 
-def _extended(graph: LaneGraph, node, x: int, y: int, k: int, ext: float) -> np.ndarray:
-    """(n, 3) x, y, heading samples of a connector with ``ext`` metres of its lanes on each side."""
-    p = graph._connector_path(node, x, y, k)
+def connector_path(c0: np.ndarray, entry_m: float, lane_w: float, x: int, y: int, k: int, name: str = "") -> Path:
+    """The connector of lane ``k`` from arm ``x`` to arm ``y`` of a node centred at ``c0`` ((2,) world xy):
+    a straight line across, or the route's quarter circle (radius ``entry - o`` right, ``entry + o`` left)."""
+    a, b = -ARM_DIRS[x], ARM_DIRS[y]
+    right_a, right_b = np.array([a[1], -a[0]]), np.array([b[1], -b[0]])
+    o = (k + 0.5) * lane_w
+    t_in, t_out = c0 - entry_m * a + o * right_a, c0 + entry_m * b + o * right_b
+    sign = float(np.sign(a[0] * b[1] - a[1] * b[0]))
+    if sign == 0:
+        return _line(t_in, t_out, name)
+    r = entry_m - o if sign < 0 else entry_m + o
+    centre = t_in + r * sign * np.array([-a[1], a[0]])
+    return _arc(centre, r, float(np.arctan2(a[1], a[0])), sign, name)
+
+
+def _extended(graph: LaneGraph, x: int, y: int, k: int, ext: float) -> np.ndarray:
+    """(n, 3) x, y, heading samples of a connector at a node centred on the origin, with ``ext``
+    metres of its lanes on each side."""
+    p = connector_path(np.zeros(2), graph.entry_m, graph.grid.lane_w, x, y, k)
     a, b = -ARM_DIRS[x], ARM_DIRS[y]
     n = int(np.ceil(ext / 0.5))
     before = p.points[0, :2] - a * np.linspace(ext, 0.5, n)[:, None]
@@ -222,10 +228,8 @@ def conflicts(graph: LaneGraph, size) -> dict:
     """
     lanes = graph.grid.lanes
     keys = [(x, y, k) for x in range(4) for y in range(4) if x != y for k in range(lanes)]
-    node = (0, 0)
     ext = graph.stop_m - graph.entry_m + size[0] / 2
-    origin = _OriginGraph(graph)
-    geo = {key: _corners(_extended(origin, node, *key, ext), size) for key in keys}
+    geo = {key: _corners(_extended(graph, *key, ext), size) for key in keys}
     out = {k: set() for k in keys}
     for i, ka in enumerate(keys):
         for kb in keys[i:]:
@@ -233,22 +237,3 @@ def conflicts(graph: LaneGraph, size) -> dict:
                 out[ka].add(kb)
                 out[kb].add(ka)
     return out
-
-
-class _OriginGraph:
-    """A view of a graph whose every node sits at the origin (for the node-independent table)."""
-
-    def __init__(self, graph: LaneGraph):
-        self._g = graph
-        self.entry_m = graph.entry_m
-
-        class _G:
-            lane_w = graph.grid.lane_w
-
-            @staticmethod
-            def node_xy(node):
-                return np.zeros(2)
-
-        self.grid = _G
-
-    _connector_path = LaneGraph._connector_path

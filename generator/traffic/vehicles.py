@@ -55,7 +55,6 @@ class Vehicle:
     v: float = 0.0
     prev: int | None = None
     grant: int | None = None          #: connector edge held
-    released: bool = True
     ego_route: list[int] | None = None
     route_pos: int = 0
     stop_p: float = 0.0
@@ -94,10 +93,10 @@ class VehicleSim:
                 veh.plan.append(veh.ego_route[veh.route_pos])
                 continue
             options = last.succ
-            if last.kind == "lane" and len(options) > 1:
-                x = options
-                w = np.array([0.5 if self.g.edges[c].arms[0] == (self.g.edges[c].arms[1] + 2) % 4 else 0.25 for c in x])
-                veh.plan.append(x[int(veh.rng.choice(len(x), p=w / w.sum()))])
+            if last.kind == "lane" and len(options) > 1:  # straight on twice as often as each turn
+                w = np.array([0.5 if self.g.edges[c].arms[0] == (self.g.edges[c].arms[1] + 2) % 4 else 0.25
+                              for c in options])
+                veh.plan.append(options[int(veh.rng.choice(len(options), p=w / w.sum()))])
             elif options:
                 veh.plan.append(options[0])
             else:
@@ -204,7 +203,7 @@ class VehicleSim:
         if self.crossing is not None and (self.crossing(node, conn.arms[0], t, t + 15.0)
                                           or self.crossing(node, conn.arms[1], t, t + 15.0)):
             return
-        veh.grant, veh.released = conn.index, False
+        veh.grant = conn.index
         self.holders.setdefault(node, {})[veh.index] = conn.index
 
     def _first_in_line(self, veh: Vehicle, occ: dict) -> bool:
@@ -248,7 +247,7 @@ class VehicleSim:
         if veh.grant is not None and veh.prev == veh.grant and veh.s - veh.length / 2 >= self.g.stop_s_from_end:
             node = self.g.edges[veh.grant].node
             self.holders.get(node, {}).pop(veh.index, None)
-            veh.grant, veh.released = None, True
+            veh.grant = None
 
     # -- geometry -------------------------------------------------------------------------------
     def pose(self, veh: Vehicle) -> tuple[np.ndarray, float]:

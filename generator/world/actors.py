@@ -245,6 +245,11 @@ class TrackTrajectory:
         f = (s - d[i - 1]) / max(d[i] - d[i - 1], 1e-12)
         return tr.t0 + (i - 1 + f) * tr.dt
 
+    def distance_at(self, t: float) -> float:
+        """Metres driven at time ``t`` (linear between samples)."""
+        tr = self.track
+        return float(np.interp(t, tr.t0 + tr.dt * np.arange(len(self.distance)), self.distance))
+
     @property
     def speed_mps(self) -> float:
         """Mean speed over the drive (for messages), m/s."""

@@ -245,11 +245,8 @@ class Rig:
         image ``k`` pairs with sweep :meth:`sweep_of`.
         """
         drive = self._drive()
-        s = index * self.spacing_m
-        t = drive.time_at_distance(s) if hasattr(drive, "time_at_distance") else s / drive.speed_mps
-        t = round(round(t / SWEEP_PERIOD_S) * SWEEP_PERIOD_S, 9)
-        if not hasattr(drive, "time_at_distance"):
-            s = t * drive.speed_mps
+        t = round(round(drive.time_at_distance(index * self.spacing_m) / SWEEP_PERIOD_S) * SWEEP_PERIOD_S, 9)
+        s = drive.distance_at(t)
         jit = self.camera_jitter(index)
         return Frame(index, s, t, self.T_world_ego(t)[0], jit, self.T_ego_camera(jit))
 

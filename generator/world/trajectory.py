@@ -46,6 +46,14 @@ class EgoTrajectory:
         out[:, :3, 3] = pos
         return out
 
+    def time_at_distance(self, s: float) -> float:
+        """The time the ego has driven ``s`` metres, seconds."""
+        return s / self.speed_mps
+
+    def distance_at(self, t: float) -> float:
+        """Metres driven at time ``t``."""
+        return t * self.speed_mps
+
     def knot_offsets(self, t0: float, period_s: float) -> np.ndarray:
         """(k,) float64: 0, the offsets in ``(0, period)`` where a route sample is crossed, ``period``."""
         path, speed = self.path, self.speed_mps
