@@ -137,3 +137,20 @@ def test_cli_min_points_threshold_drops_objects(town_dataset, test_spec, tmp_pat
     for f in strict["openlabel"]["frames"].values():
         assert all(d["object_data"]["num"][0]["val"] >= 500 for d in f["objects"].values())
     main(["openlabel", test_spec.source, str(root)])  # restore the default file for other tests
+
+
+@pytest.mark.parametrize("bad", ["1e308", "-1", "nan"])
+def test_times_beyond_any_drive_are_one_line(town_dataset, test_spec, tmp_path, capsys, bad):
+    """times.txt sets the instants the drive is asked for: a corrupted one is refused, not simulated."""
+    import shutil
+
+    root = tmp_path / "ds"
+    shutil.copytree(town_dataset[0] / "lidar", root / "lidar")
+    times = root / "lidar" / "sequences" / "00" / "times.txt"
+    lines = times.read_text().splitlines()
+    times.write_text("\n".join([lines[0], bad, *lines[2:]]) + "\n")
+    capsys.readouterr()
+    assert main(["openlabel", test_spec.source, str(root)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "times.txt" in err and "\n" not in err and bad not in err.replace("[0,", "")
+    assert not (root / "openlabel").exists()

@@ -53,15 +53,27 @@ class SweepFrame:
     image: int | None = None
 
 
+def _check_times(times, path) -> None:
+    """Sweep times are poses asked of the drive: finite seconds within what a drive can be simulated for."""
+    from generator.traffic.build import MAX_DRIVE_S
+
+    t = np.asarray(times, np.float64)
+    if not (np.isfinite(t).all() and (t >= 0).all() and (t <= MAX_DRIVE_S).all()):
+        raise UserError(f"{path}: every time must be finite seconds in [0, {MAX_DRIVE_S:.0f}] (the drive urbangen "
+                        "simulates); this file is not one urbangen wrote")
+
+
 def sequence_world(spec, scene, meta: dict, times: np.ndarray, source: str):
     """The world a 10 Hz sequence was cast in: actors when ``meta["traffic"]`` is true, else none."""
-    from generator.traffic.build import build_world
+    from generator.traffic.build import MAX_DRIVE_S, build_world
     from generator.world.actors import frozen_world
 
     traffic = md.field(meta, "traffic", source, default=None)
     if not isinstance(traffic, dict) or not traffic.get("actors"):
         return None
-    duration = float(md.field(meta, "traffic.duration_s", source, default=float(np.max(times)) + SWEEP_PERIOD_S))
+    duration = md.field(meta, "traffic.duration_s", source, default=float(np.max(times)) + SWEEP_PERIOD_S)
+    if isinstance(duration, bool) or not isinstance(duration, (int, float)) or not 0 <= duration <= MAX_DRIVE_S + 2:
+        raise SpecError(source, "traffic.duration_s", f"must be seconds in [0, {MAX_DRIVE_S:.0f}]")
     # the simulation is causal: a run at least as long gives the same poses over the sequence
     world = build_world(spec, scene, duration, 0.0)
     return world if world.actors else frozen_world(scene, world.ego)
@@ -166,6 +178,7 @@ def write_sequence_openlabel(spec, root: Path, sequence: str = "00", classes=DEF
         raise UserError(f"{seq.dir}: needs scans with labels")
     if seq.times is None:
         raise UserError(f"{seq.dir / 'times.txt'}: missing")
+    _check_times(seq.times, seq.dir / "times.txt")
     sensor = _sensor(meta, src)
     if scene is None:
         from generator.layout.assemble import build_scene
