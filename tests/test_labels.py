@@ -124,7 +124,7 @@ def test_semantickitti_labels_use_moving_ids_only_where_moving():
 
 
 def test_moving_ids_read_back_as_their_native_class():
-    for name, raw in MOVING.items():
+    for raw in MOVING.values():
         assert int(T.to_semantickitti_moving[T.from_semantickitti(raw)]) == raw
     assert T.from_semantickitti(252) == T.id("car") and T.from_semantickitti(253) == T.id("bicyclist")
 
