@@ -333,3 +333,22 @@ def test_track_bank_is_bit_identical_to_the_tracks(rng):
         m = actors == a
         assert np.array_equal(pos[m], tr.position(t[m])) and np.array_equal(yaw[m], tr.heading(t[m]))
         assert np.array_equal(speed[m], tr.speed(t[m]))
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+@pytest.mark.parametrize("where", ["plan", "cast"])
+def test_a_failing_sweep_raises_instead_of_hanging_and_the_scanner_goes_on(hdl64e, ground, threads, where):
+    world = world_of(ground, [("car", 9, track((6.0, -3.0, 0.0), (0.0, 5.0), np.pi / 2))], {"car": box_car()})
+    poses = column_poses(hdl64e)
+    with Scanner(ground, hdl64e, threads=threads, world=world) as sc:
+        good = sc.scan(poses, t0=0.0).points
+        real = getattr(sc.actors, where)
+
+        def broken(*args):
+            raise ArithmeticError("boom")
+
+        setattr(sc.actors, where, broken)
+        with pytest.raises(ArithmeticError, match="boom"):
+            sc.scan(poses, t0=0.0)
+        setattr(sc.actors, where, real)
+        assert same_bytes(sc.scan(poses, t0=0.0).points, good)

@@ -149,7 +149,7 @@ class ActorCaster:
         s = self.sensor
         skew = poses.ndim == 3
         P = poses if skew else poses[None]
-        S = P[:, :3, 3]
+        S = np.ascontiguousarray(P[:, :3, 3])
         s_mid, s_rad = (S.min(0) + S.max(0)) / 2, np.linalg.norm(S.max(0) - S.min(0)) / 2
         R0 = P[0, :3, :3]
         turn = float(np.arccos(np.clip((np.einsum("ij,kij->k", R0, P[:, :3, :3]).min() - 1) / 2, -1, 1)))

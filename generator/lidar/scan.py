@@ -28,7 +28,7 @@ from __future__ import annotations
 import itertools
 import os
 import threading
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor, wait
 from dataclasses import dataclass
 from typing import Self
 
@@ -168,20 +168,29 @@ class Scanner:
         skew = poses.ndim == 3
         if skew and len(poses) != self.sensor.azimuth_steps:
             raise ValueError(f"need one pose per column ({self.sensor.azimuth_steps}), got {len(poses)}")
-        plan = None
-        if self.actors is not None:
-            if t0 is None:
-                raise ValueError("this scanner has moving actors: scan(..., t0=sweep start time) is required")
-            plan = self.actors.plan(poses, float(t0), self.sensor.column_time() if skew else None)
+        if self.actors is not None and t0 is None:
+            raise ValueError("this scanner has moving actors: scan(..., t0=sweep start time) is required")
         rot_t = np.ascontiguousarray(np.swapaxes(poses[..., :3, :3], -1, -2), np.float32)
         trans = (poses[..., :3, 3] - self.caster.center).astype(np.float32)  # float64 difference first
-        sweep = _Sweep(np.empty(self.sensor.rays_per_sweep, POINT_DTYPE), len(self._chunks), rot_t, trans, skew, plan)
-        items = list(enumerate(self._chunks))
-        if self._pool is not None:
-            list(self._pool.map(lambda item: self._run_chunk(sweep, *item), items))
+        sweep = _Sweep(np.empty(self.sensor.rays_per_sweep, POINT_DTYPE), len(self._chunks), rot_t, trans, skew)
+
+        def plan():  # which actors each column may see; the workers need it only after their static cast
+            if self.actors is None:
+                return None
+            return self.actors.plan(poses, float(t0), self.sensor.column_time() if skew else None)
+
+        if self._pool is None:
+            sweep.set_plan(plan)
+            sweep.raise_plan_error()
+            for i, cols in enumerate(self._chunks):
+                self._run_chunk(sweep, i, cols)
         else:
-            for item in items:
-                self._run_chunk(sweep, *item)
+            futures = [self._pool.submit(self._run_chunk, sweep, i, cols) for i, cols in enumerate(self._chunks)]
+            sweep.set_plan(plan)
+            wait(futures)
+            sweep.raise_plan_error()
+            for f in futures:
+                f.result()
         return Scan(sweep.out[:sweep.ends[-1]], poses[0] if skew else poses, self.sensor.rays_per_sweep,
                     self.sensor.n_lasers, self.sensor.azimuth_steps)
 
@@ -214,8 +223,9 @@ class Scanner:
             d_w, o_w = d_w.reshape(-1, 3), o_w.reshape(-1, 3)
             dist, face = self.caster.intersect_local(o_w, d_w, self.sensor.max_range_m)
             on_actor = None
-            if sweep.plan is not None:
-                on_actor = self.actors.cast(sweep.plan, cols, o_w, d_w, dist, face)
+            plan = sweep.get_plan()
+            if plan is not None:
+                on_actor = self.actors.cast(plan, cols, o_w, d_w, dist, face)
             hit = np.flatnonzero((face >= 0) & (dist >= self.sensor.min_range_m))
             start = sweep.claim(i, len(hit))
         except BaseException:
@@ -232,12 +242,35 @@ class Scanner:
 
 
 class _Sweep:
-    """One sweep in flight: the output array and the chained chunk offsets."""
+    """One sweep in flight: the output array, the actors' plan and the chained chunk offsets."""
 
-    def __init__(self, out: np.ndarray, n_chunks: int, rot_t, trans, skew: bool, plan):
-        self.out, self.rot_t, self.trans, self.skew, self.plan = out, rot_t, trans, skew, plan
+    def __init__(self, out: np.ndarray, n_chunks: int, rot_t, trans, skew: bool):
+        self.out, self.rot_t, self.trans, self.skew = out, rot_t, trans, skew
         self.ends: list[int | None] = [None] * n_chunks
         self._done = [threading.Event() for _ in range(n_chunks)]
+        self._plan, self._plan_error = None, None
+        self._planned = threading.Event()
+
+    def set_plan(self, make_plan) -> None:
+        """Compute the actors' plan (``make_plan()``) and release the chunks waiting for it."""
+        try:
+            self._plan = make_plan()
+        except Exception as e:  # noqa: BLE001 - re-raised by raise_plan_error, after the chunks stopped
+            self._plan_error = e
+        finally:
+            self._planned.set()
+
+    def get_plan(self):
+        """The plan (None without actors); waits until it is known."""
+        self._planned.wait()
+        if self._plan_error is not None:
+            raise RuntimeError("planning the actors of this sweep failed") from self._plan_error
+        return self._plan
+
+    def raise_plan_error(self) -> None:
+        """Raise what planning raised, if anything."""
+        if self._plan_error is not None:
+            raise self._plan_error
 
     def claim(self, i: int, n: int) -> int:
         """Offset of chunk ``i``'s ``n`` points: the end of chunk ``i - 1`` (waits until it is known)."""
