@@ -56,6 +56,10 @@ class SweepPlan:
         Actor index, column window ``[c0, c1)``, ring window ``[r0, r1)``.
     near : (K,) float32
         No ray can meet the actor nearer than this, metres.
+    azimuth, half : (K,) float64
+        Only beams whose azimuth (encoder + the laser's ``rot_correction``, sensor frame at the
+        sweep start) lies within ``half`` of ``azimuth`` can meet the actor, radians. The
+        column window covers every laser's shift; this bound is per laser.
     pair_off : (K + 1,) int64
     position : (P, 3) float64
         Actor origin at the column's firing time minus the static caster's centre, world axes.
@@ -71,6 +75,8 @@ class SweepPlan:
     r0: np.ndarray
     r1: np.ndarray
     near: np.ndarray
+    azimuth: np.ndarray
+    half: np.ndarray
     pair_off: np.ndarray
     position: np.ndarray
     cos: np.ndarray
@@ -126,6 +132,8 @@ class ActorCaster:
         self._neg_elevation = -sensor.elevation[order]  # ascending: ring 0 is the highest beam
         self._max_elev = float(np.abs(sensor.elevation).max())
         self._rot = (float(sensor.rot_correction.min()), float(sensor.rot_correction.max()))
+        self._rot_ring = sensor.rot_correction[order]
+        self._psi = sensor.column_azimuth()
         o, _, _ = sensor.local_rays()
         self._offset = float(np.linalg.norm(o, axis=-1).max())
 
@@ -195,8 +203,9 @@ class ActorCaster:
         t = t0 + (column_time[col] if skew else np.zeros(len(col)))
         pos, yaw = self.bank.position_heading(who, t)
         moving = (self.bank.speed(who, t) > MOVING_THRESHOLD_MPS).astype(np.uint8)
-        return SweepPlan(actor, c0, c1, r0[actor], r1[actor], (d - r_tot)[actor].astype(np.float32),
-                         np.concatenate([[0], np.cumsum(n_cols)]), pos - self.center, np.cos(yaw), np.sin(yaw), moving)
+        half = np.where(every, 4.0, half + 1.5 * 2 * np.pi / s.azimuth_steps)  # + the column slack
+        return SweepPlan(actor, c0, c1, r0[actor], r1[actor], (d - r_tot)[actor].astype(np.float32), az[actor],
+                         half[actor], np.concatenate([[0], np.cumsum(n_cols)]), pos - self.center, np.cos(yaw), np.sin(yaw), moving)
 
     # -- per chunk of columns -----------------------------------------------------------------------
     def cast(self, plan: SweepPlan, cols: slice, o_w: np.ndarray, d_w: np.ndarray, dist: np.ndarray,
@@ -233,11 +242,14 @@ class ActorCaster:
         row, ring = _ragged(plan.r0[row_k], n_rings)
         cand = row_k[row]
         ray = (col[row] - cols.start) * L + ring
-        keep = np.flatnonzero(dist.take(ray) > plan.near[cand])
+        ring_col = col[row]
+        off = self._psi.take(ring_col) + self._rot_ring.take(ring) - plan.azimuth.take(cand)
+        off = np.abs(np.mod(off + np.pi, 2 * np.pi) - np.pi)  # this laser's beam vs the actor's direction
+        keep = np.flatnonzero((off <= plan.half.take(cand)) & (dist.take(ray) > plan.near.take(cand)))
         if len(keep) == 0:
             return None
         ray, cand = ray.take(keep), cand.take(keep)
-        pair = plan.pair_off[cand] + (col[row].take(keep) - plan.c0[cand])
+        pair = plan.pair_off[cand] + (ring_col.take(keep) - plan.c0[cand])
         c, s = plan.cos[pair], plan.sin[pair]
         o = o_w.take(ray, axis=0).astype(np.float64) - plan.position[pair]
         d = d_w.take(ray, axis=0).astype(np.float64)
