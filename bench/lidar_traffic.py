@@ -7,7 +7,7 @@ the most its lanes hold), then one of two worlds:
 
 * ``lanes`` (default): ``--actors`` car / truck prototypes of the town's asset library driving
   the scene's lane loops at 8-14 m/s (tracks sampled every 0.05 s), so every one of them moves
-  all the time; the ego drives route 0 at the spec's speed (no actor within 40 m of it).
+  all the time; the ego drives route 0 at the spec's speed among them (:func:`lane_world`).
 * ``sim``: :func:`generator.traffic.build.build_world` (IDM car-following, signals): ~150
   vehicles of which about a third move at any instant; the ego is the simulated one.
 
@@ -19,13 +19,15 @@ Rows, on the rays of the same HDL-64E sweeps (2083 x 64 = 133,312 rays each, mot
 * ours: ``Scanner.scan`` -- rays -> labelled points -- static town only, then with the world's
   actors moving through every sweep (:mod:`generator.lidar.actors`), 1 and 2 threads.
 
-Timings are the best of ``--rounds`` interleaved rounds (other processes on the machine hit every
-method alike); CPU seconds per sweep are printed as well (load-independent).
+Timings: each sweep of each method is timed in each of ``--rounds`` interleaved rounds and the
+best time per sweep is kept (a burst of load from other processes spoils one sample, not a row);
+CPU seconds per sweep are printed as well (load-independent).
 """
 
 from __future__ import annotations
 
 import argparse
+import itertools
 import json
 import os
 import sys
@@ -38,19 +40,23 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from generator.layout.assemble import build_scene  # noqa: E402
-from generator.lidar.caster import EmbreeCaster  # noqa: E402
-from generator.lidar.scan import Scanner  # noqa: E402
-from generator.lidar.sensors import sensor_for_spec  # noqa: E402
-from generator.spec import parse_spec  # noqa: E402
-from generator.world.actors import Actor, Track, World  # noqa: E402
-from generator.world.rig import SWEEP_PERIOD_S, Rig  # noqa: E402
+from generator.layout.assemble import build_scene
+from generator.lidar.caster import EmbreeCaster
+from generator.lidar.scan import Scanner
+from generator.lidar.sensors import sensor_for_spec
+from generator.spec import parse_spec
+from generator.world.actors import Actor, Track, World
+from generator.world.rig import SWEEP_PERIOD_S, Rig
 
 TRAFFIC_X3 = {"cars_per_km": 36, "trucks_per_km": 3, "buses_per_km": 1.5, "cyclists_per_km": 6, "motorcyclists_per_km": 3}
 
 
 def lane_world(spec, scene, n: int, duration_s: float, ego_s: float) -> World:
-    """``n`` vehicles on the scene's lane loops at 8-14 m/s, none within 40 m of the ego's start ``ego_s``."""
+    """``n`` vehicles on the scene's lane loops at 8-14 m/s.
+
+    On the ego's route (0) nobody is within 10 m of the ego at t = 0 (arc length ``ego_s``), and the
+    vehicles within 80 m drive at the ego's speed, so none runs into it during the sequence.
+    """
     from generator.layout.placement_core import Library
 
     g = np.random.default_rng(spec.seed)
@@ -58,23 +64,23 @@ def lane_world(spec, scene, n: int, duration_s: float, ego_s: float) -> World:
     t = np.arange(int(np.ceil(duration_s / 0.05)) + 3) * 0.05
     protos, actors = {}, []
     paths = [p for p in scene.paths if p.closed]
-    total = sum(p.length() for p in paths)
-    starts = np.sort(g.uniform(0.0, total, 4 * n))
-    for s in starts:
+    ends = np.cumsum([p.length() for p in paths])
+    for s in g.permutation(np.linspace(0.0, ends[-1], 4 * n, endpoint=False)):
         if len(actors) == n:
             break
-        i = int(np.searchsorted(np.cumsum([p.length() for p in paths]), s, side="right"))
-        path, s0 = paths[i], s - sum(p.length() for p in paths[:i])
-        if i == 0 and min(abs(s0 - ego_s), path.length() - abs(s0 - ego_s)) < 40.0:
+        i = int(np.searchsorted(ends, s, side="right"))
+        path, s0 = paths[i], s - (ends[i - 1] if i else 0.0)
+        gap = abs((s0 - ego_s + path.length() / 2) % path.length() - path.length() / 2) if i == 0 else np.inf
+        if gap < 10.0:
             continue
+        speed = spec.paths.speed_mps if gap < 80.0 else g.uniform(8.0, 14.0)
         kind = "truck" if len(actors) % 8 == 7 else "car"
         proto = lib.variant(kind, len(actors) % 6)
         protos[proto.key] = proto.mesh
-        pos, head = path.at(s0 + g.uniform(8.0, 14.0) * t)
-        tr = Track(0.0, 0.05, pos, np.unwrap(head))
+        pos, head = path.at(s0 + speed * t)
         lo, hi = proto.lo, proto.hi
         actors.append(Actor(len(actors), f"actor_{kind}_{len(actors):04d}", kind, kind, 60000 + len(actors), proto.key,
-                            tuple(hi - lo), tuple((hi + lo) / 2), tr))
+                            tuple(hi - lo), tuple((hi + lo) / 2), Track(0.0, 0.05, pos, np.unwrap(head))))
     return World(scene, actors, protos, {}, None, duration_s)
 
 
@@ -127,7 +133,7 @@ def main(argv=None) -> int:
         rig = Rig.from_world(spec, world)
     else:
         rig = Rig.from_spec(spec, scene)
-        world = lane_world(spec, scene, args.actors, duration, spec.paths.speed_mps * args.t0)
+        world = lane_world(spec, scene, args.actors, duration, 0.0)  # the ego starts route 0 at t = 0
     moving = np.mean([world.moving(float(x)).sum() for x in times])
     print(f"world ({args.traffic}): {len(world.actors)} actors, {moving:.0f} moving on average over the sequence, "
           f"{len(world.prototypes)} prototypes, {sum(m.n_faces for m in world.prototypes.values()):,} prototype "
@@ -143,13 +149,13 @@ def main(argv=None) -> int:
     pool = ThreadPoolExecutor(args.threads)
 
     def raw(caster, threads):
-        def run():
-            for o, d in rays:
-                if threads == 1:
-                    caster.run_raw(o, d)
-                    continue
-                edges = np.linspace(0, sensor.azimuth_steps, n_chunks + 1).round().astype(int) * sensor.n_lasers
-                list(pool.map(lambda ab: caster.run_raw(o[ab[0]:ab[1]], d[ab[0]:ab[1]]), zip(edges[:-1], edges[1:])))
+        def run(i):
+            o, d = rays[i]
+            if threads == 1:
+                caster.run_raw(o, d)
+                return
+            edges = np.linspace(0, sensor.azimuth_steps, n_chunks + 1).round().astype(int) * sensor.n_lasers
+            list(pool.map(lambda od: caster.run_raw(*od), [(o[a:b], d[a:b]) for a, b in itertools.pairwise(edges)]))
         return run
 
     t = time.perf_counter()
@@ -166,14 +172,18 @@ def main(argv=None) -> int:
     }
     for (w, th), sc in scanners.items():
         name = "ours: Scanner.scan, actors moving" if w else "ours: Scanner.scan, static town"
-        methods[(name, th)] = lambda sc=sc: [sc.scan(p, t0=float(x)) for p, x in zip(poses, times)]
-    best = {k: (np.inf, np.inf) for k in methods}
+        methods[(name, th)] = lambda i, sc=sc: sc.scan(poses[i], t0=float(times[i]))
+    # best of the rounds for every sweep on its own: a burst of load from other processes spoils one
+    # sweep of one method, not a whole row
+    best = {k: np.full((2, args.sweeps), np.inf) for k in methods}
     for _ in range(args.rounds):
         for k, fn in methods.items():
-            c0, w0 = time.process_time(), time.perf_counter()
-            fn()
-            wall, cpu = time.perf_counter() - w0, time.process_time() - c0
-            best[k] = (min(best[k][0], wall), min(best[k][1], cpu))
+            for i in range(args.sweeps):
+                c0, w0 = time.process_time(), time.perf_counter()
+                fn(i)
+                wall, cpu = time.perf_counter() - w0, time.process_time() - c0
+                best[k][:, i] = np.minimum(best[k][:, i], (wall, cpu))
+    best = {k: tuple(v.sum(1)) for k, v in best.items()}
     scans = [scanners[(True, args.threads)].scan(p, t0=float(x)) for p, x in zip(poses, times)]
     for sc in scanners.values():
         sc.close()

@@ -8,19 +8,16 @@ bindings' ``.pxd`` files say instancing is left out). So each actor *prototype* 
 BVH, built once in the prototype's local frame and shared by every actor using it, and the
 rays go to the actors instead of the actors to the BVH:
 
-1. :meth:`ActorCaster.plan`, once per sweep, vectorised over actors: the sphere that holds an
-   actor during the whole sweep (the prototype's radius about its origin + the box of the
-   origin's path, whose samples are linear in time, so the box of the samples bounds it) seen
-   from the box of the sensor's path, widened by the largest emission-point offset and the
-   sensor's rotation during the sweep, gives a conservative window of firing columns (encoder
-   azimuth, with the lasers' ``rot_correction`` spread) and of rings (elevation). Actors beyond
-   the maximum range get none. Each (actor, column) in a window gets the actor's pose and speed
-   at that column's firing time (:class:`~generator.lidar.tracks.TrackBank`).
-2. :meth:`ActorCaster.cast`, per chunk of columns after the static cast: the rays in each window
-   whose static hit lies beyond the actor's nearest possible distance are moved into the actor's
-   local frame at their own column's time, grouped by prototype (one ``run`` per prototype) with
-   ``tfar`` = the static hit, so Embree only reports actor hits that occlude the town; the
-   nearest hit per ray wins.
+1. :meth:`ActorCaster.plan`, once per sweep, vectorised over actors: conservative windows of
+   firing columns per actor (:func:`generator.lidar.windows.sweep_windows`), the actor's pose and
+   speed at each of those columns' firing times (:class:`~generator.lidar.tracks.TrackBank`), and
+   per (actor, column) the beams that can reach its box then
+   (:func:`generator.lidar.windows.column_windows`: azimuth, rings, nearest distance).
+2. :meth:`ActorCaster.cast`, per chunk of columns after the static cast: the beams in those
+   windows whose static hit lies beyond the actor's nearest possible distance are moved into the
+   actor's local frame at their own column's time, grouped by prototype (one ``run`` per
+   prototype) with ``tfar`` = the static hit, so Embree only reports actor hits that occlude the
+   town; the nearest hit per ray wins.
 
 Every column therefore sees each actor exactly where ``actor.track.pose(t0 + column_time)``
 puts it: a passing car is smeared as a spinning sensor smears it. The alternative -- a second
@@ -38,10 +35,8 @@ import numpy as np
 
 from generator.lidar.caster import EmbreeCaster
 from generator.lidar.tracks import TrackBank
+from generator.lidar.windows import BeamTable, column_windows, sweep_windows
 from generator.world.actors import MOVING_THRESHOLD_MPS
-
-_EPS = 1e-3  # metres / radians of slack on every conservative bound
-
 
 @dataclass
 class SweepPlan:
@@ -52,14 +47,8 @@ class SweepPlan:
 
     Attributes
     ----------
-    actor, c0, c1, r0, r1 : (K,) int64
-        Actor index, column window ``[c0, c1)``, ring window ``[r0, r1)``.
-    near : (K,) float32
-        No ray can meet the actor nearer than this, metres.
-    azimuth, half : (K,) float64
-        Only beams whose azimuth (encoder + the laser's ``rot_correction``, sensor frame at the
-        sweep start) lies within ``half`` of ``azimuth`` can meet the actor, radians. The
-        column window covers every laser's shift; this bound is per laser.
+    actor, c0, c1 : (K,) int64
+        Actor index and column window ``[c0, c1)``.
     pair_off : (K + 1,) int64
     position : (P, 3) float64
         Actor origin at the column's firing time minus the static caster's centre, world axes.
@@ -67,21 +56,23 @@ class SweepPlan:
         Cosine and sine of the actor's heading then.
     moving : (P,) uint8
         1 where the actor's planar speed then exceeds :data:`MOVING_THRESHOLD_MPS`.
+    azimuth, half, ring0, ring1, near : (P,) arrays
+        The column's beams that can reach the actor (:func:`generator.lidar.windows.column_windows`).
     """
 
     actor: np.ndarray
     c0: np.ndarray
     c1: np.ndarray
-    r0: np.ndarray
-    r1: np.ndarray
-    near: np.ndarray
-    azimuth: np.ndarray
-    half: np.ndarray
     pair_off: np.ndarray
     position: np.ndarray
     cos: np.ndarray
     sin: np.ndarray
     moving: np.ndarray
+    azimuth: np.ndarray
+    half: np.ndarray
+    ring0: np.ndarray
+    ring1: np.ndarray
+    near: np.ndarray
 
 
 def _ragged(starts: np.ndarray, lengths: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -125,17 +116,14 @@ class ActorCaster:
         self.instance = np.array([a.instance_id for a in actors], np.uint16)
         radius = np.array([np.linalg.norm(m.vertices, axis=1).max() for m in self.protos])
         self.radius = radius[self.proto_of]
+        bounds = np.array([m.bounds() for m in self.protos])  # (n_protos, 2, 3)
+        self._box_center = ((bounds[:, 0] + bounds[:, 1]) / 2)[self.proto_of]
+        self._box_half = ((bounds[:, 1] - bounds[:, 0]) / 2)[self.proto_of]
         self.bank = TrackBank([a.track for a in actors])
         self.center = np.asarray(center, np.float64)
         self.sensor = sensor
-        order = sensor.by_ring
-        self._neg_elevation = -sensor.elevation[order]  # ascending: ring 0 is the highest beam
-        self._max_elev = float(np.abs(sensor.elevation).max())
-        self._rot = (float(sensor.rot_correction.min()), float(sensor.rot_correction.max()))
-        self._rot_ring = sensor.rot_correction[order]
-        self._psi = sensor.column_azimuth()
-        o, _, _ = sensor.local_rays()
-        self._offset = float(np.linalg.norm(o, axis=-1).max())
+        self.beams = BeamTable.of(sensor)
+        self._column_windows = column_windows
 
     def face_normals(self) -> list[np.ndarray]:
         """Each prototype's (F_p, 3) float32 unit face normals, local frame."""
@@ -154,58 +142,21 @@ class ActorCaster:
         column_time : (steps,) float64 or None
             Firing offsets (skew on), or None: every column at ``t0``.
         """
-        s = self.sensor
         skew = poses.ndim == 3
         P = poses if skew else poses[None]
-        S = np.ascontiguousarray(P[:, :3, 3])
-        s_mid, s_rad = (S.min(0) + S.max(0)) / 2, np.linalg.norm(S.max(0) - S.min(0)) / 2
-        R0 = P[0, :3, :3]
-        turn = float(np.arccos(np.clip((np.einsum("ij,kij->k", R0, P[:, :3, :3]).min() - 1) / 2, -1, 1)))
-        t_end = t0 + (float(column_time[-1]) if skew else 0.0)
-        lo, hi = self.bank.knot_box(t0, t_end)
-        r_tot = self.radius + np.linalg.norm(hi - lo, axis=1) / 2 + s_rad + self._offset + _EPS
-        v = ((lo + hi) / 2 - s_mid) @ R0  # sensor axes at the sweep start
-        d_xy, d = np.hypot(v[:, 0], v[:, 1]), np.linalg.norm(v, axis=1)
-        alive = np.flatnonzero(d - r_tot < s.max_range_m)
-        # azimuth window -> encoder columns (one or two runs after wrapping)
-        tilt = min(self._max_elev + turn, 1.5)
-        half = np.arcsin(np.minimum(1.0, r_tot / np.maximum(d_xy, 1e-9))) + turn / np.cos(tilt) + _EPS
-        every = (d_xy <= r_tot) | (half >= np.pi)
-        az = np.arctan2(v[:, 1], v[:, 0])
-        lo_psi, hi_psi = az - half - self._rot[1], az + half - self._rot[0]
-        k = s.azimuth_steps / (2 * np.pi)
-        start = s.start_azimuth_rad
-        lo_c, hi_c = ((start - hi_psi) * k, (start - lo_psi) * k) if s.clockwise else ((lo_psi - start) * k, (hi_psi - start) * k)
-        ca = np.floor(lo_c).astype(np.int64) - 1
-        width = np.floor(hi_c).astype(np.int64) + 2 - ca
-        every |= width >= s.azimuth_steps
-        ca = np.where(every, 0, np.mod(ca, s.azimuth_steps))
-        width = np.where(every, s.azimuth_steps, width)
-        # elevation window -> rings
-        el = np.arctan2(v[:, 2], d_xy)
-        beta = np.arcsin(np.minimum(1.0, r_tot / np.maximum(d, 1e-9))) + turn + _EPS
-        r0 = np.searchsorted(self._neg_elevation, -(el + beta), "left")
-        r1 = np.searchsorted(self._neg_elevation, -(el - beta), "right")
-        r0, r1 = np.where(d <= r_tot, 0, r0), np.where(d <= r_tot, s.n_lasers, r1)
-        alive = alive[r1[alive] > r0[alive]]
-        if len(alive) == 0:
+        lo, hi = self.bank.knot_box(t0, t0 + (float(column_time[-1]) if skew else 0.0))
+        actor, c0, c1 = sweep_windows(self.beams, self.radius, lo, hi, P)
+        if len(actor) == 0:
             return None
-        # split wrapped windows: [ca, steps) + [0, ca + width - steps)
-        first = np.minimum(ca[alive] + width[alive], s.azimuth_steps)
-        wrap = ca[alive] + width[alive] - s.azimuth_steps
-        two = wrap > 0
-        actor = np.concatenate([alive, alive[two]])
-        c0 = np.concatenate([ca[alive], np.zeros(int(two.sum()), np.int64)])
-        c1 = np.concatenate([first, wrap[two]])
         n_cols = c1 - c0
         owner, col = _ragged(c0, n_cols)
         who = actor[owner]
         t = t0 + (column_time[col] if skew else np.zeros(len(col)))
         pos, yaw = self.bank.position_heading(who, t)
         moving = (self.bank.speed(who, t) > MOVING_THRESHOLD_MPS).astype(np.uint8)
-        half = np.where(every, 4.0, half + 1.5 * 2 * np.pi / s.azimuth_steps)  # + the column slack
-        return SweepPlan(actor, c0, c1, r0[actor], r1[actor], (d - r_tot)[actor].astype(np.float32), az[actor],
-                         half[actor], np.concatenate([[0], np.cumsum(n_cols)]), pos - self.center, np.cos(yaw), np.sin(yaw), moving)
+        win = self._column_windows(self.beams, pos, yaw, self._box_center[who], self._box_half[who], P[col if skew else 0 * col])
+        return SweepPlan(actor, c0, c1, np.concatenate([[0], np.cumsum(n_cols)]), pos - self.center, np.cos(yaw),
+                         np.sin(yaw), moving, win["azimuth"], win["half"], win["ring0"], win["ring1"], win["near"])
 
     # -- per chunk of columns -----------------------------------------------------------------------
     def cast(self, plan: SweepPlan, cols: slice, o_w: np.ndarray, d_w: np.ndarray, dist: np.ndarray,
@@ -236,20 +187,20 @@ class ActorCaster:
         if len(k) == 0:
             return None
         cs, ce = np.maximum(plan.c0[k], cols.start), np.minimum(plan.c1[k], cols.stop)
-        row_k, col = _ragged(cs, ce - cs)
-        row_k = k[row_k]
-        n_rings = plan.r1[row_k] - plan.r0[row_k]
-        row, ring = _ragged(plan.r0[row_k], n_rings)
-        cand = row_k[row]
-        ray = (col[row] - cols.start) * L + ring
-        ring_col = col[row]
-        off = self._psi.take(ring_col) + self._rot_ring.take(ring) - plan.azimuth.take(cand)
+        owner, col = _ragged(cs, ce - cs)
+        cand = k[owner]
+        pair = plan.pair_off[cand] + (col - plan.c0[cand])
+        live = np.flatnonzero(plan.ring1.take(pair) > plan.ring0.take(pair))
+        pair, col, cand = pair.take(live), col.take(live), cand.take(live)
+        row, ring = _ragged(plan.ring0.take(pair), plan.ring1.take(pair) - plan.ring0.take(pair))
+        pair, col, cand = pair.take(row), col.take(row), cand.take(row)
+        ray = (col - cols.start) * L + ring
+        off = self.beams.psi.take(col) + self.beams.rot.take(ring) - plan.azimuth.take(pair)
         off = np.abs(np.mod(off + np.pi, 2 * np.pi) - np.pi)  # this laser's beam vs the actor's direction
-        keep = np.flatnonzero((off <= plan.half.take(cand)) & (dist.take(ray) > plan.near.take(cand)))
+        keep = np.flatnonzero((off <= plan.half.take(pair)) & (dist.take(ray) > plan.near.take(pair)))
         if len(keep) == 0:
             return None
-        ray, cand = ray.take(keep), cand.take(keep)
-        pair = plan.pair_off[cand] + (ring_col.take(keep) - plan.c0[cand])
+        ray, pair, cand = ray.take(keep), pair.take(keep), cand.take(keep)
         c, s = plan.cos[pair], plan.sin[pair]
         o = o_w.take(ray, axis=0).astype(np.float64) - plan.position[pair]
         d = d_w.take(ray, axis=0).astype(np.float64)

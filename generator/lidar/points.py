@@ -26,8 +26,8 @@ blocks through :data:`_BLOCKS`, a second view of the same 38-byte record -- ``x,
 as one 16-byte block (``o + r d`` computed over the chunk's contiguous (n, 4) rows whose 4th
 column is ``(0, 1)``, so ``range`` comes out as ``r`` exactly, then gathered by hit),
 ``azimuth .. laser`` as one 16-byte block gathered from a per-ray template, ``class,
-instance, material, moving`` as a 4-byte and a 2-byte block gathered from per-face tables --
-plus ``cos_incidence`` on its own. Compared with one strided write per field this halves the
+instance, material, moving`` as a 4-byte block (gathered with the face normal, one 16-byte
+row per face) and a 2-byte block -- plus ``cos_incidence`` on its own. Compared with one strided write per field this halves the
 numpy passes of the labelling, which is the scanner's only cost beyond the Embree cast
 (``bench/lidar_traffic.py``). The values are the same float32 operations as a field-by-field
 fill (``x = o + r * d``; ``cos = |d0 n0 + d1 n1 + d2 n2|`` in that order), so the bytes are too.
@@ -78,10 +78,14 @@ class RecordTables:
         face = np.zeros(len(face_class), _FACE)
         face["class"], face["instance"], face["material"] = face_class, face_instance, face_material
         blocks = face.view(np.uint8).reshape(-1, 6)
-        self._face4 = np.ascontiguousarray(blocks[:, :4]).view("<u4").reshape(-1)
+        # per face one 16-byte row: unit normal (3 x float32) + class, instance, material's low byte,
+        # so one gather serves the cosine and most of the label block; one zero row at the end: a
+        # miss (face -1) reads it, so cosines can be computed for every ray of a chunk at once
+        rows = np.zeros((len(face) + 1, 4), np.uint32)  # label bits never pass through a float
+        rows.view(np.float32)[:-1, :3] = normals
+        rows[:-1, 3] = np.ascontiguousarray(blocks[:, :4]).view("<u4").reshape(-1)
+        self._normal_face4 = rows.view("V16").reshape(-1)
         self._face2 = np.ascontiguousarray(blocks[:, 4:]).view("<u2").reshape(-1)
-        # one zero row at the end: a miss (face -1) reads it, so cosines can be taken for every ray
-        self._normals = np.vstack([np.asarray(normals, np.float32), np.zeros((1, 3), np.float32)])
 
     def fill(self, out: np.ndarray, hit: np.ndarray, ray0: int, dist: np.ndarray, face: np.ndarray,
              direction: np.ndarray, skew: bool) -> None:
@@ -111,14 +115,14 @@ class RecordTables:
         xyzr += self._o4[ray0:ray0 + n]
         blocks["xyzr"] = xyzr.view("V16").reshape(-1).take(hit)
         blocks["ray"] = self._ray[skew].take(hit + ray0)
-        normal = self._normals.take(face, axis=0)
+        row = self._normal_face4.take(face).view(np.uint32).reshape(n, 4)
+        normal = row.view(np.float32)
         cos = direction[:, 0] * normal[:, 0]
         cos += direction[:, 1] * normal[:, 1]
         cos += direction[:, 2] * normal[:, 2]
         blocks["cos"] = np.abs(cos, out=cos).take(hit)
-        face_hit = face.take(hit)
-        blocks["face4"] = self._face4.take(face_hit)
-        blocks["face2"] = self._face2.take(face_hit)
+        blocks["face4"] = np.ascontiguousarray(row[:, 3]).take(hit)
+        blocks["face2"] = self._face2.take(face.take(hit))
 
 
 def _rows4(xyz: np.ndarray, w: float) -> np.ndarray:
