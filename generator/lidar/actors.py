@@ -38,6 +38,7 @@ from generator.lidar.tracks import TrackBank
 from generator.lidar.windows import BeamTable, column_windows, sweep_windows
 from generator.world.actors import MOVING_THRESHOLD_MPS
 
+
 @dataclass
 class SweepPlan:
     """Which rays of one sweep may reach which actor, and the actors' poses at those columns.
