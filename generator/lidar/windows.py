@@ -13,7 +13,7 @@ ray that an actor would stop):
    actor's box (the prototype's bounding box under the actor's pose) seen from the sensor in its
    frame at that instant bounds the beam azimuth (the box's half-width across the line of sight
    over its nearest depth) and elevation (its height range over its horizontal distance range),
-   widened only by the emission-point offset. No motion margin is needed: both poses are exact
+   widened only by the emission-point offsets (across the beam only the 2.6 cm horizontal one). No motion margin is needed: both poses are exact
    there. For a car 10 m ahead the beams kept are about a quarter of the sphere's.
 
 Frames: ``poses`` are ``T_world_sensor``; beam azimuths are CCW from the sensor's +x, elevations
@@ -43,12 +43,18 @@ class BeamTable:
         Encoder azimuth of each column, radians.
     offset : float
         Largest distance of an emission point from the sensor origin, metres.
+    lateral, radial : float
+        Largest horizontal offset of an emission point across / along its own beam's azimuth,
+        metres (the driver's ``horiz_offset``, and ``vert_offset`` times the sine of the elevation).
+    sensor : generator.lidar.sensors.Sensor
     """
 
     neg_elevation: np.ndarray
     rot: np.ndarray
     psi: np.ndarray
     offset: float
+    lateral: float
+    radial: float
     sensor: object
 
     @classmethod
@@ -56,7 +62,8 @@ class BeamTable:
         order = sensor.by_ring
         o, _, _ = sensor.local_rays()
         return cls(-sensor.elevation[order], sensor.rot_correction[order], sensor.column_azimuth(),
-                   float(np.linalg.norm(o, axis=-1).max()), sensor)
+                   float(np.linalg.norm(o, axis=-1).max()), float(np.abs(sensor.horiz_offset).max()),
+                   float(np.abs(sensor.vert_offset * np.sin(sensor.elevation)).max()), sensor)
 
 
 def sweep_windows(beams: BeamTable, radius: np.ndarray, lo: np.ndarray, hi: np.ndarray,
@@ -140,9 +147,11 @@ def column_windows(beams: BeamTable, position: np.ndarray, yaw: np.ndarray, box_
     along = sum(box_half[:, i] * np.abs(a[:, 0] * ux + a[:, 1] * uy) for i, a in enumerate(axes))
     across = sum(box_half[:, i] * np.abs(a[:, 1] * ux - a[:, 0] * uy) for i, a in enumerate(axes))
     up = sum(box_half[:, i] * np.abs(a[:, 2]) for i, a in enumerate(axes))
+    # a beam's horizontal trace is the line at its azimuth shifted across by the horizontal offset;
+    # its start moves along it by the vertical offset's horizontal part
+    depth = rho - along - beams.radial - EPS
+    half = np.where(depth > 0, np.arctan2(across + beams.lateral + EPS, np.maximum(depth, 1e-9)), 4.0) + EPS
     off = beams.offset + EPS
-    depth = rho - along - off
-    half = np.where(depth > 0, np.arctan2(across + off, np.maximum(depth, 1e-9)), 4.0) + EPS
     # horizontal distance of box points: at least the depth of the box's near face, at most its far corner's
     r_lo, r_hi = rho - along - off, np.hypot(rho + along, across) + off
     z_lo, z_hi = v[:, 2] - up - off, v[:, 2] + up + off
