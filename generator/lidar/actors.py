@@ -23,8 +23,9 @@ Every column therefore sees each actor exactly where ``actor.track.pose(t0 + col
 puts it: a passing car is smeared as a spinning sensor smears it. The alternative -- a second
 Embree scene of the posed actors rebuilt per time slice -- is exact only per slice (a car at 14
 m/s moves 1.4 m in one 0.1 s sweep, so exactness per column would take 2083 rebuilds a sweep)
-and pays a build of every actor's triangles per slice; the ray transform here costs a few
-gathers on the few thousand rays that can reach an actor.
+and pays a build per slice: measured on the default town (``bench/lidar_traffic.py``, 2 shared
+cores) 48 ms for 120 posed cars alone, 0.95 s with the town, against ~8 ms of CPU per sweep for
+this scheme with the same 120 cars moving (the sweep then takes ~23 ms on 2 threads, 43 sweeps/s).
 """
 
 from __future__ import annotations
@@ -104,6 +105,10 @@ class ActorCaster:
         Face-table row of each prototype's first face.
     instance : (n_actors,) uint16
         ``actor.instance_id``.
+    radius : (n_actors,) float64
+        Largest distance of a prototype vertex from the actor's origin (the per-sweep bound), metres.
+    bank : TrackBank
+        Every actor's track, evaluated in bulk.
     """
 
     def __init__(self, world, sensor, face_offset: int, center: np.ndarray):

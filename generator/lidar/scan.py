@@ -97,14 +97,16 @@ class Scanner:
         Work items per thread (small items balance load across threads).
     world : generator.world.actors.World, optional
         Its ``actors`` move through every sweep (None, or a world without actors: the static
-        town only, byte for byte the same points).
+        town only, byte for byte the same points). The ego must not be one of them (its own
+        body would surround the sensor).
 
     Notes
     -----
     Per sweep, each chunk of firing columns is rotated into the world in float32 relative
     to the caster's re-centring point (the float64 pose translation minus the centre is
     taken first, so nothing large is ever rounded), cast against the town, then against the
-    actors that can reach it, and turned into records (:func:`generator.lidar.points.fill_points`)
+    actors that can reach it (their plan is computed on the calling thread while the workers
+    cast the town), and turned into records (:meth:`generator.lidar.points.RecordTables.fill`)
     written straight into the sweep's array at the chunk's offset, which the chunk learns
     from the previous one once that one knows its hit count (chunks start in order, so
     nobody waits for long and no final concatenation runs on one thread). Every step
@@ -119,13 +121,13 @@ class Scanner:
         n_static = len(self.caster.face_normals)
         self.actors = (ActorCaster(world, sensor, n_static, self.caster.center)
                        if world is not None and world.actors else None)
-        cls, inst, mat = [scene.face_class], [scene.face_instance], [scene.face_material]
-        normals = [np.asarray(self.caster.face_normals, np.float32)]
-        for m in (self.actors.protos if self.actors is not None else []):
-            cls.append(m.face_class), inst.append(np.zeros(m.n_faces)), mat.append(m.face_material)
-        if self.actors is not None:
-            normals += self.actors.face_normals()
-        self._records = RecordTables(sensor, *(np.concatenate(x) for x in (cls, inst, mat, normals)))
+        # face-table rows: the town's faces, then each prototype's (instance filled per hit)
+        protos = self.actors.protos if self.actors is not None else []
+        self._records = RecordTables(
+            sensor, np.concatenate([scene.face_class, *(m.face_class for m in protos)]),
+            np.concatenate([scene.face_instance, *(np.zeros(m.n_faces, np.uint16) for m in protos)]),
+            np.concatenate([scene.face_material, *(m.face_material for m in protos)]),
+            np.concatenate([self.caster.face_normals, *(self.actors.face_normals() if protos else [])]))
         origins, dirs, _ = sensor.local_rays()
         self._o32 = origins.astype(np.float32)  # (steps, L, 3), ring order
         self._d32 = dirs.astype(np.float32)
