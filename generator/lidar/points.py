@@ -111,7 +111,8 @@ class RecordTables:
         """
         blocks = out.view(_BLOCKS)
         n = len(dist)
-        xyzr = self._d4[ray0:ray0 + n] * dist[:, None]
+        with np.errstate(invalid="ignore"):  # misses (inf) times a zero component; dropped below
+            xyzr = self._d4[ray0:ray0 + n] * dist[:, None]
         xyzr += self._o4[ray0:ray0 + n]
         blocks["xyzr"] = xyzr.view("V16").reshape(-1).take(hit)
         blocks["ray"] = self._ray[skew].take(hit + ray0)
