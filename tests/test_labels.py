@@ -85,3 +85,72 @@ def test_material_table():
     assert m.names[0] == "default" and len(set(m.names)) == len(m)
     assert ((m.reflectivity >= 0) & (m.reflectivity <= 1)).all()
     assert m.retro[m.id("sign_face")] and not m.retro[m.id("asphalt")]
+
+
+# -- moving actors: SemanticKITTI's moving-* raw ids ---------------------------------------------------------
+#: native class -> its moving raw id (reference semantic-kitti.yaml); every other class keeps its static id
+MOVING = {"car": 252, "bicyclist": 253, "ridden_bicycle": 253, "person": 254, "motorcyclist": 255,
+          "ridden_motorcycle": 255, "on_rails": 256, "bus": 257, "truck": 258, "other_vehicle": 259}
+
+
+def learning_map_of(raw, learning):
+    return np.array([learning[int(r)] for r in raw])
+
+
+def test_moving_ids_are_the_reference_ones_and_learn_as_their_static_class():
+    learning = {int(k): int(v) for k, v in T.sk_config["learning_map"].items()}
+    for i, name in enumerate(T.names):
+        raw = int(T.to_semantickitti_moving[i])
+        assert raw == MOVING.get(name, int(T.to_semantickitti[i])), name
+        assert learning[raw] == learning[int(T.to_semantickitti[i])], name
+        assert T.sk_to_unified[raw] == T.to_unified[i], name
+    from generator.labels.sets import label_sets, semantickitti_to_unified
+
+    raw = np.array(sorted(set(MOVING.values())), np.uint16)  # what evaluate / convert read
+    assert np.array_equal(label_sets()["semantickitti"].from_raw[raw], learning_map_of(raw, learning))
+    assert semantickitti_to_unified(raw).tolist() == [1, 2, 2, 2, 1, 1, 1, 1]
+    assert {T.sk_labels[r] for r in MOVING.values()} == {f"moving-{n}" for n in (
+        "car", "bicyclist", "person", "motorcyclist", "on-rails", "bus", "truck", "other-vehicle")}
+
+
+def test_semantickitti_labels_use_moving_ids_only_where_moving():
+    from generator.labels.sets import semantickitti_labels
+
+    native = np.array([T.id(n) for n in ("car", "car", "road", "person", "bicycle", "unlabeled", "truck")])
+    moving = np.array([1, 0, 1, 1, 1, 1, 1], np.uint8)
+    raw = semantickitti_labels(native, moving)
+    assert raw.dtype == np.uint16 and raw.tolist() == [252, 10, 40, 254, 11, 0, 258]
+    assert semantickitti_labels(native).tolist() == T.to_semantickitti[native].tolist()
+
+
+def test_moving_ids_read_back_as_their_native_class():
+    for raw in MOVING.values():
+        assert int(T.to_semantickitti_moving[T.from_semantickitti(raw)]) == raw
+    assert T.from_semantickitti(252) == T.id("car") and T.from_semantickitti(253) == T.id("bicyclist")
+
+
+def test_bad_moving_table_is_refused():
+    from generator.labels.registry import ClassTable
+
+    with pytest.raises(ValueError, match="learning"):
+        ClassTable(T.rows, T.sk_config, {"classes": T.unified_names, "from_semantickitti": T.sk_to_unified_map,
+                                         "to_semantickitti": T.unified_to_sk_map}, moving={"person": 252})
+    with pytest.raises(ValueError, match="moving-"):
+        ClassTable(T.rows, T.sk_config, {"classes": T.unified_names, "from_semantickitti": T.sk_to_unified_map,
+                                         "to_semantickitti": T.unified_to_sk_map}, moving={"car": 10})
+
+
+def test_dataset_label_config_carries_the_moving_ids_the_api_remaps(tmp_path):
+    """semantic-kitti-api builds its remap LUT from ``learning_map`` keys (``evaluate_semantics.py``)."""
+    from generator.formats.label_config import write_label_config
+
+    path = tmp_path / "semantic-kitti.yaml"
+    write_label_config(path, {10: 3, 252: 1, 40: 4}, {"valid": [0]})
+    cfg = yaml.safe_load(path.read_text())
+    for section in ("labels", "color_map", "learning_map", "content"):
+        assert set(MOVING.values()) <= set(cfg[section]), section
+    assert cfg["content"][252] == 1 / 8
+    keys = np.array(list(cfg["learning_map"].keys()))
+    lut = np.zeros(keys.max() + 100, np.int32)
+    lut[keys] = list(cfg["learning_map"].values())
+    assert lut[np.array([252, 10, 254, 30, 258, 18])].tolist() == [1, 1, 6, 6, 4, 4]

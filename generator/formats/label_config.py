@@ -2,8 +2,11 @@
 
 Sections ``labels``, ``color_map`` (BGR), ``learning_map``, ``learning_map_inv`` and
 ``learning_ignore`` are the reference ones (``generator/labels/semantic-kitti.yaml``), so
-SemanticKITTI tools read an urbangen dataset unchanged. ``content`` (fraction of points
-per raw id) is computed from the labels actually written.
+SemanticKITTI tools read an urbangen dataset unchanged. They include the moving-* ids
+252-259 that points on moving actors carry (:func:`generator.labels.sets.semantickitti_labels`),
+with the reference ``learning_map`` (moving-car -> car ...), so semantic-kitti-api's remap
+LUTs cover them. ``content`` (fraction of points per raw id, every reference id listed, moving
+ones included) is computed from the labels actually written.
 
 ``split`` lists every sequence present in the dataset, each under exactly one of
 ``train``, ``valid``, ``test`` (:func:`merge_split`): the split a command was asked for

@@ -2,7 +2,8 @@
 
 Every other label set is a lookup array built from the one table:
 
-* SemanticKITTI raw ids (``to_semantickitti``), with the reference label config
+* SemanticKITTI raw ids (``to_semantickitti``; ``to_semantickitti_moving`` for points on
+  moving actors, the reference's moving-* ids 252-259), with the reference label config
   ``semantic-kitti.yaml`` for names and colours;
 * the unified 11 classes of seed 000 (``unified11.yaml`` maps SemanticKITTI raw ids,
   so native -> unified is the composition native -> raw -> unified);
@@ -48,7 +49,8 @@ class ClassTable:
     Lookup arrays are indexed by native id and have one entry per class.
     """
 
-    def __init__(self, rows: list[ClassInfo], sk_config: dict, unified: dict, wet_ground: list[int] = ()):
+    def __init__(self, rows: list[ClassInfo], sk_config: dict, unified: dict, wet_ground: list[int] = (),
+                 moving: dict[str, int] | None = None):
         ids = [r.id for r in rows]
         if ids != list(range(len(rows))):
             raise ValueError(f"classes.yaml: ids must be 0..{len(rows) - 1} in order, got {ids}")
@@ -74,6 +76,22 @@ class ClassTable:
                 raise ValueError(f"classes.yaml: {r.name}: unknown SemanticKITTI id {r.semantickitti}")
             if r.proxy not in ("none", "hull"):
                 raise ValueError(f"classes.yaml: {r.name}: proxy must be 'none' or 'hull', got {r.proxy!r}")
+        #: native class name -> SemanticKITTI moving-* raw id (``semantickitti_moving`` in ``classes.yaml``)
+        self.moving_raw_ids: dict[str, int] = {str(k): int(v) for k, v in (moving or {}).items()}
+        self._check_moving(sk_config)
+
+    def _check_moving(self, sk_config: dict) -> None:
+        learning = {int(k): int(v) for k, v in sk_config["learning_map"].items()}
+        for name, raw in self.moving_raw_ids.items():
+            where = f"classes.yaml: semantickitti_moving: {name}"
+            if name not in self._by_name:
+                raise ValueError(f"{where}: unknown native class")
+            static = self._by_name[name].semantickitti
+            if raw not in self.sk_labels or not self.sk_labels[raw].startswith("moving-"):
+                raise ValueError(f"{where}: {raw} is not a SemanticKITTI moving-* id")
+            if static is None or learning.get(raw) != learning.get(static) \
+                    or self.sk_to_unified_map.get(raw) != self.sk_to_unified_map.get(static):
+                raise ValueError(f"{where}: {raw} must map to the learning and unified class of {static}")
 
     # -- single lookups ---------------------------------------------------------------
     def __len__(self) -> int:
@@ -94,6 +112,17 @@ class ClassTable:
     def to_semantickitti(self) -> np.ndarray:
         """(n_classes,) uint16: SemanticKITTI raw id per native id (no-return classes -> 0)."""
         return np.array([NO_RETURN if r.semantickitti is None else r.semantickitti for r in self.rows], np.uint16)
+
+    @functools.cached_property
+    def to_semantickitti_moving(self) -> np.ndarray:
+        """(n_classes,) uint16: SemanticKITTI raw id per native id for a point on a MOVING actor.
+
+        The moving-* id (252-259) where the class has one, else the static id (``to_semantickitti``).
+        """
+        out = self.to_semantickitti.copy()
+        for name, raw in self.moving_raw_ids.items():
+            out[self._by_name[name].id] = raw
+        return out
 
     @functools.cached_property
     def sk_to_unified(self) -> np.ndarray:
@@ -144,6 +173,8 @@ class ClassTable:
     def from_semantickitti(self, raw: int) -> int:
         """Canonical native id for a SemanticKITTI raw id (first native class mapping to it).
 
+        A moving-* id gives the first native class whose moving id it is (252 -> car).
+
         Raises
         ------
         KeyError
@@ -152,6 +183,8 @@ class ClassTable:
         hits = np.flatnonzero(self.to_semantickitti == raw)
         if raw == NO_RETURN:
             return 0
+        if hits.size == 0:
+            hits = np.flatnonzero((self.to_semantickitti_moving == raw) & (self.to_semantickitti != raw))
         if hits.size == 0:
             raise KeyError(f"no native class maps to SemanticKITTI id {raw}")
         return int(hits[0])
@@ -176,4 +209,4 @@ def class_table() -> ClassTable:
         for r in raw
     ]
     return ClassTable(rows, _load_yaml("semantic-kitti.yaml"), _load_yaml("unified11.yaml"),
-                      doc.get("wet_ground_semantickitti", ()))
+                      doc.get("wet_ground_semantickitti", ()), doc.get("semantickitti_moving", {}))

@@ -10,8 +10,11 @@ unified11       seed 000's 11 classes (``unified11.yaml``)              raw id
 
 Each set maps native ids (:attr:`LabelSet.from_native`) and, where SemanticKITTI raw
 ids determine it, raw ids (:attr:`LabelSet.from_raw`). The raw-id mappings between the
-datasets (:func:`native_to_semantickitti`, :func:`semantickitti_to_unified`,
-:func:`unified_to_semantickitti`) live here too, so no other module rebuilds them.
+datasets (:func:`native_to_semantickitti`, :func:`semantickitti_labels` with the moving-*
+ids, :func:`semantickitti_to_unified`, :func:`unified_to_semantickitti`) live here too, so no
+other module rebuilds them. The moving-* raw ids 252-259 map to the learning and unified
+classes of their static ids (``learning_map``, ``unified11.yaml``), so every raw-id lookup
+above reads them.
 """
 
 from __future__ import annotations
@@ -76,6 +79,23 @@ def label_sets() -> dict[str, LabelSet]:
 def native_to_semantickitti(native: np.ndarray) -> np.ndarray:
     """(n,) uint16 SemanticKITTI raw ids of (n,) native class ids."""
     return class_table().to_semantickitti[np.asarray(native)]
+
+
+def semantickitti_labels(native: np.ndarray, moving: np.ndarray | bool = False) -> np.ndarray:
+    """(n,) uint16 SemanticKITTI raw ids of points: moving-* ids (252-259) where ``moving``.
+
+    Parameters
+    ----------
+    native : (n,) integer
+        Native class ids (``points["class"]``).
+    moving : (n,) bool or uint8, or bool
+        Whether each point lies on an actor moving faster than
+        :data:`generator.world.actors.MOVING_THRESHOLD_MPS` at its firing time (``points["moving"]``).
+        Classes without a moving id (stuff, a bicycle without its rider) keep their static id.
+    """
+    t = class_table()
+    native = np.asarray(native)
+    return np.where(np.asarray(moving, bool), t.to_semantickitti_moving[native], t.to_semantickitti[native])
 
 
 def semantickitti_to_unified(raw: np.ndarray, source: str = "labels") -> np.ndarray:

@@ -88,7 +88,7 @@ class EmbreeCaster:
         self.build_seconds = time.perf_counter() - t0
 
     @classmethod
-    def from_scene(cls, scene) -> "EmbreeCaster":
+    def from_scene(cls, scene) -> EmbreeCaster:
         """A caster over ``scene.vertices`` / ``scene.faces`` (the real geometry, never the label proxies)."""
         return cls(scene.vertices, scene.faces)
 
@@ -97,7 +97,8 @@ class EmbreeCaster:
         """(F, 3) float32 unit normals per face, world frame (zero for degenerate faces)."""
         return self._normals
 
-    def intersect_local(self, origins: np.ndarray, directions: np.ndarray, max_distance: float) -> tuple[np.ndarray, np.ndarray]:
+    def intersect_local(self, origins: np.ndarray, directions: np.ndarray,
+                        max_distance: float | np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """First hits of rays whose origins are already re-centred (``world - center``).
 
         Parameters
@@ -106,8 +107,8 @@ class EmbreeCaster:
             Ray origins minus :attr:`center`, metres.
         directions : (n, 3) float32
             Unit directions, world axes.
-        max_distance : float
-            Hits farther than this are misses, metres.
+        max_distance : float or (n,) float32
+            Hits farther than this are misses, metres (per ray: only hits nearer than a known one).
 
         Returns
         -------
@@ -118,6 +119,7 @@ class EmbreeCaster:
         """
         o = np.ascontiguousarray(origins, np.float32)
         d = np.ascontiguousarray(directions, np.float32)
+        # a fresh tfar array every call: embreex writes the hit distances into it
         out = self._scene.run(o, d, dists=np.full(len(o), max_distance, np.float32), output=1)
         prim = out["primID"]
         dist = out["tfar"]

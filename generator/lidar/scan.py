@@ -13,45 +13,33 @@ since ``t_k`` (up to speed x 0.1 s at 10 Hz). Each point's ``time`` field gives 
 firing offset, so a consumer can de-skew. With motion skew off every column is fired
 from the pose at ``t_k`` and ``time`` is 0.
 
-Point record (:data:`POINT_DTYPE`, one structured row per return; no-return rays and
-rays blocked nearer than the sensor's minimum range are not points):
+Moving actors (``world``): each firing column also sees every actor of the world where its
+track puts it at that column's instant (skew off: at ``t0``), and the nearer of actor and
+town wins (:mod:`generator.lidar.actors`). Actor points carry the prototype's class and
+material, the actor's instance id, and ``moving`` = 1 when its planar speed at the firing
+time exceeds :data:`generator.world.actors.MOVING_THRESHOLD_MPS`.
 
-=============== ======= ==========================================================
-field           dtype   meaning
-=============== ======= ==========================================================
-x, y, z         float32 sensor frame at firing time, metres (x fwd, y left, z up)
-range           float32 distance from the laser's emission point along the beam, metres
-                        (what the device measures; differs from |xyz| by the offsets)
-azimuth         float32 beam azimuth, radians CCW from +x, in [-pi, pi)
-time            float32 firing offset after the sweep start, seconds (0 with skew off)
-cos_incidence   float32 |dot(beam direction, face normal)|
-ring            uint8   beam row by elevation, 0 = highest
-column          uint16  firing column, 0 .. azimuth_steps - 1
-laser           uint8   device laser id
-class           uint8   native class id (``scene.face_class``)
-instance        uint16  instance id (``scene.face_instance``, 0 for stuff)
-material        uint16  material id (``scene.face_material``)
-=============== ======= ==========================================================
-
+Point record: :data:`POINT_DTYPE` (:mod:`generator.lidar.points`, re-exported here).
 Points are ordered by column (firing time), then ring.
 """
 
 from __future__ import annotations
 
+import itertools
 import os
-from concurrent.futures import ThreadPoolExecutor
+import threading
+from concurrent.futures import ThreadPoolExecutor, wait
 from dataclasses import dataclass
+from typing import Self
 
 import numpy as np
 
+from generator.lidar.actors import ActorCaster
 from generator.lidar.caster import RayCaster, make_caster
+from generator.lidar.points import POINT_DTYPE, RecordTables
 from generator.lidar.sensors import Sensor
 
-POINT_DTYPE = np.dtype([
-    ("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("range", "<f4"), ("azimuth", "<f4"), ("time", "<f4"),
-    ("cos_incidence", "<f4"), ("ring", "u1"), ("column", "<u2"), ("laser", "u1"), ("class", "u1"),
-    ("instance", "<u2"), ("material", "<u2"),
-])
+__all__ = ["POINT_DTYPE", "Scan", "Scanner"]
 
 
 @dataclass
@@ -94,7 +82,7 @@ class Scan:
 
 
 class Scanner:
-    """Casts a sensor's sweeps against one scene, reusing the BVH for every frame.
+    """Casts a sensor's sweeps against one scene (and its moving actors), reusing every BVH.
 
     Parameters
     ----------
@@ -107,44 +95,46 @@ class Scanner:
         A prebuilt caster over the same scene (default: Embree over ``scene``).
     chunks_per_thread : int
         Work items per thread (small items balance load across threads).
+    world : generator.world.actors.World, optional
+        Its ``actors`` move through every sweep (None, or a world without actors: the static
+        town only, byte for byte the same points). The ego must not be one of them (its own
+        body would surround the sensor).
 
     Notes
     -----
     Per sweep, each chunk of firing columns is rotated into the world in float32 relative
     to the caster's re-centring point (the float64 pose translation minus the centre is
-    taken first, so nothing large is ever rounded), cast, and turned into point fields by
-    1-D gathers; the structured array is assembled once at the end. Every step releases
-    the GIL, so chunks run in parallel threads.
+    taken first, so nothing large is ever rounded), cast against the town, then against the
+    actors that can reach it (their plan is computed on the calling thread while the workers
+    cast the town), and turned into records (:meth:`generator.lidar.points.RecordTables.fill`)
+    written straight into the sweep's array at the chunk's offset, which the chunk learns
+    from the previous one once that one knows its hit count (chunks start in order, so
+    nobody waits for long and no final concatenation runs on one thread). Every step
+    releases the GIL, so chunks run in parallel threads.
     """
 
     def __init__(self, scene, sensor: Sensor, threads: int | None = None, caster: RayCaster | None = None,
-                 chunks_per_thread: int = 4):
+                 chunks_per_thread: int = 4, world=None):
         self.sensor = sensor
         self.threads = max(1, int(threads or os.cpu_count() or 1))
         self.caster = caster if caster is not None else make_caster(scene)
-        self._face_class = np.asarray(scene.face_class, np.uint8)
-        self._face_instance = np.asarray(scene.face_instance, np.uint16)
-        self._face_material = np.asarray(scene.face_material, np.uint16)
-        normals = np.asarray(self.caster.face_normals, np.float32)
-        self._normal = [np.ascontiguousarray(normals[:, i]) for i in range(3)]
-        origins, dirs, azimuth = sensor.local_rays()
-        steps, n_l = azimuth.shape
+        n_static = len(self.caster.face_normals)
+        self.actors = (ActorCaster(world, sensor, n_static, self.caster.center)
+                       if world is not None and world.actors else None)
+        # face-table rows: the town's faces, then each prototype's (instance filled per hit)
+        protos = self.actors.protos if self.actors is not None else []
+        self._records = RecordTables(
+            sensor, np.concatenate([scene.face_class, *(m.face_class for m in protos)]),
+            np.concatenate([scene.face_instance, *(np.zeros(m.n_faces, np.uint16) for m in protos)]),
+            np.concatenate([scene.face_material, *(m.face_material for m in protos)]),
+            np.concatenate([self.caster.face_normals, *(self.actors.face_normals() if protos else [])]))
+        origins, dirs, _ = sensor.local_rays()
         self._o32 = origins.astype(np.float32)  # (steps, L, 3), ring order
         self._d32 = dirs.astype(np.float32)
-        flat_o, flat_d = origins.reshape(-1, 3), dirs.reshape(-1, 3)
-        self._o = [flat_o[:, i].astype(np.float32) for i in range(3)]  # per-ray components, for 1-D gathers
-        self._d = [flat_d[:, i].astype(np.float32) for i in range(3)]
-        order = sensor.by_ring
-        self._ray_fields = {
-            "azimuth": azimuth.astype(np.float32).reshape(-1),
-            "time": np.repeat(sensor.column_time().astype(np.float32), n_l),
-            "ring": np.tile(sensor.ring[order].astype(np.uint8), steps),
-            "column": np.repeat(np.arange(steps, dtype=np.uint16), n_l),
-            "laser": np.tile(sensor.laser_id[order].astype(np.uint8), steps),
-        }
+        steps = sensor.azimuth_steps
         n_chunks = min(steps, self.threads * max(1, chunks_per_thread))
         edges = np.linspace(0, steps, n_chunks + 1).round().astype(int)
-        self._chunks = [slice(a, b) for a, b in zip(edges[:-1], edges[1:]) if b > a]
+        self._chunks = [slice(a, b) for a, b in itertools.pairwise(edges) if b > a]
         self._pool = ThreadPoolExecutor(self.threads, thread_name_prefix="lidar") if self.threads > 1 else None
 
     def close(self) -> None:
@@ -153,13 +143,13 @@ class Scanner:
             self._pool.shutdown()
             self._pool = None
 
-    def __enter__(self) -> "Scanner":
+    def __enter__(self) -> Self:
         return self
 
     def __exit__(self, *exc) -> None:
         self.close()
 
-    def scan(self, T_world_sensor: np.ndarray) -> Scan:
+    def scan(self, T_world_sensor: np.ndarray, t0: float | None = None) -> Scan:
         """Cast one sweep.
 
         Parameters
@@ -167,6 +157,10 @@ class Scanner:
         T_world_sensor : (4, 4) or (steps, 4, 4) float64
             One pose for the whole sweep (motion skew off) or one pose per firing column
             (motion skew on; column 0 is the sweep start), world frame.
+        t0 : float, optional
+            Sweep start on the world's clock, seconds: actors are posed at ``t0`` plus each
+            column's firing offset (skew on) or at ``t0`` (skew off). Required when the
+            scanner has actors.
 
         Returns
         -------
@@ -176,17 +170,31 @@ class Scanner:
         skew = poses.ndim == 3
         if skew and len(poses) != self.sensor.azimuth_steps:
             raise ValueError(f"need one pose per column ({self.sensor.azimuth_steps}), got {len(poses)}")
+        if self.actors is not None and t0 is None:
+            raise ValueError("this scanner has moving actors: scan(..., t0=sweep start time) is required")
         rot_t = np.ascontiguousarray(np.swapaxes(poses[..., :3, :3], -1, -2), np.float32)
         trans = (poses[..., :3, 3] - self.caster.center).astype(np.float32)  # float64 difference first
-        work = [(c, rot_t, trans, skew) for c in self._chunks]
-        if self._pool is not None:
-            parts = list(self._pool.map(self._cast_chunk, *zip(*work)))
+        sweep = _Sweep(np.empty(self.sensor.rays_per_sweep, POINT_DTYPE), len(self._chunks), rot_t, trans, skew)
+
+        def plan():  # which actors each column may see; the workers need it only after their static cast
+            if self.actors is None:
+                return None
+            return self.actors.plan(poses, float(t0), self.sensor.column_time() if skew else None)
+
+        if self._pool is None:
+            sweep.set_plan(plan)
+            sweep.raise_plan_error()
+            for i, cols in enumerate(self._chunks):
+                self._run_chunk(sweep, i, cols)
         else:
-            parts = [self._cast_chunk(*w) for w in work]
-        # byte-level concatenation: numpy's structured concatenate is ~20x slower than memcpy
-        points = np.concatenate([p.view(np.uint8) for p in parts]).view(POINT_DTYPE)
-        return Scan(points, poses[0] if skew else poses, self.sensor.rays_per_sweep, self.sensor.n_lasers,
-                    self.sensor.azimuth_steps)
+            futures = [self._pool.submit(self._run_chunk, sweep, i, cols) for i, cols in enumerate(self._chunks)]
+            sweep.set_plan(plan)
+            wait(futures)
+            sweep.raise_plan_error()
+            for f in futures:
+                f.result()
+        return Scan(sweep.out[:sweep.ends[-1]], poses[0] if skew else poses, self.sensor.rays_per_sweep,
+                    self.sensor.n_lasers, self.sensor.azimuth_steps)
 
     def sweep(self, rig, t0: float, motion_skew: bool = True) -> Scan:
         """Cast the sweep starting at ``t0`` seconds from ``rig``'s LiDAR.
@@ -195,43 +203,89 @@ class Scanner:
         ----------
         rig : generator.world.rig.Rig
             A rig with a trajectory.
+        t0 : float
+            Sweep start, seconds (the same clock as the world's actors).
         motion_skew : bool
             Fire each column from the pose of its own instant (a real spinning sensor), or
-            every column from the pose at ``t0``.
+            every column from the pose at ``t0`` (and every actor at ``t0``).
         """
-        return self.scan(rig.sweep_poses(t0, self.sensor.column_time() if motion_skew else None))
+        return self.scan(rig.sweep_poses(t0, self.sensor.column_time() if motion_skew else None), t0=t0)
 
-    def _cast_chunk(self, cols: slice, rot_t: np.ndarray, trans: np.ndarray, skew: bool) -> np.ndarray:
-        o_loc, d_loc = self._o32[cols], self._d32[cols]  # (k, L, 3) float32
-        if skew:
-            d_w = np.matmul(d_loc, rot_t[cols])
-            o_w = np.matmul(o_loc, rot_t[cols])
-            o_w += trans[cols, None, :]
-        else:
-            d_w = d_loc @ rot_t
-            o_w = o_loc @ rot_t
-            o_w += trans
-        d_w, o_w = d_w.reshape(-1, 3), o_w.reshape(-1, 3)
-        dist, prim = self.caster.intersect_local(o_w, d_w, self.sensor.max_range_m)
-        hit = np.flatnonzero((prim >= 0) & (dist >= self.sensor.min_range_m))
-        take = np.take  # 1-D gathers; np.take is about twice as fast as fancy indexing here
-        face = take(prim, hit)
-        r = take(dist, hit)
-        ray = hit + cols.start * self.sensor.n_lasers
-        out = np.empty(len(hit), POINT_DTYPE)  # filled here, in the worker thread
-        out["range"] = r
-        for i, name in enumerate("xyz"):
-            out[name] = take(self._o[i], ray) + r * take(self._d[i], ray)
-        cos = take(d_w[:, 0], hit) * take(self._normal[0], face)
-        cos += take(d_w[:, 1], hit) * take(self._normal[1], face)
-        cos += take(d_w[:, 2], hit) * take(self._normal[2], face)
-        out["cos_incidence"] = np.abs(cos)
-        for name, values in self._ray_fields.items():
-            if skew or name != "time":
-                out[name] = take(values, ray)
-        if not skew:
-            out["time"] = 0.0
-        out["class"] = take(self._face_class, face)
-        out["instance"] = take(self._face_instance, face)
-        out["material"] = take(self._face_material, face)
-        return out
+    def _run_chunk(self, sweep: _Sweep, i: int, cols: slice) -> None:
+        try:
+            o_loc, d_loc = self._o32[cols], self._d32[cols]  # (k, L, 3) float32
+            if sweep.skew:
+                d_w = np.matmul(d_loc, sweep.rot_t[cols])
+                o_w = np.matmul(o_loc, sweep.rot_t[cols])
+                o_w += sweep.trans[cols, None, :]
+            else:
+                d_w = d_loc @ sweep.rot_t
+                o_w = o_loc @ sweep.rot_t
+                o_w += sweep.trans
+            d_w, o_w = d_w.reshape(-1, 3), o_w.reshape(-1, 3)
+            dist, face = self.caster.intersect_local(o_w, d_w, self.sensor.max_range_m)
+            on_actor = None
+            plan = sweep.get_plan()
+            if plan is not None:
+                on_actor = self.actors.cast(plan, cols, o_w, d_w, dist, face)
+            hit = np.flatnonzero((face >= 0) & (dist >= self.sensor.min_range_m))
+            start = sweep.claim(i, len(hit))
+        except BaseException:
+            sweep.fail(i)
+            raise
+        out = sweep.out[start:start + len(hit)]
+        self._records.fill(out, hit, cols.start * self.sensor.n_lasers, dist, face, d_w, sweep.skew)
+        if on_actor is not None:
+            actor, moving = on_actor
+            a = actor.take(hit)
+            m = np.flatnonzero(a >= 0)
+            out["instance"][m] = self.actors.instance[a[m]]
+            out["moving"][m] = moving.take(hit)[m]
+
+
+class _Sweep:
+    """One sweep in flight: the output array, the actors' plan and the chained chunk offsets."""
+
+    def __init__(self, out: np.ndarray, n_chunks: int, rot_t, trans, skew: bool):
+        self.out, self.rot_t, self.trans, self.skew = out, rot_t, trans, skew
+        self.ends: list[int | None] = [None] * n_chunks
+        self._done = [threading.Event() for _ in range(n_chunks)]
+        self._plan, self._plan_error = None, None
+        self._planned = threading.Event()
+
+    def set_plan(self, make_plan) -> None:
+        """Compute the actors' plan (``make_plan()``) and release the chunks waiting for it."""
+        try:
+            self._plan = make_plan()
+        except Exception as e:  # noqa: BLE001 - re-raised by raise_plan_error, after the chunks stopped
+            self._plan_error = e
+        finally:
+            self._planned.set()
+
+    def get_plan(self):
+        """The plan (None without actors); waits until it is known."""
+        self._planned.wait()
+        if self._plan_error is not None:
+            raise RuntimeError("planning the actors of this sweep failed") from self._plan_error
+        return self._plan
+
+    def raise_plan_error(self) -> None:
+        """Raise what planning raised, if anything."""
+        if self._plan_error is not None:
+            raise self._plan_error
+
+    def claim(self, i: int, n: int) -> int:
+        """Offset of chunk ``i``'s ``n`` points: the end of chunk ``i - 1`` (waits until it is known)."""
+        start = 0
+        if i > 0:
+            self._done[i - 1].wait()
+            start = self.ends[i - 1]
+            if start is None:
+                raise RuntimeError("an earlier chunk of this sweep failed")
+        self.ends[i] = start + n
+        self._done[i].set()
+        return start
+
+    def fail(self, i: int) -> None:
+        """Release the chunks waiting on chunk ``i`` (they raise)."""
+        self._done[i].set()
