@@ -90,8 +90,8 @@ def native_from_raw(raw: np.ndarray) -> np.ndarray:
     """(n,) uint8 canonical native class of SemanticKITTI raw ids (many-to-one: lossy; unknown -> 0)."""
     t = class_table()
     lut = np.zeros(1 << 16, np.uint8)
-    for sk_id in set(int(v) for v in t.to_semantickitti):
-        lut[sk_id] = t.from_semantickitti(sk_id)
+    for sk_id in {int(v) for v in t.to_semantickitti} | {int(v) for v in t.to_semantickitti_moving}:
+        lut[sk_id] = t.from_semantickitti(sk_id)  # moving-* (252-259) read back as their static class
     return lut[np.asarray(raw, np.int64)]
 
 

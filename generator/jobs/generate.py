@@ -140,7 +140,7 @@ def preflight(spec, cfg, opts: GenerateOptions) -> Preflight:
     from generator.labels import class_table
     from generator.layout.assemble import build_scene
     from generator.jobs.drive import plan_drive
-    from generator.jobs.lidar_sequence import check_castable, check_frames
+    from generator.jobs.lidar_sequence import check_frames
     from generator.lidar.sensors import sensor_for_spec
     from generator.remission.models import intensity_fn_for_spec
     from generator.scan_effects.pipeline import processing_for_spec
@@ -162,7 +162,6 @@ def preflight(spec, cfg, opts: GenerateOptions) -> Preflight:
     scene = build_scene(spec)  # the expensive checks last: the town, then its traffic
     check_frames(scene, spec, len(plan.frames))
     drive = plan_drive(spec, scene, plan.frames)
-    check_castable(spec, drive.world)
     pairs = [j for j in stereo_frames(spec, range(drive.sweeps)) if not pair_done(seq_dir, j)]
     per_image = image_bytes(cfg.width, cfg.height, cfg.exr_codec, len(class_table().names), cfg.preview)
     need = (len(todo) * len(plan.combos) + 2 * len(pairs)) * per_image

@@ -19,7 +19,6 @@ so a sequence with ``poses.txt`` is complete. Re-running into the same folder ov
 from __future__ import annotations
 
 import dataclasses
-import inspect
 import json
 import logging
 from dataclasses import dataclass
@@ -35,6 +34,7 @@ from generator.formats.label_config import count_raw_ids, merge_counts, write_la
 from generator.formats.ply import write_ply
 from generator.previews.bev import write_bev
 from generator.labels import class_table
+from generator.labels.sets import semantickitti_labels
 from generator.formats.point_sidecars import write_point_sidecars
 from generator.scan_effects.pipeline import process_scan, processing_for_spec
 from generator.remission.models import IntensityFn, intensity_fn_for_spec
@@ -122,13 +122,6 @@ def check_sweeps(scene, spec, n: int, route: int = 0) -> None:
                         f"{spec.paths.speed_mps}: room for {int(seconds / SWEEP_PERIOD_S) + 1} sweeps, asked for {n}")
 
 
-def check_castable(spec, world) -> None:
-    """Refuse (one line) a world with actors while the scanner cannot cast them, before anything is written."""
-    if world is not None and world.actors and "world" not in inspect.signature(Scanner).parameters:
-        raise SpecError(spec.source, "traffic", "moving vehicles are not cast by the LiDAR in this version; set every "
-                        "traffic density to 0")
-
-
 def world_for(spec, scene, sweeps: int, distance_m: float = 0.0):
     """The world (:func:`generator.traffic.build.build_world`) covering ``sweeps`` 10 Hz sweeps."""
     from generator.traffic.build import build_world
@@ -175,8 +168,7 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
     starts, n_points, counts, records = [], [], {}, []
     sweeps = []  # LiDAR world poses during each sweep (fusion de-skews with them)
     actors = world.actors if world is not None else []
-    check_castable(spec, world)
-    with Scanner(scene, sensor, threads=options.threads, **({"world": world} if actors else {})) as scanner:
+    with Scanner(scene, sensor, threads=options.threads, world=world if actors else None) as scanner:
         for j in progress_bar(range(options.frames), desc=f"lidar {name}", unit="scan", enabled=progress):
             t_j = times[j]
             scan = scanner.sweep(rig, t_j, skew)
@@ -221,12 +213,8 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
 def semantic_ids(points: np.ndarray) -> np.ndarray:
     """(n,) uint16 SemanticKITTI raw ids of processed points: the moving id (252-259) where a point
     lies on an actor moving at its firing time and the class has one, else the class's own id."""
-    table = class_table()
-    ids = table.to_semantickitti[points["class"]]
-    if "moving" in (points.dtype.names or ()) and hasattr(table, "to_semantickitti_moving"):
-        moving = points["moving"].astype(bool)
-        ids = np.where(moving, table.to_semantickitti_moving[points["class"]], ids)
-    return ids.astype(np.uint16, copy=False)
+    moving = points["moving"] if "moving" in (points.dtype.names or ()) else False
+    return semantickitti_labels(points["class"], moving).astype(np.uint16, copy=False)
 
 
 def _remove_stale(seq: Path, n: int) -> None:

@@ -145,7 +145,7 @@ def apply_lidar_weather(points: np.ndarray, remission: np.ndarray, weather: Weat
         cand, r_soft = cand[ok], r_soft[ok]
         soft[cand] = True
         _move_along_beam(out, r_soft, cand)
-        for name in ("class", "instance", "material", "semantic"):
+        for name in ("class", "instance", "material", "semantic", "moving"):
             if name in out.dtype.names:
                 out[name][cand] = 0
         out["cos_incidence"][cand] = 0.0
