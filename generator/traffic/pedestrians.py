@@ -99,11 +99,14 @@ def simulate_pedestrians(spec: SceneSpec, grid: Grid, scene, signals, lib: Libra
     body = wc.body_of(walking + standing, MARGIN_M)
     obstacles = obstacles_of(grid, scene, body)
     ww = build_walkways(grid, obstacles, body)
+    t1 = time.perf_counter()
     cls = lib.main_class("person")
     movers = _walkers(spec, ww, body, signals, walking, n_walk, n_steps, dt, cls) if n_walk and ww.paths else []
+    t2 = time.perf_counter()
     movers += _standers(spec, grid, ww, body, obstacles, standing, n_stand, n_steps, dt, cls)
-    log.info("pedestrians: %d walking, %d standing, %d steps (%.2f s)", sum(m.attrs["role"] == "walking" for m in movers),
-             sum(m.attrs["role"] == "standing" for m in movers), n_steps, time.perf_counter() - t0)
+    log.info("pedestrians: %d walking, %d standing, %d steps (network %.2f s, walking %.2f s, standing %.2f s)",
+             sum(m.attrs["role"] == "walking" for m in movers), sum(m.attrs["role"] == "standing" for m in movers),
+             n_steps, t1 - t0, t2 - t1, time.perf_counter() - t2)
     return movers
 
 
@@ -133,8 +136,10 @@ def _walkers(spec, ww: Walkways, body: wc.Body, signals, protos, n: int, n_steps
         drawn.append((proto, color))
     if not edges:
         return []
+    t0 = time.perf_counter()
     pos, yaw = ws.simulate(net, signals, np.array(edges), np.array(ss), np.array(pace), np.array(decide),
                            n_warm, n_steps, dt)
+    log.debug("%d walkers, %d + %d steps: %.2f s", len(edges), n_warm, n_steps, time.perf_counter() - t0)
     return [Mover("person", cls, proto, Track(0.0, dt, pos[k], yaw[k]), {"color": color, "role": "walking"})
             for k, (proto, color) in enumerate(drawn)]
 

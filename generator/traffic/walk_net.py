@@ -3,8 +3,7 @@
 Edges are sampled uniformly (:class:`~generator.traffic.walkways.Walkways`), so the sample
 under any arc length is found without a search. Per sample the network also carries the
 squared speed from which a walker can still slow down (at :data:`B_MAX`) for every turn ahead
-on the same edge without exceeding :data:`A_LAT` sideways; per edge, the edges beginning
-within :data:`FOLLOW_M` after its end (where leaders are looked for).
+on the same edge without exceeding :data:`A_LAT` sideways.
 """
 
 from __future__ import annotations
@@ -45,13 +44,6 @@ class Net:
         for e, s in enumerate(ww.succ):
             self.succ[e, :len(s)] = s
         self.nsucc = np.array([len(s) for s in ww.succ])
-        near = wz.reach(ww.succ, self.length, FOLLOW_M)
-        width = max([len(r) for r in near] + [1])
-        self.reach_e = np.full((self.E, width), self.E, np.int64)
-        self.reach_d = np.full((self.E, width), np.inf)
-        for e, r in enumerate(near):
-            self.reach_e[e, :len(r)] = list(r)
-            self.reach_d[e, :len(r)] = list(r.values())
         self.nodes = sorted({n for n in ww.node if n is not None})
         self.cw = np.array([self.nodes.index(n) if n is not None else -1 for n in ww.node] + [-1])
         self.stop = np.r_[np.nan_to_num(ww.stop_s, nan=np.inf), np.inf]

@@ -2,18 +2,18 @@
 
 Per walker: edge ``e``, arc length ``s`` of its centre, speed ``v``, heading ``yaw`` and the
 next :data:`K_ROUTE` edges of its route (drawn when a branch comes into view). Every step
-each walker finds the nearest point it must be able to stop before -- a walker ahead on any
-branch within ``FOLLOW_M`` (minus the follow gap), the entry of a conflict interval it
+each walker finds the nearest point it must be able to stop before -- a walker ahead on its
+route within ``FOLLOW_M`` (minus the follow gap), the entry of a conflict interval it
 has not been granted (:mod:`generator.traffic.walk_zones`), the curb before a crosswalk it
 has not committed to -- and takes the largest speed from which it can still stop there
 braking at ``B_MAX``, also slow enough for the turns ahead (lateral acceleration
 ``A_LAT``) and changing by at most ``A_MAX dt`` / ``B_MAX dt`` (:mod:`generator.traffic.walk_net`).
 
-Conflict clusters are entered with a whole movement granted at once; walkers crossing a
-street reserve the cluster at the far curb, so people on the pavement let them off the
-road. A walker commits to a crosswalk (and steps off the curb) only when
-``signals.may_cross`` gives the walk phase time for the whole crossing at its pace; on the
-road it hurries (up to :data:`HURRY` times its pace) if it falls behind.
+Conflict clusters are entered with a whole movement granted at once. A walker commits to a
+crosswalk (and steps off the curb) only when ``signals.may_cross`` gives the walk phase time
+for the whole crossing at :data:`PLAN` times its pace (behind whoever crosses ahead of it) and
+every cluster up to just past the far curb is granted to it at once, so nobody ever waits on
+the road; there it hurries (up to :data:`HURRY` times its pace) if it falls behind.
 """
 
 from __future__ import annotations
@@ -23,14 +23,15 @@ import logging
 import numpy as np
 
 from generator.traffic import walk_zones as wz
-from generator.traffic.walk_net import A_MAX, B_MAX, YAW_RATE, Net
+from generator.traffic.walk_net import A_MAX, B_MAX, FOLLOW_M, YAW_RATE, Net
 
 log = logging.getLogger(__name__)
 
-HURRY = 1.5        #: a walker on the road speeds up to this many times its pace if the walk phase runs out
+HURRY = 1.6        #: a walker on the road speeds up to this many times its pace if the walk phase runs out
+PLAN = 1.25        #: a walker steps off the curb if it can cross at this many times its pace
+MARGIN_S = 1.0     #: ... with this many seconds to spare (the turn past the far curb, the queue ahead)
 K_ROUTE = 12       #: edges of route known ahead
 COMMIT_M = 6.0     #: a walker decides about the signal within this distance of the curb, metres
-RESERVE_S = 4.0    #: a walker crossing a street claims the corner ahead this many seconds before it gets there
 
 
 def simulate(net: Net, signals, e, s, vdes, decide, n_warm: int, n_steps: int, dt: float):
@@ -73,7 +74,9 @@ class _Walk:
         self.route = np.zeros((n, K_ROUTE), np.int64)
         for k in range(K_ROUTE):
             self.route[:, k] = self._choose(self.route[:, k - 1] if k else self.e, self.ar)
-        self.commit = np.full(n, -1, np.int64)
+        self.commit = np.full(n, -1, np.int64)      # crosswalk edge a walker has committed to
+        self.promise = np.zeros(n)                   # ... and when it will be off the road by then, s
+        self.waited = np.zeros(n)                    # seconds standing since it last walked
         self.held = np.zeros((n, net.n_iv + 1), bool)
         self.occ = np.zeros(net.n_iv + 1, np.int64)
         self.grants: list[list[tuple[int, float, int]]] = [[] for _ in range(n)]
@@ -98,15 +101,17 @@ class _Walk:
         return xyz, yaw
 
     # -- what lies ahead -----------------------------------------------------------------
-    def _ahead(self):
+    def _ahead(self) -> np.ndarray:
+        """(N, K_ROUTE) route distance from each walker to the start of each edge of its route, metres."""
         net, e, s = self.net, self.e, self.s
         rem = net.length[e] - s
         dist = np.empty((self.N, K_ROUTE))          # route distance to the start of route[:, k]
         dist[:, 0] = rem
         dist[:, 1:] = rem[:, None] + np.cumsum(net.length[self.route[:, :-1]], 1)
-        return rem, dist
+        return dist
 
-    def _leaders(self, rem):
+    def _leaders(self, dist):
+        """Route distance to the nearest walker ahead on each walker's own route (centre to centre), and who."""
         net, e, s = self.net, self.e, self.s
         order = np.lexsort((s, e))
         es, ss = e[order], s[order]
@@ -114,14 +119,13 @@ class _Walk:
         same = es[1:] == es[:-1]
         d[order[:-1][same]], who[order[:-1][same]] = (ss[1:] - ss[:-1])[same], order[1:][same]
         head = np.r_[True, ~same]
-        first_s, first_w = np.full(net.E + 1, np.inf), np.full(net.E + 1, -1)
+        first_s, first_w = np.full(net.E, np.inf), np.full(net.E, -1)
         first_s[es[head]], first_w[es[head]] = ss[head], order[head]
-        re = net.reach_e[e]
-        cand = rem[:, None] + net.reach_d[e] + first_s[re]
+        cand = np.where(dist < FOLLOW_M, dist + first_s[self.route], np.inf)
         k = cand.argmin(1)
         dd = cand[self.ar, k]
         better = dd < d
-        d[better], who[better] = dd[better], first_w[re[self.ar, k]][better]
+        d[better], who[better] = dd[better], first_w[self.route[self.ar, k]][better]
         return d, who
 
     def _zone(self, dist, who=None):
@@ -152,11 +156,11 @@ class _Walk:
     # -- one step --------------------------------------------------------------------------
     def _step(self, t: float, dt: float) -> None:
         net = self.net
-        rem, dist = self._ahead()
-        d_lead, lead = self._leaders(rem)
+        dist = self._ahead()
+        d_lead, lead = self._leaders(dist)
         d_zone, z_iv = self._zone(dist)
         d_curb, cw = self._curb(dist)
-        self._commit(t, d_lead, lead, d_zone, d_curb, cw)
+        self._commit(t, dist, d_lead, lead, d_zone, d_curb, cw)
         d_curb, _ = self._curb(dist)
         granted = self._grant(t, dt, dist, d_lead, lead, d_zone, z_iv, d_curb, cw)
         if len(granted):
@@ -165,52 +169,106 @@ class _Walk:
         v_safe = -B_MAX * dt + np.sqrt((B_MAX * dt) ** 2 + 2 * B_MAX * np.maximum(d_stop, 0.0))
         i, f = net.lookup(self.e, self.s)
         turn2 = np.minimum(net.env[i], (net.env0[self.route] + 2 * B_MAX * np.maximum(dist - self.v[:, None] * dt, 0)).min(1))
-        target = np.minimum(self._pace(t), np.sqrt(np.maximum(turn2, 0.0)))
+        target = np.minimum(self._pace(t, dist), np.sqrt(np.maximum(turn2, 0.0)))
         lo = np.maximum(self.v - B_MAX * dt, 0.0)
         v = np.minimum(np.clip(target, lo, self.v + A_MAX * dt), v_safe)
         if (v < lo - 1e-9).any():
             log.debug("%d walkers braked harder than %.1f m/s^2 at t=%.2f", int((v < lo - 1e-9).sum()), B_MAX, t)
         self.v = v
+        self.waited = np.where(v < 0.1, self.waited + dt, 0.0)
         self.s = self.s + v * dt
         self._advance()
         i, f = net.lookup(self.e, self.s)
         h = net.head[i] * (1 - f) + net.head[i + 1] * f
         self.yaw = self.yaw + np.clip(np.angle(np.exp(1j * (h - self.yaw))), -YAW_RATE * dt, YAW_RATE * dt)
 
-    def _pace(self, t: float) -> np.ndarray:
-        """Desired speed: the walker's pace, more on the road when the walk phase runs short."""
+    def _pace(self, t: float, dist) -> np.ndarray:
+        """Desired speed: the walker's pace; on a crossing at least the pace that gets everyone
+        committed behind it there off the road before the walk phase ends (a platoon moves together)."""
         net, pace = self.net, self.vdes.copy()
-        crossing = np.flatnonzero((self.commit == self.e) & (self.s <= net.road1[self.e] + 0.2))
-        for k in crossing:
-            left = self.sig.walk_left(net.nodes[net.cw[self.e[k]]], t) - 0.3
-            need = (net.road1[self.e[k]] + 0.2 - self.s[k]) / max(left, 0.05)
-            pace[k] = min(max(pace[k], need), HURRY * self.vdes[k])
+        who = np.flatnonzero(self.commit >= 0)
+        if not len(who):
+            return pace
+        cw = self.commit[who]
+        on = self.route[who] == cw[:, None]
+        pos = np.where(self.e[who] == cw, self.s[who], -dist[who, on.argmax(1)])   # along the crosswalk edge
+        keep = pos <= net.road1[cw] + 0.2
+        who, cw, pos = who[keep], cw[keep], pos[keep]
+        if not len(who):
+            return pace
+        left = np.array([self.sig.walk_left(net.nodes[net.cw[c]], t) for c in cw]) - 0.3
+        need = (net.road1[cw] + 0.2 - pos) / np.maximum(left, 0.05)
+        order = np.lexsort((pos, cw))                       # per crossing, from the back to the front
+        _, group = np.unique(cw[order], return_inverse=True)
+        big = need.max() + 1.0
+        behind = np.maximum.accumulate(need[order] + group * big) - group * big
+        k = who[order]
+        pace[k] = np.minimum(np.maximum(pace[k], behind), HURRY * self.vdes[k])
         return pace
 
-    def _commit(self, t, d_lead, lead, d_zone, d_curb, cw) -> None:
+    def _commit(self, t, dist, d_lead, lead, d_zone, d_curb, cw) -> None:
         """Commit to the crosswalk ahead when the walk phase leaves time for the whole crossing."""
-        ok = (d_curb < COMMIT_M) & (d_zone > d_curb)
-        ok &= (d_lead > d_curb) | (self.commit[np.maximum(lead, 0)] == cw)
-        for k in np.flatnonzero(ok):
-            self._try_commit(k, t, d_curb[k], cw[k])
+        ok = np.flatnonzero((d_curb < COMMIT_M) & (d_zone > d_curb))
+        for k in ok[np.argsort(-self.waited[ok], kind="stable")]:      # longest waiting first
+            self._try_commit(k, t, dist, d_curb[k], cw[k], lead[k], d_lead[k])
 
-    def _try_commit(self, k: int, t: float, d_curb: float, cw: int) -> bool:
+    def _crossing_time(self, k: int, d: float, pace: float) -> float:
+        """Seconds for walker ``k`` to walk ``d`` metres at ``pace`` from its speed now (plus a margin)."""
+        return d / pace + max(pace - self.v[k], 0.0) ** 2 / (2 * A_MAX * pace) + MARGIN_S
+
+    def _try_commit(self, k: int, t: float, dist, d_curb: float, cw: int, lead: int, d_lead: float,
+                    skip: int = -1) -> bool:
+        """Commit walker ``k`` to crosswalk edge ``cw`` (its curb ``d_curb`` metres ahead) if whoever is
+        ahead of it before the curb has committed there too, the walk phase leaves time to cross --
+        after the one ahead has (its promise) -- and every cluster from the curb to just past the far
+        curb (but ``skip``) can be granted now: so nobody ever waits on the road."""
         net = self.net
+        if lead >= 0 and d_lead <= d_curb and self.commit[lead] != cw:
+            return False
         far = d_curb + net.road1[cw] + 0.2 - net.stop[cw]
-        need = far / self.vdes[k] + max(self.vdes[k] - self.v[k], 0.0) / A_MAX + 1.0
-        if self.sig.may_cross(net.nodes[net.cw[cw]], t, need):
-            self.commit[k] = cw
-            return True
-        return False
+        pace = PLAN * self.vdes[k]            # a little brisker than usual; on the road it may hurry more
+        need = self._crossing_time(k, far, pace)
+        if lead >= 0 and self.commit[lead] == cw:      # it cannot leave the road before the one ahead
+            headway = (net.gap + pace ** 2 / (2 * B_MAX)) / pace
+            need = max(need, self.promise[lead] - t + headway)
+        if not self.sig.may_cross(net.nodes[net.cw[cw]], t, need):
+            return False
+        moves, seen = [], {skip}
+        for m, edge in enumerate([self.e[k], *self.route[k]]):
+            start = -self.s[k] if m == 0 else dist[k, m - 1]
+            for j in net.z.by_edge[edge]:
+                entry, z = start + net.iv_s0[j], net.iv_cl[j]
+                if j < net.n_iv and d_curb < entry < far + 2 * net.gap + 1.0 and z not in seen and not self.held[k, j]:
+                    seen.add(z)
+                    moves.append(self._pass(k, j))
+        if any((self.occ[clash] > self.held[k, clash]).any() for _, _, clash in moves):
+            return False
+        for move in moves:
+            self._take(k, move)
+        self.commit[k], self.promise[k] = cw, t + need
+        return True
 
-    def _movement(self, k: int, iv: int) -> tuple[list[tuple[int, int]], np.ndarray, np.ndarray]:
+    def _take(self, k: int, move) -> None:
+        """Grant walker ``k`` the intervals of ``move`` (see :meth:`_pass`)."""
+        hops, ivs, _ = move
+        self.held[k, ivs] = True
+        self.occ[ivs] += 1
+        self.grants[k] = sorted(self.grants[k] + [(h, float(self.net.iv_s1[j]), int(j)) for h, j in hops])
+        if k not in self.holding:
+            self.holding.append(k)
+
+    def _movement(self, k: int, iv: int):
+        """:meth:`_pass` through ``iv``'s cluster, remembered while walker ``k`` waits for it."""
+        key = (int(self.hop[k]), int(iv))
+        if self.moves.get(k, (None,))[0] != key:
+            self.moves[k] = (key, self._pass(k, iv))
+        return self.moves[k][1]
+
+    def _pass(self, k: int, iv: int) -> tuple[list[tuple[int, int]], np.ndarray, np.ndarray]:
         """Walker ``k``'s next pass through ``iv``'s cluster: ``(hop, interval)`` pairs in route order
         (contiguous: gaps under :data:`~generator.traffic.walk_zones.ADJACENT_M`), the (m,) intervals
         and the (c,) intervals in conflict with them."""
         net = self.net
-        key = (int(self.hop[k]), int(iv))
-        if self.moves.get(k, (None,))[0] == key:
-            return self.moves[k][1]
         z, hop = net.iv_cl[iv], int(self.hop[k])
         out, start, end = [], -self.s[k], -np.inf       # start: route distance to the start of the edge
         for m, edge in enumerate([self.e[k], *self.route[k]]):
@@ -225,9 +283,7 @@ class _Walk:
                 end = start + net.iv_s1[j]
             start += net.length[edge]
         ivs = np.array([j for _, j in out], np.int64)
-        found = (out, ivs, np.concatenate([net.z.conflicts[j] for j in ivs]))
-        self.moves[k] = (key, found)
-        return found
+        return out, ivs, np.concatenate([net.z.conflicts[j] for j in ivs])
 
     def _exit(self, k: int, move, dist) -> float:
         """Route distance from walker ``k`` to the end of its movement, metres."""
@@ -235,38 +291,27 @@ class _Walk:
         back = h - self.hop[k]
         return float(self.net.iv_s1[j] - self.s[k] if back == 0 else dist[k, back - 1] + self.net.iv_s1[j])
 
-    def _grant(self, t, dt, dist, d_lead, lead, d_zone, z_iv, d_curb, cw) -> None:
+    def _grant(self, t, dt, dist, d_lead, lead, d_zone, z_iv, d_curb, cw) -> np.ndarray:
+        """Grant the clusters walkers are about to enter, nearest first; returns who got one."""
         net = self.net
         reach = self.v ** 2 / (2 * B_MAX) + 2 * self.v * dt + 0.5
-        on_road = (self.commit == self.e) & (self.commit >= 0) & (d_zone < reach + RESERVE_S * self.vdes)
-        want = np.isfinite(d_zone) & ((d_zone < reach) | on_road)
-        granted: list[int] = []
-        if not want.any():
-            return np.array(granted, np.int64)
-        reserved = np.zeros(net.n_iv + 1, bool)
-        for k in np.flatnonzero(want & on_road):
-            reserved[self._movement(k, z_iv[k])[1]] = True
-        order = np.flatnonzero(want)[np.lexsort((d_zone[want], ~on_road[want]))]
-        for k in order:
-            move, ivs, clash = self._movement(k, z_iv[k])
+        want = np.flatnonzero(np.isfinite(d_zone) & (d_zone < reach))
+        granted = []
+        for k in want[np.lexsort((d_zone[want], -self.waited[want]))]:     # longest waiting, then nearest
+            move = self._movement(k, z_iv[k])
+            hops, _, clash = move
             if (self.occ[clash] > self.held[k, clash]).any():
                 continue
-            if not on_road[k]:
-                if d_zone[k] >= reach[k] or reserved[clash].any():
-                    continue
-                end = self._exit(k, move, dist)
-                if d_curb[k] < end and not self._try_commit(k, t, d_curb[k], cw[k]):
-                    continue           # it would wait for the signal inside the cluster
-                m = lead[k]
-                if m >= 0 and d_lead[k] - net.gap < end and (self.v[m] < 0.2 or (
-                        cw[m] == cw[k] >= 0 and self.commit[m] != cw[k] and d_curb[k] - net.gap < end)):
-                    continue           # it would stand in the cluster behind someone standing or queueing
-            self.held[k, ivs] = True
-            self.occ[ivs] += 1
-            self.grants[k] += [(h, float(net.iv_s1[j]), j) for h, j in move]
+            end = self._exit(k, hops, dist)
+            m = lead[k]
+            if m >= 0 and d_lead[k] - net.gap < end and (self.v[m] < 0.2 or (
+                    cw[m] == cw[k] >= 0 and self.commit[m] != cw[k] and d_curb[k] - net.gap < end)):
+                continue               # it would stand in the cluster behind someone standing or queueing
+            if d_curb[k] < end and not self._try_commit(k, t, dist, d_curb[k], cw[k], m, d_lead[k],
+                                                         net.iv_cl[z_iv[k]]):
+                continue               # it would wait for the signal inside the cluster
+            self._take(k, move)
             granted.append(k)
-            if k not in self.holding:
-                self.holding.append(k)
         return np.array(granted, np.int64)
 
     def _advance(self) -> None:

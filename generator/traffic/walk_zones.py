@@ -1,8 +1,9 @@
 """Where walkers on the walk network could touch, and who follows whom.
 
 Two walkers on the same route ahead of each other are kept apart by following (a gap of
-``gap`` metres of route between their centres, :func:`follow_gap`). Everywhere else two
-walkers can only touch inside *conflict intervals*: stretches ``[s0, s1]`` of an edge
+``gap`` metres of route between their centres, :func:`follow_gap`): that covers every pair of
+places joined by a stretch without branches (:func:`reach`). Everywhere else two walkers can
+only touch inside *conflict intervals*: stretches ``[s0, s1]`` of an edge
 (arc length of the centre, metres) whose footprints overlap footprints on a stretch of
 another edge -- where lines cross, merge, split or (round an obstacle) share the pavement.
 Intervals closer than :data:`ADJACENT_M` along a route, or in conflict, form one *cluster*;
@@ -48,17 +49,18 @@ class Zones:
 
 
 def reach(succ: list[tuple[int, ...]], length: np.ndarray, limit: float) -> list[dict[int, float]]:
-    """Per edge: every edge starting less than ``limit`` metres after its end -> that distance (shortest)."""
+    """Per edge: the edges that *must* follow it (no branch between) starting less than ``limit``
+    metres after its end -> that distance. A walker on an edge always has these on its route."""
     out = []
     for e in range(len(succ)):
         best: dict[int, float] = {}
-        stack = [(k, 0.0) for k in succ[e]]
-        while stack:
-            k, d = stack.pop()
-            if d >= limit or k == e or best.get(k, np.inf) <= d:
-                continue
+        k, d = e, 0.0
+        while len(succ[k]) == 1 and d < limit:
+            k = succ[k][0]
+            if k == e or k in best:
+                break
             best[k] = d
-            stack.extend((m, d + length[k]) for m in succ[k])
+            d += length[k]
         out.append(best)
     return out
 
@@ -84,7 +86,7 @@ def conflict_zones(paths, succ: list[tuple[int, ...]], near: list[dict[int, floa
     """The conflict intervals and clusters of the network ``paths`` / ``succ``.
 
     ``near`` is :func:`reach` with a limit of at least ``gap``: pairs of samples less than
-    ``gap`` of route apart (either way) are left to following.
+    ``gap`` of branch-free route apart (either way) are left to following.
     """
     length = np.array([p.s[-1] for p in paths])
     e_of, s_of, xy, yaw = [], [], [], []
