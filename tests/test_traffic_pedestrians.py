@@ -16,11 +16,20 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-from generator.layout.placement_core import WHOLE_BOX_KINDS, Library, collision_boxes, world_boxes
+from generator.layout.placement_core import (
+    WHOLE_BOX_KINDS,
+    Library,
+    collision_boxes,
+    world_boxes,
+)
 from generator.layout.streets import CROSSWALK_U, make_grid
 from generator.traffic import walk_net
 from generator.traffic.movers import DT_S
-from generator.traffic.pedestrians import max_speed, sidewalk_length, simulate_pedestrians
+from generator.traffic.pedestrians import (
+    max_speed,
+    sidewalk_length,
+    simulate_pedestrians,
+)
 from generator.traffic.signals import CYCLE_S, WALK_S, Signals
 
 N_STEPS = int(CYCLE_S / DT_S)          # one whole signal cycle: every node has a walk phase

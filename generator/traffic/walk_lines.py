@@ -24,6 +24,8 @@ from generator.layout.streets import CROSSWALK_U, Grid
 from generator.traffic.walk_clear import Body
 
 R_TURN = 1.0        #: radius of every turn, metres
+FURNITURE_M = 0.2   #: half width of a pole or trunk on the kerb-side line of a sidewalk
+LOT_EDGE_M = 0.15   #: hedges and fences at the edge of a lot may reach this far onto the sidewalk
 KERB, LOT = 0, 1    #: line families
 
 
@@ -57,19 +59,23 @@ class Line:
 def lane_offsets(grid: Grid, body: Body) -> tuple[float, ...]:
     """Offsets of the kerb and lot lines from the street centre line, metres.
 
-    Both stay inside the crosswalk band and on the sidewalk; the kerb line leaves room
-    between itself and the curb for a walker waiting for the signal; the lot line is
-    ``2 hy + 0.3`` farther out. A sidewalk too narrow for two lines gets one (kerb), one too
-    narrow for any gets none.
+    Both stay inside the crosswalk band, beside the poles and trunks on the sidewalk's
+    kerb-side line and clear of the hedges and fences at the lot edge; the kerb line leaves
+    room between itself and the curb for a walker waiting for the signal where it can; the lot
+    line is ``2 hy + 0.3`` farther out. A sidewalk too narrow for two lines gets one (kerb: the
+    sidewalks become one-way), one too narrow for any gets none.
     """
-    rh, wi, ch = grid.road_half, grid.walk_inner, grid.corridor_half
-    lo = max(rh + CROSSWALK_U[0] + body.hy, wi + body.hy + 0.1)
-    hi = min(rh + CROSSWALK_U[1] - body.hy, ch - body.hy - 0.15)
-    wait = wi + 2 * body.hx + 0.05 + body.hy + 0.35
-    sep = 2 * body.hy + 0.3
+    rh, wi, ch, hy = grid.road_half, grid.walk_inner, grid.corridor_half, body.hy
+    furniture = wi + min(0.5, grid.sidewalk_w / 2) + FURNITURE_M        # poles and trunks stand on this side
+    lo = max(rh + CROSSWALK_U[0] + hy, furniture + hy + 0.02)
+    hi = min(rh + CROSSWALK_U[1] - hy, ch - LOT_EDGE_M - hy - 0.02)
+    wait = wi + 2 * body.hx + 0.05 + hy + 0.35
+    sep = 2 * hy + 0.3
     if hi - lo >= sep:
         a = min(max(lo, wait), hi - sep)
         return (a, min(hi, a + sep + 0.2))
+    if hi < lo:                  # no room beside the furniture: in between it, round it
+        lo = max(rh + CROSSWALK_U[0] + hy, wi + hy + 0.05)
     return ((lo + hi) / 2,) if hi >= lo else ()
 
 

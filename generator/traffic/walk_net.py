@@ -48,6 +48,7 @@ class Net:
         self.cw = np.array([self.nodes.index(n) if n is not None else -1 for n in ww.node] + [-1])
         self.stop = np.r_[np.nan_to_num(ww.stop_s, nan=np.inf), np.inf]
         self.road1 = np.nan_to_num(ww.road_s[:, 1], nan=-np.inf)
+        self.cross_len = np.nan_to_num(ww.road_s[:, 1] - ww.stop_s, nan=0.0)      # curb stop to off the road
         self.gap = gap
         self.z = zones
         self.n_iv = len(zones.edge)

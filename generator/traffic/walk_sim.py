@@ -23,6 +23,7 @@ import logging
 import numpy as np
 
 from generator.traffic import walk_zones as wz
+from generator.traffic.signals import CYCLE_S, WALK_S
 from generator.traffic.walk_net import A_MAX, B_MAX, FOLLOW_M, YAW_RATE, Net
 
 log = logging.getLogger(__name__)
@@ -30,6 +31,7 @@ log = logging.getLogger(__name__)
 HURRY = 1.6        #: a walker on the road speeds up to this many times its pace if the walk phase runs out
 PLAN = 1.25        #: a walker steps off the curb if it can cross at this many times its pace
 MARGIN_S = 1.0     #: ... with this many seconds to spare (the turn past the far curb, the queue ahead)
+RED_WEIGHT = 0.25  #: a crossing that will be red on arrival is chosen this many times as often as another way
 K_ROUTE = 12       #: edges of route known ahead
 COMMIT_M = 6.0     #: a walker decides about the signal within this distance of the curb, metres
 
@@ -59,11 +61,11 @@ def simulate(net: Net, signals, e, s, vdes, decide, n_warm: int, n_steps: int, d
     yaw : (N, n_steps) float64
         Headings, radians, unwrapped.
     """
-    return _Walk(net, signals, e, s, vdes, decide).run(n_warm, n_steps, dt)
+    return _Walk(net, signals, e, s, vdes, decide, -n_warm * dt).run(n_warm, n_steps, dt)
 
 
 class _Walk:
-    def __init__(self, net: Net, signals, e, s, vdes, decide):
+    def __init__(self, net: Net, signals, e, s, vdes, decide, t0: float):
         self.net, self.sig = net, signals
         n = len(e)
         self.N, self.ar = n, np.arange(n)
@@ -72,8 +74,10 @@ class _Walk:
         self.decide, self.dptr = decide, np.zeros(n, np.int64)
         self.hop = np.zeros(n, np.int64)
         self.route = np.zeros((n, K_ROUTE), np.int64)
+        ahead = net.length[self.e] - self.s                  # route distance to the end of the last edge chosen
         for k in range(K_ROUTE):
-            self.route[:, k] = self._choose(self.route[:, k - 1] if k else self.e, self.ar)
+            self.route[:, k] = self._choose(self.route[:, k - 1] if k else self.e, self.ar, t0, ahead / self.vdes)
+            ahead = ahead + net.length[self.route[:, k]]
         self.commit = np.full(n, -1, np.int64)      # crosswalk edge a walker has committed to
         self.promise = np.zeros(n)                   # ... and when it will be off the road by then, s
         self.waited = np.zeros(n)                    # seconds standing since it last walked
@@ -85,10 +89,26 @@ class _Walk:
         i, f = net.lookup(self.e, self.s)
         self.yaw = net.head[i] * (1 - f) + net.head[i + 1] * f
 
-    def _choose(self, prev: np.ndarray, who: np.ndarray) -> np.ndarray:
+    def _choose(self, prev: np.ndarray, who: np.ndarray, t: float, eta: np.ndarray) -> np.ndarray:
+        """Next edge after ``prev`` for walkers ``who`` (reaching its end in ``eta`` seconds from ``t``):
+        at random over the successors, a crossing whose signal will not let the walker across when
+        it gets there :data:`RED_WEIGHT` times as likely as another way; crossings a walker could not
+        make within a walk phase even hurrying are left out."""
+        net = self.net
         u = self.decide[who, np.minimum(self.dptr[who], self.decide.shape[1] - 1)]
         self.dptr[who] += 1
-        return self.net.succ[prev, (u * self.net.nsucc[prev]).astype(np.int64)]
+        succ = net.succ[prev]                                              # (n, S), -1 padded
+        length = np.where(succ >= 0, net.cross_len[succ], np.inf)
+        ok = (succ >= 0) & (length / (0.9 * HURRY * self.vdes[who, None]) + MARGIN_S < WALK_S - 1.0)
+        ok = np.where(ok.any(1, keepdims=True), ok, succ >= 0)
+        weight = ok.astype(np.float64)
+        for r, c in zip(*np.nonzero(ok & (net.cw[np.maximum(succ, 0)] >= 0) & (net.nsucc[prev] > 1)[:, None])):
+            need = length[r, c] / (PLAN * self.vdes[who[r]]) + MARGIN_S
+            if not self.sig.may_cross(net.nodes[net.cw[succ[r, c]]], t + eta[r], need):
+                weight[r, c] = RED_WEIGHT
+        cum = np.cumsum(weight, 1)
+        col = (cum > (u * cum[:, -1])[:, None]).argmax(1)
+        return succ[np.arange(len(who)), col]
 
     def run(self, n_warm: int, n_steps: int, dt: float):
         xyz, yaw = np.zeros((self.N, n_steps, 3)), np.zeros((self.N, n_steps))
@@ -160,11 +180,10 @@ class _Walk:
         d_lead, lead = self._leaders(dist)
         d_zone, z_iv = self._zone(dist)
         d_curb, cw = self._curb(dist)
-        self._commit(t, dist, d_lead, lead, d_zone, d_curb, cw)
-        d_curb, _ = self._curb(dist)
-        granted = self._grant(t, dt, dist, d_lead, lead, d_zone, z_iv, d_curb, cw)
+        granted = self._decide(t, dt, dist, d_lead, lead, d_zone, z_iv, d_curb, cw)
         if len(granted):
             d_zone[granted] = self._zone(dist, granted)[0]
+        d_curb, _ = self._curb(dist)
         d_stop = np.minimum.reduce([d_lead - net.gap, d_zone - 0.01, d_curb])
         v_safe = -B_MAX * dt + np.sqrt((B_MAX * dt) ** 2 + 2 * B_MAX * np.maximum(d_stop, 0.0))
         i, f = net.lookup(self.e, self.s)
@@ -177,7 +196,7 @@ class _Walk:
         self.v = v
         self.waited = np.where(v < 0.1, self.waited + dt, 0.0)
         self.s = self.s + v * dt
-        self._advance()
+        self._advance(t)
         i, f = net.lookup(self.e, self.s)
         h = net.head[i] * (1 - f) + net.head[i + 1] * f
         self.yaw = self.yaw + np.clip(np.angle(np.exp(1j * (h - self.yaw))), -YAW_RATE * dt, YAW_RATE * dt)
@@ -206,41 +225,38 @@ class _Walk:
         pace[k] = np.minimum(np.maximum(pace[k], behind), HURRY * self.vdes[k])
         return pace
 
-    def _commit(self, t, dist, d_lead, lead, d_zone, d_curb, cw) -> None:
-        """Commit to the crosswalk ahead when the walk phase leaves time for the whole crossing."""
-        ok = np.flatnonzero((d_curb < COMMIT_M) & (d_zone > d_curb))
-        for k in ok[np.argsort(-self.waited[ok], kind="stable")]:      # longest waiting first
-            self._try_commit(k, t, dist, d_curb[k], cw[k], lead[k], d_lead[k])
-
     def _crossing_time(self, k: int, d: float, pace: float) -> float:
         """Seconds for walker ``k`` to walk ``d`` metres at ``pace`` from its speed now (plus a margin)."""
         return d / pace + max(pace - self.v[k], 0.0) ** 2 / (2 * A_MAX * pace) + MARGIN_S
 
     def _try_commit(self, k: int, t: float, dist, d_curb: float, cw: int, lead: int, d_lead: float,
-                    skip: int = -1) -> bool:
+                    skip=()) -> bool:
         """Commit walker ``k`` to crosswalk edge ``cw`` (its curb ``d_curb`` metres ahead) if whoever is
         ahead of it before the curb has committed there too, the walk phase leaves time to cross --
-        after the one ahead has (its promise) -- and every cluster from the curb to just past the far
-        curb (but ``skip``) can be granted now: so nobody ever waits on the road."""
+        after the one ahead has (its promise) -- and every pass through a cluster from the curb to just
+        past the far curb (but intervals ``skip``) can be granted now: so nobody ever waits on the road."""
         net = self.net
         if lead >= 0 and d_lead <= d_curb and self.commit[lead] != cw:
             return False
         far = d_curb + net.road1[cw] + 0.2 - net.stop[cw]
         pace = PLAN * self.vdes[k]            # a little brisker than usual; on the road it may hurry more
         need = self._crossing_time(k, far, pace)
+        if need > WALK_S - 1.0 or self.waited[k] > CYCLE_S - WALK_S:   # a wide street, or missed a phase
+            pace = 0.9 * HURRY * self.vdes[k]
+            need = self._crossing_time(k, far, pace)
         if lead >= 0 and self.commit[lead] == cw:      # it cannot leave the road before the one ahead
-            headway = (net.gap + pace ** 2 / (2 * B_MAX)) / pace
-            need = max(need, self.promise[lead] - t + headway)
+            v = min(pace, PLAN * self.vdes[lead])       # a platoon walks at its leader's pace
+            need = max(need, self.promise[lead] - t + (net.gap + v * v / (2 * B_MAX)) / v + 0.5)
         if not self.sig.may_cross(net.nodes[net.cw[cw]], t, need):
             return False
-        moves, seen = [], {skip}
+        moves, seen = [], set(skip)
         for m, edge in enumerate([self.e[k], *self.route[k]]):
             start = -self.s[k] if m == 0 else dist[k, m - 1]
             for j in net.z.by_edge[edge]:
-                entry, z = start + net.iv_s0[j], net.iv_cl[j]
-                if j < net.n_iv and d_curb < entry < far + 2 * net.gap + 1.0 and z not in seen and not self.held[k, j]:
-                    seen.add(z)
+                entry = start + net.iv_s0[j]
+                if j < net.n_iv and d_curb < entry < far + 2 * net.gap + 1.0 and j not in seen and not self.held[k, j]:
                     moves.append(self._pass(k, j))
+                    seen.update(moves[-1][1].tolist())
         if any((self.occ[clash] > self.held[k, clash]).any() for _, _, clash in moves):
             return False
         for move in moves:
@@ -249,8 +265,9 @@ class _Walk:
         return True
 
     def _take(self, k: int, move) -> None:
-        """Grant walker ``k`` the intervals of ``move`` (see :meth:`_pass`)."""
-        hops, ivs, _ = move
+        """Grant walker ``k`` the intervals of ``move`` (see :meth:`_pass`) it does not hold yet."""
+        hops = [(h, j) for h, j in move[0] if not self.held[k, j]]
+        ivs = np.array([j for _, j in hops], np.int64)
         self.held[k, ivs] = True
         self.occ[ivs] += 1
         self.grants[k] = sorted(self.grants[k] + [(h, float(self.net.iv_s1[j]), int(j)) for h, j in hops])
@@ -265,9 +282,10 @@ class _Walk:
         return self.moves[k][1]
 
     def _pass(self, k: int, iv: int) -> tuple[list[tuple[int, int]], np.ndarray, np.ndarray]:
-        """Walker ``k``'s next pass through ``iv``'s cluster: ``(hop, interval)`` pairs in route order
-        (contiguous: gaps under :data:`~generator.traffic.walk_zones.ADJACENT_M`), the (m,) intervals
-        and the (c,) intervals in conflict with them."""
+        """Walker ``k``'s pass through ``iv``'s cluster starting at interval ``iv`` (its next
+        occurrence on the route): ``(hop, interval)`` pairs in route order (contiguous: gaps under
+        :data:`~generator.traffic.walk_zones.ADJACENT_M`), the (m,) intervals and the (c,)
+        intervals in conflict with them."""
         net = self.net
         z, hop = net.iv_cl[iv], int(self.hop[k])
         out, start, end = [], -self.s[k], -np.inf       # start: route distance to the start of the edge
@@ -275,9 +293,12 @@ class _Walk:
             if out and start - end > wz.ADJACENT_M:
                 break
             for j in net.z.by_edge[edge]:
-                if net.iv_cl[j] != z or (m == 0 and net.iv_s1[j] <= self.s[k]):
+                if not out:
+                    if j != iv or (m == 0 and net.iv_s1[j] <= self.s[k]):
+                        continue                        # not yet at ``iv``
+                elif net.iv_cl[j] != z:
                     continue
-                if out and start + net.iv_s0[j] - end > wz.ADJACENT_M:
+                elif start + net.iv_s0[j] - end > wz.ADJACENT_M:
                     break
                 out.append((hop + m, int(j)))
                 end = start + net.iv_s1[j]
@@ -291,30 +312,42 @@ class _Walk:
         back = h - self.hop[k]
         return float(self.net.iv_s1[j] - self.s[k] if back == 0 else dist[k, back - 1] + self.net.iv_s1[j])
 
-    def _grant(self, t, dt, dist, d_lead, lead, d_zone, z_iv, d_curb, cw) -> np.ndarray:
-        """Grant the clusters walkers are about to enter, nearest first; returns who got one."""
-        net = self.net
+    def _decide(self, t, dt, dist, d_lead, lead, d_zone, z_iv, d_curb, cw) -> np.ndarray:
+        """Commit walkers to the crossings ahead and grant the clusters they are about to enter,
+        longest waiting first (then nearest); returns who got a cluster."""
         reach = self.v ** 2 / (2 * B_MAX) + 2 * self.v * dt + 0.5
-        want = np.flatnonzero(np.isfinite(d_zone) & (d_zone < reach))
+        cross = (d_curb < COMMIT_M) & (d_zone > d_curb)          # nothing to enter before the curb
+        enter = np.isfinite(d_zone) & (d_zone < reach)
+        want = np.flatnonzero(cross | enter)
         granted = []
-        for k in want[np.lexsort((d_zone[want], -self.waited[want]))]:     # longest waiting, then nearest
-            move = self._movement(k, z_iv[k])
-            hops, _, clash = move
-            if (self.occ[clash] > self.held[k, clash]).any():
+        for k in want[np.lexsort((d_zone[want], -self.waited[want]))]:
+            if cross[k] and not self._try_commit(k, t, dist, d_curb[k], cw[k], lead[k], d_lead[k]):
                 continue
-            end = self._exit(k, hops, dist)
-            m = lead[k]
-            if m >= 0 and d_lead[k] - net.gap < end and (self.v[m] < 0.2 or (
-                    cw[m] == cw[k] >= 0 and self.commit[m] != cw[k] and d_curb[k] - net.gap < end)):
-                continue               # it would stand in the cluster behind someone standing or queueing
-            if d_curb[k] < end and not self._try_commit(k, t, dist, d_curb[k], cw[k], m, d_lead[k],
-                                                         net.iv_cl[z_iv[k]]):
-                continue               # it would wait for the signal inside the cluster
-            self._take(k, move)
-            granted.append(k)
+            if enter[k] and self._enter(k, t, dist, d_lead[k], lead, d_curb, cw, z_iv[k]):
+                granted.append(k)
         return np.array(granted, np.int64)
 
-    def _advance(self) -> None:
+    def _enter(self, k: int, t: float, dist, d_lead: float, lead, d_curb, cw, iv: int) -> bool:
+        """Grant walker ``k`` its pass through the cluster of interval ``iv`` if no one holds a
+        conflicting interval, it will not stand inside behind someone standing or queueing, and --
+        when its curb is inside -- it can commit to the crossing at once."""
+        net = self.net
+        move = self._movement(k, iv)
+        hops, _, clash = move
+        if (self.occ[clash] > self.held[k, clash]).any():
+            return False
+        end = self._exit(k, hops, dist)
+        m = lead[k]
+        if m >= 0 and d_lead - net.gap < end and (self.v[m] < 0.2 or (
+                cw[m] == cw[k] >= 0 and self.commit[m] != cw[k] and d_curb[k] - net.gap < end)):
+            return False
+        if self.commit[k] != cw[k] and d_curb[k] < end and not self._try_commit(
+                k, t, dist, d_curb[k], cw[k], m, d_lead, move[1].tolist()):
+            return False
+        self._take(k, move)
+        return True
+
+    def _advance(self, t: float) -> None:
         """Move walkers past the ends of their edges onto the next route edge; release passed intervals."""
         net = self.net
         while True:
@@ -326,7 +359,8 @@ class _Walk:
             self.commit[over] = np.where(self.commit[over] == left, -1, self.commit[over])
             self.e[over] = self.route[over, 0]
             self.route[over, :-1] = self.route[over, 1:]
-            self.route[over, -1] = self._choose(self.route[over, -2], over)
+            ahead = net.length[self.e[over]] - self.s[over] + net.length[self.route[over, :-1]].sum(1)
+            self.route[over, -1] = self._choose(self.route[over, -2], over, t, ahead / self.vdes[over])
             self.hop[over] += 1
         for k in self.holding:
             g = self.grants[k]
