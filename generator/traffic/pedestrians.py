@@ -58,7 +58,7 @@ def sidewalk_length(grid: Grid) -> float:
 
 def max_speed(spec: SceneSpec) -> float:
     """The fastest a walker ever goes (its pace at most, hurrying across a street), m/s."""
-    return ws.HURRY * (1 + SPEED_JITTER) * spec.traffic.pedestrian_speed_mps
+    return wn.HURRY * (1 + SPEED_JITTER) * spec.traffic.pedestrian_speed_mps
 
 
 def simulate_pedestrians(spec: SceneSpec, grid: Grid, scene, signals, lib: Library, n_steps: int,

@@ -1,4 +1,4 @@
-"""The walk network as flat arrays for stepping walkers, and the limits every walker keeps.
+"""The walk network as flat arrays for stepping walkers, and the numbers every walker lives by.
 
 Edges are sampled uniformly (:class:`~generator.traffic.walkways.Walkways`), so the sample
 under any arc length is found without a search. Per sample the network also carries the
@@ -17,6 +17,11 @@ B_MAX = 1.5        #: slowing down, m/s^2
 A_LAT = 1.5        #: turning (lateral) acceleration, m/s^2
 YAW_RATE = 4.0     #: heading change, rad/s
 FOLLOW_M = 8.0     #: how far ahead leaders are looked for, metres
+HURRY = 1.6        #: a walker on the road speeds up to this many times its pace if the walk phase runs out
+PLAN = 1.25        #: a walker steps off the curb if it can cross at this many times its pace
+MARGIN_S = 1.0     #: ... with this many seconds to spare (the turn past the far curb, the queue ahead)
+COMMIT_M = 6.0     #: a walker decides about the signal within this distance of the curb, metres
+RED_WEIGHT = 0.25  #: a crossing that will be red on arrival is chosen this many times as often as another way
 
 
 class Net:
