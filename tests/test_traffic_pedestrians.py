@@ -23,14 +23,17 @@ from generator.layout.placement_core import (
     world_boxes,
 )
 from generator.layout.streets import CROSSWALK_U, make_grid
-from generator.traffic import walk_net
+from generator.traffic import walk_clear, walk_net
 from generator.traffic.movers import DT_S
 from generator.traffic.pedestrians import (
+    MARGIN_M,
     max_speed,
+    person_protos,
     sidewalk_length,
     simulate_pedestrians,
 )
 from generator.traffic.signals import CYCLE_S, WALK_S, Signals
+from generator.traffic.walkways import build_walkways, obstacles_of
 
 N_STEPS = int(CYCLE_S / DT_S)          # one whole signal cycle: every node has a walk phase
 GROUND = {"road", "road_marking", "crosswalk", "curb", "sidewalk", "parking", "terrain", "other_ground", "rail_track"}
@@ -259,3 +262,45 @@ def test_density_scales_the_counts(test_spec, test_scene):
     for d, (walk, stand) in counts.items():
         assert (walk, stand) == (round(d * length / 100), round(d / 2 * length / 100))
     assert counts[4.0][0] >= 2 * counts[2.0][0] - 1
+
+
+def test_walk_network_joins_smoothly_keeps_right_and_tags_crosswalks(town, test_scene):
+    spec, grid = town[0], town[1]
+    standing, walking = person_protos(Library(spec.seed), spec)
+    ww = build_walkways(grid, obstacles_of(grid, test_scene, walk_clear.body_of(walking + standing, MARGIN_M)),
+                        walk_clear.body_of(walking + standing, MARGIN_M))
+    assert len(ww.paths) > 50 and len(ww.offsets) == 2
+    kerb, lot = ww.offsets
+    crossings, checked = set(), {True: 0, False: 0}
+    for e, p in enumerate(ww.paths):
+        assert ww.succ[e], "an edge that leads nowhere"
+        for f in ww.succ[e]:                          # joined end to start, heading continuous
+            q = ww.paths[f]
+            assert np.linalg.norm(p.points[-1, :2] - q.points[0, :2]) < 1e-6
+            assert abs(np.angle(np.exp(1j * (p.headings[-1] - q.headings[0])))) < 0.05
+        xy = p.points[:, :2]
+        node = _crosswalk_node(grid, xy)
+        on_road = _street_distance(grid, xy) < grid.road_half
+        assert (node[on_road] >= 0).all(), "an edge crosses a road outside a crosswalk band"
+        if on_road.any():
+            assert set(node[on_road]) == {grid.nodes.index(ww.node[e])}
+            crossings.add(ww.node[e])
+        else:
+            assert ww.node[e] is None
+        # keep right: on a straight stretch of sidewalk at a nominal offset, the kerb line has the
+        # road on the walker's right and the lot line has it on the left
+        d = _street_distance(grid, xy)
+        dx, dy = np.cos(p.headings), np.sin(p.headings)
+        for centres, axis in ((grid.ys, 1), (grid.xs, 0)):
+            off = xy[:, axis, None] - centres[None]
+            k = np.abs(off).argmin(1)
+            v = off[np.arange(len(xy)), k]
+            along = np.abs(dx if axis == 1 else dy) > 0.999
+            for nominal, road_right in ((kerb, True), (lot, False)):
+                at = along & (np.abs(np.abs(v) - nominal) < 1e-6) & (d >= grid.walk_inner)
+                # the road lies across the centre line (towards -sign(v)); the walker's right is (dy, -dx)
+                right = np.sign(v) * (dx if axis == 1 else -dy) > 0
+                assert at.sum() == 0 or (right[at] == road_right).all()
+                checked[road_right] += int(at.sum())
+    assert min(checked.values()) > 1000               # both directions of many sidewalks were checked
+    assert len(crossings) == len(grid.nodes)          # every node's crosswalks are in the network
