@@ -31,7 +31,8 @@ from generator.traffic import walk_net as wn
 from generator.traffic import walk_sim as ws
 from generator.traffic import walk_zones as wz
 from generator.traffic.movers import DT_S, Mover
-from generator.traffic.walkways import R_TURN, Walkways, build_walkways, obstacles_of
+from generator.traffic.walk_lines import R_TURN
+from generator.traffic.walkways import Walkways, build_walkways, obstacles_of
 from generator.world.actors import Track
 
 log = logging.getLogger(__name__)
