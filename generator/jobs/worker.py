@@ -2,8 +2,10 @@
 
 The parent (pure Python, no bpy) starts workers with the ``spawn`` start method and
 hands each one a :class:`generator.jobs.executors.RenderJob`. The worker builds the
-SceneModel and the Blender renderer once (:class:`generator.blender.renderer.Renderer`,
-the only bpy it touches), asks the rig for each frame, renders its variants, writes
+SceneModel, the world in time and the Blender renderer once
+(:class:`generator.blender.renderer.Renderer`, the only bpy it touches), asks the rig for each
+frame, exposes it at the frame's time on the drive's timeline (actors where their tracks are,
+motion blur when the render config asks), renders its variants, writes
 each image's files atomically and reports progress on a queue:
 ``("ready", stats)``, ``("frame", index, {"images": {name: seconds}, "rss_mb": ...})``,
 ``("error", message)`` and ``("done", stats)`` (including the seconds spent inside
@@ -73,19 +75,21 @@ def _run(job, queue, scratch: Path) -> None:
     from generator.blender.renderer import Renderer  # imports bpy (after the sys.path clean-up)
     from generator.jobs.variants import render_frame
     from generator.layout import build_scene
+    from generator.world.actors import frozen_world
     from generator.world.rig import Rig
 
     spec, cfg = job.spec, job.config
     t = time.perf_counter()
     scene = build_scene(spec)
-    layout_s = time.perf_counter() - t
-    renderer = Renderer(scene, spec, cfg, scratch)
     rig = Rig.from_spec(spec, scene)
+    world = frozen_world(scene, rig.trajectory)
+    layout_s = time.perf_counter() - t
+    renderer = Renderer(scene, spec, cfg, scratch, world)
     queue.put(("ready", {"layout_s": layout_s, "blender_build_s": renderer.build_seconds, "pid": os.getpid()}))
 
     t_start = time.perf_counter()
     for n, index in enumerate(job.frames, 1):
-        images = render_frame(renderer, spec, cfg, rig.frame(index), Path(job.out), job.combos)
+        images = render_frame(renderer, spec, cfg, rig.frame(index), Path(job.out), job.combos, rig)
         queue.put(("frame", index, {"images": images, "rss_mb": _rss_mb(), "frames_done": n}))
     if job.stereo:
         from generator.jobs.stereo import render_pair
