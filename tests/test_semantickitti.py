@@ -153,7 +153,7 @@ def test_written_sequence_sizes_and_static_objects_stay_put(test_spec, tmp_path)
     meta = write_sequence(scene, spec, tmp_path, SequenceOptions(frames=4, sequence="05", threads=2), progress=False)
     seq = sk.Sequence(tmp_path, 5)
     assert len(seq) == 4 and seq.frames == [0, 1, 2, 3]
-    np.testing.assert_allclose(seq.times, [k * spec.paths.spacing_m / spec.paths.speed_mps for k in range(4)])
+    np.testing.assert_allclose(seq.times, [0.0, 0.1, 0.2, 0.3])  # a 10 Hz stream, as KITTI's
     # lidar pose of scan 0 in the world, from the route and the mount
     t_world_velo0 = rig.ego_pose(scene.paths[0].points[0], HEADING) @ rig.mount(spec.sensors.lidar.xyz_m, spec.sensors.lidar.rpy_deg)
     boxes = {50: (scene.objects[1].box.center, scene.objects[1].box.size), 10: (scene.objects[2].box.center, scene.objects[2].box.size)}

@@ -35,8 +35,8 @@ def register(sub) -> None:
     p.add_argument("spec", type=text_path, help="scene spec JSON (e.g. scenes/default_town.json)")
     p.add_argument("--out", required=True, type=path, help="dataset folder (sequences/NN/ is written inside)")
     p.add_argument("--frames", type=Integer(1, MAX_FRAMES), default=10,
-                   help=f"number of scans, 1..{MAX_FRAMES} (default 10, more than generate's 2 frames: scans are "
-                        "cheap, images are not)")
+                   help=f"number of consecutive 10 Hz sweeps (times.txt steps 0.1 s), 1..{MAX_FRAMES} "
+                        "(default 10: one second of driving)")
     p.add_argument("--sequence", type=sequence_id, default="00", help="sequence number, 00..99 (default 00)")
     p.add_argument("--threads", type=Integer(1, 256), default=None, help="casting threads, 1..256 (default: all cores)")
     p.add_argument("--range-image", action="store_true", help="also save range/NNNNNN.npy (rings x columns, 0 = no return)")
@@ -63,16 +63,18 @@ def run(args) -> int:
     check_free_space(out, args.frames * scan_bytes(sensor.rays_per_sweep, **extras), f"{args.frames} scans")
 
     from generator.layout.assemble import build_scene
-    from generator.jobs.lidar_sequence import SequenceOptions, check_frames, write_dataset_label_config, write_sequence
+    from generator.jobs.lidar_sequence import (SequenceOptions, check_sweeps, world_for, write_dataset_label_config,
+                                               write_sequence)
 
     scene = build_scene(spec)
-    check_frames(scene, spec, args.frames)
+    check_sweeps(scene, spec, args.frames)
+    world = world_for(spec, scene, args.frames)  # traffic problems are refused here, before any write
     opts = SequenceOptions(frames=args.frames, sequence=name, threads=args.threads, range_image=args.range_image,
                            ply=args.ply, bev=not args.no_bev, resolution=(cfg.width, cfg.height), render_config=cfg.name)
     # The sequence is cast into a stage inside DIR and moved into place when complete: a failure
     # (or Ctrl-C) while casting and writing leaves DIR as it was.
     with staging(out, "lidar") as stage:
-        meta = write_sequence(scene, spec, stage, opts, sensor=sensor, intensity_fn=intensity_fn)
+        meta = write_sequence(scene, spec, stage, opts, sensor=sensor, intensity_fn=intensity_fn, world=world)
         _move_in(stage / "sequences" / name, out / "sequences" / name, args.frames)
     write_dataset_label_config(out, args.split, [name] if args.split else None)
     pts = meta["points_per_scan"]

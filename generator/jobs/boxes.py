@@ -14,7 +14,7 @@ from generator.formats import semantickitti as sk
 from generator.formats.openlabel import build_openlabel, write_openlabel
 from generator.imaging import meta_fields as md
 from generator.safeload import printable
-from generator.world.rig import Rig
+from generator.world.rig import Frame, Rig
 
 log = logging.getLogger(__name__)
 
@@ -111,8 +111,14 @@ def write_sequence_openlabel(spec, root: Path, sequence: str = "00", classes=DEF
 
         scene = build_scene(spec)
     route = md.integer(meta, "scene.route", src, 0, max(len(scene.paths) - 1, 0), default=0)
-    rig = Rig.from_spec(spec, scene, route)
-    frames = [rig.frame(k) for k in seq.frames]
+    if route == 0:  # the drive of the sequence: the ego among the traffic of the world in time
+        from generator.jobs.lidar_sequence import world_for
+
+        rig = Rig.from_world(spec, world_for(spec, scene, max(seq.frames) + 1))
+    else:
+        rig = Rig.from_spec(spec, scene, route)
+    frames = [Frame(k, 0.0, float(seq.times[k]), rig.T_world_ego(float(seq.times[k]))[0], rig.camera_jitter(k),
+                    rig.T_ego_camera(rig.camera_jitter(k))) for k in seq.frames]
     counts = []
     for k in seq.frames:
         _, _, inst = seq.read_labelled(k)  # whole scan and labels, one label per point

@@ -58,13 +58,17 @@ def lidar_done(out: Path, plan: Plan, spec) -> bool:
     meta = out / "lidar" / "sequences" / plan.sequence / "lidar_meta.json"
     if not os.path.lexists(meta):
         return False
-    n = len(plan.frames)  # the metadata grows with the scans (~2 KB and ~200 values each): budget by the plan
+    n = 20 * len(plan.frames)  # the metadata grows with the scans (~2 KB and ~200 values each), ~15 sweeps a frame
     try:
         m = load_json(meta, max_bytes=MAX_METADATA_BYTES + n * 16 * 1024, max_nodes=100_000 + n * 2_000)
     except UserError:  # damaged: it is cast again
         return False
-    scene = m.get("scene") if isinstance(m, dict) else None
-    return isinstance(scene, dict) and scene.get("spec_hash") == spec.spec_hash and m.get("frames") == len(plan.frames)
+    if not isinstance(m, dict) or not isinstance(m.get("image_frames"), list):
+        return False
+    scene = m.get("scene")
+    pairs = sorted(tuple(p) for p in m["image_frames"] if isinstance(p, list) and len(p) == 2)
+    return (isinstance(scene, dict) and scene.get("spec_hash") == spec.spec_hash
+            and [k for k, _ in pairs] == sorted(plan.frames))
 
 
 def images_done(out: Path, plan: Plan) -> list[int]:
@@ -73,14 +77,17 @@ def images_done(out: Path, plan: Plan) -> list[int]:
     return [k for k in plan.frames if all((images / f"{n}.json").exists() for n in plan.images_of(k))]
 
 
-def write_lidar(spec, cfg, out: Path, plan: Plan, scene=None) -> dict:
-    from generator.layout.assemble import build_scene
+def write_lidar(spec, cfg, out: Path, plan: Plan, scene=None, drive=None) -> dict:
+    """The whole drive's 10 Hz sweeps (:mod:`generator.jobs.drive`) into ``out/lidar/sequences/NN``."""
+    from generator.jobs.drive import plan_drive
     from generator.jobs.lidar_sequence import SequenceOptions, write_dataset_label_config, write_sequence
+    from generator.layout.assemble import build_scene
 
     scene = build_scene(spec) if scene is None else scene
-    opts = SequenceOptions(frames=len(plan.frames), sequence=plan.sequence, resolution=cfg.resolution,
-                           render_config=cfg.name, weather=True)
-    meta = write_sequence(scene, spec, out / "lidar", opts)
+    drive = plan_drive(spec, scene, plan.frames) if drive is None else drive
+    opts = SequenceOptions(frames=drive.sweeps, sequence=plan.sequence, resolution=cfg.resolution,
+                           render_config=cfg.name, weather=True, image_frames=tuple(drive.image_frames))
+    meta = write_sequence(scene, spec, out / "lidar", opts, world=drive.world)
     write_dataset_label_config(out / "lidar")
     return meta
 
@@ -92,6 +99,7 @@ class Preflight:
     plan: Plan
     manifest: dict
     scene: object
+    drive: object
 
 
 def read_manifest(out: Path) -> dict | None:
@@ -131,6 +139,7 @@ def preflight(spec, cfg, opts: GenerateOptions) -> Preflight:
     """Check the whole run before anything is written (see the module docstring); a problem is one line."""
     from generator.labels import class_table
     from generator.layout.assemble import build_scene
+    from generator.jobs.drive import plan_drive
     from generator.jobs.lidar_sequence import check_frames
     from generator.lidar.sensors import sensor_for_spec
     from generator.remission.models import intensity_fn_for_spec
@@ -150,16 +159,17 @@ def preflight(spec, cfg, opts: GenerateOptions) -> Preflight:
     done = set(images_done(out, plan))
     todo = [k for k in plan.frames if k not in done]
     seq_dir = out / "lidar" / "sequences" / plan.sequence
-    pairs = [k for k in stereo_frames(spec, plan.frames) if not pair_done(seq_dir, k)]
+    scene = build_scene(spec)  # the expensive checks last: the town, then its traffic
+    check_frames(scene, spec, len(plan.frames))
+    drive = plan_drive(spec, scene, plan.frames)
+    pairs = [j for j in stereo_frames(spec, range(drive.sweeps)) if not pair_done(seq_dir, j)]
     per_image = image_bytes(cfg.width, cfg.height, cfg.exr_codec, len(class_table().names), cfg.preview)
     need = (len(todo) * len(plan.combos) + 2 * len(pairs)) * per_image
-    scans = 0 if lidar_done(out, plan, spec) else len(plan.frames)
+    scans = 0 if lidar_done(out, plan, spec) else drive.sweeps
     need += scans * scan_bytes(sensor.rays_per_sweep)
     check_free_space(out, need, f"{len(todo) * len(plan.combos)} images and {len(pairs)} stereo pairs at "
                                 f"{cfg.width}x{cfg.height}, {scans} scans")
-    scene = build_scene(spec)  # the one expensive check, last
-    check_frames(scene, spec, len(plan.frames))
-    return Preflight(plan, manifest, scene)
+    return Preflight(plan, manifest, scene, drive)
 
 
 def run_generate(spec, cfg, opts: GenerateOptions) -> dict:
@@ -186,7 +196,7 @@ def run_generate(spec, cfg, opts: GenerateOptions) -> dict:
 
     if not lidar_done(out, plan, spec):
         t = time.perf_counter()
-        write_lidar(spec, cfg, out, plan, scene())
+        write_lidar(spec, cfg, out, plan, scene(), pre.drive)
         run["lidar_s"] = round(time.perf_counter() - t, 2)
     manifest["finished"]["lidar"] = True
     mf.save(out, manifest)
@@ -195,7 +205,7 @@ def run_generate(spec, cfg, opts: GenerateOptions) -> dict:
     manifest["finished"]["images"] = [n for k in plan.frames if k in done for n in plan.images_of(k)]
     todo = [k for k in plan.frames if k not in done]
     seq_dir = out / "lidar" / "sequences" / plan.sequence
-    pairs = stereo_frames(spec, plan.frames)
+    pairs = stereo_frames(spec, range(pre.drive.sweeps))
     manifest["finished"]["stereo"] = [k for k in pairs if pair_done(seq_dir, k)]
     stereo_todo = [k for k in pairs if k not in manifest["finished"]["stereo"]]
     if todo or stereo_todo:

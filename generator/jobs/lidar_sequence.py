@@ -1,7 +1,8 @@
 """Cast a whole SemanticKITTI sequence along a route: scans, labels, poses, calib, previews.
 
-Per frame ``k`` of :meth:`generator.world.rig.Rig.frames` one sweep starting at
-``t_k``; files under ``out/sequences/NN/`` (see :mod:`generator.formats.semantickitti`)
+A 10 Hz stream: sweep ``j`` starts at ``t_j = j * SWEEP_PERIOD_S`` (0.1 s) along the ego's drive
+through the world in time (:func:`generator.traffic.build.build_world`: the static town and the
+moving actors, each column of a sweep seeing them where they are at its firing time); files under ``out/sequences/NN/`` (see :mod:`generator.formats.semantickitti`)
 plus ``bev/NNNNNN.png`` (bird's-eye view), optionally ``range/NNNNNN.npy`` (range image,
 rings x columns float32, 0 = no return) and ``ply/NNNNNN.ply``; ``lidar_meta.json`` says
 how the data was made (sensor, conventions, remission placeholder, point counts); the
@@ -38,7 +39,8 @@ from generator.scan_effects.pipeline import process_scan, processing_for_spec
 from generator.remission.models import IntensityFn, intensity_fn_for_spec
 from generator.lidar.scan import Scanner
 from generator.lidar.sensors import Sensor, sensor_for_spec
-from generator.world.rig import Rig
+from generator.world.actors import MOVING_THRESHOLD_MPS
+from generator.world.rig import SWEEP_PERIOD_S, Rig
 from generator.progress import progress as progress_bar
 
 log = logging.getLogger(__name__)
@@ -60,7 +62,7 @@ class SequenceOptions:
     Attributes
     ----------
     frames : int
-        Number of scans (frames 0 .. frames-1 of route 0).
+        Number of consecutive 10 Hz sweeps (sweep j starts at ``j * SWEEP_PERIOD_S``).
     sequence : str
         Folder name ``NN``.
     threads : int or None
@@ -72,7 +74,9 @@ class SequenceOptions:
     render_config : str
         Name of that render config (recorded in the metadata).
     route : int
-        Route index of the scene.
+        Route index of the scene (traffic drives route 0; another route is a frozen drive).
+    image_frames : tuple of (int, int)
+        ``(image frame k, sweep j)`` pairs of a ``generate`` run, recorded in the metadata.
     weather : bool
         LiDAR weather when ``spec.lidar.weather.enabled`` is null (auto): ``generate`` sets
         True (its images carry the weather), the ``lidar`` command leaves it False.
@@ -88,10 +92,11 @@ class SequenceOptions:
     render_config: str = "preview"
     route: int = 0
     weather: bool = False
+    image_frames: tuple = ()
 
 
 def check_frames(scene, spec, n: int, route: int = 0) -> None:
-    """Refuse more frames than fit on an open route (a loop wraps)."""
+    """Refuse more image frames than fit on an open route (a loop wraps)."""
     if n < 1:
         raise UserError(f"--frames must be >= 1, got {n}")
     if route >= len(scene.paths):
@@ -102,8 +107,28 @@ def check_frames(scene, spec, n: int, route: int = 0) -> None:
                         f"paths.spacing_m = {spec.paths.spacing_m}, asked for {n}")
 
 
+def check_sweeps(scene, spec, n: int, route: int = 0) -> None:
+    """Refuse more 10 Hz sweeps than the ego can drive on an open route (a loop wraps)."""
+    if n < 1:
+        raise UserError(f"--frames must be >= 1, got {n}")
+    if route >= len(scene.paths):
+        raise UserError(f"{spec.source}: the scene has no route {route}")
+    path = scene.paths[route]
+    seconds = path.length() / spec.paths.speed_mps
+    if not path.closed and (n - 1) * SWEEP_PERIOD_S > seconds:
+        raise UserError(f"{spec.source}: route {route} takes {seconds:.1f} s at paths.speed_mps = "
+                        f"{spec.paths.speed_mps}: room for {int(seconds / SWEEP_PERIOD_S) + 1} sweeps, asked for {n}")
+
+
+def world_for(spec, scene, sweeps: int, distance_m: float = 0.0):
+    """The world (:func:`generator.traffic.build.build_world`) covering ``sweeps`` 10 Hz sweeps."""
+    from generator.traffic.build import build_world
+
+    return build_world(spec, scene, sweeps * SWEEP_PERIOD_S + 0.2, distance_m)
+
+
 def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, sensor: Sensor | None = None,
-                   intensity_fn: IntensityFn | None = None, progress: bool = True) -> dict:
+                   intensity_fn: IntensityFn | None = None, progress: bool = True, world=None) -> dict:
     """Cast and write one sequence; returns the metadata written to ``lidar_meta.json``.
 
     Parameters
@@ -124,26 +149,32 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
     sensor = sensor_for_spec(spec) if sensor is None else sensor
     intensity_fn = intensity_fn_for_spec(spec) if intensity_fn is None else intensity_fn
     processing = processing_for_spec(spec, sensor, options.weather, intensity_fn)
-    check_frames(scene, spec, options.frames, options.route)
+    check_sweeps(scene, spec, options.frames, options.route)
     name = sk.sequence_name(options.sequence)
     seq = inside(out, "sequences", name)
-    rig = Rig.from_spec(spec, scene, options.route)
-    frames = rig.frames(options.frames)
+    if options.route != 0:  # traffic drives route 0's ego; another route is a frozen drive
+        world = None
+        rig = Rig.from_spec(spec, scene, options.route)
+    else:
+        world = world_for(spec, scene, options.frames) if world is None else world
+        rig = Rig.from_world(spec, world)
+    times = np.array([Rig.sweep_time(j) for j in range(options.frames)])
     calib = kitti_calib.kitti_calib(rig, *options.resolution)
     tr = kitti_calib.homogeneous(calib["Tr"])
     kitti_calib.write_calib(seq / "calib.txt", calib)
-    to_sk = class_table().to_semantickitti
     skew = spec.sensors.lidar.motion_skew
     starts, n_points, counts, records = [], [], {}, []
     sweeps = []  # LiDAR world poses during each sweep (fusion de-skews with them)
-    with Scanner(scene, sensor, threads=options.threads) as scanner:
-        for f in progress_bar(frames, desc=f"lidar {name}", unit="scan", enabled=progress):
-            scan = scanner.sweep(rig, f.t, skew)
-            pts, remission, record = process_scan(scan.points, processing, spec, f.index)
+    actors = world.actors if world is not None else []
+    with Scanner(scene, sensor, threads=options.threads, **({"world": world} if actors else {})) as scanner:
+        for j in progress_bar(range(options.frames), desc=f"lidar {name}", unit="scan", enabled=progress):
+            t_j = times[j]
+            scan = scanner.sweep(rig, t_j, skew)
+            pts, remission, record = process_scan(scan.points, processing, spec, j)
             scan = dataclasses.replace(scan, points=pts)  # xyz, range image and side files follow the processed points
             records.append(record)
-            stem = f"{f.index:06d}"
-            semantic = to_sk[pts["class"]]
+            stem = f"{j:06d}"
+            semantic = semantic_ids(pts)
             sk.write_scan(seq / "velodyne" / f"{stem}.bin", scan.xyz, remission)
             sk.write_labels(seq / "labels" / f"{stem}.label", semantic, pts["instance"])
             write_point_sidecars(seq, stem, pts["time"], pts["class"])  # fusion: de-skew times, native classes
@@ -155,19 +186,36 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
             if options.ply:
                 write_ply(seq / "ply" / f"{stem}.ply", scan.xyz, remission, semantic, pts["instance"],
                           class_table().colors[pts["class"]])
-            starts.append(f.T_world_ego @ rig.T_ego_lidar)
-            sweeps.append(rig.sweep_record(f.t, sensor.period_s))
+            starts.append(rig.T_world_lidar(t_j)[0])
+            sweeps.append(rig.sweep_record(t_j, sensor.period_s))
             n_points.append(int(len(pts)))
             counts = merge_counts(counts, count_raw_ids(semantic))
     _remove_stale(seq, options.frames)
     sk.write_poses(seq / "poses.txt", kitti_calib.camera_poses(np.array(starts), tr))
-    sk.write_times(seq / "times.txt", np.array([f.t for f in frames]))
+    sk.write_times(seq / "times.txt", times)
     meta = _metadata(scene, spec, sensor, options, intensity_fn, n_points, counts)
+    meta["sweep_period_s"] = SWEEP_PERIOD_S
+    meta["traffic"] = {"actors": len(actors), "moving_threshold_mps": MOVING_THRESHOLD_MPS,
+                       "moving_ids": "SemanticKITTI 252-259 for points on an actor moving faster than the "
+                                     "threshold at its firing time; instance ids stay the same all sequence"}
+    if options.image_frames:
+        meta["image_frames"] = [list(p) for p in options.image_frames]
     meta["processing"], meta["scans"] = processing.describe(), records
     meta["sweep_poses_world"] = {"period_s": sensor.period_s, "frames": sweeps}
     write_json(seq / META_NAME, meta)
     write_dataset_label_config(out)
     return meta
+
+
+def semantic_ids(points: np.ndarray) -> np.ndarray:
+    """(n,) uint16 SemanticKITTI raw ids of processed points: the moving id (252-259) where a point
+    lies on an actor moving at its firing time and the class has one, else the class's own id."""
+    table = class_table()
+    ids = table.to_semantickitti[points["class"]]
+    if "moving" in (points.dtype.names or ()) and hasattr(table, "to_semantickitti_moving"):
+        moving = points["moving"].astype(bool)
+        ids = np.where(moving, table.to_semantickitti_moving[points["class"]], ids)
+    return ids.astype(np.uint16, copy=False)
 
 
 def _remove_stale(seq: Path, n: int) -> None:

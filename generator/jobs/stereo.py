@@ -1,6 +1,7 @@
 """The KITTI camera stream of a LiDAR sequence: a fixed stereo pair beside the scans.
 
-Every ``sensors.stereo.every``-th scan ``k`` of ``sequences/NN`` gets a rectified stereo
+Every ``sensors.stereo.every``-th 10 Hz sweep ``k`` of ``sequences/NN`` (default every 10th: one
+pair a second) gets a rectified stereo
 pair (:meth:`generator.world.rig.Rig.T_ego_stereo`: camera 2 at the nominal camera mount,
 camera 3 ``baseline_m`` to its right, no jitter), so ``P2 @ Tr`` of the sequence's
 ``calib.txt`` projects the scan into its image exactly as KITTI tools do:
@@ -98,7 +99,7 @@ def render_pair(renderer, spec, cfg, rig, sensor, index: int, seq_dir: Path) -> 
     """
     t0 = time.perf_counter()
     tod, kind = lidar_combination(index)
-    t_scan = rig.frame(index).t  # the sweep start of scan ``index``
+    t_scan = rig.sweep_time(index)  # the start of sweep ``index`` (10 Hz)
     t_exp = t_scan + exposure_offset(sensor, spec.sensors.lidar.motion_skew)
     light = draw_lighting(spec, index, tod)
     wetness, puddles = frame_wetness(spec, index) if is_wet(kind) else (0.0, 0.0)

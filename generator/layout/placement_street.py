@@ -201,6 +201,9 @@ def place_parked(placer: Placer, spec: SceneSpec, st: Street) -> None:
                 proto = trucks[int(g.integers(N_TRUCK))] if truck else _vehicle(placer, "car", int(g.integers(N_CAR)))
                 nb = 2 if truck else 1
                 fits = proto.hi[1] - proto.lo[1] <= grid.parking_w - 0.1
+                if not fits and spec.traffic.enabled:  # moving traffic needs the lane: no double parking
+                    b += nb
+                    continue
                 v = s * (grid.lane_half + grid.parking_w / 2) if fits else s * (grid.lane_half - grid.lane_w / 2)
                 u = u0 + (b + nb / 2) * BAY_M
                 c = (proto.lo + proto.hi) / 2     # centre the body (not the local origin) on the spot
@@ -216,7 +219,7 @@ def place_lane_cars(placer: Placer, spec: SceneSpec, st: Street) -> None:
     centres, spread over the lanes no route drives."""
     grid = st.grid
     dens = spec.density.moving_cars_per_100m
-    if dens <= 0:
+    if dens <= 0 or spec.traffic.enabled:  # the frozen town's stand-ins for traffic; real traffic replaces them
         return
     g = stream(spec.seed, "layout", "lane_cars")
     lanes = []
@@ -260,7 +263,7 @@ def place_people(placer: Placer, spec: SceneSpec, st: Street) -> None:
                 yaw = seg.yaw + (0 if g.random() < 0.5 else np.pi) + g.normal(0, 0.1) if i >= N_PEOPLE // 2 \
                     else g.uniform(0, 2 * np.pi)
                 placer.try_place(protos[i], x, y, st.h, yaw, {"color": clothing_color(g)}, pad=0.15)
-        if g.random() < 0.25:       # someone crossing at one end of this segment
+        if g.random() < 0.25 and not spec.traffic.enabled:  # someone frozen on a crosswalk (traffic: they walk)
             u = g.uniform(*CROSSWALK_U) if g.random() < 0.5 else seg.length - g.uniform(*CROSSWALK_U)
             v = g.uniform(-grid.road_half + 0.6, grid.road_half - 0.6)
             x, y = seg.to_world(u, v)[0]

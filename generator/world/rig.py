@@ -29,8 +29,22 @@ from generator.geometry.transforms import invert, mount, pose
 from generator.rng import stream
 from generator.world.trajectory import EgoTrajectory
 
-__all__ = ["Frame", "R_BODY_OPTICAL", "Rig", "camera_extrinsics", "ego_pose", "intrinsics", "invert", "mount",
-           "pixel_rays", "pose"]
+__all__ = [
+    "R_BODY_OPTICAL",
+    "SWEEP_PERIOD_S",
+    "Frame",
+    "Rig",
+    "camera_extrinsics",
+    "ego_pose",
+    "intrinsics",
+    "invert",
+    "mount",
+    "pixel_rays",
+    "pose",
+]
+
+#: One LiDAR sweep: sweeps start every 0.1 s (a 10 Hz spinning sensor, as KITTI's HDL-64E).
+SWEEP_PERIOD_S = 0.1
 
 #: Rotation taking optical-frame vectors (x right, y down, z forward) to body axes
 #: (x forward, y left, z up): columns are the optical axes written in the body frame.
@@ -151,7 +165,14 @@ class Rig:
     trajectory: EgoTrajectory | None = None
 
     @classmethod
-    def from_spec(cls, spec, scene=None, route: int = 0) -> "Rig":
+    def from_world(cls, spec, world) -> Rig:
+        """The rig of ``spec`` riding the ego of ``world`` (:class:`generator.world.actors.World`)."""
+        import dataclasses
+
+        return dataclasses.replace(cls.from_spec(spec), trajectory=world.ego)
+
+    @classmethod
+    def from_spec(cls, spec, scene=None, route: int = 0) -> Rig:
         """The rig of ``spec`` driving route ``route`` of ``scene`` (mounts only without a scene)."""
         cam, lidar, p = spec.sensors.camera, spec.sensors.lidar, spec.paths
         traj = EgoTrajectory(scene.paths[route], p.speed_mps) if scene is not None else None
@@ -217,11 +238,30 @@ class Rig:
         return tuple(float(v) for v in g.uniform(-bounds, bounds))
 
     def frame(self, index: int) -> Frame:
-        """Frame ``index`` along the route (a loop wraps around)."""
+        """Frame ``index``: where the ego has driven ``index * spacing_m`` metres (a loop wraps around).
+
+        The frame time is the start of the LiDAR sweep nearest to that instant (a multiple of
+        :data:`SWEEP_PERIOD_S`): the camera is exposed with a sweep, as KITTI triggers it, and
+        image ``k`` pairs with sweep :meth:`sweep_of`.
+        """
+        drive = self._drive()
         s = index * self.spacing_m
-        t = s / self._drive().speed_mps
+        t = drive.time_at_distance(s) if hasattr(drive, "time_at_distance") else s / drive.speed_mps
+        t = round(round(t / SWEEP_PERIOD_S) * SWEEP_PERIOD_S, 9)
+        if not hasattr(drive, "time_at_distance"):
+            s = t * drive.speed_mps
         jit = self.camera_jitter(index)
         return Frame(index, s, t, self.T_world_ego(t)[0], jit, self.T_ego_camera(jit))
+
+    @staticmethod
+    def sweep_of(frame: Frame) -> int:
+        """Index of the 10 Hz LiDAR sweep that starts when ``frame`` is exposed."""
+        return round(frame.t / SWEEP_PERIOD_S)
+
+    @staticmethod
+    def sweep_time(j: int) -> float:
+        """Start of sweep ``j``, seconds."""
+        return round(j * SWEEP_PERIOD_S, 9)
 
     def frames(self, n_frames: int, first: int = 0) -> list[Frame]:
         """Frames ``first .. first + n_frames - 1`` (check :meth:`max_frames` on an open route)."""
@@ -229,8 +269,11 @@ class Rig:
 
     def max_frames(self) -> int:
         """How many distinct frames fit on the route (a loop: one lap)."""
-        path = self._drive().path
-        return max(1, int(math.floor(path.length() / self.spacing_m)) + (0 if path.closed else 1))
+        drive = self._drive()
+        if not hasattr(drive, "path"):  # a simulated drive: as far as it was simulated
+            return max(1, math.floor(float(drive.distance[-1]) / self.spacing_m) + 1)
+        path = drive.path
+        return max(1, math.floor(path.length() / self.spacing_m) + (0 if path.closed else 1))
 
     def sweep_poses(self, t0: float, column_times: np.ndarray | None) -> np.ndarray:
         """LiDAR world poses of a sweep starting at ``t0`` seconds.

@@ -1,0 +1,317 @@
+"""Build the world in time: the static town + simulated vehicles, pedestrians and the ego.
+
+:func:`build_world` is the one entry point. With every ``traffic`` density 0 it returns the
+frozen town (no actors, the ego at constant speed along route 0, exactly as before traffic
+existed). Otherwise pedestrians are simulated first (they only obey the signals), then the
+vehicles and the ego, which also keep off crosswalks pedestrians are on. Every draw comes from
+a stream named ``("traffic", ...)`` of the spec seed, and the simulation is causal, so the
+world at a time ``t`` does not depend on how long a run is.
+
+Vehicles start on free lane edges at rest and settle for :data:`WARMUP_S` seconds (the ego
+waiting at its start) before t = 0.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+
+import numpy as np
+
+from generator.errors import SpecError
+from generator.geometry.mesh import merge
+from generator.layout.placement_street import vehicle_color
+from generator.layout.streets import make_grid
+from generator.rng import stream
+from generator.traffic.lanes import LaneGraph
+from generator.traffic.movers import DT_S, Mover
+from generator.traffic.signals import Signals
+from generator.traffic.vehicles import Vehicle, VehicleSim
+from generator.world.actors import Actor, Track, TrackTrajectory, World, frozen_world
+from generator.world.trajectory import EgoTrajectory
+
+log = logging.getLogger(__name__)
+
+WARMUP_S = 20.0
+MAX_DRIVE_S = 900.0
+SPACING_M = 6.0       #: lanes hold at most one vehicle per (length + this), for the capacity check
+EGO_SIZE_M = (4.6, 1.9)
+# spec field -> (asset kind, variants, speed factor of the limit, max acceleration m/s^2)
+KINDS = {
+    "cars_per_km": ("car", 6, (0.8, 1.0), 2.0),
+    "trucks_per_km": ("truck", 3, (0.7, 0.85), 1.2),
+    "buses_per_km": ("bus", 4, (0.7, 0.85), 1.0),
+    "other_vehicles_per_km": ("construction_vehicle", 4, (0.5, 0.7), 1.0),
+    "cyclists_per_km": ("bicyclist", 4, (0.35, 0.55), 1.0),
+    "motorcyclists_per_km": ("motorcyclist", 4, (0.8, 1.0), 2.5),
+}
+
+
+def build_world(spec, scene, duration_s: float, distance_m: float = 0.0) -> World:
+    """The world of ``spec`` over at least ``[0, duration_s]`` seconds.
+
+    Parameters
+    ----------
+    spec : generator.spec.SceneSpec
+    scene : generator.world.scene.SceneModel
+        The static town built from ``spec``.
+    duration_s : float
+        Simulated seconds from t = 0 (tracks run a little longer for central differences).
+    distance_m : float
+        Keep simulating until the ego has driven this far as well (frames along the route).
+
+    Raises
+    ------
+    SpecError
+        More vehicles than the free lanes can hold, or the ego cannot drive ``distance_m``
+        within :data:`MAX_DRIVE_S`.
+    """
+    if not spec.traffic.enabled:
+        return frozen_world(scene, EgoTrajectory(scene.paths[0], spec.paths.speed_mps))
+    t_start = time.perf_counter()
+    from generator.layout.placement_core import Library
+
+    grid = make_grid(spec)
+    graph = LaneGraph(grid)
+    signals = Signals(spec.seed, grid.nodes)
+    lib = Library(spec.seed)
+    n_steps_min = int(np.ceil((duration_s + 1.0) / DT_S)) + 1
+    peds = _pedestrians(spec, grid, scene, signals, lib, n_steps_min, distance_m)
+    crossing = _crosswalk_occupancy(grid, graph, peds)
+    blocked = _blocked_lanes(graph, scene)
+    movers, ego_track, ego_dist = _drive(spec, graph, signals, lib, blocked, crossing, duration_s, distance_m)
+    peds = [_extend_track(p, len(ego_dist)) for p in peds]
+    world = _assemble(scene, movers + peds, TrackTrajectory(ego_track, ego_dist), ego_track.t1)
+    log.info("traffic %s: %d vehicles, %d pedestrians over %.1f s, simulated in %.2f s", spec.name, len(movers),
+             len(peds), ego_track.t1, time.perf_counter() - t_start)
+    return world
+
+
+def _pedestrians(spec, grid, scene, signals, lib, n_steps: int, distance_m: float) -> list[Mover]:
+    if spec.traffic.pedestrians_per_100m <= 0 and spec.traffic.standing_pedestrians_per_100m <= 0:
+        return []
+    from generator.traffic.pedestrians import simulate_pedestrians
+
+    if distance_m > 0:  # the drive may take longer than asked: cover the slowest plausible ego
+        n_steps = max(n_steps, int(np.ceil((distance_m / (0.25 * spec.paths.speed_mps) + 5.0) / DT_S)))
+    return simulate_pedestrians(spec, grid, scene, signals, lib, n_steps, DT_S)
+
+
+def _extend_track(m: Mover, n: int) -> Mover:
+    tr = m.track
+    if len(tr.yaw) >= n:
+        return m
+    pad = n - len(tr.yaw)
+    m.track = Track(tr.t0, tr.dt, np.vstack([tr.xyz, np.repeat(tr.xyz[-1:], pad, 0)]),
+                    np.r_[tr.yaw, np.repeat(tr.yaw[-1:], pad)])
+    return m
+
+
+def _crosswalk_occupancy(grid, graph: LaneGraph, peds: list[Mover]):
+    """``crossing(node, arm, t0, t1)``: is a pedestrian within 1 m of that crosswalk band then."""
+    from generator.layout.streets import CROSSWALK_U
+    from generator.traffic.lanes import ARM_DIRS
+
+    walkers = [p for p in peds if p.attrs.get("role") != "standing"]
+    if not walkers:
+        return None
+    xy = np.stack([p.track.xyz[:, :2] for p in walkers], 1)   # (T, n, 2)
+    occupied = {}
+    for node in grid.nodes:
+        c = grid.node_xy(node)
+        for arm in grid.arms(node):
+            e = ARM_DIRS[arm]
+            rel = xy - c
+            along = rel @ e
+            across = rel @ np.array([-e[1], e[0]])
+            u0, u1 = grid.road_half + CROSSWALK_U[0] - 1.0, grid.road_half + CROSSWALK_U[1] + 1.0
+            inside = (along > u0) & (along < u1) & (np.abs(across) < grid.road_half + 0.5)
+            occupied[(node, arm)] = inside.any(1)
+
+    def crossing(node, arm, t0: float, t1: float) -> bool:
+        occ = occupied[(node, arm)]
+        i0, i1 = max(0, int(np.floor(t0 / DT_S))), int(np.ceil(t1 / DT_S)) + 1
+        return bool(occ[i0:i1].any()) if i0 < len(occ) else False
+
+    return crossing
+
+
+def _blocked_lanes(graph: LaneGraph, scene) -> set[int]:
+    """Lane edges a static object stands on (a double-parked truck, a car left in a lane)."""
+    from generator.traffic.lanes import boxes_overlap
+
+    boxes = [o.box for o in scene.objects if o.instance_id > 0]
+    if not boxes:
+        return set()
+    quads = np.stack([b.corners_xy() for b in boxes])
+    out = set()
+    for e in graph.lanes():
+        p0, p1 = e.path.points[0, :2], e.path.points[-1, :2]
+        d = (p1 - p0) / max(np.linalg.norm(p1 - p0), 1e-9)
+        n = np.array([-d[1], d[0]]) * (graph.grid.lane_w / 2 - 0.3)
+        lane = np.array([[p0 - n, p1 - n, p1 + n, p0 + n]])
+        if boxes_overlap(lane, quads).any():
+            out.add(e.index)
+    return out
+
+
+def _prune(graph: LaneGraph, blocked: set[int], keep: set[int]) -> set[int]:
+    """Drop blocked lanes from the graph, and then every lane left without a way on (dead ends).
+
+    Lanes in ``keep`` (the ego's route, clear of objects by construction) are never dropped.
+    Returns every dropped lane edge.
+    """
+    blocked = set(blocked) - keep
+    while True:
+        for e in graph.edges:
+            if e.kind == "lane":
+                e.succ = [c for c in e.succ if graph.edges[c].succ[0] not in blocked]
+        dead = {e.index for e in graph.lanes() if not e.succ and e.index not in blocked and e.index not in keep}
+        if not dead:
+            return blocked
+        blocked |= dead
+
+
+def _ego_route(graph: LaneGraph) -> list[int]:
+    """Route 0 (the comb loop of :mod:`generator.layout.routes`) as a cycle of edges of ``graph``."""
+    from generator.layout.routes import _turning, comb_nodes
+    from generator.traffic.vehicles import arm_towards
+
+    grid = graph.grid
+    corners = _turning(comb_nodes(len(grid.xs) - 1, len(grid.ys) - 1))
+    nodes = []
+    for i, a in enumerate(corners):
+        b = corners[(i + 1) % len(corners)]
+        step = np.sign(np.subtract(b, a)).astype(int)
+        n = a
+        while n != b:
+            nodes.append(n)
+            n = (n[0] + int(step[0]), n[1] + int(step[1]))
+    k = grid.lanes - 1
+    out = []
+    for i, a in enumerate(nodes):
+        b, c = nodes[(i + 1) % len(nodes)], nodes[(i + 2) % len(nodes)]
+        out.append(graph.lane_out(a, arm_towards(a, b), k).index)
+        out.append(graph.connector[(b, arm_towards(b, a), arm_towards(b, c), k)])
+    return out
+
+
+def _drive(spec, graph, signals, lib, blocked, crossing, duration_s, distance_m):
+    tr = spec.traffic
+    route = _ego_route(graph)
+    blocked = _prune(graph, blocked, set(route))
+    free = [e for e in graph.lanes() if e.index not in blocked]
+    if not free:
+        raise SpecError(spec.source, "traffic", "every lane is blocked by parked objects: no room for moving traffic")
+    ego = Vehicle(0, *EGO_SIZE_M, spec.paths.speed_mps, 1.5, [route[0]], 0.0, stream(spec.seed, "traffic", "ego"),
+                  ego_route=route, stop_p=tr.ego_stop_probability)
+    ego.plan.append(route[1])
+    ego.route_pos = 1
+    vehicles, movers = [ego], []
+    km = sum(e.length for e in free) / 1000.0
+    _check_capacity(spec, lib, km)
+    g = stream(spec.seed, "traffic", "vehicles")
+    taken: dict[int, list] = {route[0]: [(0.0, EGO_SIZE_M[0])]}
+    for field_name, (kind, n_var, speed, a_max) in KINDS.items():
+        for _ in range(round(getattr(tr, field_name) * km)):
+            proto = _proto(lib, kind, int(g.integers(n_var)))
+            length, width = float(proto.hi[0] - proto.lo[0]), float(proto.hi[1] - proto.lo[1])
+            e, s = _free_spot(graph, free, taken, length, g, field_name, spec)
+            i = len(vehicles)
+            v = Vehicle(i, length, width, min(tr.speed_limit_mps * float(g.uniform(*speed)), tr.speed_limit_mps),
+                        a_max, [e.index], s, stream(spec.seed, "traffic", "vehicle", i))
+            vehicles.append(v)
+            movers.append(Mover(kind, lib.main_class(kind), proto, None, {"color": vehicle_color(g), "role": "driving"}))
+    sim = VehicleSim(graph, signals, vehicles, crossing)
+    for v in vehicles:
+        sim._extend(v)
+    ego.v_des = 0.0
+    n_warm = round(WARMUP_S / DT_S)
+    for k in range(n_warm):
+        sim.step(-WARMUP_S + k * DT_S, DT_S)
+    ego.v_des = spec.paths.speed_mps
+    rec_xy, rec_h, dist = [], [], [0.0]
+    t, k = 0.0, 0
+    while True:
+        poses = [sim.pose(v) for v in vehicles]
+        rec_xy.append([p[0] for p in poses])
+        rec_h.append([p[1] for p in poses])
+        if k > 0:
+            dist.append(dist[-1] + float(np.linalg.norm(rec_xy[-1][0] - rec_xy[-2][0])))
+        if t >= duration_s + 1.0 and dist[-1] >= distance_m + 1.0:
+            break
+        if t > MAX_DRIVE_S:
+            raise SpecError(spec.source, "paths.spacing_m", f"the ego cannot drive {distance_m:.0f} m within "
+                            f"{MAX_DRIVE_S:.0f} s of traffic; ask for fewer frames or less traffic")
+        sim.step(t, DT_S)
+        k += 1
+        t = k * DT_S
+    xy, hd = np.asarray(rec_xy), np.unwrap(np.asarray(rec_h), axis=0)
+    for j, m in enumerate(movers, start=1):
+        c = (m.proto.lo + m.proto.hi) / 2
+        cs, sn = np.cos(hd[:, j]), np.sin(hd[:, j])
+        origin = xy[:, j] - np.stack([c[0] * cs - c[1] * sn, c[0] * sn + c[1] * cs], -1)
+        m.track = Track(0.0, DT_S, np.c_[origin, np.zeros(len(origin))], hd[:, j])
+    ego_track = Track(0.0, DT_S, np.c_[xy[:, 0], np.zeros(len(xy))], hd[:, 0])
+    return movers, ego_track, np.asarray(dist)
+
+
+def _check_capacity(spec, lib, km: float) -> None:
+    tr = spec.traffic
+    lengths = {"cars_per_km": 4.6, "trucks_per_km": 8.0, "buses_per_km": 12.0, "other_vehicles_per_km": 7.0,
+               "cyclists_per_km": 1.8, "motorcyclists_per_km": 2.2}
+    used = sum(getattr(tr, f) * (lengths[f] + SPACING_M) for f in KINDS)   # metres of lane per km
+    if used > 1000.0:
+        worst = max(KINDS, key=lambda f: getattr(tr, f) * (lengths[f] + SPACING_M))
+        raise SpecError(spec.source, f"traffic.{worst}", f"the vehicles asked for need {used / 1000:.2f} km of "
+                        "lane per km of lane (all kinds together, with safe gaps); lower the densities")
+
+
+def _free_spot(graph, free, taken, length, g, field_name, spec):
+    lengths = np.array([e.length for e in free])
+    for _ in range(200):
+        e = free[int(g.choice(len(free), p=lengths / lengths.sum()))]
+        lo, hi = length / 2 + 1.0, e.length - graph.stop_s_from_end - length / 2 - 1.0
+        if hi <= lo:
+            continue
+        s = float(g.uniform(lo, hi))
+        if all(abs(s - s2) > (length + l2) / 2 + SPACING_M for s2, l2 in taken.get(e.index, [])):
+            taken.setdefault(e.index, []).append((s, length))
+            return e, s
+    raise SpecError(spec.source, f"traffic.{field_name}", "more vehicles than the free lanes can hold; lower it")
+
+
+def _proto(lib, kind: str, i: int):
+    """The prototype of a vehicle kind; a rider and the two-wheeler ridden merged into one."""
+    if kind not in ("bicyclist", "motorcyclist"):
+        return lib.variant(kind, i)
+    from generator.layout.placement_core import Proto
+
+    key = f"{kind}_riding_v{i}"
+    if key not in lib.protos:
+        rider = lib.variant(kind, i, lambda g: {"with_vehicle": False})
+        vehicle = lib.variant("ridden_bicycle" if kind == "bicyclist" else "ridden_motorcycle", i, stream_kind=kind)
+        mesh = merge([vehicle.mesh, rider.mesh])
+        lo, hi = mesh.bounds()
+        lib.protos[key] = Proto(key, kind, mesh, lo, hi, np.zeros((0, 6)))
+    return lib.protos[key]
+
+
+def _assemble(scene, movers: list[Mover], ego: TrackTrajectory, duration_s: float) -> World:
+    from generator.geometry.proxy import label_proxy
+
+    base = max([o.instance_id for o in scene.objects] + [0]) + 1
+    if base + len(movers) > 65535:
+        raise SpecError("", "traffic", f"{len(movers)} actors exceed the instance ids left in a uint16 label")
+    prototypes, proxies, actors = {}, {}, []
+    for uid, m in enumerate(movers):
+        key = f"actor_{m.proto.key}"
+        if key not in prototypes:
+            prototypes[key] = m.proto.mesh
+            hull = label_proxy(m.proto.mesh)
+            if hull is not None:
+                proxies[key] = hull
+        lo, hi = np.asarray(m.proto.lo, float), np.asarray(m.proto.hi, float)
+        actors.append(Actor(uid, f"actor_{m.kind}_{uid:04d}", m.kind, m.cls, base + uid, key, tuple(hi - lo),
+                            tuple((lo + hi) / 2), m.track, key if key in proxies else None, dict(m.attrs)))
+    return World(scene, actors, prototypes, proxies, ego, duration_s)

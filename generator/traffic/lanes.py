@@ -1,0 +1,254 @@
+"""The lane graph vehicles drive: lane edges between intersections and connectors through them.
+
+Every street segment carries ``lanes`` lanes per direction (right-hand traffic, lane ``k``
+centred ``(k + 0.5) * lane_w`` right of the centre line). A *lane edge* runs from the exit
+point of one intersection to the entry point of the next; a *connector* runs through an
+intersection from an incoming lane to the same lane number of another arm: straight across,
+or a quarter circle. Entry and exit points sit :attr:`LaneGraph.entry_m` from the node
+centre; the turning arcs are those of the ego's route (:mod:`generator.layout.routes`: a
+right turn of the outer lane has radius ``r``, its left turn ``r + 2 off``, concentric), so
+route 0 is a walk on this graph.
+
+Vehicles stop with their front at the stop line (:attr:`LaneGraph.stop_m` from the node
+centre) until they may enter. Two connectors *conflict* when a standard car on one (from the
+stop line to past the far crosswalk) can touch a standard car on the other
+(:func:`conflicts`); one table serves every node, as every node has the same cross-section.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from generator.layout.routes import MIN_RADIUS_M, RIGHT_RADIUS_M
+from generator.layout.streets import STOP_U, Grid
+from generator.world.scene import Path
+
+ARM_DIRS = np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [0.0, -1.0]])  #: east, north, west, south
+STEP_M = 0.25
+CAR_BOX_M = (4.8, 2.1)    #: the standard vehicle of the conflict table (length, width)
+CONFLICT_PAD_M = 0.3
+
+
+@dataclass
+class Edge:
+    """A directed lane edge or connector.
+
+    Attributes
+    ----------
+    index : int
+    path : Path
+        Centre line (open polyline, world frame).
+    kind : {"lane", "connector"}
+    node : tuple of int or None
+        The intersection a connector crosses; for a lane, the node it arrives at.
+    lane : int
+        Lane number (0 next to the centre line).
+    arms : (int, int)
+        Connector: (arm it comes from, arm it leaves by); lane: (arm it leaves its start node by, -1).
+    succ : list of int
+        Edges that may follow.
+    """
+
+    index: int
+    path: Path
+    kind: str
+    node: tuple[int, int] | None
+    lane: int
+    arms: tuple[int, int]
+    succ: list[int] = field(default_factory=list)
+
+    @property
+    def length(self) -> float:
+        return float(self.path.s[-1])
+
+
+def _line(p0: np.ndarray, p1: np.ndarray, name: str) -> Path:
+    n = max(1, int(np.ceil(np.linalg.norm(p1 - p0) / STEP_M)))
+    pts = p0 + (p1 - p0) * (np.arange(n + 1)[:, None] / n)
+    hd = np.full(n + 1, np.arctan2(*(p1 - p0)[::-1]))
+    s = np.linspace(0.0, float(np.linalg.norm(p1 - p0)), n + 1)
+    return Path(name, np.c_[pts, np.zeros(n + 1)], hd, s)
+
+
+def _arc(centre: np.ndarray, r: float, h0: float, sign: float, name: str) -> Path:
+    n = max(2, int(np.ceil(r * np.pi / 2 / STEP_M)))
+    ang = h0 + sign * np.pi / 2 * np.arange(n + 1) / n
+    radial = ang - sign * np.pi / 2
+    pts = centre + r * np.stack([np.cos(radial), np.sin(radial)], 1)
+    return Path(name, np.c_[pts, np.zeros(n + 1)], ang, np.linspace(0.0, r * np.pi / 2, n + 1))
+
+
+class LaneGraph:
+    """Lane edges and connectors of a :class:`~generator.layout.streets.Grid`.
+
+    Attributes
+    ----------
+    edges : list of Edge
+    lane_edge : dict
+        ``(segment index, direction, lane) -> edge index`` (direction +1 towards +u).
+    connector : dict
+        ``(node, arm_in, arm_out, lane) -> edge index``.
+    entry_m, stop_m : float
+        Distance from a node centre to the connectors' ends and to the stop line, metres.
+    conflict : dict
+        ``(arm_in, arm_out, lane) -> set of (arm_in, arm_out, lane)`` it conflicts with.
+    """
+
+    def __init__(self, grid: Grid):
+        self.grid = grid
+        off = (grid.lanes - 0.5) * grid.lane_w
+        r_right = max(MIN_RADIUS_M, min(RIGHT_RADIUS_M, (grid.road_half - 0.3 - off) / (1 - np.sqrt(0.5))))
+        self.entry_m = r_right + off
+        self.stop_m = grid.road_half + STOP_U[1]
+        self.edges: list[Edge] = []
+        self.lane_edge: dict = {}
+        self.connector: dict = {}
+        for seg in grid.segments:
+            a, b = grid.node_xy(seg.a), grid.node_xy(seg.b)
+            u = (b - a) / np.linalg.norm(b - a)
+            for d in (1, -1):
+                start, end, e = (a, b, u) if d > 0 else (b, a, -u)
+                right = np.array([e[1], -e[0]])
+                for k in range(grid.lanes):
+                    o = (k + 0.5) * grid.lane_w
+                    p = _line(start + self.entry_m * e + o * right, end - self.entry_m * e + o * right, f"lane_{seg.index}_{d}_{k}")
+                    arm_out = int(np.argmax(ARM_DIRS @ e))
+                    node = seg.b if d > 0 else seg.a
+                    self.lane_edge[(seg.index, d, k)] = self._add(p, "lane", node, k, (arm_out, -1))
+        for node in grid.nodes:
+            arms = grid.arms(node)
+            for x in arms:
+                for y in arms:
+                    if y != x:
+                        for k in range(grid.lanes):
+                            self.connector[(node, x, y, k)] = self._add(self._connector_path(node, x, y, k), "connector",
+                                                                        node, k, (x, y))
+        self._link()
+        self.conflict = conflicts(self, CAR_BOX_M)
+
+    def _add(self, path: Path, kind: str, node, lane: int, arms) -> int:
+        self.edges.append(Edge(len(self.edges), path, kind, node, lane, arms))
+        return len(self.edges) - 1
+
+    def _connector_path(self, node, x: int, y: int, k: int) -> Path:
+        c0 = self.grid.node_xy(node)
+        a, b = -ARM_DIRS[x], ARM_DIRS[y]
+        right_a, right_b = np.array([a[1], -a[0]]), np.array([b[1], -b[0]])
+        o = (k + 0.5) * self.grid.lane_w
+        t_in, t_out = c0 - self.entry_m * a + o * right_a, c0 + self.entry_m * b + o * right_b
+        sign = float(np.sign(a[0] * b[1] - a[1] * b[0]))
+        name = f"conn_{node[0]}_{node[1]}_{x}{y}_{k}"
+        if sign == 0:
+            return _line(t_in, t_out, name)
+        r = self.entry_m - o if sign < 0 else self.entry_m + o
+        centre = t_in + r * sign * np.array([-a[1], a[0]])
+        return _arc(centre, r, float(np.arctan2(a[1], a[0])), sign, name)
+
+    def _link(self) -> None:
+        for (node, x, y, k), ci in self.connector.items():
+            # the lane arriving at ``node`` from arm x, and the lane leaving by arm y
+            self.lane_in(node, x, k).succ.append(ci)
+            self.edges[ci].succ.append(self.lane_out(node, y, k).index)
+
+    def _segment_of(self, node, arm: int):
+        nb = (node[0] + int(ARM_DIRS[arm][0]), node[1] + int(ARM_DIRS[arm][1]))
+        return self.grid.segment_between(node, nb)
+
+    def lane_in(self, node, arm: int, k: int) -> Edge:
+        """The lane of number ``k`` arriving at ``node`` from arm ``arm``."""
+        seg, d = self._segment_of(node, arm)
+        return self.edges[self.lane_edge[(seg.index, -d, k)]]
+
+    def lane_out(self, node, arm: int, k: int) -> Edge:
+        """The lane of number ``k`` leaving ``node`` by arm ``arm``."""
+        seg, d = self._segment_of(node, arm)
+        return self.edges[self.lane_edge[(seg.index, d, k)]]
+
+    def lanes(self) -> list[Edge]:
+        return [e for e in self.edges if e.kind == "lane"]
+
+    @property
+    def stop_s_from_end(self) -> float:
+        """Distance from a lane edge's end back to its stop line, metres."""
+        return self.stop_m - self.entry_m
+
+
+def _extended(graph: LaneGraph, node, x: int, y: int, k: int, ext: float) -> np.ndarray:
+    """(n, 3) x, y, heading samples of a connector with ``ext`` metres of its lanes on each side."""
+    p = graph._connector_path(node, x, y, k)
+    a, b = -ARM_DIRS[x], ARM_DIRS[y]
+    n = int(np.ceil(ext / 0.5))
+    before = p.points[0, :2] - a * np.linspace(ext, 0.5, n)[:, None]
+    after = p.points[-1, :2] + b * np.linspace(0.5, ext, n)[:, None]
+    hb, ha = np.full(n, np.arctan2(a[1], a[0])), np.full(n, np.arctan2(b[1], b[0]))
+    step = max(1, round(0.5 / STEP_M))
+    mid = np.c_[p.points[::step, :2], p.headings[::step]]
+    return np.vstack([np.c_[before, hb], mid, np.c_[after, ha]])
+
+
+def _corners(samples: np.ndarray, size) -> np.ndarray:
+    """(n, 4, 2) corners of boxes of ``size`` centred on the (n, 3) x, y, heading samples."""
+    hl, hw = size[0] / 2 + CONFLICT_PAD_M, size[1] / 2 + CONFLICT_PAD_M
+    local = np.array([[-hl, -hw], [hl, -hw], [hl, hw], [-hl, hw]])
+    c, s = np.cos(samples[:, 2]), np.sin(samples[:, 2])
+    rot = np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)   # (n, 2, 2)
+    return samples[:, None, :2] + np.einsum("nij,kj->nki", rot, local)
+
+
+def boxes_overlap(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(n, m) bool: which convex quads ``a`` (n, 4, 2) and ``b`` (m, 4, 2) overlap (separating axes)."""
+    def axes(q):
+        e = np.roll(q, -1, axis=1) - q
+        return np.stack([-e[..., 1], e[..., 0]], -1)[:, :2]   # two edge normals suffice for rectangles
+
+    sep = np.zeros((len(a), len(b)), bool)
+    for own, ax_all in ((True, axes(a)), (False, axes(b))):
+        for j in range(2):
+            ax = ax_all[:, None, j, :] if own else ax_all[None, :, j, :]   # (n, 1, 2) or (1, m, 2)
+            ax = np.broadcast_to(ax, (len(a), len(b), 2))
+            pa = np.einsum("nkd,nmd->nmk", a, ax)
+            pb = np.einsum("mkd,nmd->nmk", b, ax)
+            sep |= (pa.max(-1) < pb.min(-1)) | (pb.max(-1) < pa.min(-1))
+    return ~sep
+
+
+def conflicts(graph: LaneGraph, size) -> dict:
+    """Which connector kinds ``(arm_in, arm_out, lane)`` conflict, measured at a four-arm node.
+
+    The table is the same for every node: every node has the same cross-section and entry
+    distance, and a node with fewer arms simply lacks some connectors.
+    """
+    lanes = graph.grid.lanes
+    keys = [(x, y, k) for x in range(4) for y in range(4) if x != y for k in range(lanes)]
+    node = (0, 0)
+    ext = graph.stop_m - graph.entry_m + size[0] / 2
+    origin = _OriginGraph(graph)
+    geo = {key: _corners(_extended(origin, node, *key, ext), size) for key in keys}
+    out = {k: set() for k in keys}
+    for i, ka in enumerate(keys):
+        for kb in keys[i:]:
+            if ka == kb or boxes_overlap(geo[ka], geo[kb]).any():
+                out[ka].add(kb)
+                out[kb].add(ka)
+    return out
+
+
+class _OriginGraph:
+    """A view of a graph whose every node sits at the origin (for the node-independent table)."""
+
+    def __init__(self, graph: LaneGraph):
+        self._g = graph
+        self.entry_m = graph.entry_m
+
+        class _G:
+            lane_w = graph.grid.lane_w
+
+            @staticmethod
+            def node_xy(node):
+                return np.zeros(2)
+
+        self.grid = _G
+
+    _connector_path = LaneGraph._connector_path

@@ -1,0 +1,154 @@
+"""Moving traffic: vehicles keep the lanes, never touch, drive smoothly; the ego drives among them."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from generator.errors import SpecError
+from generator.layout.assemble import build_scene
+from generator.layout.streets import make_grid
+from generator.spec.load import parse_spec
+from generator.traffic.build import build_world
+from generator.traffic.lanes import LaneGraph, boxes_overlap
+from generator.world.actors import MOVING_THRESHOLD_MPS, Track
+from generator.world.rig import SWEEP_PERIOD_S, Rig
+from generator.world.scene import OrientedBox
+
+TRAFFIC = {"cars_per_km": 25, "trucks_per_km": 2, "buses_per_km": 1, "cyclists_per_km": 3, "motorcyclists_per_km": 2,
+           "other_vehicles_per_km": 1}
+DURATION = 40.0
+
+
+def spec_with(traffic: dict, **extra):
+    doc = {"name": "traffic_town", "seed": 11,
+           "town": {"blocks_x": 2, "blocks_y": 2, "block_size_m": 45, "block_size_jitter_m": 6, "margin_m": 10},
+           "density": {"moving_cars_per_100m": 0}, "traffic": traffic, **extra}
+    return parse_spec(doc, "traffic_town.json")
+
+
+@pytest.fixture(scope="module")
+def town():
+    spec = spec_with(TRAFFIC)
+    scene = build_scene(spec)
+    return spec, scene, build_world(spec, scene, DURATION)
+
+
+def _times():
+    return np.arange(0.0, DURATION, 0.1)
+
+
+def test_vehicles_exist_move_and_the_ego_is_not_an_actor(town):
+    spec, scene, world = town
+    kinds = {a.kind for a in world.actors}
+    assert {"car", "truck", "bus", "bicyclist", "motorcyclist", "construction_vehicle"} <= kinds
+    speeds = np.array([[a.track.speed(t)[0] for a in world.actors] for t in _times()])
+    assert (speeds > MOVING_THRESHOLD_MPS).mean() > 0.3          # traffic flows ...
+    assert speeds.max() <= spec.traffic.speed_limit_mps + 1e-6   # ... within the limit
+    assert len({a.instance_id for a in world.actors}) == len(world.actors)
+    assert min(a.instance_id for a in world.actors) > max(o.instance_id for o in scene.objects)
+
+
+def test_no_two_boxes_touch_at_any_time_ego_included(town):
+    _, scene, world = town
+    parked = np.stack([o.box.corners_xy() for o in scene.objects if o.instance_id > 0])
+    for t in _times():
+        q = np.stack([b.corners_xy() for b in world.boxes(t)])
+        ov = boxes_overlap(q, q)
+        np.fill_diagonal(ov, False)
+        assert not ov.any(), f"actors {np.argwhere(ov)[0]} overlap at t={t:.1f}"
+        E = world.ego.T_world_ego(t)[0]
+        ego = OrientedBox((E[0, 3], E[1, 3], 0.7), (4.6, 1.9, 1.5), float(np.arctan2(E[1, 0], E[0, 0])))
+        assert not boxes_overlap(ego.corners_xy()[None], q).any(), f"an actor touches the ego at t={t:.1f}"
+        assert not boxes_overlap(q, parked).any(), f"an actor touches a static object at t={t:.1f}"
+
+
+def test_vehicles_stay_on_the_driving_lanes(town):
+    spec, _, world = town
+    grid = make_grid(spec)
+    drive = grid.drivable_rects()
+    for t in _times()[::5]:
+        for a in world.actors:
+            c = np.asarray(a.box(t).center[:2])
+            inside = ((c[0] >= drive[:, 0]) & (c[0] <= drive[:, 2]) & (c[1] >= drive[:, 1]) & (c[1] <= drive[:, 3])).any()
+            assert inside, f"{a.name} off the lanes at t={t:.1f}: {c}"
+
+
+def test_motion_is_continuous_and_bounded(town):
+    _, _, world = town
+    for a in world.actors:
+        tr = a.track
+        step = np.linalg.norm(np.diff(tr.xyz[:, :2], axis=0), axis=1)
+        assert step.max() <= 25.0 * tr.dt + 1e-9                 # no teleport
+        assert np.abs(np.diff(tr.yaw)).max() <= 1.5 * tr.dt * 10  # < 1.5 rad/s... x10 margin for tight arcs
+        v = np.diff(tr.xyz[:, :2], axis=0) / tr.dt
+        acc = np.linalg.norm(np.diff(v, axis=0), axis=1) / tr.dt
+        assert np.percentile(acc, 99.5) <= 9.0, a.name           # braking clamped at 8 m/s^2 (+ turning)
+
+
+def test_ego_drives_route_zero_with_stops(town):
+    spec, scene, world = town
+    rig = Rig.from_world(spec, world)
+    times = _times()
+    pos = rig.T_world_ego(times)[:, :2, 3]
+    d = np.linalg.norm(np.diff(pos, axis=0), axis=1) / 0.1
+    assert d.max() <= spec.paths.speed_mps + 0.5
+    assert (d < 0.05).any() and (d > 0.5 * spec.paths.speed_mps).any()   # it stops and it drives
+    route = scene.paths[0].points[:, :2]
+    gap = np.min(np.linalg.norm(pos[:, None] - route[None], axis=-1), axis=1)
+    assert gap.max() < 0.6                                     # route 0's lane centres and arcs
+
+
+def test_frames_sit_on_sweep_starts(town):
+    spec, _, world = town
+    rig = Rig.from_world(spec, world)
+    for f in rig.frames(3):
+        assert abs(f.t / SWEEP_PERIOD_S - round(f.t / SWEEP_PERIOD_S)) < 1e-9
+        assert np.allclose(f.T_world_ego, rig.T_world_ego(f.t)[0])
+
+
+def test_same_seed_same_world_and_a_longer_run_is_a_prefix(town):
+    spec, scene, world = town
+    short = build_world(spec, scene, 10.0)
+    n = len(short.actors[0].track.yaw) - 30
+    for a, b in zip(world.actors, short.actors):
+        assert np.array_equal(a.track.xyz[:n], b.track.xyz[:n]) and np.array_equal(a.track.yaw[:n], b.track.yaw[:n])
+
+
+def test_zero_traffic_is_the_frozen_town(test_spec, test_scene):
+    world = build_world(test_spec, test_scene, 5.0)
+    assert world.actors == []
+    rig = Rig.from_world(test_spec, world)
+    assert np.allclose(rig.T_world_ego(1.0), Rig.from_spec(test_spec, test_scene).T_world_ego(1.0))
+
+
+def test_every_connector_conflicts_with_itself_and_opposite_straights_do_not(town):
+    spec, _, _ = town
+    graph = LaneGraph(make_grid(spec))
+    for key, others in graph.conflict.items():
+        assert key in others
+    assert (2, 0, 0) not in graph.conflict[(0, 2, 0)]
+
+
+@pytest.mark.parametrize("field, value, says", [
+    ("cars_per_km", -1, "traffic.cars_per_km"),
+    ("speed_limit_mps", 60, "traffic.speed_limit_mps"),
+])
+def test_bad_traffic_fields_are_one_line(field, value, says):
+    with pytest.raises(SpecError) as e:
+        spec_with({field: value})
+    assert says in str(e.value) and "\n" not in str(e.value)
+
+
+def test_more_vehicles_than_lanes_hold_is_refused():
+    spec = spec_with({"cars_per_km": 140, "buses_per_km": 30})
+    scene = build_scene(spec)
+    with pytest.raises(SpecError, match=r"traffic\.(buses|cars)_per_km"):
+        build_world(spec, scene, 5.0)
+
+
+def test_track_interpolates_between_samples():
+    tr = Track(0.0, 0.5, np.array([[0.0, 0, 0], [1, 0, 0], [3, 0, 0]]), np.array([0.0, 0.0, np.pi / 2]))
+    assert np.allclose(tr.position(0.25), [[0.5, 0, 0]])
+    assert np.allclose(tr.heading(0.75), [np.pi / 4])
+    assert np.allclose(tr.velocity(0.5, h=0.25), [[3.0, 0, 0]])
