@@ -75,14 +75,13 @@ def _run(job, queue, scratch: Path) -> None:
     from generator.blender.renderer import Renderer  # imports bpy (after the sys.path clean-up)
     from generator.jobs.variants import render_frame
     from generator.layout import build_scene
-    from generator.world.actors import frozen_world
     from generator.world.rig import Rig
 
     spec, cfg = job.spec, job.config
     t = time.perf_counter()
     scene = build_scene(spec)
-    rig = Rig.from_spec(spec, scene)
-    world = frozen_world(scene, rig.trajectory)
+    world = _world(spec, scene, job)
+    rig = Rig.from_world(spec, world)
     layout_s = time.perf_counter() - t
     renderer = Renderer(scene, spec, cfg, scratch, world)
     queue.put(("ready", {"layout_s": layout_s, "blender_build_s": renderer.build_seconds, "pid": os.getpid()}))
@@ -106,6 +105,22 @@ def _run(job, queue, scratch: Path) -> None:
         "rss_mb": _rss_mb(), "setup_s": layout_s + renderer.build_seconds, "frames_s": time.perf_counter() - t_start,
         "cycles_rgb_s": cycles["rgb"], "cycles_labels_s": cycles["labels"],
     }))
+
+
+def _world(spec, scene, job):
+    """The world in time over this job's frames and stereo sweeps.
+
+    The same world the parent planned (:func:`generator.jobs.drive.plan_drive` over all frames):
+    the traffic simulation is causal and seeded by name, so a shorter run has the same state at
+    every instant it covers; it only has to reach this job's last frame and last stereo sweep.
+    """
+    from generator.jobs.drive import MARGIN_M
+    from generator.traffic.build import build_world
+    from generator.world.rig import SWEEP_PERIOD_S
+
+    last = max(job.frames, default=0)
+    duration = (max(job.stereo) + 1) * SWEEP_PERIOD_S + 0.2 if job.stereo else 0.0
+    return build_world(spec, scene, duration, last * spec.paths.spacing_m + MARGIN_M)
 
 
 def _rss_mb() -> float:
