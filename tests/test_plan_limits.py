@@ -122,7 +122,8 @@ def test_disk_too_small_is_refused_before_any_work(tmp_path, capsys, monkeypatch
     err = _refused(capsys, ["render", SPEC, "--config", "preview", "--out", str(out), "--frames", "10"], out)
     assert "(10 images at 640x360)" in err
     err = _refused(capsys, ["generate", SPEC, "--config", "test", "--out", str(out), "--frames", "3"], out)
-    assert "36 images and 3 stereo pairs" in err and "3 scans" in err
+    # 3 frames 6 m apart at 8 m/s are 1.5 s of drive: 16 sweeps at 10 Hz, a stereo pair every 10th
+    assert "36 images and 2 stereo pairs" in err and "16 scans" in err
 
 
 def test_a_resumed_plan_is_checked_merged(tmp_path, capsys):

@@ -74,9 +74,10 @@ def run(args) -> int:
         exact &= frame.native_exact
         timed &= frame.times is not None
         world = P.transform(frame.pose, fused.xyz_start)  # Eq. 2, first-LiDAR frame
-        maps["lidar"].add(world, frame.native)
+        maps["lidar"].add_static(world, frame.native, frame.semantic, frame.instance)
         seen = fused.proj.index[fused.visible]
-        maps["camera"].add(world[seen], fused.image_class[fused.visible])
+        maps["camera"].add_static(world[seen], fused.image_class[fused.visible], frame.semantic[seen],
+                                  frame.instance[seen])
         smeared = int((~fused.visible & (fused.image_class != fused.lidar_class)).sum())
         if frame.index == overlay_k or (overlay_k is None and smeared > best):
             overlay, best = (frame.class_id, fused), smeared
@@ -84,7 +85,8 @@ def run(args) -> int:
     for k in progress(ds.seq.frames, desc="map", unit="scan"):
         if k not in ds.frames:
             scan = ds.read_scan(k)
-            maps["lidar"].add(P.transform(scan["pose"], deskewed(scan, deskew)), scan["native"])
+            maps["lidar"].add_static(P.transform(scan["pose"], deskewed(scan, deskew)), scan["native"],
+                                     scan["semantic"], scan["instance"])
     settings = {
         "dataset": str(root), "sequence": ds.seq.dir.name, "abs_tol_m": abs_tol, "rel_tol": rel_tol,
         "deskew": ("on (point_times/ + sweep poses of lidar_meta.json)" if deskew and timed else

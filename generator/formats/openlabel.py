@@ -25,11 +25,20 @@ the parent). Per frame ``frame_properties.transforms`` holds
 * ``camera_to_vehicle-iso8855``: the camera pose of that frame (jitter included).
 
 Objects: key = the object's instance id (the high 16 bits of the ``.label`` files), ``type``
-= native class name. Per frame each object present has one cuboid in ``vehicle-iso8855``
-at the frame time (the sweep start): ``(x, y, z, qx, qy, qz, qw, sx, sy, sz)`` with size =
-length (along the heading), width, height in metres; and ``num`` ``lidar_points`` = points
-of that instance in the frame's scan. Objects with fewer points than the threshold
-(``spec.labels.openlabel_min_points``) are left out of that frame.
+= native class name. Static town objects and actors (:mod:`generator.world.actors`) share the
+key space in disjoint ranges: actors' instance ids follow every static one, and an actor
+keeps its id (its uid) for the whole sequence. Per frame each object present has one cuboid
+in ``vehicle-iso8855`` at the frame time (the sweep start): ``(x, y, z, qx, qy, qz, qw, sx,
+sy, sz)`` with size = length (along the heading), width, height in metres; ``num``
+``lidar_points`` = points of that instance in the frame's scan; and its motion at the same
+instant (:mod:`generator.formats.openlabel_motion`): ``vec`` ``velocity`` (m/s) and
+``acceleration`` (m/s^2) of the cuboid centre over ground, expressed in ``odom``; ``num``
+``speed`` and ``acceleration_magnitude``; ``boolean`` ``moving``. Objects with fewer points
+than the threshold (``spec.labels.openlabel_min_points``) are left out of that frame.
+
+Timestamps: ``frame_properties.timestamp`` and, per stream of the frame,
+``stream_properties.sync.timestamp`` = the sweep start in seconds on the sequence's timeline
+(``times.txt``); the camera stream appears in a frame only when an image was exposed then.
 
 Motion skew: the ``.bin`` scans keep the coordinates of each column's firing instant (KITTI
 convention), so on a moving ego a raw scan drawn in the frame's vehicle frame is shifted by
@@ -48,8 +57,9 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from generator import __version__
-from generator.world import rig
 from generator.atomic import write_text
+from generator.formats import openlabel_motion as om
+from generator.world import rig
 
 SCHEMA_PATH = Path(__file__).resolve().parent / "schemas" / "openlabel_json_schema-v1.0.0.json"
 ODOM, VEHICLE, LIDAR, CAMERA = "odom", "vehicle-iso8855", "lidar", "camera"
@@ -118,19 +128,31 @@ def _intervals(frames: list[int]) -> list[dict]:
     return out
 
 
+def _candidates(objects, actors) -> dict[int, tuple[str, str, object]]:
+    """Instance id -> (name, class, state at t) of static objects and actors."""
+    out = {o.instance_id: (o.name, o.cls, (lambda t, box=o.box: om.static_motion(box))) for o in objects}
+    for a in actors:
+        if a.instance_id in out:
+            raise ValueError(f"actor {a.name}: instance id {a.instance_id} is a static object's too")
+        out[a.instance_id] = (a.name, a.cls, (lambda t, a=a: om.actor_motion(a, t)))
+    return out
+
+
 def build_openlabel(*, objects, frames, times, counts, min_points: int, T_ego_lidar: np.ndarray,
                     T_ego_camera_nominal: np.ndarray, K: np.ndarray, width: int, height: int,
-                    streams: dict, frame_uris: list[dict], info: dict) -> dict:
+                    streams: dict, frame_uris: list[dict], info: dict, actors=()) -> dict:
     """The OpenLABEL document of one sequence.
 
     Parameters
     ----------
     objects : list of generator.world.scene.SceneObject
-        Candidate objects (their ``box`` and ``instance_id``).
-    frames : list of generator.world.rig.Frame
-        The sequence's frames (``T_world_ego`` and ``T_ego_camera`` at the sweep start).
+        Candidate static objects (their ``box``, ``instance_id``, ``name``, ``cls``).
+    frames : list
+        The sequence's frames (sweeps): each with ``index``, ``T_world_ego`` (4, 4) at the sweep
+        start and ``T_ego_camera`` (4, 4, optical camera in the ego frame, jitter included) or
+        ``None`` when no image was exposed with that sweep (:class:`generator.world.rig.Frame` fits).
     times : (n_frames,) float
-        Seconds since the sequence start.
+        Sweep starts, seconds on the world timeline (``times.txt``); actors are evaluated there.
     counts : list of dict
         Per frame: instance id -> LiDAR points of that instance in the scan.
     min_points : int
@@ -142,40 +164,46 @@ def build_openlabel(*, objects, frames, times, counts, min_points: int, T_ego_li
     streams : dict
         ``{"camera": {"uri", "description"}, "lidar": {"uri", "description", "stream_properties"}}``.
     frame_uris : list of dict
-        Per frame ``{"camera": uri, "lidar": uri}`` of the frame's files.
+        Per frame ``{"lidar": uri}`` and ``"camera": uri`` when the frame has an image.
     info : dict
         Extra ``metadata.urbangen`` fields (scene, seed, spec hash...).
+    actors : sequence of generator.world.actors.Actor
+        Movers: cuboid and motion from their tracks at each frame's time.
     """
     T_world_odom = frames[0].T_world_ego
     T_odom_world = rig.invert(T_world_odom)
     doc_frames: dict[str, dict] = {}
     present: dict[int, list[int]] = {}
-    by_uid = {o.instance_id: o for o in objects}
+    cands = _candidates(objects, actors)
     for f, t, cnt, uris in zip(frames, times, counts, frame_uris):
         T_vehicle_world = rig.invert(f.T_world_ego)
         objs = {}
-        for uid in sorted(by_uid):
+        for uid in sorted(cands):
             n = int(cnt.get(uid, 0))
             if n < max(min_points, 1):
                 continue
+            m = cands[uid][2](float(t))
             objs[str(uid)] = {"object_data": {
                 "cuboid": [{"name": CUBOID_NAME, "coordinate_system": VEHICLE,
-                            "val": cuboid_val(by_uid[uid].box, T_vehicle_world)}],
+                            "val": cuboid_val(m.box, T_vehicle_world)}],
                 "num": [{"name": POINTS_NAME, "type": "value", "val": n}]}}
+            for kind, items in om.motion_data(m, T_odom_world[:3, :3], ODOM).items():
+                objs[str(uid)]["object_data"].setdefault(kind, []).extend(items)
             present.setdefault(uid, []).append(f.index)
+        transforms = {f"{VEHICLE}_to_{ODOM}": {"src": VEHICLE, "dst": ODOM,
+                                               "transform_src_to_dst": _m(T_odom_world @ f.T_world_ego)}}
+        if getattr(f, "T_ego_camera", None) is not None:
+            transforms[f"{CAMERA}_to_{VEHICLE}"] = {"src": CAMERA, "dst": VEHICLE,
+                                                    "transform_src_to_dst": _m(f.T_ego_camera)}
         doc_frames[str(f.index)] = {
             "frame_properties": {
                 "timestamp": float(t),
-                "streams": {key: {"uri": uri} for key, uri in uris.items()},
-                "transforms": {
-                    f"{VEHICLE}_to_{ODOM}": {"src": VEHICLE, "dst": ODOM,
-                                             "transform_src_to_dst": _m(T_odom_world @ f.T_world_ego)},
-                    f"{CAMERA}_to_{VEHICLE}": {"src": CAMERA, "dst": VEHICLE,
-                                               "transform_src_to_dst": _m(f.T_ego_camera)},
-                }},
+                "streams": {key: {"uri": uri, "stream_properties": {"sync": {"timestamp": float(t)}}}
+                            for key, uri in uris.items()},
+                "transforms": transforms},
             "objects": objs,
         }
-    doc_objects = {str(uid): {"name": by_uid[uid].name, "type": by_uid[uid].cls, "coordinate_system": VEHICLE,
+    doc_objects = {str(uid): {"name": cands[uid][0], "type": cands[uid][1], "coordinate_system": VEHICLE,
                               "frame_intervals": _intervals(ks)} for uid, ks in sorted(present.items())}
     camera_matrix = np.hstack([np.asarray(K, np.float64), np.zeros((3, 1))])
     ol = {
@@ -185,7 +213,8 @@ def build_openlabel(*, objects, frames, times, counts, min_points: int, T_ego_li
             "annotator": f"urbangen {__version__} (automatic: boxes from the scene model, counts from the ray-cast labels)",
             "comment": ("matrix4x4 row-major, X_dst = M X_src; pose_wrt_parent maps child -> parent; cuboids "
                         "(x,y,z,qx,qy,qz,qw,length,width,height) in vehicle-iso8855 at the frame time (sweep "
-                        f"start); objects with fewer than {min_points} LiDAR points left out of a frame"),
+                        "start); velocity/acceleration of the cuboid centre over ground at the same instant, in "
+                        f"odom (central differences, h = 0.05 s); moving = speed > {om.MOVING_THRESHOLD_MPS} m/s; objects with fewer than {min_points} LiDAR points left out of a frame"),
             "urbangen": {**info, "T_world_odom": [float(v) for v in np.round(T_world_odom.reshape(-1), 9)],
                          "min_points": int(min_points)},
         },

@@ -74,9 +74,14 @@ class FusedFrame:
 
 
 def fuse_frame(frame: FusionFrame, deskew: bool = True, abs_tol_m: float = P.ABS_TOL_M,
-               rel_tol: float = P.REL_TOL) -> FusedFrame:
-    """De-skew, project, occlusion-test and label one frame (see the module docstring)."""
-    xyz = deskewed(frame, deskew)
+               rel_tol: float = P.REL_TOL, actors=None) -> FusedFrame:
+    """De-skew, project, occlusion-test and label one frame (see the module docstring).
+
+    ``actors``: instance id -> ``T_world_actor(t)`` (:func:`generator.fusion.movers.actor_poses`);
+    with it (and ``deskew``) actor points are also de-skewed by their actor's motion to the
+    image time (the sweep start); without it only the sensor's motion is undone.
+    """
+    xyz = deskewed(frame, deskew, actors)
     T = P.camera_from_lidar(frame.T_world_camera, frame.T_world_lidar_start)
     h, w = frame.class_id.shape
     proj = P.project(P.transform(T, xyz), frame.K, w, h)

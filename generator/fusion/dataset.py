@@ -63,6 +63,8 @@ class FusionFrame:
         LiDAR world poses at ``sweep_times`` (see :meth:`generator.world.rig.Rig.sweep_record`).
     pose : (4, 4) float64
         LiDAR pose in the first LiDAR frame (``poses.txt`` / SemanticKITTI convention).
+    t_sweep : float or None
+        Sweep start on the world timeline, seconds (``times.txt``; the image time).
     """
 
     index: int
@@ -81,6 +83,7 @@ class FusionFrame:
     sweep_times: np.ndarray
     sweep_poses: np.ndarray
     pose: np.ndarray
+    t_sweep: float | None = None
 
 
 def native_from_raw(raw: np.ndarray) -> np.ndarray:
@@ -194,7 +197,7 @@ class FusionDataset:
     def read_scan(self, k: int, image_meta: dict | None = None) -> dict:
         """The LiDAR part of frame ``k`` (any scan of the sequence): the :class:`FusionFrame`
         fields ``xyz, semantic, instance, native, native_exact, times, T_world_lidar_start,
-        sweep_times, sweep_poses, pose``."""
+        sweep_times, sweep_poses, pose, t_sweep``."""
         rec = self.seq.read(k, True, self.poses)
         if rec.semantic is None:
             raise UserError(f"{self.seq.labels_dir}: missing (fusion needs labelled scans)")
@@ -205,7 +208,8 @@ class FusionDataset:
         return dict(xyz=rec.points[:, :3], semantic=rec.semantic, instance=rec.instance,
                     native=native if native is not None else native_from_raw(rec.semantic),
                     native_exact=native is not None, times=times, T_world_lidar_start=sweep_poses[0],
-                    sweep_times=sweep_times, sweep_poses=sweep_poses, pose=rec.pose)
+                    sweep_times=sweep_times, sweep_poses=sweep_poses, pose=rec.pose,
+                    t_sweep=float(self.seq.times[k]) if self.seq.times is not None and k < len(self.seq.times) else None)
 
     def read(self, k: int) -> FusionFrame:
         """Frame ``k`` (must be in :attr:`frames`)."""
@@ -220,14 +224,28 @@ class FusionDataset:
             yield self.read(k)
 
 
-def deskewed(scan: dict | FusionFrame, deskew: bool = True) -> np.ndarray:
+def deskewed(scan: dict | FusionFrame, deskew: bool = True, actors=None) -> np.ndarray:
     """(n, 3) float64 points of a scan in the LiDAR frame at the sweep start (raw when
-    ``deskew`` is False or the scan has no firing times / only one known pose)."""
+    ``deskew`` is False or the scan has no firing times / only one known pose).
+
+    ``actors`` (instance id -> ``T_world_actor(t)``, :func:`generator.fusion.movers.actor_poses`):
+    points of those actors are then also moved by their actor's motion from their firing
+    instant to the sweep start (:func:`generator.fusion.movers.deskew_movers`), the image time.
+    """
     get = scan.get if isinstance(scan, dict) else lambda key: getattr(scan, key)
     xyz = np.asarray(get("xyz"), np.float64)
     times, ts = get("times"), get("sweep_times")
-    if not deskew or times is None or len(ts) < 2:
+    if not deskew:
         return xyz
-    from generator.fusion.projection import deskew as _deskew
+    if times is not None and len(ts) >= 2:
+        from generator.fusion.projection import deskew as _deskew
 
-    return _deskew(xyz, times, ts, get("sweep_poses"))
+        xyz = _deskew(xyz, times, ts, get("sweep_poses"))
+    if actors:
+        from generator.fusion.movers import deskew_movers
+
+        t0 = get("t_sweep")
+        if t0 is None:
+            raise UserError("de-skewing actors needs the sweep start times (times.txt)")
+        xyz = deskew_movers(xyz, get("instance"), times, t0, t0, get("T_world_lidar_start"), actors)
+    return xyz

@@ -13,6 +13,12 @@ SemanticKITTI-only dataset gives raw ids; their canonical native class
 road_marking and crosswalk, sidewalk 48 from sidewalk and curb, vegetation 70 from
 vegetation and tree_crown, traffic-sign 81 from traffic_light and traffic_sign. urbangen
 sequences carry ``native_labels/`` side files, so their maps keep every native class.
+
+Only the STATIC world is accumulated (:meth:`VoxelMap.add_static`): points labelled moving-*
+(SemanticKITTI raw ids 252-259) and every point of an actor (its instance id; a car waiting at a
+light is static in its label but still a mover) are left out, so a car driving through the
+sequence leaves no smear of voxels along its path. The dropped points are what dynamic-object
+removal research wants separated; :func:`generator.fusion.movers.static_mask` says which.
 """
 
 from __future__ import annotations
@@ -62,6 +68,7 @@ class VoxelMap:
         self._count = np.zeros(0, np.int64)
         self._sum = np.zeros((0, 3), np.float64)
         self.points = 0
+        self.dropped = 0  # moving / actor points left out by add_static
 
     def add(self, xyz: np.ndarray, labels: np.ndarray) -> None:
         """Count (n, 3) float points (map frame, metres) with (n,) native labels (< 64)."""
@@ -77,6 +84,28 @@ class VoxelMap:
         key = (((idx[:, 0] << AXIS_BITS | idx[:, 1]) << AXIS_BITS | idx[:, 2]) << LABEL_BITS) | labels
         self._merge(key, np.ones(len(key), np.int64), xyz)
         self.points += len(key)
+
+    def add_static(self, xyz: np.ndarray, labels: np.ndarray, semantic: np.ndarray, instance: np.ndarray,
+                   actor_instances=()) -> int:
+        """Count only the static points of a scan; returns how many points were dropped.
+
+        Parameters
+        ----------
+        xyz : (n, 3) float
+            Map frame, metres.
+        labels : (n,) integer
+            Native classes (< 64).
+        semantic, instance : (n,) integer
+            SemanticKITTI raw id and instance id per point (moving-* ids 252-259 are dropped).
+        actor_instances : iterable of int
+            Instance ids of the actors (dropped whatever their label).
+        """
+        from generator.fusion.movers import static_mask
+
+        keep = static_mask(semantic, instance, actor_instances)
+        self.add(np.asarray(xyz, np.float64).reshape(-1, 3)[keep], np.asarray(labels)[keep])
+        self.dropped += int((~keep).sum())
+        return int((~keep).sum())
 
     def _merge(self, key: np.ndarray, count: np.ndarray, sums: np.ndarray) -> None:
         key = np.concatenate([self._key, key])

@@ -1,9 +1,20 @@
-"""OpenLABEL 1.0 boxes of a dataset's LiDAR sequence (used by ``urbangen openlabel`` and ``generate``)."""
+"""OpenLABEL 1.0 boxes of a dataset's LiDAR sequence (used by ``urbangen openlabel`` and ``generate``).
+
+Two layouts of ``lidar_meta.json``:
+
+* a 10 Hz stream (``sweep_period_s`` present): OpenLABEL frame ``j`` = sweep ``j`` at
+  ``times.txt[j]``; the ego pose there, the camera transform only for sweeps an image was
+  exposed with (``image_frames`` ``[[k, j], ...]``); with ``traffic`` true the world (actors
+  included) is rebuilt from the spec -- deterministic from its seed -- over the recorded
+  ``duration_s`` (else the sequence's last time plus one sweep) and ``distance_m``;
+* the older one-sweep-per-image layout: frame ``k`` = :meth:`generator.world.rig.Rig.frame`.
+"""
 
 from __future__ import annotations
 
 import logging
 import os
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -14,11 +25,61 @@ from generator.formats import semantickitti as sk
 from generator.formats.openlabel import build_openlabel, write_openlabel
 from generator.imaging import meta_fields as md
 from generator.safeload import printable
-from generator.world.rig import Frame, Rig
+from generator.world.rig import SWEEP_PERIOD_S, Rig
 
 log = logging.getLogger(__name__)
 
 DEFAULT_CLASSES = ("car", "truck", "person")
+
+
+@dataclass(frozen=True)
+class SweepFrame:
+    """One OpenLABEL frame of a 10 Hz stream: sweep ``index`` starting at ``t`` seconds.
+
+    Attributes
+    ----------
+    T_world_ego : (4, 4) float64
+        Ego pose at the sweep start.
+    T_ego_camera : (4, 4) float64 or None
+        Camera (optical) in the ego frame of the image exposed with this sweep, jitter included.
+    image : int or None
+        That image's frame number.
+    """
+
+    index: int
+    t: float
+    T_world_ego: np.ndarray
+    T_ego_camera: np.ndarray | None = None
+    image: int | None = None
+
+
+def sequence_world(spec, scene, meta: dict, times: np.ndarray, source: str):
+    """The world a 10 Hz sequence was cast in: actors when ``meta["traffic"]`` is true, else none."""
+    from generator.traffic.build import build_world
+    from generator.world.actors import frozen_world
+
+    traffic = md.field(meta, "traffic", source, default=None)
+    if not isinstance(traffic, dict) or not traffic.get("actors"):
+        return None
+    duration = float(md.field(meta, "traffic.duration_s", source, default=float(np.max(times)) + SWEEP_PERIOD_S))
+    # the simulation is causal: a run at least as long gives the same poses over the sequence
+    world = build_world(spec, scene, duration, 0.0)
+    return world if world.actors else frozen_world(scene, world.ego)
+
+
+def sweep_frames(rig: Rig, meta: dict, frames: list[int], times: np.ndarray, source: str) -> list[SweepFrame]:
+    """Per sweep: the ego pose at ``times[j]`` and, for sweeps paired with an image, its camera."""
+    pairs = md.field(meta, "image_frames", source, default=[])
+    if not isinstance(pairs, list) or not all(isinstance(p, list) and len(p) == 2 and all(
+            isinstance(v, int) and not isinstance(v, bool) and v >= 0 for v in p) for p in pairs):
+        raise SpecError(source, "image_frames", "must be a list of [image frame, sweep] pairs of integers >= 0")
+    image_of = {j: k for k, j in pairs}
+    out = []
+    for j in frames:
+        k = image_of.get(j)
+        cam = rig.T_ego_camera(rig.camera_jitter(k)) if k is not None else None
+        out.append(SweepFrame(j, float(times[j]), rig.T_world_ego(float(times[j]))[0], cam, k))
+    return out
 
 
 def _camera(root: Path, seq, meta: dict, meta_source: str) -> tuple[np.ndarray, int, int, str]:
@@ -111,14 +172,11 @@ def write_sequence_openlabel(spec, root: Path, sequence: str = "00", classes=DEF
 
         scene = build_scene(spec)
     route = md.integer(meta, "scene.route", src, 0, max(len(scene.paths) - 1, 0), default=0)
-    if route == 0:  # the drive of the sequence: the ego among the traffic of the world in time
-        from generator.jobs.lidar_sequence import world_for
-
-        rig = Rig.from_world(spec, world_for(spec, scene, max(seq.frames) + 1))
-    else:
-        rig = Rig.from_spec(spec, scene, route)
-    frames = [Frame(k, 0.0, float(seq.times[k]), rig.T_world_ego(float(seq.times[k]))[0], rig.camera_jitter(k),
-                    rig.T_ego_camera(rig.camera_jitter(k))) for k in seq.frames]
+    stream = md.field(meta, "sweep_period_s", src, default=None) is not None
+    world = sequence_world(spec, scene, meta, seq.times, src) if stream else None
+    rig = Rig.from_world(spec, world) if world is not None else Rig.from_spec(spec, scene, route)
+    frames = sweep_frames(rig, meta, seq.frames, seq.times, src) if stream else [rig.frame(k) for k in seq.frames]
+    actors = [a for a in world.actors if a.cls in classes] if world is not None else []
     counts = []
     for k in seq.frames:
         _, _, inst = seq.read_labelled(k)  # whole scan and labels, one label per point
@@ -137,12 +195,15 @@ def write_sequence_openlabel(spec, root: Path, sequence: str = "00", classes=DEF
     info = {"scene": spec.name, "seed": spec.seed, "spec_hash": spec.spec_hash, "sequence": name, "route": route,
             "classes": list(classes)}
     exr = {int(p.name[:6]): p.name for p in sorted((root / "images").glob("[0-9]*_*.exr"), reverse=True)}
-    frame_uris = [{"camera": f"images/{exr.get(k, f'{k:06d}_day_clear.exr')}",
-                   "lidar": f"lidar/sequences/{name}/velodyne/{k:06d}.bin"} for k in seq.frames]
+    frame_uris = []
+    for f in frames:
+        k = f.image if stream else f.index
+        uris = {"camera": f"images/{exr.get(k, f'{k:06d}_day_clear.exr')}"} if k is not None else {}
+        frame_uris.append({**uris, "lidar": f"lidar/sequences/{name}/velodyne/{f.index:06d}.bin"})
     doc = build_openlabel(objects=objects, frames=frames, times=[seq.times[k] for k in seq.frames], counts=counts,
                           min_points=min_points, T_ego_lidar=rig.T_ego_lidar,
                           T_ego_camera_nominal=rig.T_ego_camera(), K=K, width=w, height=h,
-                          streams=streams, frame_uris=frame_uris, info=info)
+                          streams=streams, frame_uris=frame_uris, info=info, actors=actors)
     try:
         write_openlabel(out, doc)
     except ValueError as e:  # a bug, not a user error: say so loudly

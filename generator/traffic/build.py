@@ -90,7 +90,12 @@ def build_world(spec, scene, duration_s: float, distance_m: float = 0.0) -> Worl
 def _pedestrians(spec, grid, scene, signals, lib, n_steps: int, distance_m: float) -> list[Mover]:
     if spec.traffic.pedestrians_per_100m <= 0 and spec.traffic.standing_pedestrians_per_100m <= 0:
         return []
-    from generator.traffic.pedestrians import simulate_pedestrians
+    try:
+        from generator.traffic.pedestrians import simulate_pedestrians
+    except ImportError:  # the walking model has not landed yet: refuse plainly rather than half-simulate
+        field = "pedestrians_per_100m" if spec.traffic.pedestrians_per_100m > 0 else "standing_pedestrians_per_100m"
+        raise SpecError(spec.source, f"traffic.{field}", "moving pedestrians are not simulated in this version; "
+                        "set it to 0 (people_per_100m still places standing ones)") from None
 
     if distance_m > 0:  # the drive may take longer than asked: cover the slowest plausible ego
         n_steps = max(n_steps, int(np.ceil((distance_m / (0.25 * spec.paths.speed_mps) + 5.0) / DT_S)))
