@@ -85,7 +85,7 @@ def build(world: World, materials: list, handles: geometry.BlenderScene) -> Acto
     return ActorObjects(world, keys, owners, objects)
 
 
-def headlights(objs: ActorObjects, make_spot, collection: "bpy.types.Collection") -> int:
+def headlights(objs: ActorObjects, make_spot, collection: bpy.types.Collection) -> int:
     """Spot lights at every actor's ``headlight`` anchors, parented to its object; return how many.
 
     ``make_spot(name, location, direction, collection) -> bpy.types.Object`` creates one light

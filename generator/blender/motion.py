@@ -47,7 +47,7 @@ class Keys:
         one (replacing any other animation).
     """
 
-    def __init__(self, ob: "bpy.types.Object"):
+    def __init__(self, ob: bpy.types.Object):
         self.object = ob
         ad = ob.animation_data
         if ad is not None and ad.action is not None and ad.action.name.startswith(ACTION_PREFIX):
@@ -67,7 +67,7 @@ class Keys:
         ad.action_slot = slot
 
     @staticmethod
-    def present(ob: "bpy.types.Object") -> bool:
+    def present(ob: bpy.types.Object) -> bool:
         """Whether ``ob`` carries motion keys."""
         ad = ob.animation_data
         return ad is not None and ad.action is not None and ad.action.name.startswith(ACTION_PREFIX)
@@ -105,7 +105,7 @@ def yaw_values(xyz: np.ndarray, yaw: np.ndarray) -> np.ndarray:
     return out
 
 
-def blender_values(ob: "bpy.types.Object", matrices) -> np.ndarray:
+def blender_values(ob: bpy.types.Object, matrices) -> np.ndarray:
     """(3, 6) key values of three rigid poses (opening, instant, closing), decomposed by Blender itself.
 
     Each pose ((4, 4), world) is assigned to ``ob.matrix_world`` and its location and Euler rotation
@@ -121,6 +121,6 @@ def blender_values(ob: "bpy.types.Object", matrices) -> np.ndarray:
     return out
 
 
-def set_frame(scene: "bpy.types.Scene") -> None:
+def set_frame(scene: bpy.types.Scene) -> None:
     """Evaluate the scene at the image instant (after keys changed)."""
     scene.frame_set(FRAME)

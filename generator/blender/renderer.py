@@ -68,7 +68,6 @@ class Renderer:
         if world is not None and world.actors:
             self.actors = actors.build(world, self.materials, self.handles)
             self.night_counts["headlights"] += actors.headlights(self.actors, night.headlight, self.night_lights)
-        self.t: float | None = None
         # Every light and world exists from the start: a render must not depend on earlier renders.
         lighting.ensure_sun(self.bscene)
         night.ensure_moon(self.bscene)
@@ -135,7 +134,6 @@ class Renderer:
 
     def set_time(self, t: float) -> None:
         """Pose every actor at time ``t`` (seconds on the world's timeline) and over the exposure."""
-        self.t = float(t)
         if self.actors is not None:
             self.actors.pose(self.shutter_times(t))
             motion.set_frame(self.bscene)
