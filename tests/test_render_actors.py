@@ -272,3 +272,12 @@ def test_written_metadata_records_time_and_visible_actors(tmp_path, test_spec, t
     for uid, a in seen.items():
         assert a["velocity_mps"] == pytest.approx(v[uid].tolist(), abs=1e-9)
         assert a["speed_mps"] == pytest.approx(CARS[uid][3]) and a["instance_id"] == world.actors[uid].instance_id
+    # (same Blender scene) each car's headlights drive with it: at its anchors, posed at the time set
+    r.set_time(t + LATER)
+    for a, ob in zip(world.actors, r.actors.objects):
+        lights = [np.array(x.matrix_world.translation) for x in r.night_lights.objects if x.parent == ob]
+        anchors = world.prototypes[a.prototype].anchors["headlight"]
+        pose = a.track.pose(t + LATER)[0]
+        expect = anchors @ pose[:3, :3].T + pose[:3, 3]
+        assert len(lights) == len(anchors)
+        np.testing.assert_allclose(sorted(map(tuple, lights)), sorted(map(tuple, expect)), atol=1e-4)
