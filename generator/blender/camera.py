@@ -53,5 +53,6 @@ def place(scene: "bpy.types.Scene", T_world_camera: np.ndarray, hfov_deg: float,
     data.shift_x = data.shift_y = 0.0
     data.clip_start = 0.05
     data.clip_end = 10000.0  # beyond the 2 km ground ring: no gap at the horizon
-    scene.camera = cam
+    if scene.camera != cam:  # assigning it again would rebuild the scene's dependency graph
+        scene.camera = cam
     return cam

@@ -34,6 +34,8 @@ SHUTTER_FRAMES = 2.0
 CHANNELS = (("location", 0), ("location", 1), ("location", 2),
             ("rotation_euler", 0), ("rotation_euler", 1), ("rotation_euler", 2))
 ACTION_PREFIX = "ug_motion:"
+#: An object in no scene, used to decompose poses the way Blender does.
+SCRATCH = "ug_motion_scratch"
 _LINEAR = bpy.types.Keyframe.bl_rna.properties["interpolation"].enum_items["LINEAR"].value
 
 
@@ -108,16 +110,20 @@ def yaw_values(xyz: np.ndarray, yaw: np.ndarray) -> np.ndarray:
 def blender_values(ob: bpy.types.Object, matrices) -> np.ndarray:
     """(3, 6) key values of three rigid poses (opening, instant, closing), decomposed by Blender itself.
 
-    Each pose ((4, 4), world) is assigned to ``ob.matrix_world`` and its location and Euler rotation
-    read back, the instant first: its key then holds exactly what a plain ``matrix_world``
-    assignment of the same pose leaves on the object, so a keyed render at :data:`FRAME` equals an
-    unkeyed one bit for bit; the opening's and closing's Euler angles stay continuous with the
-    instant's (Blender's compatible-Euler decomposition).
+    Each pose ((4, 4), world) is assigned to the ``matrix_world`` of a scratch object (outside
+    every scene, so nothing is re-evaluated) that starts from ``ob``'s current rotation, and its
+    location and Euler rotation are read back, the instant first: its key then holds exactly what
+    a plain ``ob.matrix_world`` assignment of the same pose leaves on ``ob``, so a keyed render at
+    :data:`FRAME` equals an unkeyed one bit for bit; the opening's and closing's Euler angles stay
+    continuous with the instant's (Blender's compatible-Euler decomposition).
     """
+    scratch = bpy.data.objects.get(SCRATCH) or bpy.data.objects.new(SCRATCH, None)
+    scratch.rotation_mode = ob.rotation_mode
+    scratch.rotation_euler = ob.rotation_euler
     out = np.empty((3, 6))
     for i in (1, 0, 2):
-        ob.matrix_world = matrices[i]
-        out[i] = (*ob.location, *ob.rotation_euler)
+        scratch.matrix_world = matrices[i]
+        out[i] = (*scratch.location, *scratch.rotation_euler)
     return out
 
 
