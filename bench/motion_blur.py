@@ -19,6 +19,13 @@ the ego's own motion blurring near and far objects by their real parallax, and t
 of both; the vector blur smears a car's colour over a background it never saw behind the car and
 leaves its shadow sharp. Its price is the motion BVH and the extra scene evaluations at the
 shutter's ends, measured here; the label passes are unaffected (always rendered without blur).
+Measured on the default town (52 actors, frame 7), preview 640x360, 12 spp, 10 ms shutter, on
+2 cores shared with other jobs (wall time swung by +-30 % with their load, so the process's CPU
+time is the cost to read): CPU per image none 16.4 s, Cycles blur 16.7 s (1.02x), vector pass +
+post blur 18.6 s (1.13x; the vector pass makes Cycles evaluate the motion in the RGB pass as
+well, and the numpy blur adds 0.05 s). Masks, instances and depth of the Cycles mode equal the
+sharp render's bit for bit; with the vector pass on, Cycles' motion BVH moves a few far depth
+values by ~1e-5 m.
 
     python bench/motion_blur.py [--spec scenes/default_town.json] [--config preview]
                                 [--shutter 0.01] [--images 3] [--out out/motion_blur]
