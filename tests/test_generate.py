@@ -69,10 +69,10 @@ def test_dataset_is_complete_balanced_and_valid(reference, capsys):
     assert set(counts.values()) == {3}
     assert (reference / "openlabel" / "00.json").exists()
     assert (reference / "stats" / "table2_conditions.csv").exists()
-    assert len(list((reference / "lidar/sequences/00/velodyne").glob("*.bin"))) == 3
+    assert len(list((reference / "lidar/sequences/00/velodyne").glob("*.bin"))) == 16  # 1.5 s of drive at 10 Hz
     capsys.readouterr()
     assert main(["validate", str(reference)]) == 0
-    assert "valid: 9 images, 3 scans, 1 OpenLABEL" in capsys.readouterr().out
+    assert "valid: 9 images, 16 scans, 1 OpenLABEL" in capsys.readouterr().out
 
 
 def test_rerun_skips_finished_work(reference, root, capsys):

@@ -19,6 +19,7 @@ so a sequence with ``poses.txt`` is complete. Re-running into the same folder ov
 from __future__ import annotations
 
 import dataclasses
+import inspect
 import json
 import logging
 from dataclasses import dataclass
@@ -28,7 +29,7 @@ import numpy as np
 
 from generator import __version__
 from generator.atomic import atomic_path, inside, write_json
-from generator.errors import UserError
+from generator.errors import SpecError, UserError
 from generator.formats import kitti_calib, semantickitti as sk
 from generator.formats.label_config import count_raw_ids, merge_counts, write_label_config
 from generator.formats.ply import write_ply
@@ -166,6 +167,9 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
     starts, n_points, counts, records = [], [], {}, []
     sweeps = []  # LiDAR world poses during each sweep (fusion de-skews with them)
     actors = world.actors if world is not None else []
+    if actors and "world" not in inspect.signature(Scanner).parameters:
+        raise SpecError(spec.source, "traffic", "moving vehicles are not cast by the LiDAR in this version; set every "
+                        "traffic density to 0")
     with Scanner(scene, sensor, threads=options.threads, **({"world": world} if actors else {})) as scanner:
         for j in progress_bar(range(options.frames), desc=f"lidar {name}", unit="scan", enabled=progress):
             t_j = times[j]
