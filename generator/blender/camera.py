@@ -14,7 +14,7 @@ from generator.blender.bpy_guard import bpy, mathutils
 R_OPTICAL_BLENDER = np.diag([1.0, -1.0, -1.0])
 
 
-def _blender(T_world_camera: np.ndarray) -> "mathutils.Matrix":
+def _blender(T_world_camera: np.ndarray) -> mathutils.Matrix:
     m = np.array(T_world_camera, np.float64)
     m[:3, :3] = m[:3, :3] @ R_OPTICAL_BLENDER
     return mathutils.Matrix(m.tolist())

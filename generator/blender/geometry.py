@@ -87,8 +87,8 @@ def build(scene: SceneModel, materials: list, parent: "bpy.types.Collection") ->
     return BlenderScene(real, proxies, objs, hulls, meshes)
 
 
-def new_object(name: str, data: "bpy.types.Mesh", transform: np.ndarray, instance_id: int, cls: str | None = None,
-               attrs: dict | None = None) -> "bpy.types.Object":
+def new_object(name: str, data: bpy.types.Mesh, transform: np.ndarray, instance_id: int, cls: str | None = None,
+               attrs: dict | None = None) -> bpy.types.Object:
     """An object of mesh ``data`` at ``transform`` ((4, 4) world-from-local) carrying its instance id as
     ``pass_index``; a real object (``cls`` given) also its colour and class (see the module docstring)."""
     ob = bpy.data.objects.new(name, data)

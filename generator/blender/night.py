@@ -27,7 +27,7 @@ NIGHT_SKY = (0.004, 0.006, 0.012)
 MOON_STRENGTH = 0.015
 
 
-def _spot(name: str, power: float, cone_deg: float, color, location, direction, collection) -> "bpy.types.Object":
+def _spot(name: str, power: float, cone_deg: float, color, location, direction, collection) -> bpy.types.Object:
     data = bpy.data.lights.new(name, "SPOT")
     data.energy = power
     data.spot_size = math.radians(cone_deg)
@@ -42,7 +42,7 @@ def _spot(name: str, power: float, cone_deg: float, color, location, direction, 
     return ob
 
 
-def headlight(name: str, location, direction, collection) -> "bpy.types.Object":
+def headlight(name: str, location, direction, collection) -> bpy.types.Object:
     """One headlight spot at ``location`` shining along ``direction`` (dark until :func:`set_night`)."""
     ob = _spot(name, HEADLIGHT_POWER_W, HEADLIGHT_CONE_DEG, HEADLIGHT_COLOR, location, direction, collection)
     ob.data.energy = 0.0
