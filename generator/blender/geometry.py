@@ -35,7 +35,8 @@ class BlenderScene:
     meshes: dict
 
 
-def _mesh(name: str, m: Mesh, materials: list) -> "bpy.types.Mesh":
+def mesh(name: str, m: Mesh, materials: list) -> "bpy.types.Mesh":
+    """A Blender mesh of ``m``: its faces, material slots, flat/smooth shading and per-face ``class_id``."""
     me = bpy.data.meshes.new(name)
     n_v, n_f = len(m.vertices), m.n_faces
     me.vertices.add(n_v)
@@ -72,26 +73,34 @@ def build(scene: SceneModel, materials: list, parent: "bpy.types.Collection") ->
     proxies = bpy.data.collections.new("urbangen_proxies")
     parent.children.link(real)
     parent.children.link(proxies)
-    meshes = {key: _mesh(key, m, materials) for key, m in scene.prototypes.items()}
-    proxy_meshes = {key: _mesh("hull:" + key, m, materials) for key, m in scene.proxies.items()}
+    meshes = {key: mesh(key, m, materials) for key, m in scene.prototypes.items()}
+    proxy_meshes = {key: mesh("hull:" + key, m, materials) for key, m in scene.proxies.items()}
     objs, hulls = [], []
     for o in scene.objects:
-        ob = bpy.data.objects.new(o.name, meshes[o.prototype])
-        ob.matrix_world = _matrix(o.transform)
-        ob.pass_index = int(o.instance_id)
-        color = o.attrs.get("color", o.attrs.get("facade_color", (1.0, 1.0, 1.0)))
-        ob.color = (float(color[0]), float(color[1]), float(color[2]), 1.0)
-        ob["ug_roof_color"] = [float(c) for c in o.attrs.get("roof_color", (1.0, 1.0, 1.0))]
-        ob["ug_class"] = o.cls
+        ob = new_object(o.name, meshes[o.prototype], o.transform, o.instance_id, o.cls, o.attrs)
         real.objects.link(ob)
         objs.append(ob)
         if o.proxy is not None:
-            hb = bpy.data.objects.new(o.name + "_hull", proxy_meshes[o.proxy])
-            hb.matrix_world = _matrix(o.transform)
-            hb.pass_index = int(o.instance_id)
+            hb = new_object(o.name + "_hull", proxy_meshes[o.proxy], o.transform, o.instance_id)
             proxies.objects.link(hb)
             hulls.append(hb)
     return BlenderScene(real, proxies, objs, hulls, meshes)
+
+
+def new_object(name: str, data: bpy.types.Mesh, transform: np.ndarray, instance_id: int, cls: str | None = None,
+               attrs: dict | None = None) -> bpy.types.Object:
+    """An object of mesh ``data`` at ``transform`` ((4, 4) world-from-local) carrying its instance id as
+    ``pass_index``; a real object (``cls`` given) also its colour and class (see the module docstring)."""
+    ob = bpy.data.objects.new(name, data)
+    ob.matrix_world = _matrix(transform)
+    ob.pass_index = int(instance_id)
+    if cls is not None:
+        attrs = attrs or {}
+        color = attrs.get("color", attrs.get("facade_color", (1.0, 1.0, 1.0)))
+        ob.color = (float(color[0]), float(color[1]), float(color[2]), 1.0)
+        ob["ug_roof_color"] = [float(c) for c in attrs.get("roof_color", (1.0, 1.0, 1.0))]
+        ob["ug_class"] = cls
+    return ob
 
 
 def _matrix(t: np.ndarray) -> "mathutils.Matrix":

@@ -22,11 +22,12 @@ LAMP_CONE_DEG = 130.0
 LAMP_COLOR = (1.0, 0.78, 0.5)      # warm high-pressure sodium / 3000 K LED
 HEADLIGHT_POWER_W = 250.0
 HEADLIGHT_CONE_DEG = 40.0
+HEADLIGHT_COLOR = (1.0, 0.95, 0.85)
 NIGHT_SKY = (0.004, 0.006, 0.012)
 MOON_STRENGTH = 0.015
 
 
-def _spot(name: str, power: float, cone_deg: float, color, location, direction, collection) -> None:
+def _spot(name: str, power: float, cone_deg: float, color, location, direction, collection) -> bpy.types.Object:
     data = bpy.data.lights.new(name, "SPOT")
     data.energy = power
     data.spot_size = math.radians(cone_deg)
@@ -38,6 +39,14 @@ def _spot(name: str, power: float, cone_deg: float, color, location, direction, 
     ob.location = tuple(float(v) for v in location)
     ob.rotation_euler = mathutils.Vector(tuple(float(v) for v in direction)).to_track_quat("-Z", "Y").to_euler()
     collection.objects.link(ob)
+    return ob
+
+
+def headlight(name: str, location, direction, collection) -> bpy.types.Object:
+    """One headlight spot at ``location`` shining along ``direction`` (dark until :func:`set_night`)."""
+    ob = _spot(name, HEADLIGHT_POWER_W, HEADLIGHT_CONE_DEG, HEADLIGHT_COLOR, location, direction, collection)
+    ob.data.energy = 0.0
+    return ob
 
 
 def build_lights(model: SceneModel, parent: "bpy.types.Collection") -> tuple["bpy.types.Collection", dict]:
@@ -54,7 +63,7 @@ def build_lights(model: SceneModel, parent: "bpy.types.Collection") -> tuple["bp
         if "headlight" in anchors and o.attrs.get("placement") != "parked":
             fwd = o.transform[:3, :3] @ np.array([1.0, 0.0, -0.12])
             for p in apply(o.transform, anchors["headlight"]):
-                _spot(f"{o.name}_headlight", HEADLIGHT_POWER_W, HEADLIGHT_CONE_DEG, (1.0, 0.95, 0.85), p, fwd, coll)
+                _spot(f"{o.name}_headlight", HEADLIGHT_POWER_W, HEADLIGHT_CONE_DEG, HEADLIGHT_COLOR, p, fwd, coll)
                 counts["headlights"] += 1
     set_night(None, coll, False)
     return coll, counts

@@ -1,4 +1,5 @@
-"""One Blender scene per process: build the SceneModel once, render many camera poses."""
+"""One Blender scene per process: build the SceneModel (and the world's actors) once, render many
+camera poses at many times."""
 
 from __future__ import annotations
 
@@ -10,8 +11,9 @@ from pathlib import Path
 import numpy as np
 
 from generator.world import rig
-from generator.blender import camera, controls, geometry, lighting, materials, night, passes, session
+from generator.blender import actors, camera, controls, geometry, lighting, materials, motion, night, passes, session
 from generator.blender.bpy_guard import bpy
+from generator.world.actors import World
 from generator.world.scene import SceneModel
 from generator.spec.model import SceneSpec
 from generator.spec.render import RenderConfig
@@ -30,7 +32,7 @@ class RenderedFrame:
 
 
 class Renderer:
-    """Owns the Blender scene of one SceneModel.
+    """Owns the Blender scene of one SceneModel and the actors of its world.
 
     Parameters
     ----------
@@ -39,9 +41,19 @@ class Renderer:
     cfg : RenderConfig
     scratch : Path
         Folder for the temporary EXRs Blender writes (one per pass, deleted after reading).
+    world : World, optional
+        The town in time: its actors are rendered where their tracks are at the time set by
+        :meth:`set_time`. None, or a world without actors: the static town, exactly as before.
+
+    Notes
+    -----
+    Per image: :meth:`set_time` (actors), :meth:`place_camera` (with the camera's poses at
+    :meth:`shutter_times` when motion blur is on), then :meth:`render_labels` (always sharp, at the
+    instant) and :meth:`render_rgb` (blurred over the exposure when ``cfg.motion_blur.enabled``).
     """
 
-    def __init__(self, scene: SceneModel, spec: SceneSpec, cfg: RenderConfig, scratch: Path):
+    def __init__(self, scene: SceneModel, spec: SceneSpec, cfg: RenderConfig, scratch: Path,
+                 world: World | None = None):
         t = time.perf_counter()
         self.model, self.spec, self.cfg = scene, spec, cfg
         self.scratch = Path(scratch)
@@ -51,6 +63,11 @@ class Renderer:
         self.materials = materials.build_materials(spec.seed)
         self.handles = geometry.build(scene, self.materials, self.bscene.collection)
         self.night_lights, self.night_counts = night.build_lights(scene, self.bscene.collection)
+        self.world = world
+        self.actors = None
+        if world is not None and world.actors:
+            self.actors = actors.build(world, self.materials, self.handles)
+            self.night_counts["headlights"] += actors.headlights(self.actors, night.headlight, self.night_lights)
         # Every light and world exists from the start: a render must not depend on earlier renders.
         lighting.ensure_sun(self.bscene)
         night.ensure_moon(self.bscene)
@@ -102,9 +119,38 @@ class Renderer:
                     light_objects={k: v for k, v in self.night_counts.items()} if is_night else {})
         return info
 
-    def place_camera(self, T_world_camera: np.ndarray) -> None:
-        """Put the camera at an optical-frame pose (world)."""
-        camera.place(self.bscene, T_world_camera, self.spec.sensors.camera.hfov_deg)
+    @property
+    def motion_blur(self) -> dict:
+        """The motion-blur settings images are rendered with (for metadata)."""
+        mb = self.cfg.motion_blur
+        return {"enabled": mb.enabled, "shutter_s": mb.shutter_s if mb.enabled else 0.0,
+                "method": "cycles" if mb.enabled else "none"}
+
+    def shutter_times(self, t: float) -> np.ndarray:
+        """(3,) float64: when the shutter opens, the image instant ``t`` and when it closes, seconds
+        (all ``t`` with motion blur off)."""
+        half = self.cfg.motion_blur.shutter_s / 2 if self.cfg.motion_blur.enabled else 0.0
+        return np.array([t - half, t, t + half])
+
+    def set_time(self, t: float) -> None:
+        """Pose every actor at time ``t`` (seconds on the world's timeline) and over the exposure."""
+        if self.actors is not None:
+            self.actors.pose(self.shutter_times(t))
+            motion.set_frame(self.bscene)
+
+    def place_camera(self, T_world_camera: np.ndarray, shutter: np.ndarray | None = None) -> None:
+        """Put the camera at an optical-frame pose (world).
+
+        Parameters
+        ----------
+        T_world_camera : (4, 4) float64
+            Pose at the image instant.
+        shutter : (2, 4, 4) float64, optional
+            Poses when the shutter opens and closes (at :meth:`shutter_times`), for motion blur from
+            the camera's own motion; ignored when the config's motion blur is off.
+        """
+        moving = shutter if self.cfg.motion_blur.enabled else None
+        camera.place(self.bscene, T_world_camera, self.spec.sensors.camera.hfov_deg, moving)
 
     def render_rgb(self, seed: int) -> tuple[np.ndarray, float]:
         """The RGB pass from the current camera under the current conditions: ((H, W, 3) float32, seconds)."""
@@ -114,10 +160,12 @@ class Renderer:
         """The real and label passes from the current camera (independent of lighting and weather)."""
         return passes.render_labels(self.bscene, self.handles, self.k, self.scratch)
 
-    def render(self, T_world_camera: np.ndarray, seed: int, light_info: dict) -> RenderedFrame:
-        """Render the RGB and label passes from one camera pose (optical frame, world)."""
+    def render(self, T_world_camera: np.ndarray, seed: int, light_info: dict,
+               shutter: np.ndarray | None = None) -> RenderedFrame:
+        """Render the RGB and label passes from one camera pose (optical frame, world; ``shutter`` as
+        in :meth:`place_camera`) at the time last set by :meth:`set_time`."""
         t0 = time.perf_counter()
-        self.place_camera(T_world_camera)
+        self.place_camera(T_world_camera, shutter)
         rgb, rgb_s = self.render_rgb(seed)
         labels = self.render_labels()
         secs = {"rgb_pass": rgb_s, **labels.seconds, "render_total": time.perf_counter() - t0}

@@ -1,14 +1,16 @@
 """Blender session: an empty scene configured for Cycles from a RenderConfig.
 
 Two render states share one scene: the RGB pass (the config's samples, bounces,
-filter, denoiser) and the label pass (1 sample, no bounces, a box filter of minimal
-width, no denoising, the label material and world as view-layer overrides).
+filter, denoiser, motion blur) and the label pass (1 sample, no bounces, a box filter of
+minimal width, no denoising, no motion blur, the label material and world as view-layer
+overrides).
 """
 
 from __future__ import annotations
 
 import logging
 
+from generator.blender import motion
 from generator.blender.bpy_guard import bpy
 from generator.spec.render import RenderConfig
 
@@ -59,6 +61,7 @@ def configure(scene: "bpy.types.Scene", cfg: RenderConfig) -> str:
     r.use_compositing = False
     r.use_sequencer = False
     r.film_transparent = False
+    r.use_motion_blur = False
     s = r.image_settings
     s.media_type = "MULTI_LAYER_IMAGE"
     s.color_depth = "32"
@@ -89,6 +92,11 @@ def rgb_state(scene: "bpy.types.Scene", cfg: RenderConfig, seed: int) -> None:
         c.denoiser = "OPENIMAGEDENOISE"
         c.denoising_quality = cfg.denoiser_quality.upper()
     c.seed = seed % (2**31 - 1)
+    blur = cfg.motion_blur.enabled
+    scene.render.use_motion_blur = blur
+    if blur:  # the exposure spans the keys around the image instant (generator.blender.motion)
+        scene.render.motion_blur_shutter = motion.SHUTTER_FRAMES
+        scene.render.motion_blur_position = "CENTER"
     vl = scene.view_layers[0]
     vl.material_override = None
     vl.world_override = None
@@ -105,6 +113,7 @@ def label_state(scene: "bpy.types.Scene", material, world) -> None:
     c.pixel_filter_type = "BOX"
     c.filter_width = 0.01
     c.seed = 0
+    scene.render.use_motion_blur = False  # labels at the image instant: never blended
     vl = scene.view_layers[0]
     vl.material_override = material
     vl.world_override = world

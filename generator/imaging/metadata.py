@@ -63,7 +63,8 @@ def class_pixels(class_id: np.ndarray) -> dict[str, int]:
 
 def image_metadata(*, image: str, files: dict, frame, k: np.ndarray, width: int, height: int, hfov_deg: float,
                    class_id: np.ndarray, time_of_day: str, weather: dict, lighting: dict, spec, render_cfg,
-                   device: str, timings: dict, blender_version: str | None, camera_model: dict | None = None) -> dict:
+                   device: str, timings: dict, blender_version: str | None, camera_model: dict | None = None,
+                   motion: dict | None = None) -> dict:
     """The metadata record of one image.
 
     Parameters
@@ -76,6 +77,10 @@ def image_metadata(*, image: str, files: dict, frame, k: np.ndarray, width: int,
     camera_model : dict, optional
         The camera model's record (:func:`generator.postfx.camera.apply_camera`); None when
         the model is off, and then the record has no ``camera_model`` section (as before it).
+    motion : dict, optional
+        The ``motion`` section (:func:`generator.jobs.exposure.motion_record`): the motion-blur
+        settings and every visible actor's velocity at the image time ``frame.t`` (written as
+        ``time_s``); None leaves it out.
     """
     T = frame.T_world_camera
     jit = frame.camera_jitter
@@ -99,6 +104,7 @@ def image_metadata(*, image: str, files: dict, frame, k: np.ndarray, width: int,
             "intrinsics": {"width": width, "height": height, "hfov_deg": hfov_deg, "fx": float(k[0, 0]),
                            "fy": float(k[1, 1]), "cx": float(k[0, 2]), "cy": float(k[1, 2]), "K": _list(k)},
         },
+        "time_s": float(frame.t),
         "ego": {"T_world_ego": _list(frame.T_world_ego), "s_m": frame.s, "t_s": frame.t},
         "time_of_day": time_of_day,
         "weather": weather,
@@ -111,6 +117,8 @@ def image_metadata(*, image: str, files: dict, frame, k: np.ndarray, width: int,
     }
     if camera_model is not None:
         record["camera_model"] = camera_model
+    if motion is not None:
+        record["motion"] = motion
     return record
 
 

@@ -23,12 +23,15 @@ def image_name(frame_index: int, time_of_day: str = "day", weather: str = "clear
 
 
 def write_image(out: Path, frame, spec, cfg, renderer, rendered, time_of_day: str, weather: dict,
-                rgb=None, name: str | None = None, camera: dict | None = None) -> tuple[str, dict]:
+                rgb=None, name: str | None = None, camera: dict | None = None,
+                motion: dict | None = None) -> tuple[str, dict]:
     """Write one image variant (``rgb`` overrides the rendered RGB, e.g. after fog in post).
 
     ``camera`` is the camera model's record (:func:`generator.jobs.variants.camera_post`):
     it goes into the metadata, and the preview shows the camera's 8-bit output; None (the
-    model off) writes the files as before the model existed.
+    model off) writes the files as before the model existed. ``motion`` is the image's motion
+    record (:func:`generator.jobs.exposure.motion_record`: motion-blur settings, visible actors and
+    their velocities at ``frame.t``).
 
     Returns
     -------
@@ -48,7 +51,7 @@ def write_image(out: Path, frame, spec, cfg, renderer, rendered, time_of_day: st
                             hfov_deg=spec.sensors.camera.hfov_deg, class_id=lab.class_id, time_of_day=time_of_day,
                             weather=weather, lighting=rendered.lighting, spec=spec, render_cfg=cfg,
                             device=renderer.device, timings=planned, blender_version=renderer.blender_version,
-                            camera_model=camera)
+                            camera_model=camera, motion=motion)
     problems = validate_metadata(record)
     if problems:
         raise RuntimeError(f"metadata of {name} does not match its schema: {problems[0]}")

@@ -11,8 +11,9 @@ camera 3 ``baseline_m`` to its right, no jitter), so ``P2 @ Tr`` of the sequence
 ``semantic_2/NNNNNN.png``      Cityscapes label id per pixel, uint8 (KITTI semantics layout)
 ``passes_2/NNNNNN.exr``        the dataset EXR: linear RGB, one mask per native class,
                                depth (metres along the ray) and instance ids
-``passes_2/NNNNNN.json``       exposure time, camera pose (world), intrinsics, weather (and
-                               the camera model's record when it is on)
+``passes_2/NNNNNN.json``       exposure time, camera pose (world), intrinsics, weather, motion
+                               (blur settings, visible actors' velocities) and the camera
+                               model's record when it is on
 ============================== ===========================================================
 
 Camera model (render config ``camera_model: true``): both cameras of the pair are one camera
@@ -37,6 +38,7 @@ from PIL import Image
 
 from generator.atomic import atomic_path, write_json
 from generator.imaging.exr import LabelledImage, write_exr
+from generator.jobs.exposure import expose, motion_record
 from generator.jobs.variants import camera_post, weather_post
 from generator.labels import class_table
 from generator.previews.preview import display_rgb
@@ -99,7 +101,6 @@ def render_pair(renderer, spec, cfg, rig, sensor, index: int, seq_dir: Path) -> 
     tod, kind = lidar_combination(index)
     t_scan = rig.sweep_time(index)  # the start of sweep ``index`` (10 Hz)
     t_exp = t_scan + exposure_offset(sensor, spec.sensors.lidar.motion_skew)
-    T_world_ego = rig.T_world_ego(t_exp)[0]
     light = draw_lighting(spec, index, tod)
     wetness, puddles = frame_wetness(spec, index) if is_wet(kind) else (0.0, 0.0)
     lighting = renderer.set_conditions(light, wetness, puddles)
@@ -107,8 +108,7 @@ def render_pair(renderer, spec, cfg, rig, sensor, index: int, seq_dir: Path) -> 
     stem = f"{index:06d}"
     images, exposure = {}, None
     for cam in CAMERAS:
-        T_world_camera = T_world_ego @ rig.T_ego_stereo(cam)
-        renderer.place_camera(T_world_camera)
+        T_world_camera = expose(renderer, rig, t_exp, rig.T_ego_stereo(cam))
         labels = renderer.render_labels()
         rgb, _ = renderer.render_rgb(seed=child_seed(spec.seed, "frame", index, "stereo", cam))
         img, weather = weather_post(spec, index, tod, kind, rgb, labels.depth, renderer.k, ("stereo", cam))
@@ -124,7 +124,7 @@ def render_pair(renderer, spec, cfg, rig, sensor, index: int, seq_dir: Path) -> 
             "exposure_offset_s": t_exp - t_scan, "T_world_camera": T_world_camera.tolist(),
             "K": renderer.k.tolist(), "width": cfg.width, "height": cfg.height, "time_of_day": tod,
             "weather": weather, "lighting": {k: v for k, v in lighting.items() if k != "light_objects"},
-            "seed": spec.seed, "spec_hash": spec.spec_hash}
+            "seed": spec.seed, "spec_hash": spec.spec_hash, "motion": motion_record(renderer, t_exp, labels.instance)}
         if camera is not None:
             record["camera_model"] = camera
         write_json(seq_dir / f"passes_{cam}" / f"{stem}.json", record)

@@ -18,6 +18,7 @@ import numpy as np
 from generator.postfx.camera import apply_camera, draw_params
 from generator.postfx.fog import fog_image
 from generator.postfx.rain import rain_image
+from generator.jobs.exposure import expose, motion_record
 from generator.jobs.images import write_image
 from generator.rng import child_seed, stream
 from generator.weather import combinations, draw_lighting, draw_weather, frame_wetness, has_fog, has_rain, is_wet
@@ -114,8 +115,13 @@ def camera_post(spec, cfg, frame_index: int, time_of_day: str, kind: str, rgb: n
     return apply_camera(rgb, params, g, exposure)
 
 
-def render_frame(renderer, spec, cfg, frame, out: Path, combos: list[tuple[str, str]]) -> dict[str, dict]:
+def render_frame(renderer, spec, cfg, frame, out: Path, combos: list[tuple[str, str]], rig=None) -> dict[str, dict]:
     """Render and write every variant in ``combos`` of ``frame``.
+
+    With ``rig`` (a :class:`generator.world.rig.Rig`), the image is exposed at ``frame.t`` on the
+    drive's timeline (:func:`generator.jobs.exposure.expose`: the world's actors where their tracks
+    are then, the camera moving over the shutter when motion blur is on) and its metadata gets the
+    ``motion`` record; without, the camera is put at ``frame.T_world_camera`` as is.
 
     Returns
     -------
@@ -123,9 +129,13 @@ def render_frame(renderer, spec, cfg, frame, out: Path, combos: list[tuple[str, 
         Image name -> seconds per stage.
     """
     t = time.perf_counter()
-    renderer.place_camera(frame.T_world_camera)
+    if rig is None:
+        renderer.place_camera(frame.T_world_camera)
+    else:
+        expose(renderer, rig, frame.t, frame.T_ego_camera)
     labels = renderer.render_labels()
     label_s = time.perf_counter() - t
+    motion = None if rig is None else motion_record(renderer, frame.t, labels.instance)
     timings = {}
     for tod, wet in renders_needed(combos):
         light = draw_lighting(spec, frame.index, tod)
@@ -143,7 +153,8 @@ def render_frame(renderer, spec, cfg, frame, out: Path, combos: list[tuple[str, 
             if camera is not None:
                 secs["camera_model"] = time.perf_counter() - t
             rendered = _Rendered(labels, info, secs)
-            name, written = write_image(out, frame, spec, cfg, renderer, rendered, tod, params, rgb=img, camera=camera)
+            name, written = write_image(out, frame, spec, cfg, renderer, rendered, tod, params, rgb=img, camera=camera,
+                                        motion=motion)
             timings[name] = written
     return timings
 

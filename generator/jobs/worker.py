@@ -2,8 +2,10 @@
 
 The parent (pure Python, no bpy) starts workers with the ``spawn`` start method and
 hands each one a :class:`generator.jobs.executors.RenderJob`. The worker builds the
-SceneModel and the Blender renderer once (:class:`generator.blender.renderer.Renderer`,
-the only bpy it touches), asks the rig for each frame, renders its variants, writes
+SceneModel, the world in time and the Blender renderer once
+(:class:`generator.blender.renderer.Renderer`, the only bpy it touches), asks the rig for each
+frame, exposes it at the frame's time on the drive's timeline (actors where their tracks are,
+motion blur when the render config asks), renders its variants, writes
 each image's files atomically and reports progress on a queue:
 ``("ready", stats)``, ``("frame", index, {"images": {name: seconds}, "rss_mb": ...})``,
 ``("error", message)`` and ``("done", stats)`` (including the seconds spent inside
@@ -78,14 +80,15 @@ def _run(job, queue, scratch: Path) -> None:
     spec, cfg = job.spec, job.config
     t = time.perf_counter()
     scene = build_scene(spec)
+    world = _world(spec, scene, job)
+    rig = Rig.from_world(spec, world)
     layout_s = time.perf_counter() - t
-    renderer = Renderer(scene, spec, cfg, scratch)
-    rig = Rig.from_spec(spec, scene)
+    renderer = Renderer(scene, spec, cfg, scratch, world)
     queue.put(("ready", {"layout_s": layout_s, "blender_build_s": renderer.build_seconds, "pid": os.getpid()}))
 
     t_start = time.perf_counter()
     for n, index in enumerate(job.frames, 1):
-        images = render_frame(renderer, spec, cfg, rig.frame(index), Path(job.out), job.combos)
+        images = render_frame(renderer, spec, cfg, rig.frame(index), Path(job.out), job.combos, rig)
         queue.put(("frame", index, {"images": images, "rss_mb": _rss_mb(), "frames_done": n}))
     if job.stereo:
         from generator.jobs.stereo import render_pair
@@ -102,6 +105,22 @@ def _run(job, queue, scratch: Path) -> None:
         "rss_mb": _rss_mb(), "setup_s": layout_s + renderer.build_seconds, "frames_s": time.perf_counter() - t_start,
         "cycles_rgb_s": cycles["rgb"], "cycles_labels_s": cycles["labels"],
     }))
+
+
+def _world(spec, scene, job):
+    """The world in time over this job's frames and stereo sweeps.
+
+    The same world the parent planned (:func:`generator.jobs.drive.plan_drive` over all frames):
+    the traffic simulation is causal and seeded by name, so a shorter run has the same state at
+    every instant it covers; it only has to reach this job's last frame and last stereo sweep.
+    """
+    from generator.jobs.drive import MARGIN_M
+    from generator.traffic.build import build_world
+    from generator.world.rig import SWEEP_PERIOD_S
+
+    last = max(job.frames, default=0)
+    duration = (max(job.stereo) + 1) * SWEEP_PERIOD_S + 0.2 if job.stereo else 0.0
+    return build_world(spec, scene, duration, last * spec.paths.spacing_m + MARGIN_M)
 
 
 def _rss_mb() -> float:

@@ -16,6 +16,25 @@ PRESET_DIR = Path(__file__).resolve().parents[2] / "render_configs"
 
 
 @dataclass(frozen=True)
+class MotionBlur:
+    """Motion blur of the RGB pass (``motion_blur`` in the schema).
+
+    Attributes
+    ----------
+    enabled : bool
+        Off: a sharp snapshot at the image time, exactly as before the switch existed.
+    shutter_s : float
+        Exposure time, seconds, centred on the image time.
+    """
+
+    enabled: bool = False
+    shutter_s: float = 0.01
+
+    def to_dict(self) -> dict:
+        return {"enabled": self.enabled, "shutter_s": self.shutter_s}
+
+
+@dataclass(frozen=True)
 class RenderConfig:
     """Cycles settings for one dataset (see ``schemas/render.schema.json``)."""
 
@@ -32,6 +51,7 @@ class RenderConfig:
     exr_codec: str
     preview: bool
     camera_model: bool = False
+    motion_blur: MotionBlur = MotionBlur()
     source: str = ""
     config_hash: str = ""
 
@@ -49,6 +69,8 @@ class RenderConfig:
         d.pop("config_hash")
         if not d["camera_model"]:  # off = as every config before the model: same hash, same records
             d.pop("camera_model")
+        if not self.motion_blur.enabled:  # off = as every config before the switch: same hash, same records
+            d.pop("motion_blur")
         d["resolution"] = list(d["resolution"])
         return d
 
