@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from generator.errors import SpecError
+from generator.labels import class_table
 from generator.layout.assemble import build_scene
 from generator.layout.streets import make_grid
 from generator.spec.load import parse_spec
@@ -154,18 +155,45 @@ def test_track_interpolates_between_samples():
     assert np.allclose(tr.velocity(0.5, h=0.25), [[3.0, 0, 0]])
 
 
-@pytest.mark.parametrize("command", [["lidar", "--frames", "3"], ["generate", "--config", "test", "--frames", "2"],
-                                     ["render", "--config", "test", "--frames", "2"]])
-def test_a_traffic_spec_the_sensors_cannot_show_yet_is_one_line_and_writes_nothing(tmp_path, capsys, command):
-    """Until the LiDAR casts actors and the renderer poses them, a traffic spec is refused before any write."""
+def test_lidar_sequence_through_traffic_labels_movers_and_repeats_byte_for_byte(tmp_path):
+    """``urbangen lidar`` on a traffic spec: 10 Hz times, moving-* ids exactly where the actor moved faster than
+    the threshold at the point's firing time, one instance id per actor all sequence, same seed -> same bytes."""
     import json
 
     from generator.cli import main
+    from generator.formats import semantickitti as sk
+    from generator.formats.point_sidecars import read_sidecar
 
+    doc = {"name": "t", "seed": 5, "town": {"blocks_x": 2, "blocks_y": 2, "block_size_m": 45,
+                                             "block_size_jitter_m": 0}, "traffic": TRAFFIC}
     spec = tmp_path / "s.json"
-    spec.write_text(json.dumps({"name": "t", "seed": 1, "town": {"blocks_x": 1, "blocks_y": 1, "block_size_m": 36,
-                                                                  "block_size_jitter_m": 0}, "traffic": {"cars_per_km": 5}}))
-    out = tmp_path / "out"
-    assert main([command[0], str(spec), "--out", str(out), *command[1:]]) == 2
-    err = capsys.readouterr().err.strip().splitlines()[-1]
-    assert "s.json: traffic: moving" in err and not out.exists()
+    spec.write_text(json.dumps(doc))
+    n = 8
+    outs = [tmp_path / "a", tmp_path / "b"]
+    for out in outs:
+        assert main(["lidar", str(spec), "--out", str(out), "--frames", str(n), "--no-bev", "--threads", "2"]) == 0
+    seq = outs[0] / "sequences" / "00"
+    for f in sorted(seq.rglob("*")):
+        if f.is_file():
+            assert f.read_bytes() == (outs[1] / f.relative_to(outs[0])).read_bytes(), f.name
+    assert np.allclose(np.diff(sk.read_times(seq / "times.txt")), SWEEP_PERIOD_S)
+    parsed = parse_spec(doc, "s.json")
+    world = build_world(parsed, build_scene(parsed), n * SWEEP_PERIOD_S + 0.2)
+    by_instance = {a.instance_id: a for a in world.actors}
+    seen_moving, class_of = 0, {}
+    for j in range(n):
+        sem, inst = sk.read_labels(seq / "labels" / f"{j:06d}.label")
+        times = read_sidecar(seq, "point_times", j, len(sem))
+        on = np.isin(inst, list(by_instance))
+        for i in np.unique(inst[on]):
+            pts = inst == i
+            speed = by_instance[int(i)].track.speed(j * SWEEP_PERIOD_S + times[pts].astype(float))
+            clear = np.abs(speed - MOVING_THRESHOLD_MPS) > 0.01  # firing times are stored as float32
+            assert np.array_equal(sem[pts][clear] >= 252, (speed > MOVING_THRESHOLD_MPS)[clear])
+            class_of.setdefault(int(i), set()).update(np.unique(sem[pts]).tolist())
+            seen_moving += int((sem[pts] >= 252).sum())
+        assert not (sem[~on] >= 252).any()  # the static town never moves
+    assert seen_moving > 300
+    to_static = {252: 10, 253: 31, 254: 30, 255: 32, 256: 16, 257: 13, 258: 18, 259: 20}
+    for i, ids in class_of.items():  # an instance is one actor all sequence: its class, moving or not (a rider's bike)
+        assert {to_static.get(x, x) for x in ids} <= {int(class_table()[by_instance[i].cls].semantickitti), 11, 15}, (i, ids)

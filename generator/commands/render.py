@@ -18,7 +18,7 @@ from pathlib import Path
 from generator.atomic import TMP_PREFIX
 from generator.commands.options import Integer, path, shown, text_path
 from generator.commands.preflight import os_reason, output_dir
-from generator.errors import SpecError, UserError
+from generator.errors import UserError
 from generator.jobs.executors import EXECUTORS, make_jobs, run_jobs
 from generator.jobs.plan import (MAX_FRAME_INDEX, MAX_FRAMES, MAX_WORKERS, check_free_space, check_plan, check_workers,
                                  image_bytes, make_plan)
@@ -69,9 +69,6 @@ class RenderArgs:
 def check_render_args(args) -> RenderArgs:
     """Load the spec and config and check the shared options; a bad one is a one-line user error."""
     spec = load_spec(args.spec)
-    if spec.traffic.enabled:  # the renderer cannot pose actors yet: images would show a town the LiDAR does not
-        raise SpecError(spec.source, "traffic", "moving actors are not rendered in this version; set every traffic "
-                        "density to 0")
     cfg = load_render_config(args.config)
     out = output_dir(args.out, "--out")
     try:

@@ -33,6 +33,7 @@ from generator.world.trajectory import EgoTrajectory
 log = logging.getLogger(__name__)
 
 WARMUP_S = 20.0
+LOOKAHEAD_S = 16.0   #: vehicles ask about crosswalks up to 15 s ahead (VehicleSim._crossing_clear)
 MAX_DRIVE_S = 900.0
 SPACING_M = 6.0       #: lanes hold at most one vehicle per (length + this), for the capacity check
 EGO_SIZE_M = (4.6, 1.9)
@@ -75,11 +76,18 @@ def build_world(spec, scene, duration_s: float, distance_m: float = 0.0) -> Worl
     graph = LaneGraph(grid)
     signals = Signals(spec.seed, grid.nodes)
     lib = Library(spec.seed)
-    n_steps_min = int(np.ceil((duration_s + 1.0) / DT_S)) + 1
-    peds = _pedestrians(spec, grid, scene, signals, lib, n_steps_min, distance_m)
-    crossing = _crosswalk_occupancy(grid, graph, peds)
-    blocked = _blocked_lanes(graph, scene)
-    movers, ego_track, ego_dist = _drive(spec, graph, signals, lib, blocked, crossing, duration_s, distance_m)
+    horizon_s = duration_s + 1.0 + LOOKAHEAD_S
+    if distance_m > 0:  # the drive may take longer than asked: cover a slow ego
+        horizon_s = max(horizon_s, distance_m / (0.25 * spec.paths.speed_mps) + 5.0 + LOOKAHEAD_S)
+    while True:  # vehicles look ahead at crosswalks: pedestrians must be simulated past the drive's end
+        peds = _pedestrians(spec, grid, scene, signals, lib, int(np.ceil(horizon_s / DT_S)) + 1)
+        crossing = _crosswalk_occupancy(grid, graph, peds)
+        blocked = _blocked_lanes(graph, scene)
+        movers, ego_track, ego_dist = _drive(spec, graph, signals, lib, blocked, crossing, duration_s, distance_m)
+        if crossing is None or crossing.asked_s <= horizon_s:
+            break
+        horizon_s = 2.0 * crossing.asked_s  # same answers up to the old horizon (causal): a longer run, same world
+        graph = LaneGraph(grid)
     peds = [_extend_track(p, len(ego_dist)) for p in peds]
     world = _assemble(scene, movers + peds, TrackTrajectory(ego_track, ego_dist), ego_track.t1)
     log.info("traffic %s: %d vehicles, %d pedestrians over %.1f s, simulated in %.2f s", spec.name, len(movers),
@@ -87,13 +95,11 @@ def build_world(spec, scene, duration_s: float, distance_m: float = 0.0) -> Worl
     return world
 
 
-def _pedestrians(spec, grid, scene, signals, lib, n_steps: int, distance_m: float) -> list[Mover]:
+def _pedestrians(spec, grid, scene, signals, lib, n_steps: int) -> list[Mover]:
     if spec.traffic.pedestrians_per_100m <= 0 and spec.traffic.standing_pedestrians_per_100m <= 0:
         return []
     from generator.traffic.pedestrians import simulate_pedestrians
 
-    if distance_m > 0:  # the drive may take longer than asked: cover the slowest plausible ego
-        n_steps = max(n_steps, int(np.ceil((distance_m / (0.25 * spec.paths.speed_mps) + 5.0) / DT_S)))
     return simulate_pedestrians(spec, grid, scene, signals, lib, n_steps, DT_S)
 
 
@@ -129,9 +135,13 @@ def _crosswalk_occupancy(grid, graph: LaneGraph, peds: list[Mover]):
             occupied[(node, arm)] = inside.any(1)
 
     def crossing(node, arm, t0: float, t1: float) -> bool:
+        crossing.asked_s = max(crossing.asked_s, t1)
         occ = occupied[(node, arm)]
-        i0, i1 = max(0, int(np.floor(t0 / DT_S))), int(np.ceil(t1 / DT_S)) + 1
-        return bool(occ[i0:i1].any()) if i0 < len(occ) else False
+        i0 = max(0, int(np.floor(t0 / DT_S)))      # before t = 0 (the warm-up) people are where they start
+        i1 = max(i0 + 1, int(np.ceil(t1 / DT_S)) + 1)
+        return bool(occ[i0:i1].any())
+
+    crossing.asked_s = 0.0  # the latest instant asked about: the run is redone if it lies past the simulated one
 
     return crossing
 
