@@ -47,6 +47,31 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
+def dataset_actors(root: Path, n_sweeps: int):
+    """Instance id -> ``T_world_actor(t)`` of the moving actors of the dataset's spec, or None.
+
+    The spec is the one ``generate``/``render`` recorded in ``root/manifest.json``; its world is
+    rebuilt (deterministic, and causal: a run covering the sweeps has the same tracks as the
+    drive that made them). None without a manifest or without traffic.
+    """
+    from generator.jobs import manifest as mf
+
+    doc = mf.load(root)
+    if doc is None or not isinstance(doc.get("spec"), dict) or not isinstance(doc["spec"].get("traffic"), dict):
+        return None
+    from generator.fusion.movers import actor_poses
+    from generator.layout.assemble import build_scene
+    from generator.spec.load import parse_spec
+    from generator.traffic.build import build_world
+    from generator.world.rig import SWEEP_PERIOD_S
+
+    spec = parse_spec(doc["spec"], str(root / mf.NAME))
+    if not spec.traffic.enabled:
+        return None
+    log.info("rebuilding the traffic of %s to de-skew its moving actors", spec.name)
+    return actor_poses(build_world(spec, build_scene(spec), n_sweeps * SWEEP_PERIOD_S + 0.2))
+
+
 def run(args) -> int:
     from generator.fusion import projection as P
     from generator.fusion.agreement import HEADLINE, Agreement, fuse_frame
@@ -63,21 +88,23 @@ def run(args) -> int:
     if overlay_k is not None and overlay_k not in ds.frames:
         raise UserError(f"--overlay-frame: frame {overlay_k} has no image and scan (have {ds.frames[0]}..{ds.frames[-1]})")
     deskew = not args.no_deskew
+    actors = dataset_actors(root, len(ds.seq.frames))
+    movers = set(actors or ())
     agree, raw = Agreement(), Agreement()
     maps = {"lidar": VoxelMap(args.voxel), "camera": VoxelMap(args.voxel)}
     overlay, best, exact, timed = None, -1, True, True
     for frame in progress(ds, total=len(ds), desc="fuse", unit="frame"):
-        fused = fuse_frame(frame, deskew, abs_tol, rel_tol)
+        fused = fuse_frame(frame, deskew, abs_tol, rel_tol, actors)
         agree.add(fused)
         if deskew and frame.times is not None:
             raw.add(fuse_frame(frame, False, abs_tol, rel_tol))
         exact &= frame.native_exact
         timed &= frame.times is not None
         world = P.transform(frame.pose, fused.xyz_start)  # Eq. 2, first-LiDAR frame
-        maps["lidar"].add_static(world, frame.native, frame.semantic, frame.instance)
+        maps["lidar"].add_static(world, frame.native, frame.semantic, frame.instance, movers)
         seen = fused.proj.index[fused.visible]
         maps["camera"].add_static(world[seen], fused.image_class[fused.visible], frame.semantic[seen],
-                                  frame.instance[seen])
+                                  frame.instance[seen], movers)
         smeared = int((~fused.visible & (fused.image_class != fused.lidar_class)).sum())
         if frame.index == overlay_k or (overlay_k is None and smeared > best):
             overlay, best = (frame.class_id, fused), smeared
@@ -85,8 +112,8 @@ def run(args) -> int:
     for k in progress(ds.seq.frames, desc="map", unit="scan"):
         if k not in ds.frames:
             scan = ds.read_scan(k)
-            maps["lidar"].add_static(P.transform(scan["pose"], deskewed(scan, deskew)), scan["native"],
-                                     scan["semantic"], scan["instance"])
+            maps["lidar"].add_static(P.transform(scan["pose"], deskewed(scan, deskew, actors)), scan["native"],
+                                     scan["semantic"], scan["instance"], movers)
     settings = {
         "dataset": str(root), "sequence": ds.seq.dir.name, "abs_tol_m": abs_tol, "rel_tol": rel_tol,
         "deskew": ("on (point_times/ + sweep poses of lidar_meta.json)" if deskew and timed else
@@ -94,6 +121,8 @@ def run(args) -> int:
         "lidar_classes": ("native, from native_labels/" if exact else
                           "canonical native class of the SemanticKITTI raw id (lossy: no native_labels/)"),
         "voxel_m": args.voxel,
+        "moving_actors": (f"{len(movers)} actors of the spec in manifest.json: their points de-skewed by their own "
+                          "motion, kept out of the semantic maps" if movers else "none"),
     }
     report = agree.to_dict(settings)
     if raw.frames:
