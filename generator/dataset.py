@@ -10,6 +10,11 @@
     frame = ds.frame(0)                         # one call: every image variant, the scan, its boxes
     scan = frame.scan                           # .xyz .remission .semantic .instance .pose .time
 
+Frames and sweeps: the LiDAR is a 10 Hz stream and images are exposed at some of its sweeps
+(``image_frames`` of ``lidar_meta.json``); image frame ``k`` pairs with sweep ``frame.sweep``,
+whose scan and OpenLABEL boxes :meth:`Dataset.frame` returns. :meth:`Dataset.scan` and
+:meth:`Dataset.boxes` take sweep indices.
+
 Arrays and frames
 -----------------
 * ``ImageSample.rgb`` (H, W, 3) float32 linear RGB; ``class_id`` (H, W) uint8 native class
@@ -92,9 +97,10 @@ class ScanSample:
 
 @dataclass
 class FrameSample:
-    """Everything of frame ``index``: its image variants, its scan and its boxes."""
+    """Everything of image frame ``index``: its image variants, the scan and boxes of ``sweep``."""
 
     index: int
+    sweep: int
     images: dict[str, ImageSample] = field(default_factory=dict)
     scan: ScanSample | None = None
     boxes: list[Box] = field(default_factory=list)
@@ -120,6 +126,13 @@ class Dataset:
         self.seq = sk.Sequence(lidar, self.sequence) if has_seq else None
         self._poses = self.seq.lidar_poses() if self.seq is not None else None
         self._boxes = self._read_boxes(self.root / "openlabel" / f"{self.sequence}.json")
+        meta = self.seq.dir / "lidar_meta.json" if self.seq is not None else None
+        #: image frame -> the sweep it was exposed with (identity without ``image_frames``)
+        self._sweep_of = md.image_sweeps(md.load_metadata(meta), str(meta)) if meta and meta.exists() else {}
+
+    def sweep_of(self, frame: int) -> int:
+        """The sweep image frame ``frame`` was exposed with."""
+        return self._sweep_of.get(frame, frame)
 
     # -- images ------------------------------------------------------------------------------
     def image_names(self, frame: int | None = None) -> list[str]:
@@ -151,19 +164,21 @@ class Dataset:
                           rec.time)
 
     def boxes(self, index: int) -> list[Box]:
-        """The OpenLABEL cuboids of frame ``index`` (empty when the dataset has none)."""
+        """The OpenLABEL cuboids of sweep ``index`` (empty when the dataset has none)."""
         return list(self._boxes.get(index, []))
 
     def frame(self, index: int) -> FrameSample:
-        """Every image variant, the scan and the boxes of frame ``index``, in one call."""
-        out = FrameSample(index, {n: self.image(n) for n in self.image_names(index)})
-        if self.seq is not None and index in self.seq.frames:
-            out.scan = self.scan(index)
-        out.boxes = self.boxes(index)
+        """Every image variant of image frame ``index``, with the scan and boxes of its sweep, in one call."""
+        j = self.sweep_of(index)
+        out = FrameSample(index, j, {n: self.image(n) for n in self.image_names(index)})
+        if self.seq is not None and j in self.seq.frames:
+            out.scan = self.scan(j)
+        out.boxes = self.boxes(j)
         return out
 
     def __iter__(self):
-        frames = sorted({int(n[:6]) for n in self.image_names()} | set(self.scan_indices()))
+        """Image frames in order (each with its sweep); every sweep when there are no images."""
+        frames = sorted({int(n[:6]) for n in self.image_names()}) or self.scan_indices()
         for k in frames:
             yield self.frame(k)
 

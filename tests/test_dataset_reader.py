@@ -57,3 +57,25 @@ def test_iterating_visits_every_frame(dataset):
 def test_missing_dataset_is_a_user_error(tmp_path):
     with pytest.raises(UserError, match="no such dataset"):
         Dataset(tmp_path / "nope")
+
+
+def test_an_image_frame_pairs_with_the_sweep_it_was_exposed_with(tmp_path, test_spec, test_scene):
+    """A 10 Hz stream: image 1 is exposed with sweep j (> 1); the reader and fusion pair them, not scan 1."""
+    from generator.fusion.dataset import FusionDataset
+    from generator.jobs.lidar_sequence import SequenceOptions, write_sequence
+    from generator.world.rig import Rig
+
+    rig = Rig.from_spec(test_spec, test_scene)
+    j = Rig.sweep_of(rig.frame(1))
+    assert j > 1
+    write_raycast_images(tmp_path, test_scene, test_spec, 2)
+    write_sequence(test_scene, test_spec, tmp_path / "lidar",
+                   SequenceOptions(frames=j + 1, threads=2, bev=False, image_frames=((0, 0), (1, j))), progress=False)
+    ds = Dataset(tmp_path)
+    f = ds.frame(1)
+    assert f.sweep == j and f.scan.index == j
+    assert np.array_equal(f.scan.xyz, sk.Sequence(tmp_path / "lidar", 0).read(j).points[:, :3])
+    assert [g.index for g in ds] == [0, 1]
+    fusion = FusionDataset(tmp_path)
+    assert fusion.frames == [0, 1] and fusion.scan_of[1] == j
+    assert np.isclose(fusion.read(1).t_sweep, Rig.sweep_time(j))

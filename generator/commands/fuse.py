@@ -110,7 +110,7 @@ def run(args) -> int:
             overlay, best = (frame.class_id, fused), smeared
     # scans without an image still go into the LiDAR-labelled map
     for k in progress(ds.seq.frames, desc="map", unit="scan"):
-        if k not in ds.frames:
+        if k not in ds.paired_scans:
             scan = ds.read_scan(k)
             maps["lidar"].add_static(P.transform(scan["pose"], deskewed(scan, deskew, actors)), scan["native"],
                                      scan["semantic"], scan["instance"], movers)
@@ -134,7 +134,7 @@ def run(args) -> int:
                  f"{100 * report['without_deskew']['agreement_native']:.2f} % (native).\n")
     positions = {k: (ds.poses[k][:3, 3] if ds.poses is not None else np.zeros(3)) for k in ds.seq.frames}
     trajectory = {"lidar": np.array([positions[k] for k in ds.seq.frames]),
-                  "camera": np.array([positions[k] for k in ds.frames])}
+                  "camera": np.array([positions[ds.scan_of[k]] for k in ds.frames])}
     with staging(out, "fusion") as stage:  # every file written in full before any is moved into place
         write_json(stage / "agreement.json", report)
         write_text(stage / "agreement.md", text)

@@ -22,6 +22,8 @@ from generator.previews.contact_sheet import variants_sheet
 from generator.imaging.exr import read_exr
 from generator.previews.preview import camera_model_of, colorize, display_rgb, side_by_side
 from generator.labels import class_table
+from generator.fusion.movers import is_moving_label
+from generator.imaging import meta_fields as md
 
 PREFERRED = ("day_clear", "night_clear")
 MIN_HEIGHT = 360
@@ -62,16 +64,23 @@ def _bev(root: Path, frame: int, size: int) -> np.ndarray | None:
         return None
     for name in list_sequences(lidar):
         seq = lidar / "sequences" / name
-        scan = seq / "velodyne" / f"{frame:06d}.bin"
+        meta = seq / "lidar_meta.json"
+        sweeps = md.image_sweeps(md.load_metadata(meta), str(meta)) if meta.exists() else {}
+        j = sweeps.get(frame, frame)  # the sweep the image was exposed with (a 10 Hz stream)
+        scan = seq / "velodyne" / f"{j:06d}.bin"
         if not scan.exists():
             continue
         pts = read_scan(scan)
-        native = read_sidecar(seq, NATIVE_DIR, frame, len(pts))
+        native = read_sidecar(seq, NATIVE_DIR, j, len(pts))
+        label = seq / "labels" / f"{j:06d}.label"
+        sem = read_labels(label)[0] if os.path.lexists(label) else np.zeros(len(pts), np.uint16)
+        if len(sem) != len(pts):
+            raise UserError(f"{label}: {len(sem)} labels but the scan has {len(pts)} points")
         if native is None:
-            sem, _ = read_labels(seq / "labels" / f"{frame:06d}.label")
             t = class_table()
             native = np.array([t.from_semantickitti(int(r)) if r in t.sk_labels else 0 for r in sem], np.uint8)
-        img = bev_image(pts[:, :3], native, extent_m=80.0, res_m=0.1, legend=False, title=f"scan {frame:06d}")
+        img = bev_image(pts[:, :3], native, extent_m=80.0, res_m=0.1, legend=False, title=f"scan {j:06d}",
+                        moving=is_moving_label(sem))
         img = img.resize((size * img.width // img.height, size), Image.NEAREST)
         return np.asarray(img.convert("RGB"))
     return None

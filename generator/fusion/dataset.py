@@ -129,7 +129,8 @@ def read_image(meta_path: Path) -> tuple[dict, object]:
 
 
 class FusionDataset:
-    """Images and LiDAR sequence ``seq`` of dataset folder ``root``, joined by frame index.
+    """Images and LiDAR sequence ``seq`` of dataset folder ``root``: image frame ``k`` joined with the
+    sweep it was exposed with (``image_frames`` of ``lidar_meta.json``; scan ``k`` without them).
 
     Parameters
     ----------
@@ -156,12 +157,18 @@ class FusionDataset:
             missing = [n for n in ("poses.txt", "calib.txt") if not os.path.lexists(self.seq.dir / n)]
             raise UserError(f"{self.seq.dir}: {' and '.join(missing)} missing; fusion places every scan with its "
                             "pose (without them every scan would stack at the origin)")
-        self.frames = [k for k in self.seq.frames if k in self.images]
+        #: image frame k -> the scan (sweep) it was exposed with; identity for the one-sweep-per-image layout
+        pairs = md.image_sweeps(self.meta, str(self.seq.dir / META_NAME))
+        scans = set(self.seq.frames)
+        self.scan_of = {k: pairs.get(k, k) if pairs else k for k in self.images}
+        self.frames = [k for k in sorted(self.images) if self.scan_of[k] in scans]
         if not self.frames:
-            raise UserError(f"{self.root}: no frame has both an image in images/ and a scan in {self.seq.velodyne}")
-        missing = sorted(set(self.seq.frames) - set(self.images))
-        if missing:
-            log.warning("%d scans without an image (first: %06d): left out", len(missing), missing[0])
+            raise UserError(f"{self.root}: no frame has both an image in images/ and its scan in {self.seq.velodyne}")
+        self.paired_scans = {self.scan_of[k] for k in self.frames}
+        unpaired = len(scans - self.paired_scans)
+        if unpaired:
+            log.info("%d of %d scans have no image (a 10 Hz stream: images at some sweeps); they go into "
+                     "the LiDAR map only", unpaired, len(scans))
 
     def _lidar_meta(self) -> tuple[dict, list]:
         path = self.seq.dir / META_NAME
@@ -217,7 +224,7 @@ class FusionDataset:
         img = read_exr(md.exr_path(meta, self.images[k]))
         name = meta.get("image") if isinstance(meta.get("image"), str) else self.images[k].stem
         return FusionFrame(index=k, image_name=name, class_id=img.class_id, depth=img.depth, K=K, T_world_camera=T,
-                           **self.read_scan(k, meta))
+                           **self.read_scan(self.scan_of[k], meta))
 
     def __iter__(self) -> Iterator[FusionFrame]:
         for k in self.frames:

@@ -201,6 +201,24 @@ def sweep_poses(meta: dict, source: str) -> list[tuple[np.ndarray, np.ndarray]]:
     return out
 
 
+def image_sweeps(meta: dict, source: str) -> dict[int, int]:
+    """Image frame ``k`` -> the sweep ``j`` it was exposed with (``image_frames`` of ``lidar_meta.json``).
+
+    Empty when the sequence has no ``image_frames`` (the older one-sweep-per-image layout, where
+    image ``k`` is scan ``k``).
+
+    Raises
+    ------
+    SpecError
+        ``image_frames`` is not a list of ``[image frame, sweep]`` pairs of integers >= 0.
+    """
+    pairs = field(meta, "image_frames", source, default=[])
+    if not isinstance(pairs, list) or not all(isinstance(p, list) and len(p) == 2 and all(
+            isinstance(v, int) and not isinstance(v, bool) and v >= 0 for v in p) for p in pairs):
+        raise SpecError(source, "image_frames", "must be a list of [image frame, sweep] pairs of integers >= 0")
+    return {k: j for k, j in pairs}
+
+
 def rigid_problem(T: np.ndarray, tol: float = 1e-3) -> str | None:
     """Why a (4, 4) world pose read from metadata is not rigid or is beyond :data:`MAX_WORLD_M`, or
     None (the rotation test of :func:`generator.formats.kitti_calib.rigid_problem`, which this layer

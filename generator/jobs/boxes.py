@@ -81,11 +81,7 @@ def sequence_world(spec, scene, meta: dict, times: np.ndarray, source: str):
 
 def sweep_frames(rig: Rig, meta: dict, frames: list[int], times: np.ndarray, source: str) -> list[SweepFrame]:
     """Per sweep: the ego pose at ``times[j]`` and, for sweeps paired with an image, its camera."""
-    pairs = md.field(meta, "image_frames", source, default=[])
-    if not isinstance(pairs, list) or not all(isinstance(p, list) and len(p) == 2 and all(
-            isinstance(v, int) and not isinstance(v, bool) and v >= 0 for v in p) for p in pairs):
-        raise SpecError(source, "image_frames", "must be a list of [image frame, sweep] pairs of integers >= 0")
-    image_of = {j: k for k, j in pairs}
+    image_of = {j: k for k, j in md.image_sweeps(meta, source).items()}
     out = []
     for j in frames:
         k = image_of.get(j)

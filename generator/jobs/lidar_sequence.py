@@ -181,7 +181,8 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
             sk.write_labels(seq / "labels" / f"{stem}.label", semantic, pts["instance"])
             write_point_sidecars(seq, stem, pts["time"], pts["class"])  # fusion: de-skew times, native classes
             if options.bev:
-                write_bev(seq / "bev" / f"{stem}.png", scan.xyz, pts["class"], title=f"{spec.name} {name}/{stem}")
+                write_bev(seq / "bev" / f"{stem}.png", scan.xyz, pts["class"], title=f"{spec.name} {name}/{stem}",
+                          moving=pts["moving"] if "moving" in pts.dtype.names else None)
             if options.range_image:
                 with atomic_path(seq / "range" / f"{stem}.npy") as tmp:
                     np.save(tmp, scan.range_image())

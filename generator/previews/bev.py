@@ -3,7 +3,8 @@
 Sensor frame seen from above: x (forward) points UP in the image, y (left) points LEFT;
 the sensor is at the centre, marked with a small white cross. Points are drawn lowest
 first, so roofs, car bodies and crowns cover the ground beneath them; cells with no
-point stay black (occlusion shadows behind objects show as black wedges).
+point stay black (occlusion shadows behind objects show as black wedges). Points on an
+actor moving at their firing time (``moving``) are drawn last, in :data:`MOVING_RGB`.
 """
 
 from __future__ import annotations
@@ -16,9 +17,12 @@ from PIL import Image, ImageDraw
 from generator.atomic import atomic_path
 from generator.labels import class_table
 
+#: Colour of moving points: pure green, far from every class colour of the table.
+MOVING_RGB = (0, 255, 0)
+
 
 def bev_image(xyz: np.ndarray, cls: np.ndarray, extent_m: float = 80.0, res_m: float = 0.1,
-              legend: bool = True, title: str | None = None) -> Image.Image:
+              legend: bool = True, title: str | None = None, moving: np.ndarray | None = None) -> Image.Image:
     """Render the scan.
 
     Parameters
@@ -31,6 +35,8 @@ def bev_image(xyz: np.ndarray, cls: np.ndarray, extent_m: float = 80.0, res_m: f
         Side of the square shown, centred on the sensor.
     res_m : float
         Metres per pixel.
+    moving : (n,) bool or uint8, optional
+        Points on a moving actor (``points["moving"]``), drawn in :data:`MOVING_RGB` above the rest.
 
     Returns
     -------
@@ -44,10 +50,13 @@ def bev_image(xyz: np.ndarray, cls: np.ndarray, extent_m: float = 80.0, res_m: f
     row = np.floor((extent_m / 2 - xyz[:, 0]) / res_m).astype(np.int64)
     col = np.floor((extent_m / 2 - xyz[:, 1]) / res_m).astype(np.int64)
     keep = (row >= 0) & (row < size) & (col >= 0) & (col < size)
-    order = np.argsort(xyz[keep, 2], kind="stable")  # low first; later writes win
+    moving = np.zeros(len(cls), bool) if moving is None else np.asarray(moving, bool)
+    z = xyz[keep, 2] + np.where(moving[keep], 1e6, 0.0)  # movers last, then low first; later writes win
+    order = np.argsort(z, kind="stable")
     r, c, k = row[keep][order], col[keep][order], cls[keep][order]
     img = np.zeros((size, size, 3), np.uint8)
     img[r, c] = table.colors[k]
+    img[r[moving[keep][order]], c[moving[keep][order]]] = MOVING_RGB
     mid = size // 2
     img[mid, mid - 4: mid + 5] = 255
     img[mid - 4: mid + 5, mid] = 255
@@ -73,6 +82,9 @@ def bev_image(xyz: np.ndarray, cls: np.ndarray, extent_m: float = 80.0, res_m: f
                        outline=(255, 255, 255))
         draw.text((size + 28, y), f"{table.names[cid]} ({counts[cid]})", fill=(255, 255, 255))
         y += 18
+    if moving.any():
+        draw.rectangle((size + 8, y, size + 22, y + 12), fill=MOVING_RGB, outline=(255, 255, 255))
+        draw.text((size + 28, y), f"moving, any class ({int(moving.sum())})", fill=(255, 255, 255))
     return out
 
 

@@ -7,7 +7,7 @@ else the fixed-exposure :func:`tonemap` every image had before the model.
 
 from __future__ import annotations
 
-import json
+import os
 from pathlib import Path
 
 import numpy as np
@@ -49,12 +49,13 @@ def display_rgb(rgb: np.ndarray, camera_model: dict | None = None) -> np.ndarray
 
 def camera_model_of(exr_path: str | Path) -> dict | None:
     """The ``camera_model`` section of the metadata JSON beside an EXR (None without one)."""
+    from generator.imaging.meta_fields import load_metadata
+
     p = Path(exr_path).with_suffix(".json")
-    try:
-        meta = json.loads(p.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+    if not os.path.lexists(p):
         return None
-    return meta.get("camera_model") if isinstance(meta, dict) else None
+    model = load_metadata(p).get("camera_model")  # a FIFO, a folder or bad JSON is one line (SpecError)
+    return model if isinstance(model, dict) else None
 
 
 def colorize(class_id: np.ndarray) -> np.ndarray:
