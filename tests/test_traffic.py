@@ -148,6 +148,14 @@ def test_more_vehicles_than_lanes_hold_is_refused():
         build_world(spec, scene, 5.0)
 
 
+def test_sweep_knots_start_at_zero_and_increase_strictly_at_every_sweep(town):
+    """Knots rebuild the ego pose within a sweep; a track sample at a sweep start is that start, not a second 0."""
+    ego = town[2].ego
+    for j in range(300):
+        k = ego.knot_offsets(Rig.sweep_time(j), SWEEP_PERIOD_S)
+        assert k[0] == 0.0 and np.isclose(k[-1], SWEEP_PERIOD_S) and np.all(np.diff(np.round(k, 12)) > 0), (j, k)
+
+
 def test_track_interpolates_between_samples():
     tr = Track(0.0, 0.5, np.array([[0.0, 0, 0], [1, 0, 0], [3, 0, 0]]), np.array([0.0, 0.0, np.pi / 2]))
     assert np.allclose(tr.position(0.25), [[0.5, 0, 0]])

@@ -231,7 +231,8 @@ class TrackTrajectory:
         tr = self.track
         k = np.arange(int(np.floor((t0 - tr.t0) / tr.dt)), int(np.ceil((t0 + period_s - tr.t0) / tr.dt)) + 1)
         times = tr.t0 + k * tr.dt - t0
-        inner = times[(times > 0) & (times < period_s) & (k > 0) & (k < len(tr.yaw) - 1)]
+        eps = 1e-9  # a sample AT t0 or t0 + period (0.3 - 0.3 = 5.6e-17) is the start or end knot, not another
+        inner = times[(times > eps) & (times < period_s - eps) & (k > 0) & (k < len(tr.yaw) - 1)]
         return np.unique(np.r_[0.0, inner, period_s])
 
     def time_at_distance(self, s: float) -> float:
