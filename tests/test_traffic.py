@@ -64,6 +64,21 @@ def test_no_two_boxes_touch_at_any_time_ego_included(town):
         assert not boxes_overlap(q, parked).any(), f"an actor touches a static object at t={t:.1f}"
 
 
+def test_no_vehicle_ever_touches_a_pedestrian():
+    """Vehicles and people share the crosswalks under the signals: their boxes never intersect (every 0.1 s)."""
+    spec = spec_with({**TRAFFIC, "pedestrians_per_100m": 2.0, "standing_pedestrians_per_100m": 0.5})
+    world = build_world(spec, build_scene(spec), DURATION)
+    people = [a for a in world.actors if a.kind == "person"]
+    vehicles = [a for a in world.actors if a.kind != "person"]
+    assert len(people) > 30 and len(vehicles) > 20
+    for t in _times():
+        p = np.stack([a.box(t).corners_xy() for a in people])
+        E = world.ego.T_world_ego(t)[0]
+        ego = OrientedBox((E[0, 3], E[1, 3], 0.7), (4.6, 1.9, 1.5), float(np.arctan2(E[1, 0], E[0, 0])))
+        hit = boxes_overlap(np.stack([a.box(t).corners_xy() for a in vehicles] + [ego.corners_xy()]), p)
+        assert not hit.any(), (t, np.argwhere(hit)[:3])
+
+
 def test_vehicles_stay_on_the_driving_lanes(town):
     spec, _, world = town
     grid = make_grid(spec)

@@ -4,7 +4,7 @@ Sensor frame seen from above: x (forward) points UP in the image, y (left) point
 the sensor is at the centre, marked with a small white cross. Points are drawn lowest
 first, so roofs, car bodies and crowns cover the ground beneath them; cells with no
 point stay black (occlusion shadows behind objects show as black wedges). Points on an
-actor moving at their firing time (``moving``) are drawn last, in :data:`MOVING_RGB`.
+actor moving at their firing time (``moving``) are drawn last, as 3x3 dots of :data:`MOVING_RGB`.
 """
 
 from __future__ import annotations
@@ -56,7 +56,10 @@ def bev_image(xyz: np.ndarray, cls: np.ndarray, extent_m: float = 80.0, res_m: f
     r, c, k = row[keep][order], col[keep][order], cls[keep][order]
     img = np.zeros((size, size, 3), np.uint8)
     img[r, c] = table.colors[k]
-    img[r[moving[keep][order]], c[moving[keep][order]]] = MOVING_RGB
+    mr, mc = r[moving[keep][order]], c[moving[keep][order]]
+    for dr in (-1, 0, 1):  # 3x3 dots: a mover stands out of the terrain and vegetation greens
+        for dc in (-1, 0, 1):
+            img[np.clip(mr + dr, 0, size - 1), np.clip(mc + dc, 0, size - 1)] = MOVING_RGB
     mid = size // 2
     img[mid, mid - 4: mid + 5] = 255
     img[mid - 4: mid + 5, mid] = 255

@@ -33,7 +33,7 @@ from generator.world.trajectory import EgoTrajectory
 log = logging.getLogger(__name__)
 
 WARMUP_S = 20.0
-LOOKAHEAD_S = 16.0   #: vehicles ask about crosswalks up to 15 s ahead (VehicleSim._crossing_clear)
+LOOKAHEAD_S = 9.0    #: vehicles ask about crosswalks up to signals.CLEAR_S ahead (VehicleSim._maybe_grant)
 MAX_DRIVE_S = 900.0
 SPACING_M = 6.0       #: lanes hold at most one vehicle per (length + this), for the capacity check
 EGO_SIZE_M = (4.6, 1.9)

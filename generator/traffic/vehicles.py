@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from generator.traffic.lanes import ARM_DIRS, LaneGraph
+from generator.traffic.signals import CLEAR_S
 
 log = logging.getLogger(__name__)
 
@@ -200,8 +201,10 @@ class VehicleSim:
                 return
         if not self._room(veh, conn, occ):
             return
-        if self.crossing is not None and (self.crossing(node, conn.arms[0], t, t + 15.0)
-                                          or self.crossing(node, conn.arms[1], t, t + 15.0)):
+        # the signals keep vehicles from entering CLEAR_S before a walk phase: only people on (or
+        # stepping onto) the crosswalks within that time can meet this vehicle
+        if self.crossing is not None and (self.crossing(node, conn.arms[0], t, t + CLEAR_S)
+                                          or self.crossing(node, conn.arms[1], t, t + CLEAR_S)):
             return
         veh.grant = conn.index
         self.holders.setdefault(node, {})[veh.index] = conn.index
