@@ -220,3 +220,19 @@ def test_lidar_sequence_through_traffic_labels_movers_and_repeats_byte_for_byte(
     to_static = {252: 10, 253: 31, 254: 30, 255: 32, 256: 16, 257: 13, 258: 18, 259: 20}
     for i, ids in class_of.items():  # an instance is one actor all sequence: its class, moving or not (a rider's bike)
         assert {to_static.get(x, x) for x in ids} <= {int(class_table()[by_instance[i].cls].semantickitti), 11, 15}, (i, ids)
+
+
+def test_a_rebuilt_world_is_checked_against_the_recorded_digest(town):
+    """fuse and openlabel rebuild the traffic from the spec; a different world (another model version) is refused."""
+    from generator.errors import UserError
+
+    spec, scene, world = town
+    times = np.arange(0, 50) * SWEEP_PERIOD_S
+    recorded = world.digest(times)
+    shorter = build_world(spec, scene, 5.2)  # causal: a shorter run has the same poses at these times
+    shorter.check_digest(recorded, times, "lidar_meta.json")
+    shorter.check_digest(recorded, times + 1e-7, "lidar_meta.json")  # times.txt rounding does not matter
+    moved = build_world(spec, scene, 5.2)
+    moved.actors[3].track.xyz[20:] += 0.01
+    with pytest.raises(UserError, match="lidar_meta.json: traffic.digest: .* not the one"):
+        moved.check_digest(recorded, times, "lidar_meta.json")

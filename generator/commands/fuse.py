@@ -47,12 +47,13 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def dataset_actors(root: Path, n_sweeps: int):
+def dataset_actors(root: Path, ds):
     """Instance id -> ``T_world_actor(t)`` of the moving actors of the dataset's spec, or None.
 
     The spec is the one ``generate``/``render`` recorded in ``root/manifest.json``; its world is
     rebuilt (deterministic, and causal: a run covering the sweeps has the same tracks as the
-    drive that made them). None without a manifest or without traffic.
+    drive that made them), and checked against the digest ``lidar_meta.json`` recorded. None
+    without a manifest or without traffic.
     """
     from generator.jobs import manifest as mf
 
@@ -69,7 +70,12 @@ def dataset_actors(root: Path, n_sweeps: int):
     if not spec.traffic.enabled:
         return None
     log.info("rebuilding the traffic of %s to de-skew its moving actors", spec.name)
-    return actor_poses(build_world(spec, build_scene(spec), n_sweeps * SWEEP_PERIOD_S + 0.2))
+    times = np.array([SWEEP_PERIOD_S * j for j in range(len(ds.seq.frames))]) if ds.seq.times is None else ds.seq.times
+    world = build_world(spec, build_scene(spec), float(np.max(times, initial=0.0)) + SWEEP_PERIOD_S + 0.2)
+    traffic = ds.meta.get("traffic") if isinstance(ds.meta.get("traffic"), dict) else {}
+    digest = traffic.get("digest")
+    world.check_digest(digest if isinstance(digest, str) else None, times, str(ds.seq.dir / "lidar_meta.json"))
+    return actor_poses(world)
 
 
 def run(args) -> int:
@@ -88,7 +94,7 @@ def run(args) -> int:
     if overlay_k is not None and overlay_k not in ds.frames:
         raise UserError(f"--overlay-frame: frame {overlay_k} has no image and scan (have {ds.frames[0]}..{ds.frames[-1]})")
     deskew = not args.no_deskew
-    actors = dataset_actors(root, len(ds.seq.frames))
+    actors = dataset_actors(root, ds)
     movers = set(actors or ())
     agree, raw = Agreement(), Agreement()
     maps = {"lidar": VoxelMap(args.voxel), "camera": VoxelMap(args.voxel)}

@@ -76,6 +76,8 @@ def sequence_world(spec, scene, meta: dict, times: np.ndarray, source: str):
         raise SpecError(source, "traffic.duration_s", f"must be seconds in [0, {MAX_DRIVE_S:.0f}]")
     # the simulation is causal: a run at least as long gives the same poses over the sequence
     world = build_world(spec, scene, duration, 0.0)
+    digest = md.field(meta, "traffic.digest", source, default=None)
+    world.check_digest(digest if isinstance(digest, str) else None, times, source)
     return world if world.actors else frozen_world(scene, world.ego)
 
 

@@ -200,6 +200,7 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
     meta["sweep_period_s"] = SWEEP_PERIOD_S
     meta["traffic"] = {"actors": len(actors), "moving_threshold_mps": MOVING_THRESHOLD_MPS,
                        "duration_s": float(world.duration_s) if actors else 0.0,
+                       "digest": world.digest(times) if actors else None,
                        "moving_ids": "SemanticKITTI 252-259 for points on an actor moving faster than the "
                                      "threshold at its firing time; instance ids stay the same all sequence"}
     if options.image_frames:

@@ -15,10 +15,12 @@ origin on the ground under the reference point of its prototype (as static objec
 
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from generator.errors import UserError
 from generator.geometry import Mesh
 from generator.world.scene import OrientedBox, SceneModel
 
@@ -173,6 +175,32 @@ class World:
     proxies: dict[str, Mesh]
     ego: object
     duration_s: float
+
+    def digest(self, times) -> str:
+        """sha256 (hex) of every actor's identity and pose and the ego's pose at ``times`` (seconds).
+
+        Recorded with a sequence (``lidar_meta.json`` ``traffic.digest``) so a world rebuilt
+        from the spec later (fusion, OpenLABEL) is known to be the one the sensors saw; poses
+        are rounded to 1e-6 so the digest does not hang on the last bit.
+        """
+        t = np.round(np.asarray(times, np.float64).reshape(-1), 4)  # times.txt keeps 7 significant digits
+        h = hashlib.sha256(np.round(self.ego.T_world_ego(t), 6).tobytes())
+        for a in self.actors:
+            h.update(f"{a.uid}/{a.instance_id}/{a.kind}/{a.cls}".encode())
+            h.update(np.round(a.track.pose(t), 6).tobytes())
+        return h.hexdigest()
+
+    def check_digest(self, recorded, times, source: str) -> None:
+        """Refuse (one line) a rebuilt world whose :meth:`digest` differs from the ``recorded`` one.
+
+        Nothing to check when nothing was recorded (a sequence from before digests).
+        """
+        if recorded is None:
+            return
+        if recorded != self.digest(times):
+            raise UserError(f"{source}: traffic.digest: the traffic rebuilt from the spec is not the one this "
+                            "sequence was cast in (made by another version of urbangen's traffic model); "
+                            "regenerate the sequence with this version")
 
     def T_world_actor(self, t: float) -> np.ndarray:
         """(n, 4, 4) float64 pose of every actor at time ``t`` (seconds)."""
