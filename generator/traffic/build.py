@@ -33,6 +33,7 @@ from generator.world.trajectory import EgoTrajectory
 log = logging.getLogger(__name__)
 
 WARMUP_S = 20.0
+LEAD_IN = 2           #: track samples before t = 0 (central differences at t = 0 see real motion)
 LOOKAHEAD_S = 9.0    #: vehicles ask about crosswalks up to signals.CLEAR_S ahead (VehicleSim._maybe_grant)
 MAX_DRIVE_S = 900.0
 SPACING_M = 6.0       #: lanes hold at most one vehicle per (length + this), for the capacity check
@@ -88,7 +89,7 @@ def build_world(spec, scene, duration_s: float, distance_m: float = 0.0) -> Worl
             break
         horizon_s = 2.0 * crossing.asked_s  # same answers up to the old horizon (causal): a longer run, same world
         graph = LaneGraph(grid)
-    peds = [_extend_track(p, len(ego_dist)) for p in peds]
+    peds = [_lead_in(_extend_track(p, len(ego_dist))) for p in peds]
     world = _assemble(scene, movers + peds, TrackTrajectory(ego_track, ego_dist), ego_track.t1)
     log.info("traffic %s: %d vehicles, %d pedestrians over %.1f s, simulated in %.2f s", spec.name, len(movers),
              len(peds), ego_track.t1, time.perf_counter() - t_start)
@@ -101,6 +102,18 @@ def _pedestrians(spec, grid, scene, signals, lib, n_steps: int) -> list[Mover]:
     from generator.traffic.pedestrians import simulate_pedestrians
 
     return simulate_pedestrians(spec, grid, scene, signals, lib, n_steps, DT_S)
+
+
+def _lead_in(m: Mover) -> Mover:
+    """Prepend :data:`LEAD_IN` samples before t = 0 at the first step's velocity, so central
+    differences at t = 0 see the motion (a walker already walking) instead of a clamped track."""
+    tr = m.track
+    if tr.t0 <= -LEAD_IN * DT_S + 1e-12 or len(tr.yaw) < 2:
+        return m
+    step = tr.xyz[1] - tr.xyz[0]
+    back = tr.xyz[0] - step * np.arange(LEAD_IN, 0, -1)[:, None]
+    m.track = Track(tr.t0 - LEAD_IN * DT_S, tr.dt, np.vstack([back, tr.xyz]), np.r_[np.repeat(tr.yaw[:1], LEAD_IN), tr.yaw])
+    return m
 
 
 def _extend_track(m: Mover, n: int) -> Mover:
@@ -237,7 +250,12 @@ def _drive(spec, graph, signals, lib, blocked, crossing, duration_s, distance_m)
         sim._extend(v)
     ego.v_des = 0.0
     n_warm = round(WARMUP_S / DT_S)
+    lead_xy, lead_h = [], []  # the warm-up's last LEAD_IN samples: tracks start before t = 0
     for k in range(n_warm):
+        if k >= n_warm - LEAD_IN:
+            poses = [sim.pose(v) for v in vehicles]
+            lead_xy.append([p[0] for p in poses])
+            lead_h.append([p[1] for p in poses])
         sim.step(-WARMUP_S + k * DT_S, DT_S)
     ego.v_des = spec.paths.speed_mps
     rec_xy, rec_h, dist = [], [], [0.0]
@@ -256,12 +274,13 @@ def _drive(spec, graph, signals, lib, blocked, crossing, duration_s, distance_m)
         sim.step(t, DT_S)
         k += 1
         t = k * DT_S
-    xy, hd = np.asarray(rec_xy), np.unwrap(np.asarray(rec_h), axis=0)
+    xy, hd = np.asarray(lead_xy + rec_xy), np.unwrap(np.asarray(lead_h + rec_h), axis=0)
     for j, m in enumerate(movers, start=1):
         c = (m.proto.lo + m.proto.hi) / 2
         cs, sn = np.cos(hd[:, j]), np.sin(hd[:, j])
         origin = xy[:, j] - np.stack([c[0] * cs - c[1] * sn, c[0] * sn + c[1] * cs], -1)
-        m.track = Track(0.0, DT_S, np.c_[origin, np.zeros(len(origin))], hd[:, j])
+        m.track = Track(-LEAD_IN * DT_S, DT_S, np.c_[origin, np.zeros(len(origin))], hd[:, j])
+    xy, hd = xy[LEAD_IN:], hd[LEAD_IN:]  # the ego's drive starts at t = 0 (it waits through the warm-up)
     ego_track = Track(0.0, DT_S, np.c_[xy[:, 0], np.zeros(len(xy))], hd[:, 0])
     return movers, ego_track, np.asarray(dist)
 
