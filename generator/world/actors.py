@@ -199,7 +199,7 @@ class World:
             return
         if recorded != self.digest(times):
             raise UserError(f"{source}: traffic.digest: the traffic rebuilt from the spec is not the one this "
-                            "sequence was cast in (made by another version of urbangen's traffic model); "
+                            "sequence was cast in (another spec in manifest.json, or another version of urbangen's traffic model); "
                             "regenerate the sequence with this version")
 
     def T_world_actor(self, t: float) -> np.ndarray:
