@@ -47,6 +47,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from generator import cli
+from json_kit import value_paths
 
 ROOT = Path(__file__).resolve().parents[1]
 MARKER = "HOSTILE-MARKER-7f3a"
@@ -148,17 +149,6 @@ def kinds(rel: str, is_dir: bool) -> list[str]:
     return out
 
 
-def _paths(doc, prefix=()) -> list[tuple]:
-    out = [prefix] if prefix else []
-    if isinstance(doc, dict):
-        for k, v in doc.items():
-            out += _paths(v, prefix + (k,))
-    elif isinstance(doc, list):
-        for i, v in enumerate(doc[:8]):
-            out += _paths(v, prefix + (i,))
-    return out
-
-
 def _set(doc, path: tuple, value) -> None:
     for k in path[:-1]:
         doc = doc[k]
@@ -210,7 +200,7 @@ def corrupt(path: Path, kind: str, data, outside: Path) -> None:
         path.write_text(text[: m.start()] + data.draw(st.sampled_from(NUMBERS)) + text[m.end():])
     elif kind == "json_field":
         doc = json.loads(raw)
-        _set(doc, data.draw(st.sampled_from(_paths(doc))), data.draw(st.sampled_from(JSON_VALUES)))
+        _set(doc, data.draw(st.sampled_from(value_paths(doc, max_items=8))), data.draw(st.sampled_from(JSON_VALUES)))
         path.write_text(json.dumps(doc))
     elif kind in ("label_ids", "native_ids", "floats"):
         dtype = {"label_ids": "<u4", "native_ids": "u1", "floats": "<f4"}[kind]

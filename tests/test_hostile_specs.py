@@ -35,6 +35,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from generator import cli
+from json_kit import value_paths
 from generator.spec import load_spec
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -51,22 +52,9 @@ _cli_settings = settings(suppress_health_check=[HealthCheck.function_scoped_fixt
 
 # -- building documents ------------------------------------------------------------------------------------------
 
-
-def _paths(doc, prefix=()) -> list[tuple]:
-    """Every path to a value in ``doc`` (mapping keys and list indices), parents before children."""
-    out = [prefix] if prefix else []
-    if isinstance(doc, dict):
-        for k, v in doc.items():
-            out += _paths(v, prefix + (k,))
-    elif isinstance(doc, list):
-        for i, v in enumerate(doc):
-            out += _paths(v, prefix + (i,))
-    return out
-
-
-SPEC_PATHS = _paths(BASE_SPEC)
-CONFIG_PATHS = _paths(BASE_CONFIG)
-SENSOR_PATHS = _paths(BASE_SENSOR)
+SPEC_PATHS = value_paths(BASE_SPEC)
+CONFIG_PATHS = value_paths(BASE_CONFIG)
+SENSOR_PATHS = value_paths(BASE_SENSOR)
 
 
 def _deep(n: int, fmt: str) -> str:
