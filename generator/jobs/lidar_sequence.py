@@ -176,13 +176,13 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
             scan = dataclasses.replace(scan, points=pts)  # xyz, range image and side files follow the processed points
             records.append(record)
             stem = f"{j:06d}"
-            semantic = semantic_ids(pts)
+            semantic = semantickitti_labels(pts["class"], pts["moving"])  # moving-* ids on movers
             sk.write_scan(seq / "velodyne" / f"{stem}.bin", scan.xyz, remission)
             sk.write_labels(seq / "labels" / f"{stem}.label", semantic, pts["instance"])
             write_point_sidecars(seq, stem, pts["time"], pts["class"])  # fusion: de-skew times, native classes
             if options.bev:
                 write_bev(seq / "bev" / f"{stem}.png", scan.xyz, pts["class"], title=f"{spec.name} {name}/{stem}",
-                          moving=pts["moving"] if "moving" in pts.dtype.names else None)
+                          moving=pts["moving"])
             if options.range_image:
                 with atomic_path(seq / "range" / f"{stem}.npy") as tmp:
                     np.save(tmp, scan.range_image())
@@ -210,13 +210,6 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
     write_json(seq / META_NAME, meta)
     write_dataset_label_config(out)
     return meta
-
-
-def semantic_ids(points: np.ndarray) -> np.ndarray:
-    """(n,) uint16 SemanticKITTI raw ids of processed points: the moving id (252-259) where a point
-    lies on an actor moving at its firing time and the class has one, else the class's own id."""
-    moving = points["moving"] if "moving" in (points.dtype.names or ()) else False
-    return semantickitti_labels(points["class"], moving).astype(np.uint16, copy=False)
 
 
 def _remove_stale(seq: Path, n: int) -> None:
