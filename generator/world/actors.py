@@ -274,6 +274,10 @@ class TrackTrajectory:
         f = (s - d[i - 1]) / max(d[i] - d[i - 1], 1e-12)
         return tr.t0 + (i - 1 + f) * tr.dt
 
+    def max_frames(self, spacing_m: float) -> int:
+        """How many frames ``spacing_m`` apart the simulated drive reaches."""
+        return max(1, int(np.floor(float(self.distance[-1]) / spacing_m)) + 1)
+
     def distance_at(self, t: float) -> float:
         """Metres driven at time ``t`` (linear between samples)."""
         tr = self.track

@@ -266,11 +266,7 @@ class Rig:
 
     def max_frames(self) -> int:
         """How many distinct frames fit on the route (a loop: one lap)."""
-        drive = self._drive()
-        if not hasattr(drive, "path"):  # a simulated drive: as far as it was simulated
-            return max(1, math.floor(float(drive.distance[-1]) / self.spacing_m) + 1)
-        path = drive.path
-        return max(1, math.floor(path.length() / self.spacing_m) + (0 if path.closed else 1))
+        return self._drive().max_frames(self.spacing_m)
 
     def sweep_poses(self, t0: float, column_times: np.ndarray | None) -> np.ndarray:
         """LiDAR world poses of a sweep starting at ``t0`` seconds.

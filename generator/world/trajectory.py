@@ -54,6 +54,11 @@ class EgoTrajectory:
         """Metres driven at time ``t``."""
         return t * self.speed_mps
 
+    def max_frames(self, spacing_m: float) -> int:
+        """How many distinct frames ``spacing_m`` apart fit on the route (a loop: one lap)."""
+        length = self.path.length()
+        return max(1, int(np.floor(length / spacing_m)) + (0 if self.path.closed else 1))
+
     def knot_offsets(self, t0: float, period_s: float) -> np.ndarray:
         """(k,) float64: 0, the offsets in ``(0, period)`` where a route sample is crossed, ``period``."""
         path, speed = self.path, self.speed_mps
