@@ -527,6 +527,24 @@ def test_fuse_refuses_missing_poses_nan_poses_bad_sweeps_and_a_nan_voxel(ds, cap
     assert "poses.txt missing" in err and "stack at the origin" in err, err
 
 
+def test_image_frames_naming_missing_or_several_sweeps(ds, capfd):
+    """An image paired with a sweep the sequence lacks, or with two sweeps: validate lists it, fuse refuses two."""
+    meta_path = ds / "lidar/sequences/00/lidar_meta.json"
+    text = meta_path.read_text()
+    meta = json.loads(text)
+    try:
+        meta["image_frames"] = [[0, 0], [1, 10**8]]
+        meta_path.write_text(json.dumps(meta))
+        _, err = run(capfd, ["validate", str(ds)], ds.parent, {1})
+        assert "image_frames: image 1 is paired with a sweep beyond the sequence's" in err, err
+        meta["image_frames"] = [[0, 0], [0, 1]]
+        meta_path.write_text(json.dumps(meta))
+        _, err = run(capfd, ["fuse", str(ds)], ds.parent, {2})
+        assert "image_frames: an image frame is paired with more than one sweep" in err, err
+    finally:
+        meta_path.write_text(text)
+
+
 def test_label_ids_outside_the_tables(kit, ds, capfd):
     seq = ds / "lidar/sequences/00"
     native = np.fromfile(seq / "native_labels/000000.bin", np.uint8)

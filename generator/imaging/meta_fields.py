@@ -210,13 +210,17 @@ def image_sweeps(meta: dict, source: str) -> dict[int, int]:
     Raises
     ------
     SpecError
-        ``image_frames`` is not a list of ``[image frame, sweep]`` pairs of integers >= 0.
+        ``image_frames`` is not a list of ``[image frame, sweep]`` pairs of integers >= 0, one per
+        image frame.
     """
     pairs = field(meta, "image_frames", source, default=[])
     if not isinstance(pairs, list) or not all(isinstance(p, list) and len(p) == 2 and all(
             isinstance(v, int) and not isinstance(v, bool) and v >= 0 for v in p) for p in pairs):
         raise SpecError(source, "image_frames", "must be a list of [image frame, sweep] pairs of integers >= 0")
-    return {k: j for k, j in pairs}
+    out = {k: j for k, j in pairs}
+    if len(out) != len(pairs):
+        raise SpecError(source, "image_frames", "an image frame is paired with more than one sweep")
+    return out
 
 
 def rigid_problem(T: np.ndarray, tol: float = 1e-3) -> str | None:

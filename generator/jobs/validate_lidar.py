@@ -102,17 +102,23 @@ def check_tables(seq: Path, root: Path, n_scans: int) -> list[str]:
     return problems
 
 
-def check_meta(seq: Path, root: Path) -> list[str]:
-    """Problems of the sequence's ``lidar_meta.json`` (when it has one)."""
-    from generator.imaging.meta_fields import load_metadata, sweep_poses
+def check_meta(seq: Path, root: Path, n_scans: int) -> list[str]:
+    """Problems of the sequence's ``lidar_meta.json`` (when it has one): sweep poses, and
+    ``image_frames`` naming sweeps the sequence has."""
+    from generator.imaging.meta_fields import image_sweeps, load_metadata, sweep_poses
 
     path = seq / META_NAME
     if not os.path.lexists(path):
         return []
     try:
-        sweep_poses(load_metadata(path, rel(path, root)), rel(path, root))
+        meta = load_metadata(path, rel(path, root))
+        sweep_poses(meta, rel(path, root))
+        beyond = sorted(k for k, j in image_sweeps(meta, rel(path, root)).items() if j >= n_scans)
     except UserError as e:
         return [str(e)]
+    if beyond:
+        return [f"{rel(path, root)}: image_frames: image {beyond[0]} is paired with a sweep beyond the "
+                f"sequence's {n_scans} scans"]
     return []
 
 
@@ -130,5 +136,5 @@ def check_lidar(root: Path) -> tuple[list[str], int]:
         for b in bins:
             problems += check_scan(seq, b, root, known)
         problems += check_tables(seq, root, len(bins))
-        problems += check_meta(seq, root)
+        problems += check_meta(seq, root, len(bins))
     return problems, n
