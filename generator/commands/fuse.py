@@ -51,31 +51,31 @@ def dataset_actors(root: Path, ds):
     """Instance id -> ``T_world_actor(t)`` of the moving actors of the dataset's spec, or None.
 
     The spec is the one ``generate``/``render`` recorded in ``root/manifest.json``; its world is
-    rebuilt (deterministic, and causal: a run covering the sweeps has the same tracks as the
-    drive that made them), and checked against the digest ``lidar_meta.json`` recorded. None
-    without a manifest or without traffic.
+    rebuilt by :func:`generator.jobs.boxes.sequence_world` (as ``openlabel`` does: over the
+    recorded duration, checked against the recorded digest). None without a manifest, without
+    traffic, or for a sequence cast without actors.
     """
+    from generator.imaging import meta_fields as md
     from generator.jobs import manifest as mf
 
-    doc = mf.load(root)
-    if doc is None or not isinstance(doc.get("spec"), dict) or not isinstance(doc["spec"].get("traffic"), dict):
+    path = root / mf.NAME
+    if not os.path.lexists(path):
+        return None
+    spec_doc = md.load_metadata(path).get("spec")  # a FIFO, a folder or bad JSON is one line
+    if not isinstance(spec_doc, dict) or not isinstance(spec_doc.get("traffic"), dict):
         return None
     from generator.fusion.movers import actor_poses
+    from generator.jobs.boxes import sequence_world
     from generator.layout.assemble import build_scene
     from generator.spec.load import parse_spec
-    from generator.traffic.build import build_world
-    from generator.world.rig import SWEEP_PERIOD_S
+    from generator.world.rig import Rig
 
-    spec = parse_spec(doc["spec"], str(root / mf.NAME))
+    spec = parse_spec(spec_doc, str(path))
     if not spec.traffic.enabled:
         return None
     log.info("rebuilding the traffic of %s to de-skew its moving actors", spec.name)
-    times = np.array([SWEEP_PERIOD_S * j for j in range(len(ds.seq.frames))]) if ds.seq.times is None else ds.seq.times
-    world = build_world(spec, build_scene(spec), float(np.max(times, initial=0.0)) + SWEEP_PERIOD_S + 0.2)
-    traffic = ds.meta.get("traffic") if isinstance(ds.meta.get("traffic"), dict) else {}
-    digest = traffic.get("digest")
-    world.check_digest(digest if isinstance(digest, str) else None, times, str(ds.seq.dir / "lidar_meta.json"))
-    return actor_poses(world)
+    times = ds.seq.times if ds.seq.times is not None else np.array([Rig.sweep_time(j) for j in ds.seq.frames])
+    return actor_poses(sequence_world(spec, build_scene(spec), ds.meta, times, str(ds.seq.dir / "lidar_meta.json")))
 
 
 def run(args) -> int:
