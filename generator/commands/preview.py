@@ -54,18 +54,27 @@ def _frames(root: Path) -> dict[int, list[Path]]:
     return out
 
 
-def _bev(root: Path, frame: int, size: int) -> np.ndarray | None:
-    from generator.formats.point_sidecars import NATIVE_DIR, read_sidecar
-    from generator.formats.semantickitti import list_sequences, read_labels, read_scan
-    from generator.previews.bev import bev_image
+def _sequences(root: Path) -> list[tuple[Path, dict[int, int]]]:
+    """Each LiDAR sequence folder of ``root`` with its image frame -> sweep pairs (read once per run)."""
+    from generator.formats.semantickitti import list_sequences
 
     lidar = root / "lidar"
     if not (lidar / "sequences").is_dir():
-        return None
+        return []
+    out = []
     for name in list_sequences(lidar):
         seq = lidar / "sequences" / name
         meta = seq / "lidar_meta.json"
-        sweeps = md.image_sweeps(md.load_metadata(meta), str(meta)) if meta.exists() else {}
+        out.append((seq, md.image_sweeps(md.load_metadata(meta), str(meta)) if os.path.lexists(meta) else {}))
+    return out
+
+
+def _bev(sequences: list[tuple[Path, dict[int, int]]], frame: int, size: int) -> np.ndarray | None:
+    from generator.formats.point_sidecars import NATIVE_DIR, read_sidecar
+    from generator.formats.semantickitti import read_labels, read_scan
+    from generator.previews.bev import bev_image
+
+    for seq, sweeps in sequences:
         j = sweeps.get(frame, frame)  # the sweep the image was exposed with (a 10 Hz stream)
         scan = seq / "velodyne" / f"{j:06d}.bin"
         if not scan.exists():
@@ -102,22 +111,23 @@ def run(args) -> int:
     out = output_dir(root / "preview", "")
     # Every sheet is made in a stage and moved into preview/ at the end: a bad EXR in the
     # last frame leaves no sheets of the first ones behind.
+    sequences = _sequences(root)
     with staging(out, "preview") as stage:
         for k, paths in frames.items():
-            _sheets(root, k, paths, stage)
+            _sheets(sequences, k, paths, stage)
         for p in sorted(stage.iterdir()):
             os.replace(p, out / p.name)
     print(f"wrote {len(frames)} preview sheet(s) into {out}")
     return 0
 
 
-def _sheets(root: Path, k: int, paths: list[Path], out: Path) -> None:
+def _sheets(sequences: list, k: int, paths: list[Path], out: Path) -> None:
     """The contact sheet of frame ``k`` (and its variants sheet) into ``out``."""
     pick = next((p for pref in PREFERRED for p in paths if p.stem.endswith(pref)), paths[0])
     img = read_exr(pick)
     h = max(img.class_id.shape[0], MIN_HEIGHT)
     panels = [_height(display_rgb(img.rgb, camera_model_of(pick)), h, True), _height(colorize(img.class_id), h, False)]
-    bev = _bev(root, k, h)
+    bev = _bev(sequences, k, h)
     if bev is not None:
         panels.append(bev)
     with atomic_path(out / f"{k:06d}.png", suffix=".png") as tmp:

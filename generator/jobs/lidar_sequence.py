@@ -168,7 +168,7 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
     starts, n_points, counts, records = [], [], {}, []
     sweeps = []  # LiDAR world poses during each sweep (fusion de-skews with them)
     actors = world.actors if world is not None else []
-    with Scanner(scene, sensor, threads=options.threads, world=world if actors else None) as scanner:
+    with Scanner(scene, sensor, threads=options.threads, world=world) as scanner:
         for j in progress_bar(range(options.frames), desc=f"lidar {name}", unit="scan", enabled=progress):
             t_j = times[j]
             scan = scanner.sweep(rig, t_j, skew)

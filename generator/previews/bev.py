@@ -51,12 +51,11 @@ def bev_image(xyz: np.ndarray, cls: np.ndarray, extent_m: float = 80.0, res_m: f
     col = np.floor((extent_m / 2 - xyz[:, 1]) / res_m).astype(np.int64)
     keep = (row >= 0) & (row < size) & (col >= 0) & (col < size)
     moving = np.zeros(len(cls), bool) if moving is None else np.asarray(moving, bool)
-    z = xyz[keep, 2] + np.where(moving[keep], 1e6, 0.0)  # movers last, then low first; later writes win
-    order = np.argsort(z, kind="stable")
+    order = np.argsort(xyz[keep, 2], kind="stable")  # low first; later writes win
     r, c, k = row[keep][order], col[keep][order], cls[keep][order]
     img = np.zeros((size, size, 3), np.uint8)
     img[r, c] = table.colors[k]
-    mr, mc = r[moving[keep][order]], c[moving[keep][order]]
+    mr, mc = row[keep & moving], col[keep & moving]  # painted over everything
     for dr in (-1, 0, 1):  # 3x3 dots: a mover stands out of the terrain and vegetation greens
         for dc in (-1, 0, 1):
             img[np.clip(mr + dr, 0, size - 1), np.clip(mc + dc, 0, size - 1)] = MOVING_RGB

@@ -30,9 +30,6 @@ class MotionBlur:
     enabled: bool = False
     shutter_s: float = 0.01
 
-    def to_dict(self) -> dict:
-        return {"enabled": self.enabled, "shutter_s": self.shutter_s}
-
 
 @dataclass(frozen=True)
 class RenderConfig:

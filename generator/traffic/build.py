@@ -25,7 +25,7 @@ from generator.layout.streets import make_grid
 from generator.rng import stream
 from generator.traffic.lanes import LaneGraph
 from generator.traffic.movers import DT_S, Mover
-from generator.traffic.signals import Signals
+from generator.traffic.signals import CLEAR_S, Signals
 from generator.traffic.vehicles import Vehicle, VehicleSim
 from generator.world.actors import Actor, Track, TrackTrajectory, World, frozen_world
 from generator.world.trajectory import EgoTrajectory
@@ -34,7 +34,7 @@ log = logging.getLogger(__name__)
 
 WARMUP_S = 20.0
 LEAD_IN = 2           #: track samples before t = 0 (central differences at t = 0 see real motion)
-LOOKAHEAD_S = 9.0    #: vehicles ask about crosswalks up to signals.CLEAR_S ahead (VehicleSim._maybe_grant)
+LOOKAHEAD_S = CLEAR_S + 1.0  #: vehicles ask about crosswalks up to CLEAR_S ahead (VehicleSim._maybe_grant)
 MAX_DRIVE_S = 900.0
 SPACING_M = 6.0       #: lanes hold at most one vehicle per (length + this), for the capacity check
 EGO_SIZE_M = (4.6, 1.9)

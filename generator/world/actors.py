@@ -212,10 +212,6 @@ class World:
         """(n, 3) float64 actor velocities at ``t``, m/s."""
         return np.array([a.track.velocity(t)[0] for a in self.actors]).reshape(-1, 3)
 
-    def accelerations(self, t: float) -> np.ndarray:
-        """(n, 3) float64 actor accelerations at ``t``, m/s^2."""
-        return np.array([a.track.acceleration(t)[0] for a in self.actors]).reshape(-1, 3)
-
     def moving(self, t: float) -> np.ndarray:
         """(n,) bool: which actors move faster than :data:`MOVING_THRESHOLD_MPS` at ``t``."""
         v = self.velocities(t)
@@ -224,10 +220,6 @@ class World:
     def boxes(self, t: float) -> list[OrientedBox]:
         """Every actor's box at ``t``."""
         return [a.box(t) for a in self.actors]
-
-    def actor_of_instance(self) -> dict[int, Actor]:
-        """Instance id -> actor."""
-        return {a.instance_id: a for a in self.actors}
 
 
 @dataclass(frozen=True)
