@@ -63,20 +63,27 @@ def _check_times(times, path) -> None:
                         "simulates); this file is not one urbangen wrote")
 
 
-def sequence_world(spec, scene, meta: dict, times: np.ndarray, source: str):
-    """The world a 10 Hz sequence was cast in: actors when ``meta["traffic"]`` is true, else none."""
+def sequence_world(spec, scene, meta: dict, times: np.ndarray, source: str, world=None):
+    """The world a 10 Hz sequence was cast in: actors when ``meta["traffic"]`` is true, else none.
+
+    ``world``: that world if the caller still has it (checked against the recorded digest),
+    else it is rebuilt from the spec.
+    """
     from generator.traffic.build import MAX_DRIVE_S, build_world
     from generator.world.actors import frozen_world
 
     traffic = md.field(meta, "traffic", source, default=None)
     if not isinstance(traffic, dict) or not traffic.get("actors"):
         return None
+    digest = md.field(meta, "traffic.digest", source, default=None)
+    if world is not None and world.actors:
+        world.check_digest(digest if isinstance(digest, str) else None, times, source)
+        return world
     duration = md.field(meta, "traffic.duration_s", source, default=float(np.max(times)) + SWEEP_PERIOD_S)
     if isinstance(duration, bool) or not isinstance(duration, (int, float)) or not 0 <= duration <= MAX_DRIVE_S + 2:
         raise SpecError(source, "traffic.duration_s", f"must be seconds in [0, {MAX_DRIVE_S:.0f}]")
     # the simulation is causal: a run at least as long gives the same poses over the sequence
     world = build_world(spec, scene, duration, 0.0)
-    digest = md.field(meta, "traffic.digest", source, default=None)
     world.check_digest(digest if isinstance(digest, str) else None, times, source)
     return world if world.actors else frozen_world(scene, world.ego)
 
@@ -145,7 +152,7 @@ def _output(root: Path, name: str) -> Path:
 
 
 def write_sequence_openlabel(spec, root: Path, sequence: str = "00", classes=DEFAULT_CLASSES,
-                             min_points: int | None = None, scene=None) -> tuple[Path, dict]:
+                             min_points: int | None = None, scene=None, world=None) -> tuple[Path, dict]:
     """Write ``root/openlabel/NN.json`` for ``root/lidar/sequences/NN`` cast from ``spec``.
 
     Parameters
@@ -156,6 +163,9 @@ def write_sequence_openlabel(spec, root: Path, sequence: str = "00", classes=DEF
         Objects with fewer LiDAR points in a frame are left out (default ``spec.labels.openlabel_min_points``).
     scene : SceneModel, optional
         The spec's scene if already built (it is rebuilt otherwise).
+    world : World, optional
+        The world the sequence was cast in, if the caller has it (``generate``); it must match the
+        digest the sequence recorded. Otherwise it is rebuilt from the spec (:func:`sequence_world`).
 
     Returns
     -------
@@ -184,7 +194,7 @@ def write_sequence_openlabel(spec, root: Path, sequence: str = "00", classes=DEF
         scene = build_scene(spec)
     route = md.integer(meta, "scene.route", src, 0, max(len(scene.paths) - 1, 0), default=0)
     stream = md.field(meta, "sweep_period_s", src, default=None) is not None
-    world = sequence_world(spec, scene, meta, seq.times, src) if stream else None
+    world = sequence_world(spec, scene, meta, seq.times, src, world) if stream else None
     rig = Rig.from_world(spec, world) if world is not None else Rig.from_spec(spec, scene, route)
     frames = sweep_frames(rig, meta, seq.frames, seq.times, src) if stream else [rig.frame(k) for k in seq.frames]
     actors = [a for a in world.actors if a.cls in classes] if world is not None else []

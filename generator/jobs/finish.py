@@ -17,9 +17,12 @@ def write_stats(out: Path) -> list[Path]:
     return write_report(Path(out) / "stats", out, sections) if sections else []
 
 
-def write_openlabel(spec, out: Path, plan, scene=None) -> Path:
-    """Write ``out/openlabel/NN.json`` for the plan's sequence (cuboids of cars, trucks, people)."""
+def write_openlabel(spec, out: Path, plan, scene=None, world=None) -> Path:
+    """Write ``out/openlabel/NN.json`` for the plan's sequence (cuboids of cars, trucks, people).
+
+    ``world``: the world the sequence was cast in, when the caller has it (else rebuilt).
+    """
     from generator.jobs.boxes import write_sequence_openlabel
 
-    path, _ = write_sequence_openlabel(spec, out, plan.sequence, scene=scene)
+    path, _ = write_sequence_openlabel(spec, out, plan.sequence, scene=scene, world=world)
     return path

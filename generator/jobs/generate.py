@@ -184,19 +184,9 @@ def run_generate(spec, cfg, opts: GenerateOptions) -> dict:
         log.info("removed %d unfinished temporary files of an interrupted run", removed)
     run = {"started": time.strftime("%Y-%m-%dT%H:%M:%S%z"), "executor": opts.executor, "workers": opts.workers}
 
-    scenes: list = [pre.scene]
-
-    def scene():
-        """The spec's scene, built at most once in this process (LiDAR and OpenLABEL share it)."""
-        if not scenes:
-            from generator.layout.assemble import build_scene
-
-            scenes.append(build_scene(spec))
-        return scenes[0]
-
     if not lidar_done(out, plan, spec):
         t = time.perf_counter()
-        write_lidar(spec, cfg, out, plan, scene(), pre.drive)
+        write_lidar(spec, cfg, out, plan, pre.scene, pre.drive)
         run["lidar_s"] = round(time.perf_counter() - t, 2)
     manifest["finished"]["lidar"] = True
     mf.save(out, manifest)
@@ -224,7 +214,7 @@ def run_generate(spec, cfg, opts: GenerateOptions) -> dict:
 
     from generator.jobs.finish import write_openlabel, write_stats
 
-    write_openlabel(spec, out, plan, scene())
+    write_openlabel(spec, out, plan, pre.scene, pre.drive.world)  # the world the sequence was cast in
     manifest["finished"]["openlabel"] = True
     write_stats(out)
     manifest["finished"]["stats"] = True
