@@ -114,14 +114,14 @@ def run(args) -> int:
     sequences = _sequences(root)
     with staging(out, "preview") as stage:
         for k, paths in frames.items():
-            _sheets(sequences, k, paths, stage)
+            _sheets(root, sequences, k, paths, stage)
         for p in sorted(stage.iterdir()):
             os.replace(p, out / p.name)
     print(f"wrote {len(frames)} preview sheet(s) into {out}")
     return 0
 
 
-def _sheets(sequences: list, k: int, paths: list[Path], out: Path) -> None:
+def _sheets(root: Path, sequences: list, k: int, paths: list[Path], out: Path) -> None:
     """The contact sheet of frame ``k`` (and its variants sheet) into ``out``."""
     pick = next((p for pref in PREFERRED for p in paths if p.stem.endswith(pref)), paths[0])
     img = read_exr(pick)
