@@ -28,7 +28,7 @@ import numpy as np
 
 from generator import __version__
 from generator.atomic import atomic_path, inside, write_json
-from generator.errors import SpecError, UserError
+from generator.errors import UserError
 from generator.formats import kitti_calib, semantickitti as sk
 from generator.formats.label_config import count_raw_ids, merge_counts, write_label_config
 from generator.formats.ply import write_ply
