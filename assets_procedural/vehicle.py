@@ -43,6 +43,10 @@ def wheel(x: float, y_out: float, side: float, radius: float, width: float, cls:
     return merge([tyre, hub])
 
 
+def _light(x: float, y: float, z: float, size: tuple[float, float, float], cls: str, material: str) -> Mesh:
+    return box(size, cls, material, (x, y, z))
+
+
 def _inset_quad(q: np.ndarray, du: float, dv: float, normal: np.ndarray, cls: str) -> Mesh:
     """A glass pane inside the quad ``q`` and ``GLASS_OFFSET`` in front of it.
 
@@ -152,7 +156,7 @@ def car(rng: np.random.Generator, variant: str | None = None) -> Mesh:
     i_a = int(np.searchsorted(xs, info["xa"]))
     hw_a = float(half[min(i_a, len(half) - 1)])
     for side in (1.0, -1.0):
-        parts.append(box((0.1, 0.16, 0.11), "car", "car_paint", (info["xa"] - 0.12, side * (hw_a + 0.04),
+        parts.append(box((0.09, 0.16, 0.11), "car", "car_paint", (info["xa"], side * (hw_a + 0.04),
                                                                  p["belt_z"] + 0.09)))
     body = merge(parts)
     body.anchors = {"headlight": head, "taillight": tail}

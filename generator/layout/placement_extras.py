@@ -24,7 +24,7 @@ import numpy as np
 
 from generator.layout.lots import Lot
 from generator.layout.placement_core import Placer, Proto
-from generator.layout.placement_street import Street, free_lane, clothing_color, vehicle_color
+from generator.layout.placement_street import Street, free_lane, person_outfit, vehicle_paint
 from generator.layout.streets import PARKING_START_U
 from generator.rng import stream
 from generator.spec.model import SceneSpec
@@ -93,7 +93,7 @@ def place_bike_racks(placer: Placer, spec: SceneSpec, st: Street) -> None:
                 bike = bikes[int(g.integers(len(bikes)))]
                 uu = u + 1.6 + 0.75 * k
                 placer.try_place(bike, *_at(seg, uu, v, bike, to_road), st.h, to_road,
-                                 {"color": vehicle_color(g), "placement": "rack"})
+                                 {**vehicle_paint(g), "placement": "rack"})
 
 
 def place_two_wheelers(placer: Placer, spec: SceneSpec, st: Street) -> None:
@@ -112,7 +112,7 @@ def place_two_wheelers(placer: Placer, spec: SceneSpec, st: Street) -> None:
             yaw = traffic + s * np.radians(g.uniform(40, 70))
             u, v = g.uniform(u0, u1), s * (grid.lane_half + grid.parking_w * 0.55)
             placer.try_place(proto, *_at(seg, u, v, proto, yaw), 0.0, yaw,
-                             {"color": vehicle_color(g), "placement": "parked"}, pad=0.1)
+                             {**vehicle_paint(g), "placement": "parked"}, pad=0.1)
 
 
 def _ridden(placer: Placer, kind: str, i: int) -> tuple[Proto, Proto]:
@@ -147,9 +147,8 @@ def place_riders(placer: Placer, spec: SceneSpec, st: Street) -> None:
         rider, vehicle = _ridden(placer, kind, int(g.integers(N_VAR)))
         u = g.uniform(u0, u1)
         x, y = _at(seg, u, v, vehicle, traffic)
-        color = vehicle_color(g)
-        if placer.try_place(vehicle, x, y, 0.0, traffic, {"color": color, "placement": "ridden"}, pad=0.3):
-            placer.place_on(rider, x, y, 0.0, traffic, {"color": clothing_color(g)})
+        if placer.try_place(vehicle, x, y, 0.0, traffic, {**vehicle_paint(g), "placement": "ridden"}, pad=0.3):
+            placer.place_on(rider, x, y, 0.0, traffic, person_outfit(g))
 
 
 def place_bus_stops(placer: Placer, spec: SceneSpec, st: Street) -> None:
@@ -174,7 +173,7 @@ def place_bus_stops(placer: Placer, spec: SceneSpec, st: Street) -> None:
             v_lane = s * (grid.lane_half - (k + 0.5) * grid.lane_w)
             if free_lane(placer, seg, v_lane, u - 7.0, u + 7.0):
                 placer.try_place(bus, *_at(seg, u, v_lane, bus, traffic), 0.0, traffic,
-                                 {"color": vehicle_color(g), "placement": "bus_stop"}, pad=0.3)
+                                 {**vehicle_paint(g), "placement": "bus_stop"}, pad=0.3)
                 break
 
 
@@ -197,7 +196,7 @@ def place_trams(placer: Placer, spec: SceneSpec, st: Street) -> None:
         _, traffic = st.side_yaws(seg, s)
         tram = placer.lib.variant("tram", int(g.integers(2)), lambda g2: {"sections": 3})
         if not placer.try_place(tram, *_at(seg, (u0 + u1) / 2, v, tram, traffic), 0.0, traffic,
-                                {"color": vehicle_color(g), "placement": "tram_stop"}, pad=0.3):
+                                {**vehicle_paint(g), "placement": "tram_stop"}, pad=0.3):
             continue
         rails = placer.lib.unique("tram_rails", length=float(u1 - u0))
         x, y = seg.to_world((u0 + u1) / 2, v)[0]
@@ -223,7 +222,7 @@ def place_other_vehicles(placer: Placer, spec: SceneSpec, st: Street) -> None:
             fits = proto.hi[1] - proto.lo[1] <= grid.parking_w - 0.1
             v = s * (grid.lane_half + grid.parking_w / 2) if fits else s * (grid.lane_half - grid.lane_w / 2)
             placer.try_place(proto, *_at(seg, g.uniform(u0, u1), v, proto, traffic), 0.0, traffic,
-                             {"color": vehicle_color(g), "placement": "parked" if fits else "lane"}, pad=0.2)
+                             {**vehicle_paint(g), "placement": "parked" if fits else "lane"}, pad=0.2)
 
 
 def _in_rects(x: float, y: float, rects: np.ndarray, pad: float = 1.0) -> bool:

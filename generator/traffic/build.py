@@ -20,7 +20,7 @@ import numpy as np
 
 from generator.errors import SpecError
 from generator.geometry.mesh import merge
-from generator.layout.placement_street import vehicle_color
+from generator.layout.placement_street import vehicle_paint
 from generator.layout.streets import make_grid
 from generator.rng import stream
 from generator.traffic.lanes import LaneGraph
@@ -244,7 +244,7 @@ def _drive(spec, graph, signals, lib, blocked, crossing, duration_s, distance_m)
             v = Vehicle(i, length, width, min(tr.speed_limit_mps * float(g.uniform(*speed)), tr.speed_limit_mps),
                         a_max, [e.index], s, stream(spec.seed, "traffic", "vehicle", i))
             vehicles.append(v)
-            movers.append(Mover(kind, lib.main_class(kind), proto, None, {"color": vehicle_color(g), "role": "driving"}))
+            movers.append(Mover(kind, lib.main_class(kind), proto, None, {**vehicle_paint(g), "role": "driving"}))
     sim = VehicleSim(graph, signals, vehicles, crossing)
     for v in vehicles:
         sim._extend(v)
