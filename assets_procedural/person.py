@@ -7,7 +7,7 @@ material, so each can take its own colour per object (:mod:`generator.layout.app
 skirt), ``shoes`` (shoes and a carried bag), ``skin`` (face, hands, bare arms and legs) and
 ``hair``.
 
-Drawn per prototype from its generator: the build (girth 0.88-1.2, shoulder breadth), the
+Drawn per prototype from its generator: the build (girth 0.88-1.12, shoulder breadth 0.94-1.05), the
 garments (trousers, shorts, skirt, long coat; short sleeves), the hair, and what the arms do
 (hang, hold a phone to the ear, hands in the pockets, carry a bag).
 """
@@ -84,9 +84,9 @@ def _arm(side: float, shoulder: np.ndarray, action: str, swing: float, rng: np.r
     """Upper arm, forearm, hand (and a bag) of one arm, unit height."""
     l1, l2 = 0.175, 0.15
     if action == "phone":
-        elbow, wrist = two_link(shoulder, np.array([0.03, side * 0.075, 0.9]), l1, l2, np.array([0.2, side * 0.6, -1.0]))
+        elbow, wrist = two_link(shoulder, np.array([0.03, side * 0.075, 0.9]), l1, l2, np.array([0.35, side * 0.3, -1.0]))
     elif action == "pockets":
-        elbow, wrist = two_link(shoulder, np.array([0.03, side * 0.095, 0.5]), l1, l2, np.array([-0.4, side * 1.0, 0.0]))
+        elbow, wrist = two_link(shoulder, np.array([0.03, side * 0.095, 0.5]), l1, l2, np.array([-1.0, side * 0.45, 0.0]))
     else:                                                            # hanging (swinging when walking) or a bag
         elbow, wrist = _limb(shoulder, swing if action == "hanging" else 0.03, np.radians(rng.uniform(8, 25)), l1, l2)
         elbow[1] += side * 0.02
@@ -99,7 +99,7 @@ def _arm(side: float, shoulder: np.ndarray, action: str, swing: float, rng: np.r
     parts.append(hand)
     if action == "bag":
         grip = wrist + d * 0.06
-        parts.append(box((0.17, 0.06, 0.19), CLS, "shoes", (grip[0], grip[1] + side * 0.02, grip[2] - 0.105)))
+        parts.append(box((0.17, 0.05, 0.19), CLS, "shoes", (grip[0], grip[1], grip[2] - 0.105)))
     return parts
 
 
@@ -124,8 +124,8 @@ def person(rng: np.random.Generator, height: float, pose: str = "standing") -> M
         raise ValueError(f"person pose must be one of {POSES}, got {pose!r}")
     if not 0.9 <= height <= 2.2:
         raise ValueError(f"person height must be in [0.9, 2.2] m, got {height}")
-    girth = rng.uniform(0.88, 1.2)
-    breadth = rng.uniform(0.92, 1.1)
+    girth = rng.uniform(0.88, 1.12)
+    breadth = rng.uniform(0.94, 1.05)
     garment = _pick(rng, GARMENTS)
     short_sleeves = garment != "coat" and rng.random() < 0.3
     arms = [_pick(rng, ARMS), "hanging"]

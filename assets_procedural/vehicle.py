@@ -156,7 +156,7 @@ def car(rng: np.random.Generator, variant: str | None = None) -> Mesh:
     i_a = int(np.searchsorted(xs, info["xa"]))
     hw_a = float(half[min(i_a, len(half) - 1)])
     for side in (1.0, -1.0):
-        parts.append(box((0.09, 0.16, 0.11), "car", "car_paint", (info["xa"], side * (hw_a + 0.04),
+        parts.append(box((0.09, 0.12, 0.1), "car", "car_paint", (info["xa"], side * (hw_a + 0.02),
                                                                  p["belt_z"] + 0.09)))
     body = merge(parts)
     body.anchors = {"headlight": head, "taillight": tail}

@@ -23,7 +23,8 @@ from __future__ import annotations
 import numpy as np
 
 from generator.layout.lots import Lot
-from generator.layout.placement_core import Placer, Proto
+from generator.geometry import pose
+from generator.layout.placement_core import Placer, Proto, oriented_box, world_boxes
 from generator.layout.placement_street import Street, free_lane, person_outfit, vehicle_paint
 from generator.layout.streets import PARKING_START_U
 from generator.rng import stream
@@ -152,7 +153,8 @@ def place_riders(placer: Placer, spec: SceneSpec, st: Street) -> None:
 
 
 def place_bus_stops(placer: Placer, spec: SceneSpec, st: Street) -> None:
-    """Shelters at the back of the sidewalk; a bus stands at the stop where its lane has no route."""
+    """Bus stops: a shelter at the back of the sidewalk and a bus standing at it, in a lane no route
+    drives; up to :data:`STOP_TRIES` spots along a side are tried for a pair that fits."""
     dens = spec.density.bus_stops_per_km
     grid = st.grid
     if dens <= 0:
@@ -163,18 +165,31 @@ def place_bus_stops(placer: Placer, spec: SceneSpec, st: Street) -> None:
         to_road, traffic = st.side_yaws(seg, s)
         if seg.length < 40 or g.random() >= dens * seg.length / 1000:
             continue
-        u = g.uniform(st.walk_u0 + 8.0, seg.length - st.walk_u0 - 14.0)
-        shelter = shelters[int(g.integers(2))]
-        v = s * (st.walk[1] - (shelter.hi[0] - shelter.lo[0]) / 2 - 0.2)
-        if not placer.try_place(shelter, *_at(seg, u, v, shelter, to_road), st.h, to_road):
-            continue
-        bus = buses[int(g.integers(2))]
-        for k in range(grid.lanes):  # the kerb-side lane first, else the next one out
-            v_lane = s * (grid.lane_half - (k + 0.5) * grid.lane_w)
-            if free_lane(placer, seg, v_lane, u - 7.0, u + 7.0):
-                placer.try_place(bus, *_at(seg, u, v_lane, bus, traffic), 0.0, traffic,
-                                 {**vehicle_paint(g), "placement": "bus_stop"}, pad=0.3)
+        for _ in range(STOP_TRIES):  # the first spot along the side where the bus and its shelter both fit
+            u = g.uniform(st.walk_u0 + 8.0, seg.length - st.walk_u0 - 14.0)
+            shelter, bus, paint = shelters[int(g.integers(2))], buses[int(g.integers(2))], vehicle_paint(g)
+            xy = _bus_spot(placer, grid, seg, s, u, bus, traffic)
+            v = s * (st.walk[1] - (shelter.hi[0] - shelter.lo[0]) / 2 - 0.2)
+            if xy is not None and placer.try_place(shelter, *_at(seg, u, v, shelter, to_road), st.h, to_road):
+                placer.try_place(bus, *xy, 0.0, traffic, {**paint, "placement": "bus_stop"}, pad=BUS_PAD_M)
                 break
+
+
+STOP_TRIES = 8    #: spots tried along one side of a segment for a bus stop
+BUS_PAD_M = 0.3
+
+
+def _bus_spot(placer: Placer, grid, seg, s: int, u: float, bus: Proto, yaw: float) -> tuple[float, float] | None:
+    """World xy of a bus standing at ``u`` in the kerb-side lane (else the next one out) that no route
+    drives and where it touches nothing placed; None if there is none."""
+    for k in range(grid.lanes):
+        v_lane = s * (grid.lane_half - (k + 0.5) * grid.lane_w)
+        if free_lane(placer, seg, v_lane, u - 7.0, u + 7.0):
+            x, y = _at(seg, u, v_lane, bus, yaw)
+            T = pose(x, y, 0.0, yaw)
+            if not placer.keepout.violated(oriented_box(bus, T)) and not placer.occ.hits(world_boxes(bus.bands, T, BUS_PAD_M)):
+                return x, y
+    return None
 
 
 def place_trams(placer: Placer, spec: SceneSpec, st: Street) -> None:
