@@ -5,7 +5,8 @@ A body is skinned (:func:`generator.geometry.loft`) over cross-sections taken al
 and whose widths come from a plan-view curve:
 
 * the top line ``U(x)``: bumper, hood, windscreen, roof, rear window, boot deck or tailgate,
-  a polyline of key points rounded by corner cutting (Chaikin), so every transition is curved;
+  a polyline of key points whose corners are rounded by arcs of a radius per corner (tight
+  at a tailgate, wide at the windscreen), so every transition is curved;
 * the bottom line: the ground clearance, cut by a wheel arch over each axle;
 * the shoulder (belt) line ``S(x)`` where the side turns in towards the roof (tumblehome).
 
@@ -67,14 +68,35 @@ def draw_dimensions(rng: np.random.Generator, body: str) -> dict[str, float]:
     return p
 
 
-def chaikin(pts: np.ndarray, n: int = 2) -> np.ndarray:
-    """Round the corners of an open polyline ((k, 2) float) by ``n`` rounds of corner cutting; ends stay."""
+def round_corners(pts: np.ndarray, radii: list[float], n: int = 4) -> np.ndarray:
+    """Round each interior corner of an open polyline by a quadratic Bezier arc.
+
+    Parameters
+    ----------
+    pts : (k, 2) float
+        The polyline, metres.
+    radii : list of float, length k
+        How far (metres) from each corner the arc starts on both sides (capped at 45 % of the
+        neighbouring segments); the ends' entries are ignored.
+    n : int
+        Points per arc.
+
+    Returns
+    -------
+    (m, 2) float
+        The rounded polyline; the ends stay.
+    """
     p = np.asarray(pts, float)
-    for _ in range(n):
-        q = 0.75 * p[:-1] + 0.25 * p[1:]
-        r = 0.25 * p[:-1] + 0.75 * p[1:]
-        p = np.concatenate([p[:1], np.stack([q, r], 1).reshape(-1, 2), p[-1:]])
-    return p
+    out = [p[0]]
+    t = np.linspace(0.0, 1.0, n)[:, None]
+    for i in range(1, len(p) - 1):
+        a, c = p[i - 1] - p[i], p[i + 1] - p[i]
+        la, lc = np.linalg.norm(a), np.linalg.norm(c)
+        r = min(radii[i], 0.45 * la, 0.45 * lc)
+        p0, p2 = p[i] + a * r / la, p[i] + c * r / lc
+        out.extend((1 - t) ** 2 * p0 + 2 * (1 - t) * t * p[i] + t ** 2 * p2)
+    out.append(p[-1])
+    return np.array(out)
 
 
 def key_points(p: dict, body: str) -> dict:
@@ -104,28 +126,32 @@ def top_line(p: dict, k: dict, tail: str) -> np.ndarray:
     cowl = belt + 0.03
     deck = {"notch": belt + 0.02, "hatch": belt - 0.04, "box": belt - 0.06, "bed": belt + 0.02}[tail]
     tail_top = {"notch": deck - 0.05, "hatch": deck - 0.1, "box": deck - 0.12, "bed": deck}[tail]
+    roof_back = {"notch": 0.3, "hatch": 0.15, "box": 0.07, "bed": 0.05}[tail]
     pts = [(-L / 2, tail_top - 0.1), (-L / 2 + 0.02, tail_top), (k["xd"], deck), (k["xc"], H), (k["xb"], H),
            (k["xa"], cowl), (L / 2 - 0.1, hood_front), (L / 2, nose)]
+    radii = [0, 0.02, 0.06 if tail == "box" else 0.15, roof_back, 0.35, 0.2, 0.1, 0]
     if tail == "bed":                         # vertical cab back wall, then the bed rail
         pts = [(-L / 2, deck - 0.08), (-L / 2 + 0.02, deck), (k["xd"] - 0.04, deck), (k["xd"], H - 0.05),
                (k["xc"], H), (k["xb"], H), (k["xa"], cowl), (L / 2 - 0.1, hood_front), (L / 2, nose)]
-    out = chaikin(np.array(pts), 3)
+        radii = [0, 0.02, 0.02, 0.03, roof_back, 0.35, 0.2, 0.1, 0]
+    out = round_corners(np.array(pts), radii)
     return out[np.concatenate([[True], np.diff(out[:, 0]) > 1e-4])]
 
 
-def stations(p: dict, k: dict) -> np.ndarray:
-    """(s,) float x of the sections: even spacing, the landmarks, pillars and both wheel arches."""
+def stations(p: dict, k: dict, max_gap: float = 0.42) -> np.ndarray:
+    """(s,) float x of the sections: the ends and the nose/tail rounding, the landmarks, the pillars
+    and both wheel arches; long gaps between them split evenly (at most ``max_gap`` metres)."""
     L, ar = p["L"], p["r"] + 0.06
-    xs = set(np.linspace(-L / 2, L / 2, int(L / 0.36) + 1))
-    xs |= {-L / 2 + 0.03, -L / 2 + 0.1, L / 2 - 0.03, L / 2 - 0.1, k["xa"], k["xb"], k["xc"], k["xd"]}
+    xs = {-L / 2, L / 2, -L / 2 + 0.05, L / 2 - 0.05, -L / 2 + 0.18, L / 2 - 0.18, k["xa"], k["xb"], k["xc"], k["xd"],
+          k["xc"] - 0.08, k["xb"] + 0.15}
     xs |= {xp + d for xp in k["pillars"] for d in (-PILLAR_M / 2, PILLAR_M / 2)}
     for wx in (k["xf"], k["xr"]):
-        xs |= {wx + ar * np.cos(a) for a in np.radians([180, 178, 140, 105, 75, 40, 2, 0])}
+        xs |= {wx + ar * np.cos(a) for a in np.radians([180, 145, 110, 70, 35, 0])}
     xs = np.array(sorted(x for x in xs if -L / 2 <= x <= L / 2))
-    keep = np.concatenate([[True], np.diff(xs) > 0.025])
-    xs = xs[keep]
-    xs[0], xs[-1] = -L / 2, L / 2
-    return xs
+    xs = xs[np.concatenate([[True], np.diff(xs) > 0.03])]
+    xs[-1] = L / 2
+    fill = [np.linspace(a, b, int(np.ceil((b - a) / max_gap)) + 1)[1:-1] for a, b in zip(xs[:-1], xs[1:])]
+    return np.sort(np.concatenate([xs, *fill]))
 
 
 def body_shell(p: dict, body: str, cls: str = "car") -> tuple[Mesh, dict]:
