@@ -44,11 +44,11 @@ def _shots() -> dict:
     rear for odd ones), then the people in two halves."""
     out = {}
     for i, body in enumerate(CAR_VARIANTS):
-        dx = 5.2 if i % 2 == 0 else -5.2
+        dx = 4.4 if i % 2 == 0 else -4.4
         out[f"{body} {'front' if dx > 0 else 'rear'} 3/4"] = (
-            (dx, CAR_GAP_M * i - 4.2, 1.7), float(np.degrees(np.arctan2(4.2, -dx))), 6.0)
-    out["people 0-4"] = ((-8.5, 3.0, 1.3), 180.0, 2.0)
-    out["people 5-9"] = ((-8.5, -3.0, 1.3), 180.0, 2.0)
+            (dx, CAR_GAP_M * i - 3.6, 1.6), float(np.degrees(np.arctan2(3.6, -dx))), 8.0)
+    out["people 0-4"] = ((-10.0, 3.0, 1.2), 180.0, 3.0)
+    out["people 5-9"] = ((-10.0, -3.0, 1.2), 180.0, 3.0)
     return out
 
 
