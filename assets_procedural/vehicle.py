@@ -15,6 +15,7 @@ from assets_procedural.car_body import body_shell, draw_dimensions
 from generator.geometry import Mesh, box, cylinder, disc, loft, merge, on_ground, polygon, pose, prism, resolve_ids
 
 GLASS_OFFSET = 0.02  # metres: glass in front of the body surface (>= 2 cm: no z-fighting)
+PROUD_M = 0.025      #: how far a car's lamps and plates stand out of its nose and tail, metres
 
 #: body types of :func:`car` and their share of a town's car models (a European street:
 #: hatchbacks and SUVs lead, then sedans and estates, few MPVs and pickups)
@@ -143,16 +144,16 @@ def car(rng: np.random.Generator, variant: str | None = None) -> Mesh:
     nose, tail_top = float(top[-1]), float(top[0])
     hw_end = float(half[-1])
     yl, yt = hw_end - 0.24, hw_end - 0.17
-    head = np.array([[L / 2 + 0.01, s * yl, nose - 0.05] for s in (1, -1)])
-    tail = np.array([[-L / 2 - 0.01, s * yt, tail_top - 0.05] for s in (1, -1)])
+    head = np.array([[L / 2 + PROUD_M, s * yl, nose - 0.05] for s in (1, -1)])
+    tail = np.array([[-L / 2 - PROUD_M, s * yt, tail_top - 0.05] for s in (1, -1)])
     for c in head:
         parts.append(box((0.16, 0.36, 0.08), "car", "headlight", (c[0] - 0.08, c[1], c[2])))
     for c in tail:
         parts.append(box((0.14, 0.28, 0.1), "car", "taillight", (c[0] + 0.07, c[1], c[2])))
     bottom_f, bottom_r = float(info["bottom"][-1]), float(info["bottom"][0])
     parts.append(box((0.08, 2 * yl - 0.42, 0.13), "car", "car_trim", (L / 2 - 0.035, 0, nose - 0.12)))  # grille
-    parts.append(box((0.03, 0.52, 0.11), "car", "licence_plate", (L / 2 - 0.005, 0, bottom_f + 0.1)))
-    parts.append(box((0.03, 0.52, 0.11), "car", "licence_plate", (-L / 2 + 0.005, 0, max(bottom_r + 0.1, tail_top - 0.3))))
+    parts.append(box((0.03, 0.52, 0.11), "car", "licence_plate", (L / 2 + PROUD_M - 0.015, 0, bottom_f + 0.1)))
+    parts.append(box((0.03, 0.52, 0.11), "car", "licence_plate", (-L / 2 - PROUD_M + 0.015, 0, max(bottom_r + 0.1, tail_top - 0.3))))
     i_a = int(np.searchsorted(xs, info["xa"]))
     hw_a = float(half[min(i_a, len(half) - 1)])
     for side in (1.0, -1.0):

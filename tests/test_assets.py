@@ -318,6 +318,8 @@ def test_building_windows_on_every_wall_and_door_on_the_front(footprint, roof):
     ("building", dict(footprint=SMALL, height=7.0, roof="gable"), ("window_glass",)),
     ("car", dict(variant="sedan"), ("car_glass",)),
     ("car", dict(variant="van"), ("car_glass",)),
+    ("car", dict(variant="suv"), ("car_glass",)),
+    ("car", dict(variant="pickup"), ("car_glass",)),
     ("truck", dict(), ("car_glass",)),
     ("traffic_light", dict(), ("tl_red", "tl_amber", "tl_green")),
     ("traffic_sign", dict(shape="octagon"), ("sign_face",)),

@@ -14,6 +14,7 @@ from trimesh.ray.ray_pyembree import RayMeshIntersector
 from assets_procedural import catalog
 from assets_procedural.car_body import BODY_TYPES
 from assets_procedural.vehicle import CAR_VARIANTS
+from generator.geometry import face_normals
 from generator.layout.appearance import Palette, appearance, fleet_paint, outfit, srgb_to_linear
 from generator.materials import material_table
 from generator.rng import stream
@@ -161,6 +162,25 @@ def test_body_types_differ_in_shape_as_they_do_on_the_street(body):
         assert top_within(0.35) > 0.85
     if t["tail"] in ("notch", "bed"):
         assert top_within(0.5) < 0.75
+
+
+@pytest.mark.parametrize("body", list(CAR_VARIANTS))
+def test_lamps_and_plates_face_out_and_stand_proud_of_the_body(body):
+    """Looking straight at a lamp or plate face from outside, it is the first surface and the body
+    lies at least 2 cm behind it (no z-fighting with the paint)."""
+    m = _car(body, 4)
+    n = face_normals(m)
+    centre = m.vertices[m.faces].mean(1)
+    for name in ("headlight", "taillight", "licence_plate"):
+        out = _of(m, name) & (np.abs(n[:, 0]) > 0.99) & (n[:, 0] * centre[:, 0] > 0)
+        faces = np.flatnonzero(out)
+        assert len(faces) >= 4, name                                       # two lamps / two plates, 2 triangles each
+        origins = centre[faces] + 0.5 * n[faces]
+        loc, ray, _ = RayMeshIntersector(m.to_trimesh()).intersects_location(origins, -n[faces], multiple_hits=True)
+        d = np.linalg.norm(loc - origins[ray], axis=1)
+        for r in range(len(faces)):
+            hits = np.sort(d[ray == r])
+            assert hits[0] == pytest.approx(0.5, abs=2e-3) and hits[1] - hits[0] >= 0.0195, name
 
 
 def test_default_body_mix_follows_the_shares():
