@@ -167,7 +167,8 @@ def body_shell(p: dict, body: str, cls: str = "car") -> tuple[Mesh, dict]:
     Returns
     -------
     shell : Mesh
-        Class ``cls``; materials ``car_paint``, ``car_glass``, ``car_trim``; closed (end caps).
+        Class ``cls``; materials ``car_body`` (paint, shaded smooth), ``car_glass``, ``car_trim``;
+        closed (end caps).
     info : dict
         ``xs`` (s,) stations, ``top``/``shoulder``/``bottom``/``half_w`` (s,) per station, the
         landmarks of :func:`key_points`.
@@ -202,7 +203,7 @@ def body_shell(p: dict, body: str, cls: str = "car") -> tuple[Mesh, dict]:
         crown = u + 0.012 + 0.03 * (u - s_) / max(H - belt, 1e-6)
         ring = side + [(0.0, crown)] + [(-y, z) for y, z in side[::-1]]
         rings.append([(x, y, z) for y, z in ring])
-    shell = loft(np.array(rings), cls, "car_paint")
+    shell = loft(np.array(rings), cls, "car_body")
     _paint_regions(shell, xs, t, k, len(rings[0]))
     info = dict(k, xs=xs, top=U, shoulder=S, bottom=zb, half_w=half, tail=tail)
     return shell, info

@@ -123,7 +123,8 @@ def car(rng: np.random.Generator, variant: str | None = None) -> Mesh:
     Mesh
         Class ``car``; 3.8-5.4 m long, 1.7-2.3 m wide (mirrors included), 1.4-1.85 m high, the
         four tyres the only faces at z = 0 and the body ``clear`` (0.13-0.24 m) above the ground.
-        Materials ``car_paint`` (the body: colour per object), ``car_glass``, ``car_trim``,
+        Materials ``car_body`` (the shell: colour per object, shaded smooth), ``car_paint`` (mirrors),
+        ``car_glass``, ``car_trim``,
         ``rubber``, ``wheel_rim``, ``chrome``, ``headlight``, ``taillight``, ``licence_plate``.
         Anchors ``"headlight"`` (2, 3) and ``"taillight"`` (2, 3) on the lamp faces.
     """

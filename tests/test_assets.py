@@ -160,7 +160,7 @@ def test_car_size_budget_and_lights(seed):
     assert m.anchors["headlight"].shape == (2, 3) and m.anchors["taillight"].shape == (2, 3)
     assert (m.anchors["headlight"][:, 0] > hi[0] - 0.05).all() and (m.anchors["taillight"][:, 0] < lo[0] + 0.05).all()
     assert of_material(m, "headlight").any() and of_material(m, "taillight").any()
-    for mat in ("car_paint", "car_glass", "rubber", "chrome", "car_trim", "wheel_rim", "licence_plate"):
+    for mat in ("car_body", "car_paint", "car_glass", "rubber", "chrome", "car_trim", "wheel_rim", "licence_plate"):
         assert of_material(m, mat).any(), mat
     assert (m.face_class == class_table().id("car")).all()
     # four tyres touch the ground

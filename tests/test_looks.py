@@ -150,7 +150,7 @@ def test_body_types_differ_in_shape_as_they_do_on_the_street(body):
     glass = m.vertices[np.unique(m.faces[_of(m, "car_glass")])]
     assert glass[:, 1].max() > 0.5 and glass[:, 1].min() < -0.5         # side windows on both sides
     assert glass[:, 0].max() > 0.2 * L / 2                              # a windscreen ahead of the middle
-    shell = m.vertices[np.unique(m.faces[_of(m, "car_paint") | _of(m, "car_glass")])]
+    shell = m.vertices[np.unique(m.faces[_of(m, "car_body") | _of(m, "car_glass")])]
 
     def top_within(d: float) -> float:
         return shell[shell[:, 0] < lo[0] + d, 2].max() / H

@@ -25,6 +25,11 @@ def car_paint(g: Nodes, rng):
                         roughness=g.lerp(metallic, 0.28, 0.38), coat=1.0, coat_roughness=0.04)
 
 
+def car_body(g: Nodes, rng):
+    """The curved shell of a car: the same paint, shaded smooth (``car_paint`` stays flat for boxy parts)."""
+    return car_paint(g, rng)
+
+
 def car_trim(g: Nodes, rng):
     return g.principled(base_color=(0.018, 0.018, 0.02), roughness=0.55)
 
