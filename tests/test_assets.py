@@ -38,7 +38,7 @@ CASES = [
     ("traffic_light-arm", "traffic_light", dict(arm=5.0)),
     *[(f"sign-{s}", "traffic_sign", dict(shape=s)) for s in ("circle", "triangle", "square", "octagon", "diamond")],
     *[(f"fence-{s}", "fence", dict(length=6.3, style=s)) for s in ("bars", "pickets", "panels")],
-    *[(f"car-{v}", "car", dict(variant=v)) for v in ("sedan", "hatchback", "estate", "van")],
+    *[(f"car-{v}", "car", dict(variant=v)) for v in ("sedan", "hatchback", "estate", "suv", "van", "pickup")],
     ("car-random", "car", dict()),
     ("truck", "truck", dict()),
     ("person", "person", dict(height=1.75)),
@@ -152,14 +152,15 @@ def extent(m: Mesh) -> np.ndarray:
 def test_car_size_budget_and_lights(seed):
     m = build("car", seed)
     L, W, H = extent(m)
-    assert 3.8 <= L <= 5.0 and 1.7 <= W <= 2.0 and 1.4 <= H <= 1.9
-    assert 300 <= m.n_faces <= 800
+    # mirrors included in W; the longest is a double-cab pickup
+    assert 3.8 <= L <= 5.45 and 1.8 <= W <= 2.08 and 1.38 <= H <= 1.9
+    assert 900 <= m.n_faces <= 1700
     lo, hi = m.bounds()
     assert np.allclose((lo[:2] + hi[:2]) / 2, 0, atol=0.1)
     assert m.anchors["headlight"].shape == (2, 3) and m.anchors["taillight"].shape == (2, 3)
     assert (m.anchors["headlight"][:, 0] > hi[0] - 0.05).all() and (m.anchors["taillight"][:, 0] < lo[0] + 0.05).all()
     assert of_material(m, "headlight").any() and of_material(m, "taillight").any()
-    for mat in ("car_paint", "car_glass", "rubber", "chrome"):
+    for mat in ("car_body", "car_paint", "car_glass", "rubber", "chrome", "car_trim", "wheel_rim", "licence_plate"):
         assert of_material(m, mat).any(), mat
     assert (m.face_class == class_table().id("car")).all()
     # four tyres touch the ground
@@ -188,18 +189,20 @@ def test_truck_size_wheels_and_class(seed):
 def test_person_height_materials_budget(height, pose):
     m = build("person", 3, height=height, pose=pose)
     assert extent(m)[2] == pytest.approx(height, abs=1e-9)
-    assert 200 <= m.n_faces <= 450
-    for mat in ("skin", "hair", "clothing"):
+    assert 200 <= m.n_faces <= 520
+    for mat in ("skin", "hair", "clothing", "shoes"):
         assert of_material(m, mat).any(), mat
     # faces +x: the hair leaves the face (+x side of the head) uncovered
     hair = m.vertices[np.unique(m.faces[of_material(m, "hair")])]
     skin_top = m.vertices[np.unique(m.faces[of_material(m, "skin")])]
     face = skin_top[skin_top[:, 2] > 0.88 * height]
     assert face[:, 0].max() > hair[:, 0].max()
+    low = m.vertices[m.faces][:, :, 2].mean(1) < 0.2 * height         # shoes, not a carried bag
+    feet = m.vertices[np.unique(m.faces[of_material(m, "shoes") & low])]
     if pose == "walking":
-        assert extent(m)[0] > 0.5  # legs apart
+        assert np.ptp(feet[:, 0]) > 0.5  # legs apart
     else:
-        assert extent(m)[0] < 0.45
+        assert np.ptp(feet[:, 0]) < 0.35
 
 
 @pytest.mark.parametrize("height", [5.0, 7.5, 11.0])
@@ -315,6 +318,8 @@ def test_building_windows_on_every_wall_and_door_on_the_front(footprint, roof):
     ("building", dict(footprint=SMALL, height=7.0, roof="gable"), ("window_glass",)),
     ("car", dict(variant="sedan"), ("car_glass",)),
     ("car", dict(variant="van"), ("car_glass",)),
+    ("car", dict(variant="suv"), ("car_glass",)),
+    ("car", dict(variant="pickup"), ("car_glass",)),
     ("truck", dict(), ("car_glass",)),
     ("traffic_light", dict(), ("tl_red", "tl_amber", "tl_green")),
     ("traffic_sign", dict(shape="octagon"), ("sign_face",)),
