@@ -100,7 +100,7 @@ class FrameSample:
     """Everything of image frame ``index``: its image variants, the scan and boxes of ``sweep``."""
 
     index: int
-    sweep: int
+    sweep: int | None
     images: dict[str, ImageSample] = field(default_factory=dict)
     scan: ScanSample | None = None
     boxes: list[Box] = field(default_factory=list)
@@ -130,9 +130,12 @@ class Dataset:
         #: image frame -> the sweep it was exposed with (identity without ``image_frames``)
         self._sweep_of = md.image_sweeps(md.load_metadata(meta), str(meta)) if meta and meta.exists() else {}
 
-    def sweep_of(self, frame: int) -> int:
-        """The sweep image frame ``frame`` was exposed with."""
-        return self._sweep_of.get(frame, frame)
+    def sweep_of(self, frame: int) -> int | None:
+        """The sweep image frame ``frame`` was exposed with; None for an image of another sequence
+        (a re-drawn town's, ``town.redraw_every_frames``: each town is its own sequence)."""
+        if self._sweep_of:
+            return self._sweep_of.get(frame)
+        return frame
 
     # -- images ------------------------------------------------------------------------------
     def image_names(self, frame: int | None = None) -> list[str]:
@@ -171,9 +174,9 @@ class Dataset:
         """Every image variant of image frame ``index``, with the scan and boxes of its sweep, in one call."""
         j = self.sweep_of(index)
         out = FrameSample(index, j, {n: self.image(n) for n in self.image_names(index)})
-        if self.seq is not None and j in self.seq.frames:
+        if self.seq is not None and j is not None and j in self.seq.frames:
             out.scan = self.scan(j)
-        out.boxes = self.boxes(j)
+        out.boxes = self.boxes(j) if j is not None else []
         return out
 
     def __iter__(self):

@@ -188,7 +188,7 @@ def build_scene(spec: SceneSpec) -> SceneModel:
     lots = make_lots(spec, grid)
     limit = spec.paths.clearance_m + EGO_HALF_WIDTH_M
     keepout = Keepout(np.concatenate([densify(r) for r in routes]), limit)
-    lib = Library(spec.seed)
+    lib = Library(spec.seed if spec.asset_seed is None else spec.asset_seed)  # re-drawn towns share the assets
     placer = Placer(lib, keepout)
     street = ps.Street(grid)
     log.info("layout %s: %d x %d blocks, %d segments, %d lots", spec.name, len(grid.xs) - 1, len(grid.ys) - 1,
