@@ -306,6 +306,6 @@ def quads(corners: np.ndarray, cls: str | int, materials, normals: np.ndarray | 
     if isinstance(materials, (str, int, np.integer)):
         mats = np.full(n, resolve_ids(cls, materials)[1])
     else:
-        table = {}
-        mats = np.array([table.setdefault(m, resolve_ids(cls, m)[1]) for m in materials], np.int64)
+        table = {m: resolve_ids(cls, m)[1] for m in set(materials)}  # a few names, thousands of quads
+        mats = np.array([table[m] for m in materials], np.int64)
     return Mesh(corners.reshape(-1, 3), faces, c, np.repeat(mats, 2))
