@@ -8,6 +8,8 @@ from outside.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import trimesh
 
@@ -89,9 +91,20 @@ def icosphere(radius: float, cls: str | int, material: str | int, subdivisions: 
               center: tuple[float, float, float] = (0.0, 0.0, 0.0),
               scale: tuple[float, float, float] = (1.0, 1.0, 1.0)) -> Mesh:
     """An icosphere (20 * 4**subdivisions triangles), optionally scaled per axis into an ellipsoid."""
-    tm = trimesh.creation.icosphere(subdivisions=subdivisions, radius=radius)
+    vertices, faces = _unit_icosphere(int(subdivisions), float(radius))
     c, m = resolve_ids(cls, material)
-    return Mesh(tm.vertices * np.asarray(scale, float) + np.asarray(center, float), tm.faces, c, m)
+    return Mesh(vertices * np.asarray(scale, float) + np.asarray(center, float), faces.copy(), c, m)
+
+
+@functools.lru_cache(maxsize=64)
+def _unit_icosphere(subdivisions: int, radius: float) -> tuple[np.ndarray, np.ndarray]:
+    """trimesh's icosphere arrays (read-only), made once per (subdivisions, radius): trees and hedges
+    ask for a thousand identical ones per town."""
+    tm = trimesh.creation.icosphere(subdivisions=subdivisions, radius=radius)
+    vertices, faces = np.array(tm.vertices, np.float64), np.array(tm.faces, np.int64)
+    vertices.setflags(write=False)
+    faces.setflags(write=False)
+    return vertices, faces
 
 
 def prism(polygon: np.ndarray, z0: float, z1: float, cls: str | int, material: str | int,
