@@ -33,7 +33,7 @@ from generator.geometry import Mesh
 log = logging.getLogger(__name__)
 
 #: Default bound of the cached arrays (meshes and derived data), bytes.
-MAX_BYTES = 768 * 2**20
+MAX_BYTES = 512 * 2**20
 
 
 class Uncacheable(TypeError):
