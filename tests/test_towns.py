@@ -184,3 +184,14 @@ def test_unhashable_parameters_bypass_the_cache():
     for _ in range(2):
         cache.build("bollard", stream(1, "x"), {"thing": object()}, builder)
     assert len(calls) == 2 and cache.bypassed == 2 and len(cache) == 0
+
+
+def test_generate_refuses_towns_past_sequence_99_and_writes_nothing(tmp_path, capsys, root):
+    spec = tmp_path / "spec.json"
+    spec.write_text(json.dumps(_doc(root, redraw_every_frames=1)))
+    out = tmp_path / "out"
+    rc, err = run_cli(capsys, ["generate", str(spec), "--config", "test", "--out", str(out), "--frames", "3",
+                               "--sequence", "98"], tmp_path, out)
+    assert rc == 2 and err.startswith("urbangen generate: --frames: frames up to 2 with town.redraw_every_frames = 1 "
+                                      "make towns up to 2, LiDAR sequences 98..100"), err
+    assert not out.exists()
