@@ -2,9 +2,6 @@
 
 Stages, each skipped when its output is already complete:
 
-Every stage runs per town: one town unless ``town.redraw_every_frames`` is set, then town ``i``
-(its own seed, its own drive from t = 0) makes sequence ``NN + i`` (:mod:`generator.jobs.towns`).
-
 1. LiDAR: one SemanticKITTI sequence (``lidar/sequences/NN``), every scan sharing its
    frame's weather draw (:func:`generator.weather.lidar_combination`). Cheap and
    byte-deterministic, so it is rewritten whole unless ``lidar_meta.json`` matches the plan.
@@ -13,6 +10,9 @@ Every stage runs per town: one town unless ``town.redraw_every_frames`` is set, 
    executor (local spawned processes or Ray); a frame is done when all its metadata JSONs
    exist, a pair when its ``image_3`` PNG does.
 3. OpenLABEL per sequence, then statistics.
+
+The stages run town by town: one town unless ``town.redraw_every_frames`` is set, then town ``i``
+(its own seed, its own drive from t = 0) makes sequence ``NN + i`` (:mod:`generator.jobs.towns`).
 
 Before the first write, :func:`preflight` checks the whole run: the manifest of a folder
 being resumed (readable, same spec, config and sequence, the merged plan), the plan's
