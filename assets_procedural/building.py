@@ -150,12 +150,17 @@ class _Facade:
         self.d = np.array([d[0], d[1], 0.0]) / self.length
         self.n = np.array([self.d[1], -self.d[0], 0.0])  # outward for a CCW footprint
         self.o = np.array([p0[0], p0[1], 0.0])
+        self._axes = [tuple(float(x) for x in c) for c in zip(self.o, self.d, (0.0, 0.0, 1.0), self.n)]
+        self._up, self._down, self._back = np.array([0, 0, 1.0]), -np.array([0, 0, 1.0]), -self.d
         self.uvw: list[list[tuple[float, float, float]]] = []  # 4 corners per quad, mapped in mesh()
         self.materials: list[str] = []
         self.facing: list[np.ndarray] = []
         self.sills: list[tuple[Hole, str]] = []
 
     def pts(self, uvw: list[tuple[float, float, float]]) -> np.ndarray:
+        if len(uvw) == 1:  # one point (a pane centre, the door): the same float operations, without arrays
+            u, v, w = (float(x) for x in uvw[0])
+            return np.array([[o + u * d + v * z + w * n for o, d, z, n in self._axes]])
         a = np.asarray(uvw, float)
         return self.o + a[:, :1] * self.d + a[:, 1:2] * np.array([0, 0, 1.0]) + a[:, 2:3] * self.n
 
@@ -177,12 +182,11 @@ class _Facade:
 
     def reveals(self, h: Hole, depth: float, material: str) -> None:
         """The four (three for a door) inner faces of the opening, facing into it."""
-        up = np.array([0, 0, 1.0])
-        self.add([(h.u0, h.v1, 0), (h.u1, h.v1, 0), (h.u1, h.v1, -depth), (h.u0, h.v1, -depth)], material, -up)
+        self.add([(h.u0, h.v1, 0), (h.u1, h.v1, 0), (h.u1, h.v1, -depth), (h.u0, h.v1, -depth)], material, self._down)
         self.add([(h.u0, h.v0, 0), (h.u0, h.v1, 0), (h.u0, h.v1, -depth), (h.u0, h.v0, -depth)], material, self.d)
-        self.add([(h.u1, h.v0, 0), (h.u1, h.v1, 0), (h.u1, h.v1, -depth), (h.u1, h.v0, -depth)], material, -self.d)
+        self.add([(h.u1, h.v0, 0), (h.u1, h.v1, 0), (h.u1, h.v1, -depth), (h.u1, h.v0, -depth)], material, self._back)
         if h.v0 > 0:
-            self.add([(h.u0, h.v0, 0), (h.u1, h.v0, 0), (h.u1, h.v0, -depth), (h.u0, h.v0, -depth)], material, up)
+            self.add([(h.u0, h.v0, 0), (h.u1, h.v0, 0), (h.u1, h.v0, -depth), (h.u0, h.v0, -depth)], material, self._up)
 
     def sill(self, h: Hole, material: str) -> None:
         """A stone sill under a window, proud of the wall (top, front, bottom, ends); built in :meth:`mesh`."""
