@@ -48,6 +48,7 @@ def test_towns_differ_and_are_reproducible(redraw, root):
     plain = load_spec(root / "scenes" / "test_town.json")
     t0, t1 = town_spec(redraw, 0), town_spec(redraw, 1)
     assert t0.seed != t1.seed and plain.seed not in (t0.seed, t1.seed)
+    assert max(t0.seed, t1.seed) < 2 ** 53  # exact in every JSON reader
     assert t0.spec_hash == t1.spec_hash == redraw.spec_hash and t1.asset_seed == redraw.seed
     d0, d1 = build_scene(t0).digest(), build_scene(t1).digest()
     assert d0 != d1 != build_scene(plain).digest()

@@ -4,7 +4,7 @@ With the option off (null, the default) a ``generate`` run shows one town, drawn
 spec's ``seed``, exactly as before. With ``N`` set, image frame ``k`` belongs to town
 ``i = k // N``; town ``i`` is the spec with
 
-* ``seed`` = :func:`town_seed` (``child_seed(seed, "town", i)``): its street grid, lots,
+* ``seed`` = :func:`town_seed` (``child_seed(seed, "town", i)``, 53 bits): its street grid, lots,
   placements, traffic, camera jitter, weather and lighting draws are its own;
 * ``asset_seed`` = the spec's seed: the towns share one asset library (the prototype meshes
   of cars, trees, people ... are drawn from the spec's seed, arranged anew in every town),
@@ -31,8 +31,9 @@ def redraw_every(spec) -> int | None:
 
 
 def town_seed(seed: int, index: int) -> int:
-    """The seed of town ``index`` of a spec whose seed is ``seed`` (63-bit, from the stream ``("town", index)``)."""
-    return child_seed(int(seed), "town", int(index))
+    """The seed of town ``index`` of a spec whose seed is ``seed``: from the stream ``("town", index)``,
+    kept below 2**53 so that every JSON reader (JavaScript's numbers too) reads it exactly."""
+    return child_seed(int(seed), "town", int(index)) >> 10
 
 
 def town_of(spec, frame: int) -> int | None:
