@@ -13,7 +13,9 @@
 Frames and sweeps: the LiDAR is a 10 Hz stream and images are exposed at some of its sweeps
 (``image_frames`` of ``lidar_meta.json``); image frame ``k`` pairs with sweep ``frame.sweep``,
 whose scan and OpenLABEL boxes :meth:`Dataset.frame` returns. :meth:`Dataset.scan` and
-:meth:`Dataset.boxes` take sweep indices.
+:meth:`Dataset.boxes` take sweep indices. A dataset of many towns (``town.redraw_every_frames``)
+has one sequence per town: ``Dataset(root, "01")`` pairs town 1's images with its scans, and an
+image of another town comes with ``sweep`` None and no scan (its ``meta["town"]`` says which).
 
 Arrays and frames
 -----------------
