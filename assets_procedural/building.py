@@ -150,17 +150,22 @@ class _Facade:
         self.d = np.array([d[0], d[1], 0.0]) / self.length
         self.n = np.array([self.d[1], -self.d[0], 0.0])  # outward for a CCW footprint
         self.o = np.array([p0[0], p0[1], 0.0])
-        self.corners: list[np.ndarray] = []
+        self._axes = [tuple(float(x) for x in c) for c in zip(self.o, self.d, (0.0, 0.0, 1.0), self.n)]
+        self._up, self._down, self._back = np.array([0, 0, 1.0]), -np.array([0, 0, 1.0]), -self.d
+        self.uvw: list[list[tuple[float, float, float]]] = []  # 4 corners per quad, mapped in mesh()
         self.materials: list[str] = []
         self.facing: list[np.ndarray] = []
-        self.extra: list[Mesh] = []
+        self.sills: list[tuple[Hole, str]] = []
 
     def pts(self, uvw: list[tuple[float, float, float]]) -> np.ndarray:
+        if len(uvw) == 1:  # one point (a pane centre, the door): the same float operations, without arrays
+            u, v, w = (float(x) for x in uvw[0])
+            return np.array([[o + u * d + v * z + w * n for o, d, z, n in self._axes]])
         a = np.asarray(uvw, float)
         return self.o + a[:, :1] * self.d + a[:, 1:2] * np.array([0, 0, 1.0]) + a[:, 2:3] * self.n
 
     def add(self, uvw: list[tuple[float, float, float]], material: str, facing: np.ndarray) -> None:
-        self.corners.append(self.pts(uvw))
+        self.uvw.append(uvw)
         self.materials.append(material)
         self.facing.append(facing)
 
@@ -177,27 +182,44 @@ class _Facade:
 
     def reveals(self, h: Hole, depth: float, material: str) -> None:
         """The four (three for a door) inner faces of the opening, facing into it."""
-        up = np.array([0, 0, 1.0])
-        self.add([(h.u0, h.v1, 0), (h.u1, h.v1, 0), (h.u1, h.v1, -depth), (h.u0, h.v1, -depth)], material, -up)
+        self.add([(h.u0, h.v1, 0), (h.u1, h.v1, 0), (h.u1, h.v1, -depth), (h.u0, h.v1, -depth)], material, self._down)
         self.add([(h.u0, h.v0, 0), (h.u0, h.v1, 0), (h.u0, h.v1, -depth), (h.u0, h.v0, -depth)], material, self.d)
-        self.add([(h.u1, h.v0, 0), (h.u1, h.v1, 0), (h.u1, h.v1, -depth), (h.u1, h.v0, -depth)], material, -self.d)
+        self.add([(h.u1, h.v0, 0), (h.u1, h.v1, 0), (h.u1, h.v1, -depth), (h.u1, h.v0, -depth)], material, self._back)
         if h.v0 > 0:
-            self.add([(h.u0, h.v0, 0), (h.u1, h.v0, 0), (h.u1, h.v0, -depth), (h.u0, h.v0, -depth)], material, up)
+            self.add([(h.u0, h.v0, 0), (h.u1, h.v0, 0), (h.u1, h.v0, -depth), (h.u0, h.v0, -depth)], material, self._up)
 
     def sill(self, h: Hole, material: str) -> None:
-        """A stone sill under a window, proud of the wall (top, front, bottom, ends)."""
-        s = box((h.u1 - h.u0 + 0.1, 0.07, 0.06), CLS, material, center=(0, 0, 0))
-        keep = s.vertices[s.faces].mean(1)[:, 1] < 0.035 - 1e-9  # drop the face against the wall
-        s = Mesh(s.vertices, s.faces[keep], s.face_class[keep], s.face_material[keep])
+        """A stone sill under a window, proud of the wall (top, front, bottom, ends); built in :meth:`mesh`."""
+        self.sills.append((h, material))
+
+    def _sill_mesh(self) -> list[Mesh]:
+        """Every sill at once: one box per distinct width (the face against the wall dropped), moved
+        to each window -- the same arithmetic per sill as building each box on its own."""
+        if not self.sills:
+            return []
         # box frame (x along u, -y outward, z up) -> local frame (right-handed: d x -n = z)
-        uc = (h.u0 + h.u1) / 2
         m = np.eye(4)
         m[:3, 0], m[:3, 1], m[:3, 2] = self.d, -self.n, (0, 0, 1.0)
-        m[:3, 3] = self.o + uc * self.d + 0.035 * self.n + (h.v0 - 0.03) * np.array([0, 0, 1.0])
-        self.extra.append(s.transformed(m))
+        shapes: dict[tuple[float, str], tuple] = {}
+        verts, faces, fcls, fmat = [], [], [], []
+        for i, (h, material) in enumerate(self.sills):
+            w = h.u1 - h.u0 + 0.1
+            if (w, material) not in shapes:
+                s = box((w, 0.07, 0.06), CLS, material, center=(0, 0, 0))
+                keep = s.vertices[s.faces].mean(1)[:, 1] < 0.035 - 1e-9  # drop the face against the wall
+                shapes[(w, material)] = (s.vertices @ m[:3, :3].T, s.faces[keep], s.face_class[keep],
+                                         s.face_material[keep])
+            rotated, f, c, mat = shapes[(w, material)]
+            uc = (h.u0 + h.u1) / 2
+            verts.append(rotated + (self.o + uc * self.d + 0.035 * self.n + (h.v0 - 0.03) * np.array([0, 0, 1.0])))
+            faces.append(f + 8 * i)
+            fcls.append(c)
+            fmat.append(mat)
+        return [Mesh(np.concatenate(verts), np.concatenate(faces), np.concatenate(fcls), np.concatenate(fmat))]
 
     def mesh(self) -> Mesh:
-        return merge([quads(np.array(self.corners), CLS, self.materials, np.array(self.facing))] + self.extra)
+        corners = self.pts([p for q in self.uvw for p in q]).reshape(-1, 4, 3) if self.uvw else np.zeros((0, 4, 3))
+        return merge([quads(corners, CLS, self.materials, np.array(self.facing))] + self._sill_mesh())
 
 
 def _opening(fc: _Facade, h: Hole, st: Style, facade_mat: str) -> np.ndarray:

@@ -113,8 +113,6 @@ def ground_pieces(grid: Grid, lots: list[Lot], placed: list[Placed] = ()) -> lis
 
 
 def _objects(grid: Grid, lots: list[Lot], placed: list[Placed], lib: Library):
-    from generator.geometry.proxy import label_proxy
-
     prototypes: dict[str, Mesh] = {}
     proxies: dict[str, Mesh] = {}
     objects: list[SceneObject] = []
@@ -143,7 +141,7 @@ def _objects(grid: Grid, lots: list[Lot], placed: list[Placed], lib: Library):
         if p.proto not in prototypes:
             mesh = lib.protos[p.proto].mesh
             prototypes[p.proto] = mesh
-            hull = label_proxy(mesh)
+            hull = lib.label_proxy(p.proto)
             if hull is not None:
                 proxies[p.proto] = hull
         objects.append(SceneObject(len(objects), name(p.kind), p.kind, p.cls, instance, p.proto, p.transform, p.box,
@@ -188,7 +186,7 @@ def build_scene(spec: SceneSpec) -> SceneModel:
     lots = make_lots(spec, grid)
     limit = spec.paths.clearance_m + EGO_HALF_WIDTH_M
     keepout = Keepout(np.concatenate([densify(r) for r in routes]), limit)
-    lib = Library(spec.seed)
+    lib = Library(spec.seed if spec.asset_seed is None else spec.asset_seed)  # re-drawn towns share the assets
     placer = Placer(lib, keepout)
     street = ps.Street(grid)
     log.info("layout %s: %d x %d blocks, %d segments, %d lots", spec.name, len(grid.xs) - 1, len(grid.ys) - 1,

@@ -31,7 +31,16 @@ def parse_spec(document: object, source: str) -> SceneSpec:
     full = with_defaults(document, schema)
     check_ranges(full, source)
     spec = build(SceneSpec, full)
-    return dataclasses.replace(spec, source=source, spec_hash=canonical_hash(spec.to_dict()))
+    return dataclasses.replace(spec, source=source, spec_hash=spec_hash(spec))
+
+
+def spec_hash(spec: SceneSpec) -> str:
+    """The spec's :func:`canonical_hash`; ``town.redraw_every_frames`` counts only when set, so the
+    hash of every spec written before that option is unchanged (resumable datasets stay resumable)."""
+    d = spec.to_dict()
+    if d["town"].get("redraw_every_frames") is None:
+        d["town"].pop("redraw_every_frames", None)
+    return canonical_hash(d)
 
 
 def load_spec(path: str | Path) -> SceneSpec:

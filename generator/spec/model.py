@@ -27,6 +27,8 @@ class Town:
     sidewalk_width_m: float
     curb_height_m: float
     margin_m: float
+    #: image frames per town of a ``generate`` run; None = one town (see :mod:`generator.spec.towns`)
+    redraw_every_frames: int | None = None
 
     @property
     def road_width_m(self) -> float:
@@ -175,7 +177,14 @@ class SceneSpec:
     source : str
         The file it was read from (for messages; relative paths in the spec resolve against it).
     spec_hash : str
-        SHA-256 of the canonical JSON of the spec with defaults filled in.
+        SHA-256 of the canonical JSON of the spec with defaults filled in (``town.redraw_every_frames``
+        left out while it is null, so specs written before the option keep their hash).
+    town_index : int or None
+        Set on the spec of town ``i`` of a re-drawn run (:func:`generator.spec.towns.town_spec`),
+        whose ``seed`` is then the town's seed; None for the spec as read.
+    asset_seed : int or None
+        The seed of the asset library (prototype meshes) when it differs from ``seed``: the
+        towns of one run share the library of the spec's own seed. None = ``seed``.
     """
 
     name: str
@@ -191,12 +200,14 @@ class SceneSpec:
     labels: Labels
     source: str = ""
     spec_hash: str = ""
+    town_index: int | None = None
+    asset_seed: int | None = None
 
     def to_dict(self) -> dict:
-        """The spec as plain JSON-able data (without ``source`` and ``spec_hash``)."""
+        """The spec as plain JSON-able data (without ``source``, ``spec_hash``, ``town_index``, ``asset_seed``)."""
         d = dataclasses.asdict(self)
-        d.pop("source")
-        d.pop("spec_hash")
+        for key in ("source", "spec_hash", "town_index", "asset_seed"):
+            d.pop(key)
         return _lists(d)
 
 
