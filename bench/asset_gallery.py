@@ -39,6 +39,8 @@ SMALL = np.array([[-5, -4], [5, -4], [5, 4], [-5, 4]], float)
 #: (label, kind, params) of the assets drawn
 EXAMPLES = [
     ("building flat brick", "building", dict(footprint=RECT, height=16.0, facade="brick")),
+    ("building glass", "building", dict(footprint=RECT, height=22.0, facade="glass")),
+    ("building plaster shops", "building", dict(footprint=RECT, height=13.0, facade="plaster")),
     ("building L concrete", "building", dict(footprint=L_SHAPE, height=22.0, facade="concrete")),
     ("building gable plaster", "building", dict(footprint=SMALL, height=6.5, roof="gable")),
     ("building hip plaster", "building", dict(footprint=SMALL, height=6.5, roof="hip", floor_height=3.0)),
