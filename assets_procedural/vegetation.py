@@ -65,18 +65,21 @@ def _branches(sk: Skeleton, cls: str, material: str) -> list[Mesh]:
     return out
 
 
-def _clumps(rng: np.random.Generator, sp: Species, tips: list, r: float, floor: float, budget: int) -> np.ndarray:
-    """(n, 3) float: leaf clump centres around the branch tips, ``CLUMP_GAP * r`` apart, none below ``floor``."""
+def _clumps(rng: np.random.Generator, sp: Species, tips: list, r: float, floor: float, budget: int,
+            gap: float, spreads=(0.5, 0.9), taken: np.ndarray | None = None, keep_off: float = 0.0) -> np.ndarray:
+    """(n <= budget, 3) float: clump centres around the branch tips, ``gap`` metres apart and
+    ``keep_off`` metres from the centres ``taken`` (k, 3), none lower than ``floor`` allows."""
     pts: list[np.ndarray] = []
-    gap = CLUMP_GAP * r * (0.8 if sp.detail == 0 else 1.0)
-    for spread in (0.5, 0.9):      # a second, looser round fills the crown up to the budget
+    taken = np.zeros((0, 3)) if taken is None else taken
+    for spread in spreads:      # later, looser rounds fill the crown up to the budget
         for tip in tips:
             for _ in range(int(rng.integers(*sp.per_tip))):
                 if len(pts) >= budget:
                     return np.array(pts)
                 p = np.asarray(tip, float) + rng.normal(0.0, spread * r, 3) * [1.0, 1.0, sp.clump_flat]
                 p[2] = max(p[2], floor + r * sp.clump_flat * 1.4)   # jittered blob bottom stays above floor
-                if all(np.linalg.norm(p - q) >= gap for q in pts):
+                if all(np.linalg.norm(p - q) >= gap for q in pts) and \
+                        (not len(taken) or np.linalg.norm(taken - p, axis=1).min() >= keep_off):
                     pts.append(p)
     return np.array(pts).reshape(-1, 3)
 
@@ -97,8 +100,8 @@ def tree(rng: np.random.Generator, height: float, species: str | None = None) ->
     -------
     Mesh
         Trunk and branches (class ``tree_trunk``, the species' bark material) and separate
-        leaf clumps (class ``tree_crown``, the species' leaf material) with open gaps between
-        them, at most :data:`TRI_BUDGET` triangles. The crown base is at least 2.4 m above
+        leaf clumps (class ``tree_crown``, the species' leaf material; big 80-triangle clumps
+        and, for broad-leaved species, small 20-triangle tufts) with open gaps between them, at most :data:`TRI_BUDGET` triangles. The crown base is at least 2.4 m above
         the ground; the top is exactly ``height``.
     """
     if not 3.0 <= height <= 30.0:
@@ -122,8 +125,15 @@ def tree(rng: np.random.Generator, height: float, species: str | None = None) ->
     parts = _branches(sk, "tree_trunk", sp.bark)
     used = sum(p.n_faces for p in parts)
     per_clump = 20 * 4 ** sp.detail
-    pts = _clumps(rng, sp, sk.tips, r, base, max(4, (TRI_BUDGET - used) // per_clump))
-    for p in pts:
+    room = TRI_BUDGET - used
+    if sp.detail == 0:
+        big = _clumps(rng, sp, sk.tips, r, base, max(4, room // per_clump), 0.8 * CLUMP_GAP * r)
+        small = np.zeros((0, 3))
+    else:   # broad leaves: big clumps, then small leaf tufts (20 triangles) round the branch ends
+        big = _clumps(rng, sp, sk.tips, r, base, max(4, int(0.6 * room) // per_clump), CLUMP_GAP * r)
+        room -= len(big) * per_clump
+        small = _clumps(rng, sp, sk.tips, r, base, max(0, room // 20), 1.05 * r, (0.8, 1.0), big, 1.6 * r)
+    for p in big:
         radii = r * rng.uniform(0.8, 1.15, 3) * np.array([1.0, 1.0, sp.clump_flat])
         yaw = 0.0
         if species == "conifer":      # boughs: long along the branch, thin across, flat
@@ -131,6 +141,9 @@ def tree(rng: np.random.Generator, height: float, species: str | None = None) ->
             radii = r * np.array([0.5, 0.5, 1.6]) if spire else radii * [1.6, 0.9, 1.0]
             yaw = float(np.arctan2(p[1], p[0]))
         parts.append(_blob(rng, p, radii, "tree_crown", sp.leaves, detail=sp.detail, yaw=yaw))
+    for p in small:
+        radii = 0.5 * r * rng.uniform(0.8, 1.2, 3) * np.array([1.0, 1.0, sp.clump_flat])
+        parts.append(_blob(rng, p, radii, "tree_crown", sp.leaves, 0.15, detail=0, yaw=float(rng.uniform(0, 6.3))))
     mesh = on_ground(merge(parts))
     # stretch everything above the crown base so the top of the crown is exactly ``height``
     z = mesh.vertices[:, 2]
