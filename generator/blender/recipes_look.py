@@ -64,7 +64,7 @@ def shop_sign(g, rng):
     """A painted fascia board over the shop windows, a colour per object, faint lettering blocks."""
     uv, co = _wall_coords(g)
     letters = g.brick(uv, color1=(1, 1, 1), color2=(1, 1, 1), mortar=(0, 0, 0), scale=1.0, mortar_size=0.05,
-                      brick_width=0.35, row_height=0.55, out="Fac")
+                      brick_width=0.35, row_height=0.55, out="Factor")
     colour = g.hsv((0.05, 0.1, 0.25), hue=g.object_info("Random"), saturation=1.0, value=1.0)
     base = g.mix(g.mul(g.math("SUBTRACT", 1.0, letters), 0.85), colour, (0.85, 0.82, 0.75))
     return g.principled(base_color=base, roughness=0.4)
