@@ -57,11 +57,11 @@ def pick_species(rng: np.random.Generator, height: float) -> str:
 
 
 def _branches(sk: Skeleton, cls: str, material: str) -> list[Mesh]:
-    """Tubes for the skeleton: the trunk with 8 sides and caps, thinner limbs with fewer, open ended."""
+    """Capped tubes for the skeleton: the trunk with 8 sides, thinner limbs with 6 or 4."""
     out = []
     for k, (p0, p1, r0, r1) in enumerate(sk.segments):
         sides = 8 if k == 0 else (6 if r0 > 0.06 else 4)
-        out.append(tube(p0, p1, max(r0, 0.012), cls, material, radius1=max(r1, 0.008), sections=sides, caps=k == 0))
+        out.append(tube(p0, p1, max(r0, 0.012), cls, material, radius1=max(r1, 0.008), sections=sides))
     return out
 
 
