@@ -172,3 +172,22 @@ def test_buildings_rest_on_the_ground_and_stay_building(facade):
             assert m.vertices[:, 2].min() == pytest.approx(0.0, abs=1e-9)
             assert (m.face_class == class_table().id("building")).all()
             assert m.n_faces < 12000
+
+
+def test_the_default_town_mixes_facades_colours_and_tree_species(default_scene):
+    """The town is not one white block repeated: several wall materials, rendered buildings in
+    several colours, a few curtain walls, balconies and shop fronts, and trees of several species."""
+    names = [r.name for r in material_table().rows]
+    buildings = [o for o in default_scene.objects if o.kind == "building"]
+    facades = {o.attrs["facade"] for o in buildings}
+    assert facades == {"plaster", "brick", "concrete", "glass"}
+    plaster = np.array([o.attrs["facade_color"] for o in buildings if o.attrs["facade"] == "plaster"])
+    hues = {int(np.argmax(c)) * 10 + int(np.argmin(c)) for c in plaster}          # which channel leads and lags
+    assert len(hues) >= 3 and np.ptp(plaster[:, 2]) > 0.25
+    mats = [{names[i] for i in np.unique(default_scene.prototypes[o.prototype].face_material)} for o in buildings]
+    assert sum("balcony_metal" in m or "awning" in m for m in mats) >= 10
+    assert 5 <= sum("facade_glass" in m for m in mats) <= len(buildings) // 4
+    trees = [{names[i] for i in np.unique(default_scene.prototypes[o.prototype].face_material)}
+             for o in default_scene.objects if o.kind == "tree"]
+    assert any("bark_birch" in m for m in trees) and any("needles" in m for m in trees)
+    assert sum(m == {"bark", "leaves"} for m in trees) > len(trees) // 3
