@@ -39,11 +39,16 @@ SMALL = np.array([[-5, -4], [5, -4], [5, 4], [-5, 4]], float)
 #: (label, kind, params) of the assets drawn
 EXAMPLES = [
     ("building flat brick", "building", dict(footprint=RECT, height=16.0, facade="brick")),
+    ("building glass", "building", dict(footprint=RECT, height=22.0, facade="glass")),
+    ("building plaster shops", "building", dict(footprint=RECT, height=13.0, facade="plaster")),
     ("building L concrete", "building", dict(footprint=L_SHAPE, height=22.0, facade="concrete")),
     ("building gable plaster", "building", dict(footprint=SMALL, height=6.5, roof="gable")),
     ("building hip plaster", "building", dict(footprint=SMALL, height=6.5, roof="hip", floor_height=3.0)),
-    ("tree 8 m", "tree", dict(height=8.0)),
-    ("tree 11 m", "tree", dict(height=11.0)),
+    ("tree plane 11 m", "tree", dict(height=11.0, species="plane")),
+    ("tree linden 9 m", "tree", dict(height=9.0, species="linden")),
+    ("tree birch 10 m", "tree", dict(height=10.0, species="birch")),
+    ("tree young 5 m", "tree", dict(height=5.0, species="young")),
+    ("tree conifer 12 m", "tree", dict(height=12.0, species="conifer")),
     ("bush 1.2 m", "bush", dict(size=1.2)),
     ("hedge 6 m", "hedge", dict(length=6.0)),
     ("lamp_post", "lamp_post", dict()),

@@ -15,6 +15,7 @@ import numpy as np
 
 from generator.blender.controls import CONTROL
 from generator.blender.nodes import Nodes
+from generator.blender.road_surface import road_wear
 
 
 def _jit(rng: np.random.Generator, base, spread: float):
@@ -55,7 +56,8 @@ def asphalt(g: Nodes, rng, tone=0.055, wear=0.5):
     base = g.ramp(grain, [(0.3, (tone * 0.7,) * 3), (0.7, (tone * 1.4,) * 3)])
     base = g.mix(g.mul(g.smooth(patches, 0.45, 0.6), wear), base, (tone * 1.8, tone * 1.75, tone * 1.7))
     base = g.mix(0.5, base, g.mix(cracks, (0.02, 0.02, 0.02), (1, 1, 1)), "MULTIPLY")
-    color, rough, normal = _wet(g, base, 0.85, g.bump(grain, 0.25, 0.01))
+    base, rough, worn = road_wear(g, co, base, tone, rng)
+    color, rough, normal = _wet(g, base, rough, g.bump(g.add(grain, worn), 0.25, 0.01))
     return g.principled(base_color=color, roughness=rough, normal=normal)
 
 

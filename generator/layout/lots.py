@@ -28,6 +28,11 @@ BACK_GAP = 2.0         #: building to lot back, metres
 FRONT_GAP_M = 2.0      #: gap left in a hedge or fence for the entrance
 FRONT_B = 0.6          #: centre line of hedges/fences, metres behind the lot front
 FACADES = ("plaster", "brick", "concrete")
+GLASS_SHARE = 0.15     #: share of buildings of 5+ storeys that are glass curtain walls
+#: render (plaster) colours a building is painted in: cream, ochre, salmon, sage, blue-grey,
+#: off-white, terracotta, yellow (multiplied into the plaster shader)
+RENDER_COLOURS = ((0.86, 0.80, 0.66), (0.80, 0.62, 0.38), (0.82, 0.58, 0.50), (0.66, 0.74, 0.60),
+                  (0.62, 0.68, 0.74), (0.88, 0.86, 0.82), (0.72, 0.45, 0.34), (0.86, 0.76, 0.45))
 ROOFS = ("flat", "gable", "hip")
 
 
@@ -139,7 +144,10 @@ def _footprint(w: float, d: float, g: np.random.Generator) -> np.ndarray:
     return np.array([(-hw, -hd), (hw, -hd), (hw, hd), (-hw, hd)])
 
 
-def _building(spec: SceneSpec, width: float, depth: float, setback: float, g: np.random.Generator) -> BuildingPlan | None:
+def _building(spec: SceneSpec, width: float, depth: float, setback: float, g: np.random.Generator,
+              look: np.random.Generator | None = None) -> BuildingPlan | None:
+    """A building plan for a lot; ``look`` (the lot's own stream) draws the curtain walls and the
+    render colours, so those draws do not shift the plans of the lots after it."""
     side = g.uniform(*SIDE_GAP, 2)
     bw = width - side.sum()
     bd = min(g.uniform(10.0, 22.0), depth - setback - BACK_GAP)
@@ -149,8 +157,12 @@ def _building(spec: SceneSpec, width: float, depth: float, setback: float, g: np
     lo, hi = spec.heights.building_m
     floors = max(1, int(round(g.uniform(lo, hi) / hf)))
     facade = FACADES[int(g.integers(len(FACADES)))]
+    glass, colour = (look.random() < GLASS_SHARE, int(look.integers(len(RENDER_COLOURS)))) if look else (False, 0)
+    if floors >= 5 and glass:      # some tall buildings are glass curtain walls
+        facade = "glass"
     roof = "flat" if floors > 4 or g.random() < 0.35 else ROOFS[1 + int(g.integers(2))]
-    base = {"plaster": (0.85, 0.8, 0.7), "brick": (0.6, 0.32, 0.24), "concrete": (0.65, 0.65, 0.63)}[facade]
+    base = {"plaster": RENDER_COLOURS[colour], "brick": (0.6, 0.32, 0.24), "concrete": (0.65, 0.65, 0.63),
+            "glass": (0.8, 0.85, 0.9)}[facade]
     tint = np.clip(np.asarray(base) * g.uniform(0.85, 1.15, 3), 0, 1)
     roof_tint = np.clip(np.array((0.35, 0.28, 0.26) if roof != "flat" else (0.4, 0.4, 0.42)) * g.uniform(0.8, 1.2, 3), 0, 1)
     attrs = {"facade_color": [round(float(c), 4) for c in tint], "roof_color": [round(float(c), 4) for c in roof_tint]}
@@ -195,7 +207,8 @@ def _plan_lot(spec, index, block, origin, yaw, width, depth, d, g) -> Lot:
     lot = Lot(index, block, (float(origin[0]), float(origin[1])), yaw, width, depth, "yard", "grass")
     if g.random() < d.buildings:
         setback = g.uniform(2.5, 4.0) if front else g.uniform(0.0, 4.0)
-        lot.building = _building(spec, width, depth, float(setback), g)
+        look = stream(spec.seed, "layout", "facade_look", index)
+        lot.building = _building(spec, width, depth, float(setback), g, look)
     if lot.building is not None:
         lot.use = "building"
         lot.ground = "grass" if g.random() < 0.7 else "paving"

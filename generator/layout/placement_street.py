@@ -22,6 +22,8 @@ from generator.spec.model import SceneSpec
 log = logging.getLogger(__name__)
 
 MIN_TREE_M = 3.0        #: the smallest tree the asset builder makes
+#: street-tree species (``assets_procedural.tree_species``), one per street-tree variant
+STREET_SPECIES = ("linden", "plane", "birch", "young")
 SIGN_SHAPES = ("circle", "triangle", "square", "octagon", "diamond")
 N_CAR, N_TRUCK, N_PEOPLE, N_LAMP, N_TL, N_STREET_TREE = 6, 3, 6, 3, 2, 4
 
@@ -102,10 +104,10 @@ def street_tree_variants(placer: Placer, spec: SceneSpec, half_width: float) -> 
     lo, hi = spec.heights.tree_m
     out = []
     for i in range(N_STREET_TREE):
-        shape = ("oval", "round")[i % 2]
+        species = STREET_SPECIES[i % len(STREET_SPECIES)]
         for attempt in range(6):
-            def params(g, attempt=attempt, shape=shape):
-                return {"height": float(max(MIN_TREE_M, g.uniform(lo, hi) * 0.85 ** attempt)), "shape": shape}
+            def params(g, attempt=attempt, species=species):
+                return {"height": float(max(MIN_TREE_M, g.uniform(lo, hi) * 0.85 ** attempt)), "species": species}
             proto = placer.lib.variant("tree", i, params, tag=f"street{attempt}")
             if max(-proto.lo[0], proto.hi[0], -proto.lo[1], proto.hi[1]) <= half_width:
                 out.append(proto)
