@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from generator.geometry import Mesh, merge, pose
+from generator.layout.districts import DISTRICTS, District, draw_districts
 from generator.layout.outskirts import outer_rows
 from generator.layout.street_meshes import rects
 from generator.layout.streets import Grid
@@ -83,6 +84,9 @@ class Lot:
     building: BuildingPlan | None = None
     front: list[FrontLine] = field(default_factory=list)
     entrance_a: float = 0.0           #: a of the door / gate (lot frame)
+    district: str = ""                #: its block's district ("" without a streets spec)
+    front_height: float | None = None  #: hedge/fence height the district drew (None: place_fronts draws it)
+    greenery: float = 1.0             #: multiplier on the lot's trees and bushes
 
     def transform(self, z: float = 0.0) -> np.ndarray:
         """(4, 4) world-from-lot transform."""
@@ -139,14 +143,15 @@ def _footprint(w: float, d: float, g: np.random.Generator) -> np.ndarray:
     return np.array([(-hw, -hd), (hw, -hd), (hw, hd), (-hw, hd)])
 
 
-def _building(spec: SceneSpec, width: float, depth: float, setback: float, g: np.random.Generator) -> BuildingPlan | None:
+def _building(spec: SceneSpec, width: float, depth: float, setback: float, g: np.random.Generator,
+              district: District | None = None) -> BuildingPlan | None:
     side = g.uniform(*SIDE_GAP, 2)
     bw = width - side.sum()
-    bd = min(g.uniform(10.0, 22.0), depth - setback - BACK_GAP)
+    bd = min(g.uniform(*(district.depth_m if district else (10.0, 22.0))), depth - setback - BACK_GAP)
     if bw < 6.0 or bd < 6.0:
         return None
     hf = spec.heights.floor_m
-    lo, hi = spec.heights.building_m
+    lo, hi = district.height_m if district else spec.heights.building_m
     floors = max(1, int(round(g.uniform(lo, hi) / hf)))
     facade = FACADES[int(g.integers(len(FACADES)))]
     roof = "flat" if floors > 4 or g.random() < 0.35 else ROOFS[1 + int(g.integers(2))]
@@ -170,26 +175,33 @@ def make_lots(spec: SceneSpec, grid: Grid) -> list[Lot]:
     g = stream(spec.seed, "layout", "lots")
     d = spec.density
     lots: list[Lot] = []
+    nx, ny = len(grid.xs) - 1, len(grid.ys) - 1
+    sections = outer_rows(grid)
+    districts = draw_districts(spec, nx * ny + len(sections))
 
-    def row(block, corner, ua, ub, widths, depth, g):
+    def row(block, corner, ua, ub, widths, depth, g, district):
         yaw = float(np.arctan2(ub[1], ub[0]) - np.pi / 2)
         a = 0.0
         for w in widths:
             origin = np.asarray(corner) + np.asarray(ua) * (a + w / 2)
             a += w
-            lots.append(_plan_lot(spec, len(lots), block, origin, yaw, float(w), float(depth), d, g))
+            lot = _plan_lot(spec, len(lots), block, origin, yaw, float(w), float(depth), d, g, district)
+            lots.append(lot)
 
-    for j in range(len(grid.ys) - 1):
-        for i in range(len(grid.xs) - 1):
+    for j in range(ny):
+        for i in range(nx):
             for (corner, ua, ub, frontage), depth in _rows(grid.block_rect(i, j), g):
-                row((i, j), corner, ua, ub, _widths(frontage, g), depth, g)
+                row((i, j), corner, ua, ub, _widths(frontage, g), depth, g, districts[j * nx + i])
     g = stream(spec.seed, "layout", "outer_lots")
-    for side, corner, ua, ub, frontage, is_corner in outer_rows(grid):
-        row((-1, side), corner, ua, ub, [frontage] if is_corner else _widths(frontage, g), grid.outer_depth, g)
+    for k, (side, corner, ua, ub, frontage, is_corner) in enumerate(sections):
+        row((-1, side), corner, ua, ub, [frontage] if is_corner else _widths(frontage, g), grid.outer_depth, g,
+            districts[nx * ny + k])
     return lots
 
 
-def _plan_lot(spec, index, block, origin, yaw, width, depth, d, g) -> Lot:
+def _plan_lot(spec, index, block, origin, yaw, width, depth, d, g, district: str = "") -> Lot:
+    if district in DISTRICTS:
+        return _plan_district_lot(spec, index, block, origin, yaw, width, depth, DISTRICTS[district], district, g)
     r = g.random()
     front = "hedge" if r < d.hedges else ("fence" if r < d.hedges + d.fences else None)
     lot = Lot(index, block, (float(origin[0]), float(origin[1])), yaw, width, depth, "yard", "grass")
@@ -205,6 +217,29 @@ def _plan_lot(spec, index, block, origin, yaw, width, depth, d, g) -> Lot:
         lot.entrance_a = float(g.uniform(-0.25, 0.25) * width)
         if lot.use == "park":
             front = None if g.random() < 0.5 else front
+    if front:
+        lot.front = _front(front, width, lot.entrance_a)
+    lot.district = district
+    return lot
+
+
+def _plan_district_lot(spec, index, block, origin, yaw, width, depth, dist: District, name: str, g) -> Lot:
+    """A lot planned by its district's parameters (see :mod:`generator.layout.districts`)."""
+    r = g.random()
+    front = "hedge" if r < dist.hedge else ("fence" if r < dist.hedge + dist.fence else None)
+    lot = Lot(index, block, (float(origin[0]), float(origin[1])), yaw, width, depth, "yard", "grass",
+              district=name, front_height=float(g.uniform(*dist.front_height_m)), greenery=dist.greenery)
+    if g.random() < dist.buildings:
+        setback = max(float(g.uniform(*dist.setback_m)), 1.5 if front else 0.0)   # clear of the hedge
+        lot.building = _building(spec, width, depth, setback, g, dist)
+    if lot.building is not None:
+        lot.use = "building"
+        lot.ground = "grass" if g.random() < dist.grass else "paving"
+        lot.entrance_a = lot.building.center[0]
+        lot.building.attrs["district"] = name
+    else:
+        lot.use = "park" if g.random() < dist.parks else "yard"
+        lot.entrance_a = float(g.uniform(-0.25, 0.25) * width)
     if front:
         lot.front = _front(front, width, lot.entrance_a)
     return lot
