@@ -2,8 +2,8 @@
 
     python bench/class_mix.py scenes/kitti_like.json [--towns 3] [--sweeps 17] [--baseline scenes/default_town.json]
 
-Each town is the spec with another seed (``seed + k``); sweeps are taken along route 0 at the
-spec's frame spacing, labels mapped to SemanticKITTI's 19 learning classes. The baseline spec
+Each town is the spec with another seed (``seed + k``); the sweeps of a town are frames spread
+evenly over one lap of route 0 (frames at the spec's spacing, every n-th), labels mapped to SemanticKITTI's 19 learning classes. The baseline spec
 (default: the default town) is measured the same way in the same run.
 """
 
@@ -42,9 +42,11 @@ def measure(spec_path: str, towns: int, sweeps: int) -> tuple[np.ndarray, float]
         spec = dataclasses.replace(spec, spec_hash=canonical_hash(spec.to_dict()))
         scene = build_scene(spec)
         rig = Rig.from_spec(spec, scene)
-        n = min(sweeps, rig.max_frames())
+        # spread the sweeps evenly over one lap of route 0 (the first few hundred metres are a
+        # street or two: their cross-sections would decide the whole mix)
+        idx = np.unique(np.linspace(0, rig.max_frames() - 1, sweeps).round().astype(int))
         with Scanner(scene, sensor_for_spec(spec), threads=2) as sc:
-            for f in rig.frames(n):
+            for f in (rig.frame(int(k)) for k in idx):
                 pts = sc.sweep(rig, f.t, spec.sensors.lidar.motion_skew).points
                 counts += np.bincount(lut[pts["class"]], minlength=20)[:20]
     return counts, time.perf_counter() - t0

@@ -61,12 +61,17 @@ class BuildingPlan:
 
 @dataclass
 class FrontLine:
-    """A hedge or fence piece along the lot front: ``a0..a1`` at ``b`` (lot frame, metres)."""
+    """A hedge or fence piece along the lot front: ``a0..a1`` at ``b`` (lot frame, metres).
+
+    ``across`` pieces run along the lot's depth instead (a lot side on a street): ``b`` from
+    ``a0`` to ``a1`` at ``a = b``.
+    """
 
     kind: str        # "hedge" | "fence"
     a0: float
     a1: float
     b: float
+    across: bool = False
 
 
 @dataclass
@@ -196,6 +201,7 @@ def make_lots(spec: SceneSpec, grid: Grid) -> list[Lot]:
     for k, (side, corner, ua, ub, frontage, is_corner) in enumerate(sections):
         row((-1, side), corner, ua, ub, [frontage] if is_corner else _widths(frontage, g), grid.outer_depth, g,
             districts[nx * ny + k])
+    line_street_edges(lots, grid)
     return lots
 
 
@@ -243,6 +249,39 @@ def _plan_district_lot(spec, index, block, origin, yaw, width, depth, dist: Dist
     if front:
         lot.front = _front(front, width, lot.entrance_a)
     return lot
+
+
+def _street_edges(lot: Lot, rect: tuple[float, float, float, float]) -> list[FrontLine]:
+    """Lines along the sides and back of a block lot that lie on its block's edge (a street), set
+    ``FRONT_B`` inside the lot, of the same kind as its front (none if the front has none)."""
+    if not lot.front:
+        return []
+    kind, w, d = lot.front[0].kind, lot.width / 2, lot.depth
+    x0, y0, x1, y1 = rect
+
+    def on_edge(p, q) -> bool:
+        for k, lo, hi in ((0, x0, x1), (1, y0, y1)):
+            for e in (lo, hi):
+                if abs(p[k] - e) < 1e-6 and abs(q[k] - e) < 1e-6:
+                    return True
+        return False
+
+    c = lot.corners_world()         # front-left, front-right, back-right, back-left
+    out = []
+    if on_edge(c[1], c[2]):
+        out.append(FrontLine(kind, FRONT_B + 0.5, d - 0.4, w - FRONT_B, True))
+    if on_edge(c[3], c[0]):
+        out.append(FrontLine(kind, FRONT_B + 0.5, d - 0.4, -w + FRONT_B, True))
+    if on_edge(c[2], c[3]):
+        out.append(FrontLine(kind, -w + 0.4, w - 0.4, d - FRONT_B))
+    return [f for f in out if f.a1 - f.a0 >= 1.0]
+
+
+def line_street_edges(lots: list[Lot], grid: Grid) -> None:
+    """District lots inside blocks: hedge or fence also along the sides and back that face a street."""
+    for lot in lots:
+        if lot.district and lot.block[0] >= 0:
+            lot.front += _street_edges(lot, grid.block_rect(*lot.block))
 
 
 def lot_ground_mesh(lot: Lot, curb_h: float) -> Mesh:

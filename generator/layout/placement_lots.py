@@ -70,8 +70,10 @@ def place_fronts(placer: Placer, spec: SceneSpec, lots: list[Lot], curb_h: float
                 proto = placer.lib.unique("hedge", length=length, height=height, depth=depth)
             else:
                 proto = placer.lib.unique("fence", length=length, height=height, style=style)
-            x, y = lot.to_world([((piece.a0 + piece.a1) / 2, piece.b)])[0]
-            if not placer.try_place(proto, x, y, curb_h, lot.yaw, dict(attrs)):
+            mid = (piece.a0 + piece.a1) / 2
+            x, y = lot.to_world([(piece.b, mid) if piece.across else (mid, piece.b)])[0]
+            yaw = lot.yaw + np.pi / 2 if piece.across else lot.yaw
+            if not placer.try_place(proto, x, y, curb_h, yaw, dict(attrs)):
                 placer.lib.discard(proto)
 
 

@@ -180,6 +180,7 @@ class Streets:
     parking_occupancy: Range
     verge_trees_per_100m: float
     verge_bushes_per_100m: float
+    verge_hedges: float
     districts: dict
 
 
