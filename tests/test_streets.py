@@ -246,3 +246,23 @@ def test_street_geometry_faces_up_and_curbs_face_the_lane(kitti):
     uv = segment_frame_points(seg, v[:, :2])
     on_edge = np.isclose(np.abs(uv[curb][:, :, 1]), grid.lane_half, atol=1e-6).all(1)
     assert on_edge.any() and (np.sign(uv[curb][on_edge][:, 0, 1]) == side).any()
+
+
+@pytest.mark.blender
+def test_blender_builds_the_street_types_as_the_scene_model(tmp_path):
+    """Verges, median islands, verge hedges and district lots reach Blender triangle for triangle."""
+    from generator.blender.renderer import Renderer
+    from generator.spec.render import load_render_config
+
+    spec = parse_spec({"name": "streets_tiny", "seed": 2,
+                       "town": {"blocks_x": 1, "blocks_y": 1, "block_size_m": 40, "block_size_jitter_m": 0,
+                                "margin_m": 12},
+                       "streets": {"types": {"residential": 1, "boulevard": 1, "arterial": 1},
+                                   "districts": {"detached": 1, "light_industry": 1}}}, "streets_tiny.json")
+    scene = build_scene(spec)
+    grid = make_grid(spec)
+    assert {k for _, k, _ in grid.raised_rects()} == {"verge", "median"}
+    n, bounds = Renderer(scene, spec, load_render_config("test"), tmp_path).evaluated_geometry()
+    assert n == len(scene.faces)
+    v = scene.vertices.astype(np.float64)
+    assert np.allclose(bounds, [v.min(0), v.max(0)], atol=1e-3)
