@@ -163,6 +163,13 @@ def test_verges_and_medians_are_raised_ground_behind_curbs(kitti, centre):
         assert grid.ground_height(np.array([[(r[0] + r[2]) / 2, (r[1] + r[3]) / 2] for *_, r in raised])).min() == h
     medians = [r for _, k, r in centre[1].raised_rects() if k == "median"]
     assert medians and all(min(r[2] - r[0], r[3] - r[1]) == pytest.approx(MEDIAN_W_M) for r in medians)
+    # the ego on its lane centre keeps clear of an island; lanes too narrow for that get none
+    lane_w = centre[0].town.lane_width_m
+    assert lane_w / 2 - EGO_HALF_WIDTH_M - MEDIAN_W_M / 2 >= 0.1 - 1e-9
+    for lane_w, island in ((2.75, False), (3.2, True), (3.5, True)):
+        spec = parse_spec({"name": "a", "seed": 1, "town": {"lane_width_m": lane_w},
+                           "streets": {"types": {"arterial": 1}}}, "a.json")
+        assert all(s.median == island for s in make_grid(spec).sections), lane_w
 
 
 def test_boulevards_have_tree_rows_and_residential_verges_greenery(kitti):

@@ -13,7 +13,9 @@ type          strips (side -1, side +1)             extra
 plain         parking, parking                      (every street of a town without ``streets``)
 residential   parking or verge, each at even odds   bushes and small trees on the verges
 boulevard     verge, verge                          a tree row on each verge
-arterial      shoulder, shoulder (asphalt)          a raised median island (other-ground)
+arterial      shoulder, shoulder (asphalt)          a raised median island (other-ground), where
+                                                    the lanes are wide enough that the ego on its
+                                                    lane centre keeps ``MEDIAN_CLEAR_M`` off it
 ============  ====================================  =========================================
 
 A *verge* is grass (terrain) raised to curb height behind a curb along the lane edge; a
@@ -33,7 +35,8 @@ from generator.rng import stream
 
 TYPES = ("plain", "residential", "boulevard", "arterial")
 STRIPS = ("parking", "verge", "shoulder")
-MEDIAN_W_M = 0.6      #: width of an arterial's median island (a car in the inner lane keeps 0.4 m off it)
+MEDIAN_W_M = 0.6      #: width of an arterial's median island
+MEDIAN_CLEAR_M = 0.1  #: the ego (half width EGO_HALF_WIDTH_M) on its lane centre keeps this off the island
 
 
 @dataclass(frozen=True)
@@ -54,11 +57,7 @@ class CrossSection:
     kind: str
     strips: tuple[str, str]
     occupancy: tuple[float, float]
-
-    @property
-    def median(self) -> bool:
-        """Whether a median island separates the directions."""
-        return self.kind == "arterial"
+    median: bool = False     #: a median island separates the directions
 
     def strip(self, side: int) -> str:
         return self.strips[0 if side < 0 else 1]
@@ -84,9 +83,12 @@ def draw_sections(spec, n_segments: int) -> tuple[CrossSection, ...]:
         ``()`` when ``spec.streets`` is None (every segment is :data:`PLAIN`) or the town has no
         parking strips (then every strip is lane asphalt and there is nothing to vary).
     """
+    from generator.layout.placement_core import EGO_HALF_WIDTH_M
+
     streets = spec.streets
     if streets is None or spec.town.parking_strip_width_m <= 0:
         return ()
+    island = spec.town.lane_width_m / 2 - EGO_HALF_WIDTH_M - MEDIAN_W_M / 2 >= MEDIAN_CLEAR_M
     g = stream(spec.seed, "layout", "street_types")
     w = np.array([float(streets.types.get(t, 0.0)) for t in TYPES])
     kinds = g.choice(len(TYPES), size=n_segments, p=w / w.sum())
@@ -103,5 +105,5 @@ def draw_sections(spec, n_segments: int) -> tuple[CrossSection, ...]:
         else:
             strips = ("shoulder", "shoulder")
         occ = tuple(float(x) for x in g.uniform(lo, hi, 2))
-        out.append(CrossSection(kind, strips, occ))
+        out.append(CrossSection(kind, strips, occ, kind == "arterial" and island))
     return tuple(out)
