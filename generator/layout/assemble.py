@@ -3,7 +3,7 @@
 Order of work (each feature draws from its own named stream, so adding one does not
 shift the others): grid -> routes -> lots (blocks, then the band outside the ring road)
 -> buildings -> hedges/fences -> traffic lights
--> lamps -> street trees -> signs -> lot greenery -> parked vehicles -> lane cars ->
+-> lamps -> street trees -> verge hedges, bushes and trees -> signs -> lot greenery -> parked vehicles -> lane cars ->
 people -> ground objects. Objects accepted earlier win space; everything keeps clear of
 the routes (see :mod:`generator.layout.placement_core`). Finally the routes are verified
 against every object box, and an internal error is raised if any sample is too close.
@@ -22,6 +22,7 @@ from generator.labels import class_table
 from generator.layout import placement_lots as pl
 from generator.layout import placement_extras as px
 from generator.layout import placement_street as ps
+from generator.layout import placement_verges as pv
 from generator.layout.lots import Lot, lot_ground_mesh, make_lots
 from generator.layout.outskirts import horizon_mesh
 from generator.layout.placement_core import EGO_HALF_WIDTH_M, Keepout, Library, Placed, Placer
@@ -44,6 +45,10 @@ STEPS = (
     ("traffic lights", lambda p, s, g, lots, st: ps.place_traffic_lights(p, s, st)),
     ("lamp posts", lambda p, s, g, lots, st: ps.place_lamps(p, s, st)),
     ("street trees", lambda p, s, g, lots, st: ps.place_street_trees(p, s, st)),
+    # verges exist only in towns with a streets spec (no-ops otherwise)
+    # (residential verge hedges first: the verge trees then stand in their gaps)
+    ("verge hedges and bushes", lambda p, s, g, lots, st: pv.place_verge_bushes(p, s, st)),
+    ("verge trees", lambda p, s, g, lots, st: pv.place_verge_trees(p, s, st)),
     ("traffic signs", lambda p, s, g, lots, st: ps.place_signs(p, s, st)),
     ("lot greenery", lambda p, s, g, lots, st: pl.place_lot_greenery(p, s, lots, g.curb_h)),
     ("parked vehicles", lambda p, s, g, lots, st: ps.place_parked(p, s, st)),

@@ -106,6 +106,8 @@ def place_two_wheelers(placer: Placer, spec: SceneSpec, st: Street) -> None:
     g = stream(spec.seed, "layout", "two_wheelers")
     bikes, motos = _protos(placer, "bicycle", n=6), _protos(placer, "motorcycle")
     for seg, s in _segments(st):
+        if grid.section(seg).strip(s) != "parking":    # a verge or shoulder (streets spec): no parking
+            continue
         _, traffic = st.side_yaws(seg, s)
         u0, u1 = PARKING_START_U, seg.length - PARKING_START_U
         for _ in range(int(g.poisson(dens * max(0.0, u1 - u0) / 100))):
@@ -138,7 +140,7 @@ def place_riders(placer: Placer, spec: SceneSpec, st: Street) -> None:
         v_lane = s * (grid.lane_half - 0.9)  # the kerb side of the outer lane, where a cyclist rides
         if u1 > u0 and free_lane(placer, seg, s * (grid.lane_half - grid.lane_w / 2), u0, u1):
             spots.append((seg, traffic, v_lane, u0, u1))
-        if grid.parking_w > 0:
+        if grid.parking_w > 0 and grid.section(seg).strip(s) != "verge":
             spots.append((seg, traffic, s * (grid.lane_half + grid.parking_w / 2), u0, u1))
     if not spots:
         return
@@ -229,6 +231,8 @@ def place_other_vehicles(placer: Placer, spec: SceneSpec, st: Street) -> None:
              "construction_vehicle": _protos(placer, "construction_vehicle", n=2)}
     names, p = list(kinds), np.array([0.45, 0.4, 0.15])
     for seg, s in _segments(st):
+        if grid.section(seg).strip(s) == "verge":      # grass (streets spec): nothing parks there
+            continue
         _, traffic = st.side_yaws(seg, s)
         u0, u1 = PARKING_START_U, seg.length - PARKING_START_U
         for _ in range(int(g.poisson(dens * max(0.0, u1 - u0) / 100))):
@@ -266,7 +270,8 @@ def place_lot_extras(placer: Placer, spec: SceneSpec, lots: list[Lot], st: Stree
                 a = float(np.clip(lot.entrance_a + g.uniform(2.5, 4.0), -lot.width / 2 + 3, lot.width / 2 - 3))
                 b = -(grid.corridor_half - grid.road_half) - depth / 2
                 x, y = lot.to_world([(a, b)])[0]
-                if not _in_rects(x, y, lanes):  # not where turning cars run at the segment ends
+                # not where turning cars run at the segment ends, nor on a raised verge
+                if not _in_rects(x, y, lanes) and not (grid.sections and grid.ground_height([(x, y)])[0] > 0):
                     placer.try_place(apron, x, y, 0.0, lot.yaw - np.pi / 2, {"lot": lot.index})
         if lot.use in ("park", "yard") and dens.gravel > 0 and g.random() < dens.gravel:
             patch = placer.lib.variant("gravel_patch", int(g.integers(N_VAR)))

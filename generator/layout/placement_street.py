@@ -98,9 +98,10 @@ def place_lamps(placer: Placer, spec: SceneSpec, st: Street) -> None:
                 placer.try_place(protos[int(g.integers(N_LAMP))], x, y, st.h, to_road, pad=0.2)
 
 
-def street_tree_variants(placer: Placer, spec: SceneSpec, half_width: float) -> list[Proto]:
+def street_tree_variants(placer: Placer, spec: SceneSpec, half_width: float, tag: str = "street") -> list[Proto]:
     """Street-tree variants whose crown stays within ``half_width`` metres of the trunk (so it
-    never reaches over a route lane); a variant that comes out too wide is rebuilt shorter."""
+    never reaches over a route lane); a variant that comes out too wide is rebuilt shorter.
+    ``tag`` names the variant family (another width limit needs its own family)."""
     lo, hi = spec.heights.tree_m
     out = []
     for i in range(N_STREET_TREE):
@@ -108,7 +109,7 @@ def street_tree_variants(placer: Placer, spec: SceneSpec, half_width: float) -> 
         for attempt in range(6):
             def params(g, attempt=attempt, species=species):
                 return {"height": float(max(MIN_TREE_M, g.uniform(lo, hi) * 0.85 ** attempt)), "species": species}
-            proto = placer.lib.variant("tree", i, params, tag=f"street{attempt}")
+            proto = placer.lib.variant("tree", i, params, tag=f"{tag}{attempt}")
             if max(-proto.lo[0], proto.hi[0], -proto.lo[1], proto.hi[1]) <= half_width:
                 out.append(proto)
                 break
@@ -180,7 +181,10 @@ def place_parked(placer: Placer, spec: SceneSpec, st: Street) -> None:
     """Cars (one bay) and trucks (two bays) in the parking strips, facing the traffic of their side.
 
     A truck wider than the strip double-parks in the lane next to it instead (only where no
-    route drives that lane; the keep-out rejects it otherwise).
+    route drives that lane; the keep-out rejects it otherwise). Without ``spec.streets`` every
+    bay is taken with probability ``parked_cars_per_100m * BAY_M / 100``; with it, each strip
+    has its own share (:attr:`CrossSection.occupancy`) and strips that are verges or shoulders
+    get none.
     """
     grid = st.grid
     if grid.parking_w <= 0 or spec.density.parked_cars_per_100m <= 0:
@@ -192,11 +196,15 @@ def place_parked(placer: Placer, spec: SceneSpec, st: Street) -> None:
     for seg in grid.segments:
         u0, u1 = PARKING_START_U, seg.length - PARKING_START_U
         n_bays = int((u1 - u0 + 1e-6) // BAY_M)
+        sec = grid.section(seg)
         for s in (-1, 1):
+            if grid.sections and sec.strip(s) != "parking":
+                continue
+            share = sec.share(s) if grid.sections else p_occ
             _, traffic = st.side_yaws(seg, s)
             b = 0
             while b < n_bays:
-                if g.random() >= p_occ:
+                if g.random() >= share:
                     b += 1
                     continue
                 truck = b + 1 < n_bays and g.random() < spec.density.truck_fraction

@@ -8,6 +8,7 @@ Lengths in metres, angles in degrees (as written in the spec).
 from __future__ import annotations
 
 import dataclasses
+import types
 import typing
 from dataclasses import dataclass
 
@@ -169,6 +170,23 @@ class Labels:
 
 
 @dataclass(frozen=True)
+class Streets:
+    """Street variety: weights of the cross-section types and districts, parking occupancy range.
+
+    Weights are relative (``{"plain": 1, "boulevard": 3}``: a boulevard three times as often as a
+    plain street); the draws are made in :mod:`generator.layout.streets` and
+    :mod:`generator.layout.districts`.
+    """
+
+    types: dict
+    parking_occupancy: Range
+    verge_trees_per_100m: float
+    verge_bushes_per_100m: float
+    verge_hedges: float
+    districts: dict
+
+
+@dataclass(frozen=True)
 class SceneSpec:
     """A validated scene spec (see ``schemas/scene.schema.json`` for every field's meaning).
 
@@ -198,6 +216,7 @@ class SceneSpec:
     weather: Weather
     lidar: LidarProcessing
     labels: Labels
+    streets: Streets | None = None
     source: str = ""
     spec_hash: str = ""
     town_index: int | None = None
@@ -208,6 +227,8 @@ class SceneSpec:
         d = dataclasses.asdict(self)
         for key in ("source", "spec_hash", "town_index", "asset_seed"):
             d.pop(key)
+        if d["streets"] is None:      # absent: the spec (and its hash) reads as before the field existed
+            d.pop("streets")
         return _lists(d)
 
 
@@ -227,6 +248,8 @@ def build(cls, data: dict):
         if f.name not in data:
             continue
         t, v = hints[f.name], data[f.name]
+        if typing.get_origin(t) in (typing.Union, types.UnionType) and isinstance(v, dict):
+            t = next(a for a in typing.get_args(t) if dataclasses.is_dataclass(a))   # ``Streets | None`` given
         if dataclasses.is_dataclass(t):
             v = build(t, v)
         elif typing.get_origin(t) is tuple:
