@@ -179,7 +179,8 @@ class ActorCaster:
             ``d_w`` that end on an actor are replaced by the direction in the actor's frame (the
             frame of its face normals).
         dist : (n,) float32
-            Static hit distance (``inf`` on a miss); actor hits replace it where nearer.
+            Static hit distance (``inf`` or at least the sensor's max range on a miss); actor hits
+            replace it where nearer.
         face : (n,) int32
             Face-table row of the hit; actor hits get their prototype's rows.
 

@@ -98,7 +98,7 @@ class EmbreeCaster:
         return self._normals
 
     def intersect_local(self, origins: np.ndarray, directions: np.ndarray,
-                        max_distance: float | np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+                        max_distance: float | np.ndarray, mark_misses: bool = True) -> tuple[np.ndarray, np.ndarray]:
         """First hits of rays whose origins are already re-centred (``world - center``).
 
         Parameters
@@ -109,6 +109,9 @@ class EmbreeCaster:
             Unit directions, world axes.
         max_distance : float or (n,) float32
             Hits farther than this are misses, metres (per ray: only hits nearer than a known one).
+        mark_misses : bool
+            Set the distance of a miss to ``inf`` (False: it keeps ``max_distance``, for a
+            caller that marks them in its own pass over the rays).
 
         Returns
         -------
@@ -123,7 +126,8 @@ class EmbreeCaster:
         out = self._scene.run(o, d, dists=np.full(len(o), max_distance, np.float32), output=1)
         prim = out["primID"]
         dist = out["tfar"]
-        dist[prim < 0] = np.inf
+        if mark_misses:
+            dist[prim < 0] = np.inf
         return dist, prim
 
     def intersect(self, origins: np.ndarray, directions: np.ndarray, max_distance: float) -> tuple[np.ndarray, np.ndarray]:

@@ -59,6 +59,36 @@ def world_rays(o_loc, d_loc, rot_t, trans, c0, c1, o_out, d_out):  # pragma: no 
 
 
 @njit(nogil=True, cache=True, boundscheck=False)
+def returns(dist, face, min_range, hit):  # pragma: no cover - compiled
+    """Mark the misses and list the rays that are points, in one pass.
+
+    Parameters
+    ----------
+    dist : (n,) float32
+        Embree's ``tfar`` per ray, metres; set to ``inf`` where ``face`` is -1 (a miss).
+    face : (n,) int32
+        Hit face per ray (-1 on a miss).
+    min_range : float
+        Hits nearer than this are not points (the sensor's minimum range), metres.
+    hit : (n,) int64
+        Written: the indices of the rays that are points, ascending, in ``hit[:count]``.
+
+    Returns
+    -------
+    count : int
+    """
+    k = 0
+    lo = np.float32(min_range)
+    for i in range(dist.shape[0]):
+        if face[i] < 0:
+            dist[i] = np.inf
+        elif dist[i] >= lo:
+            hit[k] = i
+            k += 1
+    return k
+
+
+@njit(nogil=True, cache=True, boundscheck=False)
 def fill_records(out, hit, ray0, dist, face, d_w, o_loc, d_loc, azimuth, column_time, ring_of, laser_of,
                  faces, skew):  # pragma: no cover - compiled
     """Write one record per hit (see :data:`generator.lidar.points.POINT_DTYPE`).

@@ -36,7 +36,7 @@ import numpy as np
 
 from generator.lidar.actors import ActorCaster
 from generator.lidar.caster import RayCaster, make_caster
-from generator.lidar.kernels import world_rays
+from generator.lidar.kernels import returns, world_rays
 from generator.lidar.points import POINT_DTYPE, RecordTables
 from generator.lidar.sensors import Sensor
 
@@ -221,12 +221,14 @@ class Scanner:
             n = (cols.stop - cols.start) * self.sensor.n_lasers
             o_w, d_w = np.empty((n, 3), np.float32), np.empty((n, 3), np.float32)
             world_rays(self._o32, self._d32, sweep.rot_t, sweep.trans, cols.start, cols.stop, o_w, d_w)
-            dist, face = self.caster.intersect_local(o_w, d_w, self.sensor.max_range_m)
+            # a miss keeps the max range as its distance until returns() marks it: nothing nearer
+            dist, face = self.caster.intersect_local(o_w, d_w, self.sensor.max_range_m, mark_misses=False)
             on_actor = None
             plan = sweep.get_plan()
             if plan is not None:
                 on_actor = self.actors.cast(plan, cols, o_w, d_w, dist, face)
-            hit = np.flatnonzero((face >= 0) & (dist >= self.sensor.min_range_m))
+            hit = np.empty(n, np.int64)
+            hit = hit[:returns(dist, face, self.sensor.min_range_m, hit)]
             start = sweep.claim(i, len(hit))
         except BaseException:
             sweep.fail(i)
