@@ -100,6 +100,8 @@ def new_object(name: str, data: bpy.types.Mesh, transform: np.ndarray, instance_
         ob.color = (float(color[0]), float(color[1]), float(color[2]), 1.0)
         ob["ug_roof_color"] = [float(c) for c in attrs.get("roof_color", (1.0, 1.0, 1.0))]
         ob["ug_class"] = cls
+        # vehicle lamps burn on vehicles in use (moving traffic, ridden, at a stop), not on parked ones
+        ob["ug_lights_on"] = 0.0 if attrs.get("placement") in ("parked", "rack") else 1.0
     return ob
 
 

@@ -72,7 +72,7 @@ def check_render_args(args) -> RenderArgs:
     cfg = load_render_config(args.config)
     out = output_dir(args.out, "--out")
     try:
-        combos = parse_combos(args.variants)
+        combos = parse_combos(args.variants, spec.weather.times_of_day)
     except ValueError as e:
         raise UserError(f"--variants: {e}") from None
     check_workers(args.workers, args.executor)

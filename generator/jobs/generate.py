@@ -37,7 +37,7 @@ from generator.jobs.executors import make_jobs, run_jobs
 from generator.jobs.plan import MAX_FRAME_INDEX, MAX_IMAGES, Plan, check_free_space, check_plan, image_bytes, scan_bytes
 from generator.jobs.stereo import pair_done, stereo_frames
 from generator.safeload import MAX_METADATA_BYTES, load_json
-from generator.weather import combinations
+from generator.weather import TIMES, combinations
 
 log = logging.getLogger(__name__)
 
@@ -124,7 +124,7 @@ def read_manifest(out: Path) -> dict | None:
     need(plan, "sequence", str, "plan.")
     if not all(type(k) is int and 0 <= k <= MAX_FRAME_INDEX for k in frames) or len(frames) > MAX_IMAGES:
         raise SpecError(src, "plan.frames", f"must be at most {MAX_IMAGES} frame numbers in 0..{MAX_FRAME_INDEX}")
-    valid = {tuple(c) for c in combinations()}
+    valid = {tuple(c) for c in combinations(TIMES)}
     if not all(isinstance(c, list) and tuple(c) in valid for c in combos):
         raise SpecError(src, "plan.combos", "must be [time_of_day, weather] pairs like [day, fog]")
     finished = need(doc, "finished", dict)
