@@ -13,6 +13,7 @@ import numpy as np
 from generator.world import rig
 from generator.blender import actors, camera, controls, geometry, lighting, materials, motion, night, passes, session
 from generator.blender.bpy_guard import bpy
+from generator.weather import LIT_TIMES
 from generator.world.actors import World
 from generator.world.scene import SceneModel
 from generator.spec.model import SceneSpec
@@ -103,7 +104,7 @@ class Renderer:
         dict
             Lighting metadata: sky model, sun or moon, light groups switched on.
         """
-        lit = light.time_of_day in ("dusk", "night")
+        lit = light.time_of_day in LIT_TIMES
         night.set_night(self.bscene, self.night_lights, lit)
         values = dict(controls.DAY_DEFAULTS, wetness=wetness, puddle_seed=puddle_seed)
         if lit:

@@ -129,6 +129,12 @@ def daylight_world(scene: "bpy.types.Scene", *, sun_elevation_deg: float, sun_az
         sky.air_density = 1.0
         sky.aerosol_density = 1.0
         sky_rgb = _scale_rgb(g, sky.outputs["Color"], SKY_STRENGTH)
+        if cloud_cover <= 0.0:  # a cloudless sky: no cloud nodes to evaluate
+            g.set(bg.inputs["Color"], sky_rgb)
+            info.update(sky_model="blender_multiple_scattering", cloud_cover=0.0)
+            g.output(bg.outputs[0], "ShaderNodeOutputWorld")
+            scene.world = world
+            return info
         zen = g.node("ShaderNodeTexSky", sky_type="MULTIPLE_SCATTERING")
         for k in ("sun_disc", "sun_elevation", "sun_rotation", "altitude", "air_density", "aerosol_density"):
             setattr(zen, k, getattr(sky, k))
