@@ -239,4 +239,6 @@ def draw_lighting(spec, frame_index: int, time_of_day: str, kind: str = "clear")
     if time_of_day == "dusk":
         el, az = float(g.uniform(*w.dusk_sun_elevation_deg)), float(g.uniform(*w.sun_azimuth_deg))
         return Lighting("dusk", el, az, lit_windows=float(g.uniform(*w.lit_windows)), **clouds)
+    if not overcast:  # a clear night sky is drawn without clouds (they would be unlit against the glow)
+        clouds["cloud_cover"] = 0.0
     return Lighting("night", lit_windows=float(g.uniform(*w.lit_windows)), **clouds)

@@ -74,7 +74,7 @@ def test_dusk_sits_between_day_and_night_with_the_lights_on(rendered):
     day, night = _load(rendered, "day", "clear")[0], _load(rendered, "night", "clear")[0]
     dusk, meta = _load(rendered, "dusk", "clear")
     assert _mean(night) < _mean(dusk) < _mean(day)
-    lo, hi = (-4, 6)
+    lo, hi = (-5, 3)
     assert lo <= meta["lighting"]["sun_elevation_deg"] <= hi and meta["time_of_day"] == "dusk"
     assert "street_lamps" in meta["lighting"]["light_groups_on"]
 
