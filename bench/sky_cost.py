@@ -36,7 +36,7 @@ def main(argv=None) -> None:
     cfg = load_render_config(a.config)
     cfg = dataclasses.replace(cfg, resolution=(a.width, round(a.width * cfg.height / cfg.width)))
     scene = build_scene(spec)
-    frame = Rig.from_spec(spec).frame(a.frame)  # the static town (no traffic): the sky is what changes
+    frame = Rig.from_spec(spec, scene).frame(a.frame)  # the static town (no traffic): the sky is what changes
     r = Renderer(scene, spec, cfg, tempfile.mkdtemp(prefix="sky_cost_"))
     r.place_camera(frame.T_world_camera)
     day = draw_lighting(spec, a.frame, "day", "clear")

@@ -6,6 +6,7 @@ One frame of the test town at the test preset (camera model off: the EXR RGB is 
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import numpy as np
@@ -91,3 +92,40 @@ def test_same_seed_same_image(rendered, tmp_path, root):
         a, _ = _load(rendered, tod, "clear")
         b, _ = _load(again, tod, "clear")
         np.testing.assert_array_equal(a.rgb, b.rgb)
+
+
+def test_moving_cars_burn_tail_lights_at_night_parked_ones_do_not(tmp_path, test_spec, test_scene):
+    """A car driving ahead of the camera shows red emitters at night (tail lights: red radiance some
+    20x a lamp-lit white wall); the town's parked cars stay dark."""
+    from test_render_actors import FRAME as ACTOR_FRAME, car_world
+
+    from generator.blender.renderer import Renderer
+    from generator.jobs.exposure import expose
+    from generator.spec.render import load_render_config
+    from generator.weather import Lighting
+    from generator.world.rig import Rig
+
+    rig = Rig.from_spec(test_spec, test_scene)
+    t = rig.frame(ACTOR_FRAME).t
+    world = car_world(test_spec, test_scene, rig, t, cars=[(9.0, 0.0, "fwd", 6.0)])
+    cfg = dataclasses.replace(load_render_config("test"), resolution=(192, 108), samples=4)
+    r = Renderer(test_scene, test_spec, cfg, tmp_path, world)
+    out = {}
+    for light in (Lighting("night", lit_windows=0.3),):
+        r.set_conditions(light)
+        expose(r, rig, t, rig.frame(ACTOR_FRAME).T_ego_camera)
+        labels = r.render_labels()
+        out[light.time_of_day] = (r.render_rgb(seed=1)[0], labels)
+    mover = world.actors[0].instance_id
+
+    def red_emitters(rgb, mask):
+        px = rgb[mask]
+        return int(((px[:, 0] > 0.02) & (px[:, 0] > 6 * px[:, 1])).sum())
+
+    night_rgb, labels = out["night"]
+    car = labels.instance == mover
+    assert car.sum() > 100
+    assert red_emitters(night_rgb, car) >= 2
+    parked = (labels.class_id == class_table().id("car")) & ~car
+    if parked.any():  # no lamps of their own (a glint of another's light on the paint at most)
+        assert night_rgb[parked][:, 0].max() < 0.2 * night_rgb[car][:, 0].max()

@@ -103,7 +103,8 @@ def daylight_world(scene: "bpy.types.Scene", *, sun_elevation_deg: float, sun_az
     d = g.coords("Generated")  # the view direction in a world shader
     x, y, z = _split(g, d)
     zc = g.math("MAXIMUM", z, 0.03)
-    plane = _join(g, g.math("DIVIDE", x, zc), g.math("DIVIDE", y, zc), 0.0)
+    # the cloud-base plane, each frame's pattern a slice of 3D noise (cheaper than 4D)
+    plane = _join(g, g.math("DIVIDE", x, zc), g.math("DIVIDE", y, zc), float(cloud_seed))
     bg = g.node("ShaderNodeBackground")
     g.set(bg.inputs["Strength"], 1.0)
     info = {"sun_elevation_deg": sun_elevation_deg, "sun_azimuth_deg": sun_azimuth_deg, "sky_strength": SKY_STRENGTH,
@@ -111,11 +112,10 @@ def daylight_world(scene: "bpy.types.Scene", *, sun_elevation_deg: float, sun_az
     if overcast:
         lz = overcast_zenith(overcast_irradiance)
         grade = g.add(1.0 / 3.0, g.mul(g.math("MAXIMUM", z, 0.0), 2.0 / 3.0))
-        texture = g.noise(g.mapping(plane, scale=(0.35, 0.35, 1.0)), scale=CLOUD_SCALE, detail=6, roughness=0.6,
-                          w=cloud_seed)
+        texture = g.noise(g.mapping(plane, scale=(0.35, 0.35, 1.0)), scale=CLOUD_SCALE, detail=4, roughness=0.6)
         texture = g.add(0.8, g.mul(texture, 0.4))  # 0.8..1.2 around a mean of 1: the deck's structure
-        lum = g.mul(g.mul(grade, texture), lz)
-        g.set(bg.inputs["Color"], _scale_rgb(g, OVERCAST_TINT, lum))
+        g.set(bg.inputs["Color"], _scale_rgb(g, OVERCAST_TINT, g.mul(g.mul(grade, texture), lz)))
+        plain = _scale_rgb(g, OVERCAST_TINT, g.mul(grade, lz))
         info.update(sky_model="cie_overcast", overcast_zenith_radiance=lz, overcast_irradiance=overcast_irradiance,
                     cloud_cover=1.0)
     else:
@@ -140,7 +140,7 @@ def daylight_world(scene: "bpy.types.Scene", *, sun_elevation_deg: float, sun_az
             setattr(zen, k, getattr(sky, k))
         g.set(zen.inputs["Vector"], (0.0, 0.0, 1.0))
         zenith = _scale_rgb(g, zen.outputs["Color"], SKY_STRENGTH * CLOUD_SHADE)
-        noise = g.noise(g.mapping(plane, scale=(1.0, 1.0, 1.0)), scale=CLOUD_SCALE, detail=5, roughness=0.55, w=cloud_seed)
+        noise = g.noise(plane, scale=CLOUD_SCALE, detail=4, roughness=0.55)
         threshold = 0.72 - 0.44 * float(cloud_cover)
         density = g.smooth(noise, threshold - 0.02, threshold + 0.09)
         # thin out toward the horizon (haze) and in a gap around the sun
@@ -156,8 +156,23 @@ def daylight_world(scene: "bpy.types.Scene", *, sun_elevation_deg: float, sun_az
         lit = _scale_rgb(g, tuple(CLOUD_LIT / math.pi * c for c in sun_rgb), g.add(0.25, lit_share))
         cloud = g.mix(1.0, zenith, lit, "ADD")
         g.set(bg.inputs["Color"], g.mix(density, sky_rgb, cloud))
+        plain = sky_rgb
         info.update(sky_model="blender_multiple_scattering+procedural_clouds", cloud_cover=float(cloud_cover),
                     cloud_seed=float(cloud_seed), cloud_sun_gap_deg=list(SUN_GAP_DEG))
-    g.output(bg.outputs[0], "ShaderNodeOutputWorld")
+    g.output(_seen_detail(g, bg.outputs[0], plain), "ShaderNodeOutputWorld")
+    info["cloud_detail_rays"] = "camera and glossy (diffuse and shadow rays see the smooth sky)"
     scene.world = world
     return info
+
+
+def _seen_detail(g: Nodes, detailed, plain_color):
+    """Camera and glossy rays see ``detailed`` (clouds, the deck's texture); every other ray -- diffuse
+    bounces, the world's importance map -- the smooth ``plain_color``. The cloud noise is then evaluated
+    only where it is seen (a Mix Shader at 0 or 1 skips its other branch), and the light the town gets
+    from a cloudy sky is its average, which is what the noise averages to."""
+    lp = g.node("ShaderNodeLightPath")
+    seen = g.math("MAXIMUM", lp.outputs["Is Camera Ray"], lp.outputs["Is Glossy Ray"])
+    plain = g.node("ShaderNodeBackground")
+    g.set(plain.inputs["Color"], plain_color)
+    g.set(plain.inputs["Strength"], 1.0)
+    return g.mix_shader(seen, plain.outputs[0], detailed)
