@@ -126,6 +126,10 @@ def test_moving_cars_burn_tail_lights_at_night_parked_ones_do_not(tmp_path, test
     car = labels.instance == mover
     assert car.sum() > 100
     assert red_emitters(night_rgb, car) >= 2
-    parked = (labels.class_id == class_table().id("car")) & ~car
-    if parked.any():  # no lamps of their own (a glint of another's light on the paint at most)
-        assert night_rgb[parked][:, 0].max() < 0.2 * night_rgb[car][:, 0].max()
+    from scipy import ndimage
+
+    near = ndimage.binary_dilation(car, iterations=2)  # the pixel filter spreads the mover's lamps 1-2 px
+    parked = (labels.class_id == class_table().id("car")) & ~near
+    # no lamps of their own: at most a glint of the mover's lamps in their glass (one pixel here), where lit
+    # lamps would put a few pixels on every visible front or rear
+    assert parked.sum() > 100 and red_emitters(night_rgb, parked) <= 1
