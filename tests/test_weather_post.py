@@ -188,7 +188,7 @@ def test_bad_arguments_raise():
     with pytest.raises(ValueError):
         apply_fog(rgb, depth[:-1], 0.01, DAY_AIRLIGHT)
     with pytest.raises(ValueError):
-        airlight_for("dusk")
+        airlight_for("noon")
     with pytest.raises(ValueError):
         apply_rain(rgb, depth, -1.0, np.random.default_rng(0), "day")
     with pytest.raises(ValueError):

@@ -170,9 +170,14 @@ def window_glass(g, rng):
     # One draw per pane: every pane is its own mesh island (two triangles with their own vertices).
     pane = g.math("FRACT", g.add(g.geometry("Random Per Island"), g.object_info("Random")))
     lit = g.math("LESS_THAN", pane, lit_fraction)
-    warm = g.mix(g.object_info("Random"), (1.0, 0.75, 0.45), (0.9, 0.9, 1.0))
+    # Per lit room, from further digits of the pane's draw: a lamp colour from 2700 K to 6500 K
+    # (mostly warm) and a brightness over 1.5 decades (curtains, lamps, ceiling lights).
+    kelvin = g.math("FRACT", g.mul(pane, 37.0))
+    warm = g.ramp(kelvin, [(0.0, (1.0, 0.62, 0.32)), (0.45, (1.0, 0.74, 0.46)), (0.75, (1.0, 0.86, 0.68)),
+                           (0.92, (0.92, 0.94, 1.0))])
+    bright = g.math("POWER", 10.0, g.add(-1.0, g.mul(g.math("FRACT", g.mul(pane, 113.0)), 1.5)))
     glass = g.principled(base_color=(0.02, 0.025, 0.03), roughness=0.03, metallic=0.0, ior=1.5, specular=1.0)
-    return _emit(g, glass, warm, 6.0, "windows", lit)
+    return _emit(g, glass, warm, 6.0, "windows", g.mul(lit, bright))
 
 
 def window_frame(g, rng):
@@ -237,12 +242,12 @@ def chrome(g, rng):
 
 def headlight(g, rng):
     lens = g.principled(base_color=(0.8, 0.8, 0.8), roughness=0.1, metallic=0.6)
-    return _emit(g, lens, (1.0, 0.95, 0.85), 40.0, "vehicle_lights")
+    return _emit(g, lens, (1.0, 0.95, 0.85), 40.0, "vehicle_lights", g.attr("ug_lights_on", "OBJECT"))
 
 
 def taillight(g, rng):
     lens = g.principled(base_color=(0.4, 0.02, 0.02), roughness=0.15)
-    return _emit(g, lens, (1.0, 0.05, 0.02), 15.0, "vehicle_lights")
+    return _emit(g, lens, (1.0, 0.05, 0.02), 15.0, "vehicle_lights", g.attr("ug_lights_on", "OBJECT"))
 
 
 def pole_metal(g, rng):

@@ -13,6 +13,7 @@ import numpy as np
 from generator.world import rig
 from generator.blender import actors, camera, controls, geometry, lighting, materials, motion, night, passes, session
 from generator.blender.bpy_guard import bpy
+from generator.weather import LIT_TIMES
 from generator.world.actors import World
 from generator.world.scene import SceneModel
 from generator.spec.model import SceneSpec
@@ -92,7 +93,7 @@ class Renderer:
         Parameters
         ----------
         light : generator.weather.Lighting
-            Day (sun position) or night (lit-window fraction).
+            Day (sun, clouds), dusk (low sun, clouds, lit windows) or night (lit windows, clouds).
         wetness : float
             0 (dry) .. 1 (soaked): darker, glossier ground with puddles.
         puddle_seed : float
@@ -103,20 +104,22 @@ class Renderer:
         dict
             Lighting metadata: sky model, sun or moon, light groups switched on.
         """
-        is_night = light.time_of_day == "night"
-        night.set_night(self.bscene, self.night_lights, is_night)
+        lit = light.time_of_day in LIT_TIMES
+        night.set_night(self.bscene, self.night_lights, lit)
         values = dict(controls.DAY_DEFAULTS, wetness=wetness, puddle_seed=puddle_seed)
-        if is_night:
-            values.update(lit_windows=light.lit_windows, light_windows=1.0, light_street_lamps=1.0,
-                          light_vehicle_lights=1.0, light_traffic_lights=1.0)
-            info = night.night_world(self.bscene)
-            info["lit_windows_fraction"] = light.lit_windows
+        if lit:
+            values.update(lit_windows=light.lit_windows, **{"light_" + k: v for k, v in night.EMISSION_SCALE.items()})
+        if light.time_of_day == "night":
+            info = night.night_world(self.bscene, light.overcast, light.cloud_seed)
         else:
-            info = lighting.day_world(self.bscene, lighting.DayLight(light.sun_elevation_deg, light.sun_azimuth_deg))
+            info = lighting.day_world(self.bscene, lighting.DayLight(
+                light.sun_elevation_deg, light.sun_azimuth_deg, light.cloud_cover, light.cloud_seed, light.overcast))
+        if lit:
+            info.update(night.lights_record(), lit_windows_fraction=light.lit_windows)
         controls.apply(self.bscene, values)
         groups = [g[len("light_"):] for g, v in values.items() if g.startswith("light_") and v > 0]
         info.update(time_of_day=light.time_of_day, light_groups_on=sorted(groups), wetness=wetness,
-                    light_objects={k: v for k, v in self.night_counts.items()} if is_night else {})
+                    light_objects={k: v for k, v in self.night_counts.items()} if lit else {})
         return info
 
     @property

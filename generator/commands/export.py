@@ -22,7 +22,7 @@ from generator.commands.preflight import input_dir, output_dir
 from generator.errors import UserError
 from generator.jobs.plan import MAX_FRAME_INDEX, check_free_space
 from generator.safeload import MAX_METADATA_BYTES, load_json, printable
-from generator.weather import combinations
+from generator.weather import TIMES, combinations
 from generator.formats.cityscapes import DEFAULT_SPLIT, SPLITS, CityscapesImage, city_name, export, image_stem
 
 FORMATS = ("cityscapes",)
@@ -50,9 +50,9 @@ def _metadata(exr: Path) -> tuple[int, str, str]:
         raise UserError(f"{path}: not image metadata (needs frame, time_of_day, weather.kind)") from None
     if type(frame) is not int or not 0 <= frame <= MAX_FRAME_INDEX:
         raise UserError(f"{path}: frame: must be an integer in 0..{MAX_FRAME_INDEX}")
-    if not (isinstance(tod, str) and isinstance(kind, str) and (tod, kind) in set(combinations())):  # they name folders: known words only
-        raise UserError(f"{path}: time_of_day, weather.kind: must be one of the 12 known combinations "
-                        f"(day/night x {', '.join(sorted({w for _, w in combinations()}))})")
+    if not (isinstance(tod, str) and isinstance(kind, str) and (tod, kind) in set(combinations(TIMES))):  # they name folders: known words only
+        raise UserError(f"{path}: time_of_day, weather.kind: must be one of the known combinations "
+                        f"({'/'.join(TIMES)} x {', '.join(sorted({w for _, w in combinations()}))})")
     return frame, tod, kind
 
 

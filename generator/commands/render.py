@@ -2,8 +2,9 @@
 
 Renders frames along the scene's route: per image one multilayer EXR (RGB + one mask
 channel per class + depth + instance), a metadata JSON and a preview PNG, in
-``DIR/images/``. ``--variants all`` renders the 12 weather x time-of-day combinations
-of every frame (4 RGB renders; fog and rain in post). Images whose metadata already
+``DIR/images/``. ``--variants all`` renders the 6 weathers at every time of day the spec lists
+(``weather.times_of_day``; default day and night: 12 combinations, 6 RGB renders; fog and rain
+in post). Images whose metadata already
 exists are skipped (rerun = resume).
 """
 
@@ -38,8 +39,8 @@ def add_render_arguments(p, out_help: str, frames: int, variants: str) -> None:
     p.add_argument("--frames", type=Integer(1, MAX_FRAMES), default=frames,
                    help=f"frames along the route, 1..{MAX_FRAMES} (default {frames})")
     p.add_argument("--variants", default=variants,
-                   help=f"all (12 weather x time combinations per frame), clear (day, clear), or pairs like "
-                        f"day:fog,night:rain (default {variants})")
+                   help=f"all (6 weathers x the spec's times of day per frame, 12 by default), clear (day, "
+                        f"clear), or pairs like day:fog,dusk:clear,night:rain (default {variants})")
     p.add_argument("--workers", type=Integer(1, MAX_WORKERS), default=1,
                    help="parallel Blender processes (default 1; local: at most one per core)")
     p.add_argument("--executor", default="local", choices=EXECUTORS,
@@ -72,7 +73,7 @@ def check_render_args(args) -> RenderArgs:
     cfg = load_render_config(args.config)
     out = output_dir(args.out, "--out")
     try:
-        combos = parse_combos(args.variants)
+        combos = parse_combos(args.variants, spec.weather.times_of_day)
     except ValueError as e:
         raise UserError(f"--variants: {e}") from None
     check_workers(args.workers, args.executor)

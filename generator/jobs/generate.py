@@ -41,7 +41,7 @@ from generator.jobs.plan import MAX_FRAME_INDEX, MAX_IMAGES, Plan, check_free_sp
 from generator.jobs.stereo import pair_done, stereo_frames
 from generator.jobs.towns import town_runs
 from generator.safeload import MAX_METADATA_BYTES, load_json
-from generator.weather import combinations
+from generator.weather import TIMES, combinations
 
 log = logging.getLogger(__name__)
 
@@ -141,7 +141,7 @@ def read_manifest(out: Path) -> dict | None:
     need(plan, "sequence", str, "plan.")
     if not all(type(k) is int and 0 <= k <= MAX_FRAME_INDEX for k in frames) or len(frames) > MAX_IMAGES:
         raise SpecError(src, "plan.frames", f"must be at most {MAX_IMAGES} frame numbers in 0..{MAX_FRAME_INDEX}")
-    valid = {tuple(c) for c in combinations()}
+    valid = {tuple(c) for c in combinations(TIMES)}
     if not all(isinstance(c, list) and tuple(c) in valid for c in combos):
         raise SpecError(src, "plan.combos", "must be [time_of_day, weather] pairs like [day, fog]")
     finished = need(doc, "finished", dict)

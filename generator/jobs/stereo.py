@@ -43,7 +43,7 @@ from generator.jobs.variants import camera_post, weather_post
 from generator.labels import class_table
 from generator.previews.preview import display_rgb
 from generator.rng import child_seed
-from generator.weather import draw_lighting, frame_wetness, is_wet, lidar_combination
+from generator.weather import draw_lighting, frame_wetness, is_wet, lidar_combination, light_level
 
 CAMERAS = (2, 3)
 
@@ -98,10 +98,10 @@ def render_pair(renderer, spec, cfg, rig, sensor, index: int, seq_dir: Path) -> 
         Seconds per stage.
     """
     t0 = time.perf_counter()
-    tod, kind = lidar_combination(index)
+    tod, kind = lidar_combination(index, spec.weather.times_of_day)
     t_scan = rig.sweep_time(index)  # the start of sweep ``index`` (10 Hz)
     t_exp = t_scan + exposure_offset(sensor, spec.sensors.lidar.motion_skew)
-    light = draw_lighting(spec, index, tod)
+    light = draw_lighting(spec, index, tod, kind)
     wetness, puddles = frame_wetness(spec, index) if is_wet(kind) else (0.0, 0.0)
     lighting = renderer.set_conditions(light, wetness, puddles)
     to_cs = class_table().to_cityscapes
@@ -111,7 +111,8 @@ def render_pair(renderer, spec, cfg, rig, sensor, index: int, seq_dir: Path) -> 
         T_world_camera = expose(renderer, rig, t_exp, rig.T_ego_stereo(cam))
         labels = renderer.render_labels()
         rgb, _ = renderer.render_rgb(seed=child_seed(spec.seed, "frame", index, "stereo", cam))
-        img, weather = weather_post(spec, index, tod, kind, rgb, labels.depth, renderer.k, ("stereo", cam))
+        img, weather = weather_post(spec, index, tod, kind, rgb, labels.depth, renderer.k, ("stereo", cam),
+                                    light_level(light))
         img, camera = camera_post(spec, cfg, index, tod, kind, img, ("stereo",), (cam,), exposure)
         if camera is not None:
             camera["exposure_from"] = f"image_{CAMERAS[0]}"

@@ -1,11 +1,12 @@
 """All weather x time-of-day variants of one frame, at the cost of a few renders.
 
 Per frame: the label passes once (masks, instances and depth are shared by every
-variant); one RGB render per (time of day, dry | wet); then fog and rain in
-post-processing from the depth pass (seed 003 Sec. III.A), then the camera model when the
-render config turns it on (:func:`camera_post`: the camera sees the foggy, rainy scene). The
-12 combinations of Table II therefore cost 4 RGB renders, and a frame's variants differ only
-in RGB.
+variant); one RGB render per (time of day, dry | wet, clear sky | overcast)
+(:func:`generator.weather.render_key`: clear is sunny and dry, fog overcast and dry, the
+wet kinds overcast and wet); then fog and rain in post-processing from the depth pass (seed
+003 Sec. III.A), then the camera model when the render config turns it on
+(:func:`camera_post`: the camera sees the foggy, rainy scene). The 12 combinations of Table
+II therefore cost 6 RGB renders, and a frame's variants differ only in RGB.
 """
 
 from __future__ import annotations
@@ -21,11 +22,15 @@ from generator.postfx.rain import rain_image
 from generator.jobs.exposure import expose, motion_record
 from generator.jobs.images import write_image
 from generator.rng import child_seed, stream
-from generator.weather import combinations, draw_lighting, draw_weather, frame_wetness, has_fog, has_rain, is_wet
+from generator.weather import (DEFAULT_TIMES, TIMES, combinations, draw_lighting, draw_weather, frame_wetness, has_fog,
+                               has_rain, light_level, render_key)
 
 
-def parse_combos(text: str) -> list[tuple[str, str]]:
-    """``all`` | ``clear`` | ``day:clear,night:rain_fog,...`` -> list of (time_of_day, kind).
+def parse_combos(text: str, times=DEFAULT_TIMES) -> list[tuple[str, str]]:
+    """``all`` | ``clear`` | ``day:clear,dusk:fog,night:rain_fog,...`` -> list of (time_of_day, kind).
+
+    ``all`` is every weather at each of ``times`` (the spec's ``weather.times_of_day``); pairs
+    may name any time of day urbangen knows (:data:`generator.weather.TIMES`).
 
     Raises
     ------
@@ -33,28 +38,37 @@ def parse_combos(text: str) -> list[tuple[str, str]]:
         With a message naming the bad item.
     """
     if text == "all":
-        return combinations()
+        return combinations(times)
     if text == "clear":
         return [("day", "clear")]
     out = []
-    valid = set(combinations())
+    valid = set(combinations(TIMES))
     for item in text.split(","):
         pair = tuple(item.strip().split(":"))
         if pair not in valid:
             raise ValueError(f"unknown variant {item!r}; use all, clear or time:weather pairs like day:fog "
-                             f"(times: day, night; weather: clear, fog, rain, rain_fog, wet, wet_fog)")
+                             f"(times: {', '.join(TIMES)}; weather: clear, fog, rain, rain_fog, wet, wet_fog)")
         out.append(pair)
     return list(dict.fromkeys(out))
 
 
-def renders_needed(combos: list[tuple[str, str]]) -> list[tuple[str, bool]]:
-    """The (time_of_day, wet) renders that serve ``combos``, in a fixed order."""
-    return sorted({(t, is_wet(k)) for t, k in combos}, key=lambda r: (r[0] != "day", r[1]))
+def renders_needed(combos: list[tuple[str, str]]) -> list[tuple[str, bool, bool]]:
+    """The (time_of_day, wet, overcast) renders that serve ``combos``, in a fixed order."""
+    return sorted({(t, *render_key(k)) for t, k in combos}, key=lambda r: (TIMES.index(r[0]), r[1], r[2]))
+
+
+def cycles_seed(spec, frame_index: int, time_of_day: str, wet: bool, overcast: bool) -> int:
+    """Cycles' seed of one RGB render (the sunny renders keep the seeds they had before skies were drawn)."""
+    return child_seed(spec.seed, "frame", frame_index, "cycles", time_of_day, int(wet), *(("overcast",) if overcast else ()))
 
 
 def weather_post(spec, frame_index: int, time_of_day: str, kind: str, rgb: np.ndarray, depth: np.ndarray,
-                 k: np.ndarray, stream_tag: tuple = ()) -> tuple[np.ndarray, dict]:
+                 k: np.ndarray, stream_tag: tuple = (), level: float = 1.0) -> tuple[np.ndarray, dict]:
     """Fog and rain of weather ``kind`` applied in post to one rendered image.
+
+    The post fx are written for a clear day's radiance (their airlight, emitter thresholds and
+    streak clips are radiances): they run on ``rgb / level`` and the result is scaled back, so a
+    dim dusk or night render gets fog and rain in proportion to its own light.
 
     Parameters
     ----------
@@ -66,6 +80,8 @@ def weather_post(spec, frame_index: int, time_of_day: str, kind: str, rgb: np.nd
         Camera intrinsics (rain streak lengths).
     stream_tag : tuple
         Extra names of the rain stream (another camera of the same frame draws its own drops).
+    level : float
+        The scene's light relative to a clear day (:func:`generator.weather.light_level`).
 
     Returns
     -------
@@ -74,12 +90,17 @@ def weather_post(spec, frame_index: int, time_of_day: str, kind: str, rgb: np.nd
     """
     weather = draw_weather(spec, frame_index, kind)
     img, params = rgb, weather.to_dict()
+    if not (has_fog(kind) or has_rain(kind)):
+        return img, params
+    scale = np.float32(level)
+    img = img / scale
     if has_fog(kind):
         img, params["fog"] = fog_image(img, depth, weather.visibility_m, time_of_day)
     if has_rain(kind):
         g = stream(spec.seed, "frame", frame_index, "rain", time_of_day, kind, *stream_tag)
         img, params["rain"] = rain_image(img, depth, weather.rain_rate_mmh, g, time_of_day, k=k)
-    return img, params
+    params["post_fx_light_level"] = float(level)
+    return (img * scale).astype(np.float32, copy=False), params
 
 
 def camera_post(spec, cfg, frame_index: int, time_of_day: str, kind: str, rgb: np.ndarray,
@@ -137,15 +158,17 @@ def render_frame(renderer, spec, cfg, frame, out: Path, combos: list[tuple[str, 
     label_s = time.perf_counter() - t
     motion = None if rig is None else motion_record(renderer, frame.t, labels.instance)
     timings = {}
-    for tod, wet in renders_needed(combos):
-        light = draw_lighting(spec, frame.index, tod)
+    for tod, wet, overcast in renders_needed(combos):
+        kinds = [k for t_, k in combos if t_ == tod and render_key(k) == (wet, overcast)]
+        light = draw_lighting(spec, frame.index, tod, kinds[0])
+        level = light_level(light)
         wetness, puddles = frame_wetness(spec, frame.index) if wet else (0.0, 0.0)
         info = renderer.set_conditions(light, wetness, puddles)
-        info.update({k: v for k, v in light.to_dict().items() if v is not None})
-        rgb, rgb_s = renderer.render_rgb(seed=child_seed(spec.seed, "frame", frame.index, "cycles", tod, int(wet)))
-        for kind in [k for t_, k in combos if t_ == tod and is_wet(k) == wet]:
+        info.update({k: v for k, v in light.to_dict().items() if v is not None}, light_level=level)
+        rgb, rgb_s = renderer.render_rgb(seed=cycles_seed(spec, frame.index, tod, wet, overcast))
+        for kind in kinds:
             t = time.perf_counter()
-            img, params = weather_post(spec, frame.index, tod, kind, rgb, labels.depth, renderer.k)
+            img, params = weather_post(spec, frame.index, tod, kind, rgb, labels.depth, renderer.k, level=level)
             post_s = time.perf_counter() - t
             secs = {"rgb_pass": rgb_s, "label_passes_shared": label_s, "post_fx": post_s}
             t = time.perf_counter()

@@ -24,8 +24,9 @@ Exposure. The camera meters the scene it sees, ``m = metered * 2**radiance_scale
 ``E = KEY / REFERENCE_LUMINANCE * 2**(ev + radiance_scale_ev)``. EV 0 is the exposure of a
 clear day (metered luminance :data:`REFERENCE_LUMINANCE`), so a clear day's mid grey lands on
 :data:`KEY`. The camera may darken a bright scene a lot (the default town's day fog: -1.4 EV)
-but brighten a dark one only up to ``ev_max`` (exposure time and gain run out): the renders'
-night (+1.7..1.9 EV, gain 3..4) stays dark and a foggy day does not wash out.
+but brighten a dark one only up to ``ev_max`` (exposure time and gain run out): a night street,
+~12 EV below a clear day in log-average, is exposed some 9-10 EV up (gain ~4..8) and stays
+darker than mid grey with bright lamps, as night footage is, and a foggy day does not wash out.
 
 Gain. Up to ``EV_BASE_GAIN`` the camera changes its exposure time at base gain (G = 1);
 above it, it raises the gain, ``G = 2**(ev - EV_BASE_GAIN)``. Photo-electrons behind an output
@@ -57,14 +58,15 @@ REFERENCE_LUMINANCE = 0.16
 AE_STRENGTH = 0.8
 #: Lowest EV (relative to a clear day) the camera reaches: shortest exposure at base gain.
 EV_MIN = -3.0
-#: The EV from which the camera raises its gain (below it: shorter exposure, gain 1).
-EV_BASE_GAIN = 0.0
-#: The renders' radiance in EV relative to a physical scene of the same look: the night
-#: renders' log-average luminance is ~2.6 EV below the day's where a lit street at night is
-#: ~8 EV below a sunny one, so the camera sees night radiance 3 EV lower than rendered
-#: (it then runs into its exposure limit, as real cameras do at night). 0 once night is lit
-#: physically.
-RADIANCE_SCALE_EV = {"day": 0.0, "night": -3.0}
+#: The EV from which the camera raises its gain (below it: longer exposure at gain 1): an
+#: automotive camera's exposure time runs from ~1/4000 s on a clear day to ~1/30 s (7 EV)
+#: before it raises the gain (up to another 2..4 EV, :data:`RANGES` ``ev_max``).
+EV_BASE_GAIN = 7.0
+#: The renders' radiance in EV relative to a physical scene of the same look, per time of day.
+#: 0: the renders are lit at real ratios (a lit street at night is some 10-12 EV below a sunny
+#: one, :mod:`generator.blender.night`); kept in the metadata for datasets made before, when
+#: night renders were seen 3 EV darker than rendered.
+RADIANCE_SCALE_EV = {"day": 0.0, "dusk": 0.0, "night": 0.0}
 #: Metering grid: about this many blocks across; weights ``FLOOR + exp(-r^2 / 2 SIGMA^2)``
 #: with r in units of the image width about a point a little below the centre.
 METER_BLOCKS = 64
@@ -79,7 +81,7 @@ PSF_WEIGHTS = (0.25, 0.25, 0.25, 0.25)
 #: Ranges of the per-image draws (uniform unless said otherwise).
 RANGES = {
     "ev_comp": (-0.3, 0.3),            # metering bias, EV (normal, sd 0.15, clipped)
-    "ev_max": (1.5, 2.5),              # highest EV: longest exposure time x highest gain
+    "ev_max": (9.0, 11.0),             # highest EV: longest exposure time x highest gain
     "psf_share": (0.02, 0.06),         # energy in the tail
     "vignetting": (0.10, 0.30),        # light loss at the corners
     "ca_scale": (0.0002, 0.0010),      # |lateral CA|: R magnified by 1 + c, B by 1 - c (sign drawn)

@@ -35,7 +35,11 @@ from generator.weather import KOSCHMIEDER
 DAY_AIRLIGHT = (0.68, 0.71, 0.76)
 #: Night airlight, linear RGB: a dark blue-grey (city sky glow scattered by the fog).
 NIGHT_AIRLIGHT = (0.010, 0.012, 0.018)
-BASE_AIRLIGHT = {"day": DAY_AIRLIGHT, "night": NIGHT_AIRLIGHT}
+#: Dusk: sky light scattered like by day (the caller scales the image by the scene's light level,
+#: :func:`generator.weather.light_level`), with lamp halos like at night.
+BASE_AIRLIGHT = {"day": DAY_AIRLIGHT, "dusk": DAY_AIRLIGHT, "night": NIGHT_AIRLIGHT}
+#: Times of day whose lamps are lit (halos in fog).
+LAMP_TIMES = ("dusk", "night")
 
 #: Halo widths as a fraction of the image width, and the share of the halo in each.
 HALO_WIDTHS = (0.006, 0.02, 0.06)
@@ -149,7 +153,7 @@ def airlight_for(time_of_day: str, rgb: np.ndarray | None = None, beta_per_m: fl
 
     Parameters
     ----------
-    time_of_day : {"day", "night"}
+    time_of_day : {"day", "dusk", "night"}
     rgb : (H, W, 3) float32, optional
         The fog-free render; at night its lamps lift the airlight (halos).
     beta_per_m : float
@@ -166,7 +170,7 @@ def airlight_for(time_of_day: str, rgb: np.ndarray | None = None, beta_per_m: fl
         base = BASE_AIRLIGHT[time_of_day]
     except KeyError:
         raise ValueError(f"unknown time of day {time_of_day!r}; known: {', '.join(BASE_AIRLIGHT)}") from None
-    if time_of_day == "night" and rgb is not None and depth is not None and beta_per_m > 0:
+    if time_of_day in LAMP_TIMES and rgb is not None and depth is not None and beta_per_m > 0:
         glow, params = lamp_halo(rgb, depth, beta_per_m)
         return Airlight(base, glow, params)
     return Airlight(base)
@@ -208,7 +212,7 @@ def fog_image(rgb: np.ndarray, depth: np.ndarray, visibility_m: float, time_of_d
     depth : (H, W) float32, metres along the ray (inf = sky)
     visibility_m : float
         Meteorological visibility (m).
-    time_of_day : {"day", "night"}
+    time_of_day : {"day", "dusk", "night"}
 
     Returns
     -------

@@ -34,16 +34,16 @@ NEAR_M, FAR_M = 0.5, 25.0
 LAYER_EDGES_M = (1.5, 4.0, 10.0)
 LAYER_SIGMA_PX = (1.3, 0.8, 0.6, 0.5)
 #: Exposure time (s) of the camera by time of day (longer at night): streak length = f v T / d.
-EXPOSURE_S = {"day": 1.0 / 60.0, "night": 1.0 / 30.0}
+EXPOSURE_S = {"day": 1.0 / 60.0, "dusk": 1.0 / 30.0, "night": 1.0 / 30.0}
 #: Streaks per image at 1 mm/h and the exponent of their growth with the rain rate.
 STREAKS_AT_1MMH = 300
 STREAK_RATE_EXP = 0.75
 #: Peak opacity of a 2 mm drop's streak before defocus; streak radiance = GAIN x local brightness.
 STREAK_ALPHA = 0.5
-STREAK_GAIN = {"day": 1.5, "night": 1.5}
+STREAK_GAIN = {"day": 1.5, "dusk": 1.5, "night": 1.5}
 #: Share of the whole view's mean radiance in a streak: by day drops refract the bright sky;
 #: at night only the light near a drop counts (streaks are dark except near lamps).
-ENV_SHARE = {"day": 0.5, "night": 0.0}
+ENV_SHARE = {"day": 0.5, "dusk": 0.25, "night": 0.0}
 #: Lamp light a drop catches at night (x blurred emitter map).
 LAMP_GLINT = 0.12
 #: Mean lens drops at 10 mm/h (Poisson), radius range as a fraction of the image width.
@@ -152,8 +152,8 @@ def streak_radiance(rgb: np.ndarray, time_of_day: str) -> np.ndarray:
     f = max(1, int(sigma / 3.0))  # the radiance is smooth: build it on a block-averaged grid
     src = block_mean(np.minimum(rgb, 1.0), f)  # lamps enter through the glint term
     src = 0.6 * src + 0.4 * src.mean(-1, keepdims=True)
-    if time_of_day == "night":
-        src += np.float32(LAMP_GLINT / STREAK_GAIN["night"]) * block_mean(emitter_map(rgb), f)
+    if time_of_day != "day":  # lamps are lit at dusk and night
+        src += np.float32(LAMP_GLINT / STREAK_GAIN[time_of_day]) * block_mean(emitter_map(rgb), f)
     share = ENV_SHARE[time_of_day]
     small = STREAK_GAIN[time_of_day] * ((1.0 - share) * gaussian(src, sigma / f) + share * src.mean((0, 1), keepdims=True))
     return upsample(small.astype(np.float32), f, h, w)
@@ -209,7 +209,7 @@ def rain_image(rgb: np.ndarray, depth: np.ndarray, rate_mmh: float, rng: np.rand
         Rain rate (mm/h); more rain = more, longer streaks and more lens drops.
     rng : numpy.random.Generator
         The image's rain stream (``stream(seed, "frame", k, "rain", time, kind)``).
-    time_of_day : {"day", "night"}
+    time_of_day : {"day", "dusk", "night"}
     k : (3, 3) float64, optional
         Intrinsics; the focal length sets streak lengths (default: 90 deg horizontal FOV).
 

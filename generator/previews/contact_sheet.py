@@ -10,7 +10,7 @@ from PIL import Image, ImageDraw
 from generator.atomic import atomic_path
 from generator.imaging.exr import read_exr
 from generator.previews.preview import camera_model_of, colorize, display_rgb
-from generator.weather import KINDS, TIMES
+from generator.weather import DEFAULT_TIMES, KINDS, TIMES
 
 
 def _caption(img: np.ndarray, text: str) -> np.ndarray:
@@ -22,7 +22,8 @@ def _caption(img: np.ndarray, text: str) -> np.ndarray:
 
 
 def variants_sheet(images_dir: str | Path, frame: int, out_png: str | Path, scale: float = 0.5) -> list[str]:
-    """Grid of every variant of ``frame`` found in ``images_dir`` (rows: weather; columns: day, night, labels).
+    """Grid of every variant of ``frame`` found in ``images_dir`` (rows: weather; columns: day, dusk when the
+    frame has dusk images, night, labels).
 
     Returns
     -------
@@ -31,9 +32,10 @@ def variants_sheet(images_dir: str | Path, frame: int, out_png: str | Path, scal
     """
     images_dir = Path(images_dir)
     rows, names, label_tile = [], [], None
+    times = [t for t in TIMES if t in DEFAULT_TIMES or any(images_dir.glob(f"{frame:06d}_{t}_*.exr"))]
     for kind in KINDS:
         tiles = []
-        for tod in TIMES:
+        for tod in times:
             name = f"{frame:06d}_{tod}_{kind}"
             path = images_dir / f"{name}.exr"
             if not path.exists():

@@ -72,7 +72,7 @@ def enabled_for_spec(spec, default: bool) -> bool:
 
 def frame_weather(spec, frame_index: int) -> tuple[str, Weather]:
     """(time of day, weather draw) the scan of ``frame_index`` shares with its images."""
-    tod, kind = lidar_combination(frame_index)
+    tod, kind = lidar_combination(frame_index, spec.weather.times_of_day)
     return tod, draw_weather(spec, frame_index, kind)
 
 

@@ -139,6 +139,9 @@ class Weather:
     sun_elevation_deg: Range
     sun_azimuth_deg: Range
     lit_windows: Range
+    dusk_sun_elevation_deg: Range
+    cloud_cover: Range
+    times_of_day: tuple[str, ...]
 
 
 @dataclass(frozen=True)
@@ -252,6 +255,8 @@ def build(cls, data: dict):
             t = next(a for a in typing.get_args(t) if dataclasses.is_dataclass(a))   # ``Streets | None`` given
         if dataclasses.is_dataclass(t):
             v = build(t, v)
+        elif typing.get_origin(t) is tuple and typing.get_args(t)[0] is str:
+            v = tuple(str(x) for x in v)
         elif typing.get_origin(t) is tuple:
             v = tuple(float(x) for x in v)
         elif t is float and isinstance(v, int):

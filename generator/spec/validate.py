@@ -93,6 +93,10 @@ def describe(schema: dict) -> str:
     if t == "array" and "minItems" in schema and schema.get("minItems") == schema.get("maxItems"):
         item = describe(schema.get("items", {}))
         words = f"a list of {schema['minItems']} items, each {item}"
+    elif t == "array" and ("minItems" in schema or schema.get("uniqueItems")):
+        words = f"a list of at least {schema.get('minItems', 0)} items, each {describe(schema.get('items', {}))}"
+        if schema.get("uniqueItems"):
+            words += ", none repeated"
     if "pattern" in schema:
         words += f" matching {schema['pattern']}"
     return words
@@ -118,7 +122,7 @@ def _message(err: jsonschema.ValidationError, root: dict) -> tuple[str, str]:
     if err.validator == "required":
         missing = err.message.split("'")[1]
         return _field_path(path + [missing]), "is required"
-    if err.validator in ("minItems", "maxItems") and isinstance(err.instance, list):
+    if err.validator in ("minItems", "maxItems", "uniqueItems") and isinstance(err.instance, list):
         return _field_path(path), f"must be {describe(_resolve(err.schema, root))}, got {_value(err.instance)}"
     schema = _resolve(err.schema, root)
     if err.validator == "minProperties":

@@ -26,7 +26,7 @@ from generator.labels import class_table
 from generator.safeload import printable
 from generator.stats.chart import log_bar_chart
 from generator.stats.report import Figure, Section, Table
-from generator.weather import KINDS, TIMES
+from generator.weather import DEFAULT_TIMES, KINDS, TIMES
 from generator.progress import progress
 
 log = logging.getLogger(__name__)
@@ -34,7 +34,7 @@ log = logging.getLogger(__name__)
 #: Table II row names, in KINDS order (seed 003 wording).
 KIND_TITLES = {"clear": "Clear", "fog": "Fog", "rain": "Rain", "rain_fog": "Rain & fog", "wet": "Wet",
                "wet_fog": "Wet & fog"}
-TIME_TITLES = {"day": "Day", "night": "Night"}
+TIME_TITLES = {"day": "Day", "dusk": "Dusk", "night": "Night"}
 CHART = "pixels_per_class.png"
 #: Most pixels one class may claim in one image (a 65535 x 65535 image).
 MAX_PIXELS = 65535 * 65535
@@ -213,16 +213,21 @@ def table1(data: ImageData) -> Table:
 # -- Table II ------------------------------------------------------------------------------
 
 def table2(data: ImageData) -> Table:
-    """Seed 003 Table II: images per weather (rows, KINDS order) x time of day, with totals."""
-    counts = np.zeros((len(KINDS), len(TIMES)), np.int64)
+    """Seed 003 Table II: images per weather (rows, KINDS order) x time of day, with totals.
+
+    Columns: day and night (seed 003's), and dusk when the dataset has dusk images.
+    """
+    present = {r.time_of_day for r in data.records}
+    times = [t for t in TIMES if t in DEFAULT_TIMES or t in present]
+    counts = np.zeros((len(KINDS), len(times)), np.int64)
     for r in data.records:
-        counts[KINDS.index(r.weather), TIMES.index(r.time_of_day)] += 1
+        counts[KINDS.index(r.weather), times.index(r.time_of_day)] += 1
     rows = [[KIND_TITLES[k], *map(int, counts[i]), int(counts[i].sum())] for i, k in enumerate(KINDS)]
     rows.append(["Total", *map(int, counts.sum(0)), int(counts.sum())])
     ids = [*KINDS, "total"]
     return Table("table2_conditions", "Table II. Distribution of images with respect to lighting and weather conditions",
-                 ["Weather", *(TIME_TITLES[t] for t in TIMES), "Total"],
-                 ["weather", *TIMES, "total"], rows, csv_rows=[[k, *r[1:]] for k, r in zip(ids, rows)])
+                 ["Weather", *(TIME_TITLES[t] for t in times), "Total"],
+                 ["weather", *times, "total"], rows, csv_rows=[[k, *r[1:]] for k, r in zip(ids, rows)])
 
 
 def chart(t1: Table) -> Figure:
