@@ -269,9 +269,11 @@ def test_rendered_depth_equals_lidar_range_on_shared_rays(rendered_dataset):
         h, w = frame.depth.shape
         cls, _, dist = raycast_image(caster, scene, frame.T_world_camera, frame.K, w, h)
         shared = (cls == frame.class_id) & ~P.boundary_mask(frame.class_id) & np.isfinite(frame.depth)
-        # a ray through a gap of a porous (hull-labelled) crown or hedge: same class, another surface
-        shared &= ~(T.hull_classes[frame.class_id] & _depth_edges(frame.depth))
-        assert shared.sum() > 0.4 * h * w
+        # a ray through a gap of a porous (hull-labelled) crown or hedge, or past the edge of a building's
+        # thin part (balcony rail, awning) in front of its wall: same class, another surface a sub-pixel away
+        thin = T.hull_classes[frame.class_id] | (frame.class_id == T.id("building"))
+        shared &= ~(thin & _depth_edges(frame.depth))
+        assert shared.sum() > 0.3 * h * w  # (facades with balconies have many depth edges at 96 x 64)
         err = np.abs(dist[shared].astype(np.float64) - frame.depth[shared])
         assert np.percentile(err, 99) < 0.003, np.percentile(err, 99)
         # the few larger ones are grazing rays on the road far away (float32 ray directions)
