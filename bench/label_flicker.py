@@ -55,30 +55,37 @@ def _reference(r, marks) -> tuple[np.ndarray, np.ndarray]:
     return b.mean(-1), b[..., (REF * REF) // 2]
 
 
-def _crop_box(cov: np.ndarray) -> tuple[slice, slice]:
-    """A 48 x 96 window on the distant markings (the marked pixels highest in the image)."""
-    ys, xs = np.nonzero(cov > 0)
-    y0 = int(np.percentile(ys, 5))
-    x0 = int(np.median(xs[ys < y0 + 30]))
-    h, w = cov.shape
-    y0 = int(np.clip(y0 - 8, 0, h - 48))
-    x0 = int(np.clip(x0 - 48, 0, w - 96))
-    return slice(y0, y0 + 48), slice(x0, x0 + 96)
+def _crop_box(heat: np.ndarray, h: int = 40, w: int = 80) -> tuple[slice, slice]:
+    """The ``h`` x ``w`` window holding the most 1x spurious flips (summed over the frames)."""
+    c = np.cumsum(np.cumsum(np.pad(heat.astype(float), ((1, 0), (1, 0))), 0), 1)
+    win = c[h:, w:] - c[:-h, w:] - c[h:, :-w] + c[:-h, :-w]
+    y0, x0 = np.unravel_index(np.argmax(win), win.shape)
+    return slice(y0, y0 + h), slice(x0, x0 + w)
 
 
-def _strip(path: Path, labels: dict, cov: list, box, n: int) -> None:
+def _strip(path: Path, labels: dict, flips: dict, cov: list, box, n: int) -> None:
+    """Rows 1x, 3x (marking white, flips since the previous frame red), coverage; frames left to right."""
     from PIL import Image, ImageDraw
 
     rows = []
     for k in (1, 3):
-        rows.append([np.where(m[box], 255, 40).astype(np.uint8) for m in labels[k][:n]])
-    rows.append([(np.clip(c[box], 0, 1) * 255).astype(np.uint8) for c in cov[:n]])
-    tiles = [np.concatenate([np.pad(t, ((2, 2), (2, 2)), constant_values=128) for t in row], 1) for row in rows]
-    img = np.kron(np.concatenate(tiles, 0), np.ones((4, 4), np.uint8))
-    canvas = Image.fromarray(img).convert("RGB")
+        row = []
+        for t in range(n):
+            tile = np.where(labels[k][t][box], 235, 45).astype(np.uint8)[..., None].repeat(3, -1)
+            if t:
+                tile[flips[k][t - 1][box]] = (230, 30, 30)
+            row.append(tile)
+        rows.append(row)
+    rows.append([(np.clip(c[box], 0, 1) * 255).astype(np.uint8)[..., None].repeat(3, -1) for c in cov[:n]])
+    pad = ((2, 2), (2, 2), (0, 0))
+    tiles = [np.concatenate([np.pad(t, pad, constant_values=128) for t in row], 1) for row in rows]
+    img = np.kron(np.concatenate(tiles, 0), np.ones((5, 5, 1), np.uint8))
+    canvas = Image.fromarray(img)
     d = ImageDraw.Draw(canvas)
-    for i, name in enumerate(("1x (pixel centre)", "3x majority", "coverage (7x7)")):
-        d.text((6, 6 + i * 52 * 4), name, fill=(255, 60, 60))
+    th = (box[0].stop - box[0].start + 4) * 5
+    for i, name in enumerate(("1x (pixel centre); red: spurious flip", "3x majority; red: spurious flip",
+                              "marking coverage (7x7 reference)")):
+        d.text((8, 6 + i * th), name, fill=(60, 200, 255))
     path.parent.mkdir(parents=True, exist_ok=True)
     canvas.save(path)
 
@@ -128,13 +135,16 @@ def main() -> None:
           f"1x pass == centre samples of the 7x7 reference on {min(centre_ok):.4%} of pixels")
     print(f"{'factor':>7}{'spurious flips':>16}{'of pixels':>11}{'wrong vs cov':>14}{'area mean':>11}{'area spread':>13}"
           f"{'label pass s':>14}{'vs RGB':>9}")
+    flip_maps: dict = {}
     for k in FACTORS:
         flips = stable_n = wrong = near_n = 0
+        flip_maps[k] = []
         for t in range(a.frames - 1):
             c0, c1, m0, m1 = cov[t], cov[t + 1], labels[k][t], labels[k][t + 1]
             near = (c0 > 0) | (c1 > 0) | m0 | m1
             stable = near & (((c0 <= 0.3) & (c1 <= 0.3)) | ((c0 >= 0.7) & (c1 >= 0.7))) & (np.abs(c1 - c0) < 0.15)
-            flips += int((stable & (m0 != m1)).sum())
+            flip_maps[k].append(stable & (m0 != m1))
+            flips += int(flip_maps[k][-1].sum())
             stable_n += int(stable.sum())
         for t in range(a.frames):
             c, m = cov[t], labels[k][t]
@@ -146,7 +156,9 @@ def main() -> None:
               f"{area.std() / area.mean():>13.2%}{ls:>14.3f}{ls / rgb_s:>9.1%}")
     print(f"dry RGB pass of the first pose: {rgb_s:.2f} s; 'of pixels' = of pixels near markings whose coverage "
           f"stayed on one side of 1/2; 'wrong vs cov' = of pixels near markings, all frames")
-    _strip(Path(a.png), labels, cov, _crop_box(cov[0]), min(a.frames, 6))
+    box = _crop_box(np.sum(flip_maps[1], axis=0))
+    _strip(Path(a.png), labels, flip_maps, cov, box, min(a.frames, 6))
+    print(f"strip: rows {box[0].start}-{box[0].stop}, columns {box[1].start}-{box[1].stop}")
     print(f"wrote {a.png}")
 
 
