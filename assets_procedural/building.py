@@ -5,49 +5,30 @@ is used as given), the front (the door) on the edge(s) facing -y. Every face is 
 ``building``. Windows are holes in the wall with reveals, a frame ring and one separate
 glass quad per window (material ``window_glass``) 12-18 cm behind the wall plane, so no
 face is closer than 2 cm to a parallel face of another material.
+
+The window rhythm, shop fronts and balconies are drawn per building
+(:mod:`assets_procedural.facade_layout`); what stands proud of the wall (balconies, sign
+bands, awnings) is drawn by :mod:`assets_procedural.facade_details`.
 """
 
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
 
 import numpy as np
 
-from generator.geometry import Mesh, box, merge, quads
 from assets_procedural.building_roof import flat_roof, pitched_roof, rectangle_of
+from assets_procedural.facade_details import balcony, shop_front
+from assets_procedural.facade_layout import Hole, Style, draw_style, holes, wall_rects
+from generator.geometry import Mesh, box, merge, quads
 
 log = logging.getLogger(__name__)
 
 CLS = "building"
-FACADES = {"plaster": "facade_plaster", "brick": "facade_brick", "concrete": "facade_concrete"}
+FACADES = {"plaster": "facade_plaster", "brick": "facade_brick", "concrete": "facade_concrete", "glass": "facade_glass"}
 ROOFS = ("flat", "gable", "hip")
 FRAME_W = 0.06          # width of the frame ring, metres
 FRAME_FROM_GLASS = 0.03  # frame ring sits this far in front of the glass
-
-
-@dataclass(frozen=True)
-class Style:
-    """Per-building window rhythm drawn once from the rng (metres)."""
-
-    pitch: float        # distance between window columns
-    win_w: float
-    win_h: float
-    sill: float         # window bottom above the floor level
-    recess: float       # glass depth behind the wall plane
-    pattern: str        # "single" | "mullion" | "cross"
-    shop: bool          # ground floor of the front with shop windows
-
-
-@dataclass(frozen=True)
-class Hole:
-    """A rectangular opening in facade coordinates (u along the edge, v = z)."""
-
-    u0: float
-    u1: float
-    v0: float
-    v1: float
-    kind: str  # "window" | "shop" | "door"
 
 
 def _clean(footprint: np.ndarray) -> np.ndarray:
@@ -70,73 +51,6 @@ def _clean(footprint: np.ndarray) -> np.ndarray:
     return p
 
 
-def _style(rng: np.random.Generator, height: float) -> Style:
-    win_w = float(rng.uniform(0.9, 1.5))
-    return Style(
-        pitch=float(win_w + rng.uniform(1.0, 2.0)),
-        win_w=win_w,
-        win_h=float(rng.uniform(1.3, 1.7)),
-        sill=float(rng.uniform(0.8, 0.95)),
-        recess=float(rng.uniform(0.12, 0.18)),
-        pattern=str(rng.choice(["single", "mullion", "cross"])),
-        shop=bool(height >= 9.0 and rng.random() < 0.35),
-    )
-
-
-def _columns(length: float, st: Style) -> np.ndarray:
-    """(nc,) float: window column centres along an edge of ``length`` metres."""
-    usable = length - 1.2
-    if usable < st.win_w:
-        return np.zeros(0)
-    nc = int((usable - st.win_w) // st.pitch) + 1
-    return length / 2 + (np.arange(nc) - (nc - 1) / 2) * st.pitch
-
-
-def _holes(length: float, n_floors: float, fh: float, st: Style, door: dict | None) -> list[Hole]:
-    """Window, shop-window and door openings of one facade."""
-    cols = _columns(length, st)
-    win_h = min(st.win_h, fh - st.sill - 0.35)
-    holes: list[Hole] = []
-    door_col = None
-    if door is not None:
-        if len(cols):
-            door_col = int(np.argmin(np.abs(cols - length / 2)))
-            uc = float(cols[door_col])
-            room = 2 * st.pitch - st.win_w - 0.5 if len(cols) > 1 else length - 0.6
-        else:
-            uc, room = length / 2, length - 0.6
-        w = min(door["width"], room, length - 0.6)
-        holes.append(Hole(uc - w / 2, uc + w / 2, 0.0, min(door["height"], fh - 0.3), "door"))
-        door["u"] = uc
-    for f in range(n_floors):
-        for k, uc in enumerate(cols):
-            if f == 0 and k == door_col:
-                continue
-            if f == 0 and door is not None and st.shop:
-                half = (st.pitch - 0.6) / 2
-                holes.append(Hole(uc - half, uc + half, 0.45, min(fh - 0.35, 2.9), "shop"))
-                continue
-            v0 = f * fh + st.sill
-            holes.append(Hole(uc - st.win_w / 2, uc + st.win_w / 2, v0, v0 + win_h, "window"))
-    return [h for h in holes if h.u0 > 0.05 and h.u1 < length - 0.05]
-
-
-def _wall_rects(length: float, height: float, holes: list[Hole]) -> list[tuple[float, float, float, float]]:
-    """Rectangles (u0, u1, v0, v1) covering [0, length] x [0, height] minus the holes."""
-    vs = sorted({0.0, height, *[h.v0 for h in holes], *[h.v1 for h in holes]})
-    rects = []
-    for va, vb in zip(vs[:-1], vs[1:]):
-        if vb - va < 1e-6:
-            continue
-        cuts = sorted((h.u0, h.u1) for h in holes if h.v0 <= va + 1e-9 and h.v1 >= vb - 1e-9)
-        u = 0.0
-        for u0, u1 in cuts + [(length, length)]:
-            if u0 - u > 1e-6:
-                rects.append((u, u0, va, vb))
-            u = max(u, u1)
-    return rects
-
-
 class _Facade:
     """Maps facade coordinates (u along the edge, v up, w outward) to the local frame.
 
@@ -150,17 +64,23 @@ class _Facade:
         self.d = np.array([d[0], d[1], 0.0]) / self.length
         self.n = np.array([self.d[1], -self.d[0], 0.0])  # outward for a CCW footprint
         self.o = np.array([p0[0], p0[1], 0.0])
-        self.corners: list[np.ndarray] = []
+        self._axes = [tuple(float(x) for x in c) for c in zip(self.o, self.d, (0.0, 0.0, 1.0), self.n)]
+        self._up, self._down, self._back = np.array([0, 0, 1.0]), -np.array([0, 0, 1.0]), -self.d
+        self.uvw: list[list[tuple[float, float, float]]] = []  # 4 corners per quad, mapped in mesh()
         self.materials: list[str] = []
         self.facing: list[np.ndarray] = []
-        self.extra: list[Mesh] = []
+        self.sills: list[tuple[Hole, str]] = []
+        self.extra: list[Mesh] = []  # boxes proud of the wall (balconies, sign bands, awnings)
 
     def pts(self, uvw: list[tuple[float, float, float]]) -> np.ndarray:
+        if len(uvw) == 1:  # one point (a pane centre, the door): the same float operations, without arrays
+            u, v, w = (float(x) for x in uvw[0])
+            return np.array([[o + u * d + v * z + w * n for o, d, z, n in self._axes]])
         a = np.asarray(uvw, float)
         return self.o + a[:, :1] * self.d + a[:, 1:2] * np.array([0, 0, 1.0]) + a[:, 2:3] * self.n
 
     def add(self, uvw: list[tuple[float, float, float]], material: str, facing: np.ndarray) -> None:
-        self.corners.append(self.pts(uvw))
+        self.uvw.append(uvw)
         self.materials.append(material)
         self.facing.append(facing)
 
@@ -177,27 +97,55 @@ class _Facade:
 
     def reveals(self, h: Hole, depth: float, material: str) -> None:
         """The four (three for a door) inner faces of the opening, facing into it."""
-        up = np.array([0, 0, 1.0])
-        self.add([(h.u0, h.v1, 0), (h.u1, h.v1, 0), (h.u1, h.v1, -depth), (h.u0, h.v1, -depth)], material, -up)
+        self.add([(h.u0, h.v1, 0), (h.u1, h.v1, 0), (h.u1, h.v1, -depth), (h.u0, h.v1, -depth)], material, self._down)
         self.add([(h.u0, h.v0, 0), (h.u0, h.v1, 0), (h.u0, h.v1, -depth), (h.u0, h.v0, -depth)], material, self.d)
-        self.add([(h.u1, h.v0, 0), (h.u1, h.v1, 0), (h.u1, h.v1, -depth), (h.u1, h.v0, -depth)], material, -self.d)
+        self.add([(h.u1, h.v0, 0), (h.u1, h.v1, 0), (h.u1, h.v1, -depth), (h.u1, h.v0, -depth)], material, self._back)
         if h.v0 > 0:
-            self.add([(h.u0, h.v0, 0), (h.u1, h.v0, 0), (h.u1, h.v0, -depth), (h.u0, h.v0, -depth)], material, up)
+            self.add([(h.u0, h.v0, 0), (h.u1, h.v0, 0), (h.u1, h.v0, -depth), (h.u0, h.v0, -depth)], material, self._up)
 
     def sill(self, h: Hole, material: str) -> None:
-        """A stone sill under a window, proud of the wall (top, front, bottom, ends)."""
-        s = box((h.u1 - h.u0 + 0.1, 0.07, 0.06), CLS, material, center=(0, 0, 0))
-        keep = s.vertices[s.faces].mean(1)[:, 1] < 0.035 - 1e-9  # drop the face against the wall
-        s = Mesh(s.vertices, s.faces[keep], s.face_class[keep], s.face_material[keep])
+        """A stone sill under a window, proud of the wall (top, front, bottom, ends); built in :meth:`mesh`."""
+        self.sills.append((h, material))
+
+    def _sill_mesh(self) -> list[Mesh]:
+        """Every sill at once: one box per distinct width (the face against the wall dropped), moved
+        to each window -- the same arithmetic per sill as building each box on its own."""
+        if not self.sills:
+            return []
         # box frame (x along u, -y outward, z up) -> local frame (right-handed: d x -n = z)
-        uc = (h.u0 + h.u1) / 2
         m = np.eye(4)
         m[:3, 0], m[:3, 1], m[:3, 2] = self.d, -self.n, (0, 0, 1.0)
-        m[:3, 3] = self.o + uc * self.d + 0.035 * self.n + (h.v0 - 0.03) * np.array([0, 0, 1.0])
-        self.extra.append(s.transformed(m))
+        shapes: dict[tuple[float, str], tuple] = {}
+        verts, faces, fcls, fmat = [], [], [], []
+        for i, (h, material) in enumerate(self.sills):
+            w = h.u1 - h.u0 + 0.1
+            if (w, material) not in shapes:
+                s = box((w, 0.07, 0.06), CLS, material, center=(0, 0, 0))
+                keep = s.vertices[s.faces].mean(1)[:, 1] < 0.035 - 1e-9  # drop the face against the wall
+                shapes[(w, material)] = (s.vertices @ m[:3, :3].T, s.faces[keep], s.face_class[keep],
+                                         s.face_material[keep])
+            rotated, f, c, mat = shapes[(w, material)]
+            uc = (h.u0 + h.u1) / 2
+            verts.append(rotated + (self.o + uc * self.d + 0.035 * self.n + (h.v0 - 0.03) * np.array([0, 0, 1.0])))
+            faces.append(f + 8 * i)
+            fcls.append(c)
+            fmat.append(mat)
+        return [Mesh(np.concatenate(verts), np.concatenate(faces), np.concatenate(fcls), np.concatenate(fmat))]
+
+    def box(self, u0, u1, v0, v1, w0, w1, material) -> None:
+        """A box spanning [u0, u1] x [v0, v1] x [w0, w1] in facade coordinates (no face against the wall)."""
+        b = box((u1 - u0, w1 - w0, v1 - v0), CLS, material, center=(0, 0, 0))
+        if w0 <= 1e-9:
+            keep = b.vertices[b.faces].mean(1)[:, 1] < (w1 - w0) / 2 - 1e-9
+            b = Mesh(b.vertices, b.faces[keep], b.face_class[keep], b.face_material[keep])
+        m = np.eye(4)
+        m[:3, 0], m[:3, 1], m[:3, 2] = self.d, -self.n, (0, 0, 1.0)
+        m[:3, 3] = self.o + (u0 + u1) / 2 * self.d + (w0 + w1) / 2 * self.n + (v0 + v1) / 2 * np.array([0, 0, 1.0])
+        self.extra.append(b.transformed(m))
 
     def mesh(self) -> Mesh:
-        return merge([quads(np.array(self.corners), CLS, self.materials, np.array(self.facing))] + self.extra)
+        corners = self.pts([p for q in self.uvw for p in q]).reshape(-1, 4, 3) if self.uvw else np.zeros((0, 4, 3))
+        return merge([quads(corners, CLS, self.materials, np.array(self.facing))] + self._sill_mesh() + self.extra)
 
 
 def _opening(fc: _Facade, h: Hole, st: Style, facade_mat: str) -> np.ndarray:
@@ -212,17 +160,17 @@ def _opening(fc: _Facade, h: Hole, st: Style, facade_mat: str) -> np.ndarray:
         fc.rect(h.u0, h.u0 + FRAME_W, h.v0, h.v1 - FRAME_W, wf, "window_frame")
         fc.rect(h.u1 - FRAME_W, h.u1, h.v0, h.v1 - FRAME_W, wf, "window_frame")
         return centre
-    fc.rect(h.u0, h.u1, h.v0, h.v1, -depth, "window_glass")
+    fc.rect(h.u0, h.u1, h.v0, h.v1, -depth, "shop_glass" if h.kind == "shop" else "window_glass")
     fc.ring(h.u0, h.u1, h.v0, h.v1, wf, FRAME_W, "window_frame")
     a, b, c, e = h.u0 + FRAME_W, h.u1 - FRAME_W, h.v0 + FRAME_W, h.v1 - FRAME_W
     um = (h.u0 + h.u1) / 2
-    if st.pattern in ("mullion", "cross") or h.kind == "shop":
+    if st.pattern in ("mullion", "cross") or h.kind in ("shop", "balcony"):
         fc.rect(um - 0.03, um + 0.03, c, e, wf, "window_frame")
     if st.pattern == "cross" and h.kind == "window":
         vt = h.v0 + 0.68 * (h.v1 - h.v0)
         fc.rect(a, um - 0.03, vt - 0.03, vt + 0.03, wf, "window_frame")
         fc.rect(um + 0.03, b, vt - 0.03, vt + 0.03, wf, "window_frame")
-    if h.kind == "window":
+    if h.kind == "window" and st.pattern != "ribbon":
         fc.sill(h, "facade_concrete")
     return centre
 
@@ -242,8 +190,8 @@ def building(rng: np.random.Generator, footprint: np.ndarray, height: float, flo
         hip roofs, whose ridge rises above it).
     floor_height : float
         Storey height in metres; one row of windows per storey.
-    facade : {"plaster", "brick", "concrete"}
-        Wall material.
+    facade : {"plaster", "brick", "concrete", "glass"}
+        Wall material ("glass": a curtain wall of ribbon windows and glass spandrels).
     roof : {"flat", "gable", "hip"}
         Pitched roofs need a rectangular footprint; other footprints get a flat roof.
 
@@ -251,7 +199,10 @@ def building(rng: np.random.Generator, footprint: np.ndarray, height: float, flo
     -------
     Mesh
         Class ``building``; anchors ``"door"`` (1, 3): bottom centre of the door in the wall
-        plane, and ``"windows"`` (n, 3): centres of the glass panes.
+        plane, and ``"windows"`` (n, 3): centres of the glass panes (windows, balcony doors,
+        shop windows). Shop windows (material ``shop_glass``) with a sign band and, for some
+        buildings, awnings on the front's ground floor; balconies (slab and railing) on the
+        upper floors of the front and back for some buildings.
     """
     if facade not in FACADES:
         raise ValueError(f"facade must be one of {sorted(FACADES)}, got {facade!r}")
@@ -261,21 +212,25 @@ def building(rng: np.random.Generator, footprint: np.ndarray, height: float, flo
         raise ValueError(f"height {height} m / floor_height {floor_height} m too small")
     poly = _clean(footprint)
     facade_mat = FACADES[facade]
-    st = _style(rng, height)
+    st = draw_style(rng, height, floor_height, facade)
     rect = rectangle_of(poly)
     if roof != "flat" and rect is None:
         log.debug("roof %r needs a rectangular footprint; using a flat roof", roof)
         roof = "flat"
     parapet = float(rng.uniform(0.6, 1.1)) if roof == "flat" else 0.0
-    # a storey gets windows when its window top stays 0.25 m under the roof line
+    # a storey gets windows when its window top stays 0.55 m under the wall top; the parapet
+    # is lowered to fit over the top row (rather than leaving the top storey blind)
     win_top = st.sill + min(st.win_h, floor_height - st.sill - 0.35)
-    n_floors = max(1, int((height - parapet - 0.25 - win_top) // floor_height) + 1)
+    n_floors = max(1, int((height - 0.55 - win_top) // floor_height) + 1)
+    if roof == "flat":
+        parapet = min(parapet, height - (n_floors - 1) * floor_height - win_top - 0.15)
 
     k = len(poly)
     lengths = [float(np.linalg.norm(poly[(i + 1) % k] - poly[i])) for i in range(k)]
     # outward normal of edge i is (d_y, -d_x): the front edge has the most negative n_y = -d_x
     n_y = [round(-(poly[(i + 1) % k][0] - poly[i][0]) / lengths[i], 6) for i in range(k)]
     front = min(range(k), key=lambda i: (n_y[i], -lengths[i]))
+    roles = ["front" if i == front else ("back" if n_y[i] > 0.99 else "side") for i in range(k)]
     door = {"width": float(rng.choice([1.1, 1.2, 1.8])), "height": float(rng.uniform(2.1, 2.4))}
 
     parts: list[Mesh] = []
@@ -284,15 +239,18 @@ def building(rng: np.random.Generator, footprint: np.ndarray, height: float, flo
     for i in range(k):
         fc = _Facade(poly[i], poly[(i + 1) % k])
         d = dict(door) if i == front and fc.length >= 1.4 else None
-        holes = _holes(fc.length, n_floors, floor_height, st, d)
-        for u0, u1, v0, v1 in _wall_rects(fc.length, height, holes):
+        openings = holes(rng, fc.length, n_floors, floor_height, st, d, roles[i])
+        for u0, u1, v0, v1 in wall_rects(fc.length, height, openings):
             fc.rect(u0, u1, v0, v1, 0.0, facade_mat)
-        for h in holes:
+        for h in openings:
             centre = _opening(fc, h, st, facade_mat)
             if h.kind == "door":
                 door_point = fc.pts([((h.u0 + h.u1) / 2, 0.0, 0.0)])
             else:
                 panes.append(centre)
+            if h.kind == "balcony":
+                balcony(fc, h, st, facade_mat)
+        shop_front(fc, [h for h in openings if h.kind == "shop"], st, fc.length, rng)
         parts.append(fc.mesh())
     if roof == "flat":
         parts.append(flat_roof(rng, poly, height, parapet, facade_mat))

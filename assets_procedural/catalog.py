@@ -11,6 +11,7 @@ from typing import Callable
 import numpy as np
 
 from assets_procedural.building import building
+from assets_procedural.proto_cache import CACHE
 from assets_procedural.fence import fence
 from generator.geometry import Mesh
 from generator.labels import class_table
@@ -139,6 +140,12 @@ def build(kind: str, rng: np.random.Generator, **params) -> Mesh:
         Forwarded to the family builder (e.g. ``height`` for trees, ``footprint`` for
         buildings); see each builder's docstring.
 
+    Returns
+    -------
+    Mesh
+        Built once per (kind, generator state, parameters) in a process and then shared
+        (:mod:`assets_procedural.proto_cache`): its arrays are read-only.
+
     Raises
     ------
     KeyError
@@ -148,4 +155,4 @@ def build(kind: str, rng: np.random.Generator, **params) -> Mesh:
         builder = BUILDERS[kind]
     except KeyError:
         raise KeyError(f"unknown asset kind {kind!r}; known: {', '.join(KINDS)}") from None
-    return builder(rng, **params)
+    return CACHE.build(kind, rng, params, builder)

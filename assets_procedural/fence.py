@@ -9,26 +9,69 @@ from __future__ import annotations
 
 import numpy as np
 
-from generator.geometry import Mesh, box, merge, prism, pose
+from generator.geometry import Mesh, merge, prism, pose
+from generator.geometry.primitives import _UNIT_BOX_FACES as _BOX_FACES, resolve_ids
 
 CLS = "fence"
 
 
-def _bar(x0: float, x1: float, y0: float, y1: float, z0: float, z1: float, material: str,
-         ends: bool = True) -> Mesh:
-    """An axis-aligned box spanning the given ranges.
+_UNIT = np.array([[0, 0, 0], [0, 0, 1], [0, 1, 0], [0, 1, 1], [1, 0, 0], [1, 0, 1], [1, 1, 0], [1, 1, 1]], float) - 0.5
 
-    No bottom face when it stands on the ground; ``ends=False`` also drops the two faces
-    across its longest axis (hidden ends of thin wires and of rails buried in posts).
-    """
-    size = np.array([x1 - x0, y1 - y0, z1 - z0])
-    b = box(tuple(size), CLS, material, ((x0 + x1) / 2, (y0 + y1) / 2, (z0 + z1) / 2), bottom=z0 > 0)
-    if ends:
-        return b
-    axis = int(np.argmax(size))
-    rel = b.vertices[b.faces].mean(1)[:, axis] - (x0 + x1, y0 + y1, z0 + z1)[axis] / 2
-    keep = np.abs(rel) < size[axis] / 2 - 1e-9
-    return Mesh(b.vertices, b.faces[keep], b.face_class[keep], b.face_material[keep])
+
+class _Parts:
+    """A fence's parts in order. Runs of bars (and of identical pickets) are built in one batch with
+    the same arithmetic per piece as :func:`_bar` / :meth:`Mesh.transformed` one at a time, so the
+    merged mesh has the same bytes; a fence has hundreds of bars."""
+
+    def __init__(self, material: str):
+        self.material = material
+        self.rows: list[tuple[float, ...]] = []
+        self.pieces: list[Mesh] = []
+
+    def bar(self, x0: float, x1: float, y0: float, y1: float, z0: float, z1: float, ends: bool = True) -> None:
+        self.rows.append((x0, x1, y0, y1, z0, z1, ends))
+
+    def moved(self, mesh: Mesh, transforms: list[np.ndarray]) -> None:
+        """``mesh`` under each rigid transform (all with the same rotation), in order."""
+        self._flush()
+        if not transforms:
+            return
+        rotated = mesh.vertices @ transforms[0][:3, :3].T
+        n = len(mesh.vertices)
+        self.pieces.append(Mesh(np.concatenate([rotated + T[:3, 3] for T in transforms]),
+                                np.concatenate([mesh.faces + n * i for i in range(len(transforms))]),
+                                np.tile(mesh.face_class, len(transforms)),
+                                np.tile(mesh.face_material, len(transforms))))
+
+    def _flush(self) -> None:
+        if not self.rows:
+            return
+        r = np.array(self.rows, float)
+        self.rows = []
+        size = np.stack([r[:, 1] - r[:, 0], r[:, 3] - r[:, 2], r[:, 5] - r[:, 4]], 1)
+        center = np.stack([(r[:, 0] + r[:, 1]) / 2, (r[:, 2] + r[:, 3]) / 2, (r[:, 4] + r[:, 5]) / 2], 1)
+        local = _UNIT[None] * size[:, None, :]
+        verts = local + center[:, None, :]
+        faces = _BOX_FACES
+        keep = np.ones((len(r), len(faces)), bool)
+        bottom = r[:, 4] > 0  # no bottom face on the ground (as box(bottom=z0 > 0))
+        cz = local[:, faces].mean(2)[..., 2]
+        keep &= bottom[:, None] | (cz > -size[:, 2:3] / 2 + 1e-9)
+        cut = r[:, 6] == 0  # ends=False: drop the faces across the longest axis
+        if cut.any():
+            axis = np.argmax(size, 1)
+            c = verts[:, faces].mean(2)
+            rel = np.take_along_axis(c, axis[:, None, None].repeat(len(faces), 1), 2)[..., 0] \
+                - np.take_along_axis(center * 2, axis[:, None], 1) / 2
+            half = np.take_along_axis(size, axis[:, None], 1) / 2
+            keep &= ~cut[:, None] | (np.abs(rel) < half - 1e-9)
+        idx = np.nonzero(keep)
+        cls, mat = resolve_ids(CLS, self.material)
+        self.pieces.append(Mesh(verts.reshape(-1, 3), faces[idx[1]] + 8 * idx[0][:, None], cls, mat))
+
+    def mesh(self) -> Mesh:
+        self._flush()
+        return merge(self.pieces)
 
 
 def _bars_between(xa: float, xb: float, pitch: float, width: float) -> np.ndarray:
@@ -50,13 +93,15 @@ def _bars(rng: np.random.Generator, length: float, height: float) -> Mesh:
     mat, pw, bw = "fence_metal", float(rng.uniform(0.05, 0.08)), float(rng.uniform(0.016, 0.025))
     pitch = float(rng.uniform(0.12, 0.15))
     posts = _posts(rng, length, (2.0, 2.6), pw)
-    parts = [_bar(x - pw / 2, x + pw / 2, -pw / 2, pw / 2, 0.0, height, mat) for x in posts]
+    parts = _Parts(mat)
+    for x in posts:
+        parts.bar(x - pw / 2, x + pw / 2, -pw / 2, pw / 2, 0.0, height)
     for xa, xb in zip(posts[:-1], posts[1:]):
         for z in (0.12, height - 0.12):
-            parts.append(_bar(xa, xb, -0.02, 0.02, z - 0.02, z + 0.02, mat, ends=False))
+            parts.bar(xa, xb, -0.02, 0.02, z - 0.02, z + 0.02, ends=False)
         for x in _bars_between(xa + pw / 2, xb - pw / 2, pitch, bw):
-            parts.append(_bar(x - bw / 2, x + bw / 2, -bw / 2, bw / 2, 0.05, height - 0.03, mat))
-    return merge(parts)
+            parts.bar(x - bw / 2, x + bw / 2, -bw / 2, bw / 2, 0.05, height - 0.03)
+    return parts.mesh()
 
 
 def _pickets(rng: np.random.Generator, length: float, height: float) -> Mesh:
@@ -64,18 +109,20 @@ def _pickets(rng: np.random.Generator, length: float, height: float) -> Mesh:
     mat, pw, kw, kt = "fence_wood", 0.09, float(rng.uniform(0.07, 0.1)), 0.02
     gap = float(rng.uniform(0.05, 0.08))
     posts = _posts(rng, length, (1.8, 2.4), pw)
-    parts = [_bar(x - pw / 2, x + pw / 2, -pw / 2, pw / 2, 0.0, height - 0.05, mat) for x in posts]
+    parts = _Parts(mat)
+    for x in posts:
+        parts.bar(x - pw / 2, x + pw / 2, -pw / 2, pw / 2, 0.0, height - 0.05)
     tip = min(0.08, kw * 0.8)
     outline = np.array([[-kw / 2, 0.0], [kw / 2, 0.0], [kw / 2, height - 0.05 - tip], [0.0, height - 0.05],
                         [-kw / 2, height - 0.05 - tip]])
+    # picket outline in the x-z plane, extruded along y (roll +90 deg: prism z -> -y)
+    picket = prism(outline, -pw / 2 - 0.007 - kt, -pw / 2 - 0.007, CLS, mat, bottom=True)
     for xa, xb in zip(posts[:-1], posts[1:]):
         for z in (0.3, height - 0.35):
-            parts.append(_bar(xa, xb, pw / 2 - 0.035, pw / 2 + 0.005, z - 0.04, z + 0.04, mat, ends=False))
-        for x in _bars_between(xa + pw / 2, xb - pw / 2, kw + gap, kw):
-            # picket outline in the x-z plane, extruded along y (roll +90 deg: prism z -> -y)
-            p = prism(outline, -pw / 2 - 0.007 - kt, -pw / 2 - 0.007, CLS, mat, bottom=True)
-            parts.append(p.transformed(pose(x, 0.0, 0.05, roll=np.pi / 2)))
-    return merge(parts)
+            parts.bar(xa, xb, pw / 2 - 0.035, pw / 2 + 0.005, z - 0.04, z + 0.04, ends=False)
+        parts.moved(picket, [pose(x, 0.0, 0.05, roll=np.pi / 2) for x in _bars_between(xa + pw / 2, xb - pw / 2,
+                                                                                        kw + gap, kw)])
+    return parts.mesh()
 
 
 def _panels(rng: np.random.Generator, length: float, height: float) -> Mesh:
@@ -84,17 +131,19 @@ def _panels(rng: np.random.Generator, length: float, height: float) -> Mesh:
     cell_x = float(rng.choice([0.1, 0.2]))
     cell_z = 0.2 if cell_x == 0.1 else 0.05 * 4
     posts = _posts(rng, length, (2.4, 2.6), pw)
-    parts = [_bar(x - pw / 2, x + pw / 2, -pw / 2, pw / 2, 0.0, height + 0.05, mat) for x in posts]
+    parts = _Parts(mat)
+    for x in posts:
+        parts.bar(x - pw / 2, x + pw / 2, -pw / 2, pw / 2, 0.0, height + 0.05)
     z0, z1 = 0.06, height
     for xa, xb in zip(posts[:-1], posts[1:]):
         xa, xb = xa + pw / 2, xb - pw / 2
         for x in _bars_between(xa, xb, cell_x, wire):
-            parts.append(_bar(x - wire / 2, x + wire / 2, -wire / 2, wire / 2, z0, z1, mat, ends=False))
+            parts.bar(x - wire / 2, x + wire / 2, -wire / 2, wire / 2, z0, z1, ends=False)
         nz = max(2, int(round((z1 - z0) / cell_z)) + 1)
         for z in np.linspace(z0 + wire, z1 - wire, nz):
-            parts.append(_bar(xa - 0.02, xb + 0.02, wire / 2 + 0.001, 1.5 * wire + 0.001, z - wire / 2, z + wire / 2,
-                              mat, ends=False))
-    return merge(parts)
+            parts.bar(xa - 0.02, xb + 0.02, wire / 2 + 0.001, 1.5 * wire + 0.001, z - wire / 2, z + wire / 2,
+                      ends=False)
+    return parts.mesh()
 
 
 STYLES = {"bars": _bars, "pickets": _pickets, "panels": _panels}

@@ -121,9 +121,9 @@ def _figure(rng: np.random.Generator, height: float, seat: np.ndarray, hip_dx: f
         shoe_c = feet[k] + 0.02 * h * fdir + 0.025 * h * up + np.array([0.0, 0.0, 0.01])
         ankle = shoe_c - 0.05 * h * fdir + 0.03 * h * up
         knee, ankle = two_link(hip_s, ankle, 0.245 * h, 0.25 * h, np.array([1.0, s * 0.25, 0.6]))
-        parts.append(tube(hip_s, knee, 0.045 * h * g, cls, "clothing", 0.036 * h, sections=6))
-        parts.append(tube(knee, ankle, 0.034 * h, cls, "clothing", 0.024 * h, sections=6))
-        shoe = box((0.15 * h, 0.055 * h, 0.045 * h), cls, "rubber")
+        parts.append(tube(hip_s, knee, 0.045 * h * g, cls, "clothing_bottom", 0.036 * h, sections=6))
+        parts.append(tube(knee, ankle, 0.034 * h, cls, "clothing_bottom", 0.024 * h, sections=6))
+        shoe = box((0.15 * h, 0.055 * h, 0.045 * h), cls, "shoes")
         parts.append(shoe.transformed(pose(*shoe_c, pitch=foot_pitch)))
         shoulder = hip + R @ sh_local[k]
         grip = grips[k]

@@ -1,4 +1,4 @@
-"""Vegetation: street trees, bushes and hedges made of separate leaf clusters.
+"""Vegetation: trees of several species, bushes and hedges made of separate leaf clusters.
 
 Foliage is a set of small low-poly blobs (jittered icospheres) with real gaps between them,
 so LiDAR beams and camera rays pass through a crown as they do through a real one; the
@@ -9,17 +9,21 @@ from __future__ import annotations
 
 import numpy as np
 
+from assets_procedural.tree_species import SPECIES, Skeleton, Species, conifer_skeleton, skeleton
 from generator.geometry import Mesh, icosphere, merge, on_ground, tube
 
 CROWN_BASE_MIN = 2.4  # metres: pedestrians and cars fit under a street tree
 
 
 def _blob(rng: np.random.Generator, center: np.ndarray, radii: np.ndarray, cls: str, material: str,
-          jitter: float = 0.18) -> Mesh:
-    """A leaf cluster: an ellipsoid icosphere (80 triangles) with radial noise."""
-    m = icosphere(1.0, cls, material, 1)
+          jitter: float = 0.18, detail: int = 1, yaw: float = 0.0) -> Mesh:
+    """A leaf cluster: an ellipsoid icosphere (80 triangles, 20 at ``detail`` 0) with radial noise,
+    its x half-axis turned to ``yaw`` radians."""
+    m = icosphere(1.0, cls, material, detail)
     r = 1.0 + rng.uniform(-jitter, jitter, len(m.vertices))
-    m.vertices = m.vertices * r[:, None] * radii + center
+    v = m.vertices * r[:, None] * radii
+    c, s = np.cos(yaw), np.sin(yaw)
+    m.vertices = np.c_[c * v[:, 0] - s * v[:, 1], s * v[:, 0] + c * v[:, 1], v[:, 2]] + center
     return m
 
 
@@ -42,62 +46,104 @@ def _scatter(rng: np.random.Generator, n: int, radii: np.ndarray, min_gap: float
     return np.array(pts).reshape(-1, 3)
 
 
-CROWN_SHAPES = {
-    # name: (crown width / height ratio range, crown base as a fraction of the tree height)
-    "round": ((0.85, 1.15), 0.30),
-    "oval": ((0.55, 0.75), 0.28),
-    "broad": ((1.2, 1.45), 0.35),
-}
+TRI_BUDGET = 2000   #: most triangles one tree may have (branches first, then as many clumps as fit)
+CLUMP_GAP = 1.75    #: leaf clump centres stay this many clump radii apart: the gaps rays pass through
 
 
-def tree(rng: np.random.Generator, height: float, shape: str | None = None) -> Mesh:
-    """A deciduous street tree ``height`` metres tall.
+def pick_species(rng: np.random.Generator, height: float) -> str:
+    """A species for a park or yard tree ``height`` metres tall (saplings only below 7.5 m)."""
+    names = [n for n in sorted(SPECIES) if n != "young" or height < 7.5]
+    return str(names[int(rng.integers(len(names)))])
+
+
+def _branches(sk: Skeleton, cls: str, material: str) -> list[Mesh]:
+    """Capped tubes for the skeleton: the trunk with 8 sides, thinner limbs with 6 or 4."""
+    out = []
+    for k, (p0, p1, r0, r1) in enumerate(sk.segments):
+        sides = 8 if k == 0 else (6 if r0 > 0.06 else 4)
+        out.append(tube(p0, p1, max(r0, 0.012), cls, material, radius1=max(r1, 0.008), sections=sides))
+    return out
+
+
+def _clumps(rng: np.random.Generator, sp: Species, tips: list, r: float, floor: float, budget: int,
+            gap: float, spreads=(0.5, 0.9), taken: np.ndarray | None = None, keep_off: float = 0.0) -> np.ndarray:
+    """(n <= budget, 3) float: clump centres around the branch tips, ``gap`` metres apart and
+    ``keep_off`` metres from the centres ``taken`` (k, 3), none lower than ``floor`` allows."""
+    pts: list[np.ndarray] = []
+    taken = np.zeros((0, 3)) if taken is None else taken
+    for spread in spreads:      # later, looser rounds fill the crown up to the budget
+        for tip in tips:
+            for _ in range(int(rng.integers(*sp.per_tip))):
+                if len(pts) >= budget:
+                    return np.array(pts)
+                p = np.asarray(tip, float) + rng.normal(0.0, spread * r, 3) * [1.0, 1.0, sp.clump_flat]
+                p[2] = max(p[2], floor + r * sp.clump_flat * 1.4)   # jittered blob bottom stays above floor
+                if all(np.linalg.norm(p - q) >= gap for q in pts) and \
+                        (not len(taken) or np.linalg.norm(taken - p, axis=1).min() >= keep_off):
+                    pts.append(p)
+    return np.array(pts).reshape(-1, 3)
+
+
+def tree(rng: np.random.Generator, height: float, species: str | None = None) -> Mesh:
+    """A street or park tree ``height`` metres tall: trunk, recursive branches, leaf clumps.
 
     Parameters
     ----------
     rng : numpy.random.Generator
     height : float
         Top of the crown above the ground, metres (3-30).
-    shape : {"round", "oval", "broad"}, optional
-        Crown silhouette; drawn from the rng when omitted.
+    species : {"plane", "linden", "birch", "young", "conifer"}, optional
+        Growth habit (:data:`assets_procedural.tree_species.SPECIES`): broad round, upright
+        oval, narrow white-barked, sapling, conical. Drawn with :func:`pick_species` when omitted.
 
     Returns
     -------
     Mesh
-        Trunk and 3-5 branches (class ``tree_trunk``, material ``bark``) and 16-28 leaf
-        clusters (class ``tree_crown``, ``leaves``) with open gaps between them. The crown
-        base is at least 2.4 m above the ground.
+        Trunk and branches (class ``tree_trunk``, the species' bark material) and separate
+        leaf clumps (class ``tree_crown``, the species' leaf material; big 80-triangle clumps
+        and, for broad-leaved species, small 20-triangle tufts) with open gaps between them, at most :data:`TRI_BUDGET` triangles. The crown base is at least 2.4 m above
+        the ground; the top is exactly ``height``.
     """
     if not 3.0 <= height <= 30.0:
         raise ValueError(f"tree height must be in [3, 30] m, got {height}")
-    if shape is None:
-        shape = str(rng.choice(sorted(CROWN_SHAPES)))
-    ratio, base_frac = CROWN_SHAPES[shape]
-    base = max(CROWN_BASE_MIN, base_frac * height * rng.uniform(0.9, 1.1))
-    crown_h = height - base
-    rz = crown_h / 2
-    rxy = min(rz * rng.uniform(*ratio), 0.45 * height)
-    centre = np.array([0.0, 0.0, base + rz])
-    cluster_r = np.clip(0.13 * (rxy + rz), 0.3, 1.1)
-    n = int(rng.integers(18, 27))
-    # clusters are ellipsoids of radius ~cluster_r; keep centres well apart for gaps
-    inner = np.array([rxy, rxy, rz]) - cluster_r * np.array([1.0, 1.0, 1.0])
-    inner = np.maximum(inner, 0.3)
-    pts = _scatter(rng, n - 1, inner, 1.8 * cluster_r)
-    pts = np.concatenate([pts, [[0.0, 0.0, inner[2]]]]) + centre   # one cluster crowns the top
-    trunk_r = float(np.clip(0.022 * height, 0.1, 0.4) * rng.uniform(0.85, 1.15))
-    top = centre[2] + 0.2 * rz
-    parts = [tube((0, 0, 0), (rng.normal(0, 0.05), rng.normal(0, 0.05), top), trunk_r * 1.25, "tree_trunk",
-                  "bark", radius1=trunk_r * 0.45, sections=8)]
-    # main branches from the crown base toward the upper clusters
-    n_br = int(rng.integers(3, 6))
-    for i in rng.permutation(len(pts))[:n_br]:
-        tip = pts[i] * np.array([0.8, 0.8, 1.0])
-        start = np.array([0.0, 0.0, base + rng.uniform(0.0, 0.35) * rz])
-        parts.append(tube(start, tip, trunk_r * 0.45, "tree_trunk", "bark", radius1=trunk_r * 0.15, sections=5))
-    for p in pts:
-        radii = cluster_r * rng.uniform(0.8, 1.15, 3) * np.array([1.0, 1.0, 0.65])
-        parts.append(_blob(rng, p, radii, "tree_crown", "leaves"))
+    if species is None:
+        species = pick_species(rng, height)
+    if species not in SPECIES:
+        raise ValueError(f"tree species must be one of {sorted(SPECIES)}, got {species!r}")
+    sp = SPECIES[species]
+    base = max(CROWN_BASE_MIN, sp.base_frac * height * rng.uniform(0.9, 1.1))
+    trunk_r = float(np.clip(sp.trunk * height * rng.uniform(0.85, 1.15), 0.05, 0.45))
+    if species == "conifer":
+        sk = conifer_skeleton(rng, sp, height, base, trunk_r)
+        r = float(np.clip(sp.clump * 0.5 * (height - base) * np.mean(sp.ratio), 0.3, 1.0))
+    else:
+        rz = (height - base) / 2
+        rxy = min(rz * rng.uniform(*sp.ratio), 0.45 * height)
+        centre = np.array([0.0, 0.0, base + rz])
+        sk = skeleton(rng, sp, height, base, centre, np.array([rxy, rxy, rz]), trunk_r)
+        r = float(np.clip(sp.clump * (rxy + rz), 0.25, 1.1))
+    parts = _branches(sk, "tree_trunk", sp.bark)
+    used = sum(p.n_faces for p in parts)
+    per_clump = 20 * 4 ** sp.detail
+    room = TRI_BUDGET - used
+    if sp.detail == 0:
+        big = _clumps(rng, sp, sk.tips, r, base, max(4, room // per_clump), 0.8 * CLUMP_GAP * r)
+        small = np.zeros((0, 3))
+    else:   # broad leaves: big clumps, then small leaf tufts (20 triangles) round the branch ends
+        big = _clumps(rng, sp, sk.tips, r, base, max(4, int(0.6 * room) // per_clump), CLUMP_GAP * r)
+        room -= len(big) * per_clump
+        small = _clumps(rng, sp, sk.tips, r, base, max(0, room // 20), 1.05 * r, (0.8, 1.0), big, 1.6 * r)
+    for p in big:
+        radii = r * rng.uniform(0.8, 1.15, 3) * np.array([1.0, 1.0, sp.clump_flat])
+        yaw = 0.0
+        if species == "conifer":      # boughs: long along the branch, thin across, flat
+            spire = np.hypot(*p[:2]) < 0.3 and p[2] > 0.75 * height
+            radii = r * np.array([0.5, 0.5, 1.6]) if spire else radii * [1.6, 0.9, 1.0]
+            yaw = float(np.arctan2(p[1], p[0]))
+        parts.append(_blob(rng, p, radii, "tree_crown", sp.leaves, detail=sp.detail, yaw=yaw))
+    for p in small:
+        radii = 0.5 * r * rng.uniform(0.8, 1.2, 3) * np.array([1.0, 1.0, sp.clump_flat])
+        parts.append(_blob(rng, p, radii, "tree_crown", sp.leaves, 0.15, detail=0, yaw=float(rng.uniform(0, 6.3))))
     mesh = on_ground(merge(parts))
     # stretch everything above the crown base so the top of the crown is exactly ``height``
     z = mesh.vertices[:, 2]

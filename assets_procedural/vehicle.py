@@ -1,34 +1,26 @@
-"""Vehicles: cars (sedan, hatchback, estate/SUV, van) and box trucks.
+"""Vehicles: cars (sedan, hatchback, estate, SUV, MPV van, pickup) and box trucks.
 
 Local frame: +x forward (headlights at +x), z up, origin on the ground under the centre
-of the bounding box. Cars are one class (``car``) with paint, glass, rubber, chrome and
-light materials; trucks likewise with class ``truck``. Glass sits 2 cm proud of the
-body surface so it never z-fights with the paint.
+of the bounding box. Cars are one class (``car``): a curved lofted shell whose greenhouse
+faces are the glass (:mod:`assets_procedural.car_body`), wheels, lamps and plates. Trucks
+likewise with class ``truck``; their glass sits 2 cm proud of the body surface so it never
+z-fights with the paint.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from generator.geometry import Mesh, box, cylinder, disc, loft, merge, on_ground, polygon, pose, prism
+from assets_procedural.car_body import body_shell, draw_dimensions
+from generator.geometry import Mesh, box, cylinder, disc, loft, merge, on_ground, polygon, pose, prism, resolve_ids
 
 GLASS_OFFSET = 0.02  # metres: glass in front of the body surface (>= 2 cm: no z-fighting)
+PROUD_M = 0.025      #: how far a car's lamps and plates stand out of its nose and tail, metres
 
-#: variant -> ranges (low, high) in metres; ``rear``: notch (separate boot), hatch, box (vertical tail)
-CAR_VARIANTS: dict[str, dict] = {
-    "sedan": dict(L=(4.4, 4.9), W=(1.74, 1.84), H=(1.42, 1.50), r=(0.31, 0.34), sill=(0.28, 0.32), front_oh=(0.85, 1.0),
-                  rear_oh=(1.0, 1.15), hood=(1.25, 1.45), ws=(0.85, 1.0), rear_run=(0.6, 0.75),
-                  rear="notch", windows=2, belt=0.67),
-    "hatchback": dict(L=(3.8, 4.3), W=(1.70, 1.80), H=(1.44, 1.55), r=(0.29, 0.32), sill=(0.27, 0.31), front_oh=(0.75, 0.9),
-                      rear_oh=(0.6, 0.75), hood=(0.95, 1.1), ws=(0.75, 0.9), rear_run=(0.22, 0.32),
-                      rear="hatch", windows=2, belt=0.65),
-    "estate": dict(L=(4.4, 4.9), W=(1.78, 1.86), H=(1.55, 1.75), r=(0.33, 0.37), sill=(0.34, 0.42), front_oh=(0.85, 0.95),
-                   rear_oh=(0.9, 1.05), hood=(1.05, 1.2), ws=(0.7, 0.85), rear_run=(0.1, 0.18),
-                   rear="box", windows=3, belt=0.64),
-    "van": dict(L=(4.5, 4.95), W=(1.78, 1.86), H=(1.75, 1.88), r=(0.31, 0.34), sill=(0.3, 0.34), front_oh=(0.85, 0.95),
-                rear_oh=(0.8, 0.95), hood=(0.75, 0.9), ws=(0.95, 1.1), rear_run=(0.06, 0.1),
-                rear="box", windows=3, belt=0.56),
-}
+#: body types of :func:`car` and their share of a town's car models (a European street:
+#: hatchbacks and SUVs lead, then sedans and estates, few MPVs and pickups)
+CAR_VARIANTS: dict[str, float] = {"sedan": 0.18, "hatchback": 0.28, "estate": 0.12, "suv": 0.28, "van": 0.08,
+                                  "pickup": 0.06}
 
 
 def wheel(x: float, y_out: float, side: float, radius: float, width: float, cls: str,
@@ -56,47 +48,6 @@ def _light(x: float, y: float, z: float, size: tuple[float, float, float], cls: 
     return box(size, cls, material, (x, y, z))
 
 
-def _interp(x: np.ndarray, pts: list[tuple[float, float]]) -> np.ndarray:
-    xs, vs = zip(*sorted(pts))
-    return np.interp(x, xs, vs)
-
-
-def _draw(rng: np.random.Generator, spec: dict) -> dict[str, float]:
-    return {k: float(rng.uniform(*v)) for k, v in spec.items() if isinstance(v, tuple)}
-
-
-def _lower_body(p: dict, v: dict, xa: float, xd: float, wheels_x: tuple[float, float]) -> Mesh:
-    """Lofted lower body with wheel arches cut over both axles."""
-    L, W, r, sill = p["L"], p["W"], p["r"], p["sill"]
-    belt = p["belt_z"]
-    arch_r = 1.12 * r
-    stations = {-L / 2, -L / 2 + 0.12, -L / 2 + 0.45, L / 2 - 0.45, L / 2 - 0.12, L / 2, xa, xd}
-    for wx in wheels_x:
-        stations |= {wx + arch_r * np.cos(t) for t in np.radians([180, 150, 120, 90, 60, 30, 0])}
-    xs = np.array(sorted(stations))
-    xs = xs[np.concatenate([[True], np.diff(xs) > 0.03])]
-    xs[-1] = L / 2
-    zb = np.full_like(xs, sill)
-    for wx in wheels_x:
-        inside = np.abs(xs - wx) < arch_r - 1e-6
-        zb[inside] = np.maximum(zb[inside], r + 0.02 + np.sqrt(arch_r ** 2 - (xs[inside] - wx) ** 2))
-    zb[0] += 0.08
-    zb[-1] += 0.06
-    deck = belt - (0.02 if v["rear"] == "notch" else 0.0)
-    zt = _interp(xs, [(-L / 2, deck - 0.09), (-L / 2 + 0.12, deck), (xd, belt), (xa, belt),
-                      (L / 2 - 0.12, p["hood_front"]), (L / 2, p["hood_front"] - 0.08)])
-    wf = _interp(xs, [(-L / 2, 0.87), (-L / 2 + 0.12, 0.96), (-L / 2 + 0.45, 1.0), (L / 2 - 0.45, 1.0),
-                      (L / 2 - 0.12, 0.95), (L / 2, 0.85)])
-    rings = []
-    for x, b, t, f in zip(xs, zb, zt, wf):
-        w = W / 2 * f
-        h = t - b
-        side = [(w * 0.94, b), (w, b + 0.3 * h), (w, t - min(0.08, 0.3 * h)), (w * 0.9, t)]
-        ring = side + [(-yy, zz) for yy, zz in side[::-1]]
-        rings.append([(x, yy, zz) for yy, zz in ring])
-    return loft(np.array(rings), p["cls"], "car_paint")
-
-
 def _inset_quad(q: np.ndarray, du: float, dv: float, normal: np.ndarray, cls: str) -> Mesh:
     """A glass pane inside the quad ``q`` and ``GLASS_OFFSET`` in front of it.
 
@@ -121,100 +72,97 @@ def _inset_quad(q: np.ndarray, du: float, dv: float, normal: np.ndarray, cls: st
     return polygon(c + GLASS_OFFSET * n, cls, "car_glass", n)
 
 
-def _cabin(p: dict, v: dict, xa: float, xb: float, xc: float, xd: float) -> list[Mesh]:
-    """Greenhouse: painted shell (pillars, roof) with proud glass panes."""
-    W, belt, roof_z, H = p["W"], p["belt_z"], p["H"] - 0.03, p["H"]
-    wb, wr = 0.9 * W / 2, 0.74 * W / 2
-    prof = [(xd, belt), (xc, roof_z), ((xb + xc) / 2, H), (xb, roof_z), (xa, belt)]
+def car_wheel(x: float, y_out: float, side: float, radius: float, width: float, cls: str = "car",
+              sections: int = 12) -> Mesh:
+    """A car wheel: a tyre with rounded shoulders (``rubber``), a rim face (``wheel_rim``) and a hub cap.
 
-    def half_w(z: float) -> float:
-        return wb + (wr - wb) * (z - belt) / (roof_z - belt)
+    Parameters
+    ----------
+    x : float
+        Axle position along x, metres; the axle is at z = ``radius`` (the tyre touches z = 0).
+    y_out : float
+        |y| of the tyre's outer face, metres.
+    side : float
+        +1 for the left (+y) wheel, -1 for the right.
+    sections : int
+        Points around; a multiple of 4, so one vertex touches the ground.
+    """
+    a = 2 * np.pi * np.arange(sections) / sections
+    c, s = np.cos(a), np.sin(a)
+    y_in = y_out - width
+    profile = [(0.66 * radius, y_in), (radius, y_in + 0.03), (radius, y_out - 0.03), (0.66 * radius, y_out)]
+    rings = np.array([np.stack([x + rr * c, np.full(sections, side * yy), radius + rr * s], 1) for rr, yy in profile])
+    tyre = loft(rings, cls, "rubber")
+    _, rim = resolve_ids(cls, "wheel_rim")
+    tyre.face_material[-sections:] = rim                             # the outer cap: the rim face
+    hub = disc((x, side * (y_out + 0.006), radius), (0, side, 0), 0.2 * radius, cls, "chrome", 6)
+    return merge([tyre, hub])
 
-    left = np.array([(x, half_w(z), z) for x, z in prof])
-    right = left * np.array([1, -1, 1])
-    centre = np.array([(xa + xd) / 2, 0.0, (belt + roof_z) / 2])
-    cls = p["cls"]
-    parts = [polygon(left, cls, "car_paint", (0, 1, 0)), polygon(right, cls, "car_paint", (0, -1, 0))]
-    for i in range(len(prof) - 1):
-        q = np.array([left[i], left[i + 1], right[i + 1], right[i]])
-        parts.append(polygon(q, cls, "car_paint", q.mean(0) - centre))
-    # windshield (a -> b) and rear glass (d -> c)
-    for lo, hi in ((4, 3), (0, 1)):
-        q = np.array([right[lo], left[lo], left[hi], right[hi]])
-        n = np.cross(q[1] - q[0], q[3] - q[0])
-        n = n if np.dot(n, q.mean(0) - centre) > 0 else -n
-        parts.append(_inset_quad(q, 0.07, 0.05, n, cls))
-    # side windows between the A- and C/D-pillars, split by B (and C) pillars
-    z = np.array([belt + 0.05, roof_z - 0.06])                     # sill and top of the glass
-    f = (z - belt) / (roof_z - belt)
-    front = xa + f * (xb - xa) - 0.1                                 # behind the A-pillar
-    rear = xd + f * (xc - xd) + 0.12                                 # ahead of the C/D-pillar
-    n_win = v["windows"]
-    cuts = np.linspace(0.0, 1.0, n_win + 1)
-    tilt = (wb - wr) / (roof_z - belt)
-    for side in (1.0, -1.0):
-        normal = np.array([0.0, side, tilt]) / np.hypot(1.0, tilt)
-        for k in range(n_win):
-            s0 = cuts[k] + (0.03 if k else 0.0)
-            s1 = cuts[k + 1] - (0.03 if k < n_win - 1 else 0.0)
-            xs0, xs1 = rear + s0 * (front - rear), rear + s1 * (front - rear)
-            pts = [(xs0[0], z[0]), (xs1[0], z[0]), (xs1[1], z[1]), (xs0[1], z[1])]
-            q = np.array([(x, side * half_w(zz), zz) for x, zz in pts]) + GLASS_OFFSET * normal
-            parts.append(polygon(q, cls, "car_glass", normal))
-    return parts
+
+def _arch_wall(x: float, y: float, side: float, r: float, arch: float, cls: str) -> Mesh:
+    """The inner wall of a wheel house: closes the arch tunnel behind the tyre (``car_trim``)."""
+    ang = np.radians(np.linspace(0, 180, 7))
+    pts = [(x + arch * np.cos(t), side * y, r + arch * np.sin(t)) for t in ang]
+    pts += [(x - arch, side * y, r - 0.05), (x + arch, side * y, r - 0.05)]
+    return polygon(np.array(pts), cls, "car_trim", (0, side, 0))
 
 
 def car(rng: np.random.Generator, variant: str | None = None) -> Mesh:
-    """A passenger car with a random body style and real-world proportions.
+    """A passenger car: a lofted, curved body of one body type, with wheels, lights and plates.
 
     Parameters
     ----------
     rng : numpy.random.Generator
-    variant : {"sedan", "hatchback", "estate", "van"}, optional
-        Drawn from the rng when omitted.
+        Body type (when not given) and every dimension are drawn from it.
+    variant : {"sedan", "hatchback", "estate", "suv", "van", "pickup"}, optional
+        Body type (:data:`assets_procedural.car_body.BODY_TYPES`); drawn with the shares of
+        :data:`CAR_VARIANTS` when omitted.
 
     Returns
     -------
     Mesh
-        Class ``car``; 3.8-5.0 m long, 1.7-2.0 m wide (mirrors included), 1.4-1.9 m high.
+        Class ``car``; 3.8-5.4 m long, 1.7-2.3 m wide (mirrors included), 1.4-1.85 m high, the
+        four tyres the only faces at z = 0 and the body ``clear`` (0.13-0.24 m) above the ground.
+        Materials ``car_body`` (the shell: colour per object, shaded smooth), ``car_paint`` (mirrors),
+        ``car_glass``, ``car_trim``,
+        ``rubber``, ``wheel_rim``, ``chrome``, ``headlight``, ``taillight``, ``licence_plate``.
         Anchors ``"headlight"`` (2, 3) and ``"taillight"`` (2, 3) on the lamp faces.
     """
+    names = list(CAR_VARIANTS)
     if variant is None:
-        variant = str(rng.choice(sorted(CAR_VARIANTS)))
+        variant = names[int(rng.choice(len(names), p=np.array(list(CAR_VARIANTS.values()))))]
     if variant not in CAR_VARIANTS:
-        raise ValueError(f"car variant must be one of {sorted(CAR_VARIANTS)}, got {variant!r}")
-    v = CAR_VARIANTS[variant]
-    p = _draw(rng, v)
-    p["cls"] = "car"
-    L, W, H, r = p["L"], p["W"], p["H"], p["r"]
-    p["belt_z"] = v["belt"] * H + rng.uniform(-0.02, 0.02)
-    p["hood_front"] = p["belt_z"] - rng.uniform(0.12, 0.2)
-    xf, xr = L / 2 - p["front_oh"], -L / 2 + p["rear_oh"]
-    xa = L / 2 - p["hood"]
-    xb = xa - p["ws"]
-    xd = -L / 2 + (0.35 + 0.25 * rng.random() if v["rear"] == "notch" else 0.04)
-    xc = xd + p["rear_run"]
-    if v["rear"] == "notch":
-        xc = min(xc, xb - 0.9)
-    parts = [_lower_body(p, v, xa, xd, (xr, xf))] + _cabin(p, v, xa, xb, xc, xd)
-    for x in (xr, xf):
+        raise ValueError(f"car variant must be one of {names}, got {variant!r}")
+    p = draw_dimensions(rng, variant)
+    shell, info = body_shell(p, variant)
+    L, W, r, tyre_w = p["L"], p["W"], p["r"], 0.2 + 0.1 * (p["r"] - 0.29)
+    parts = [shell]
+    for x in (info["xr"], info["xf"]):
         for side in (1.0, -1.0):
-            parts.append(wheel(x, W / 2 - 0.015, side, r, 0.2, "car"))
-    top_f, top_r = p["hood_front"] - 0.08, p["belt_z"] - 0.09
-    yl, yt = W / 2 * 0.85 - 0.2, W / 2 * 0.87 - 0.17
-    head = np.array([[L / 2 + 0.02, s * yl, top_f - 0.09] for s in (1, -1)])
-    tail = np.array([[-L / 2 - 0.02, s * yt, top_r - 0.1] for s in (1, -1)])
+            parts.append(car_wheel(x, W / 2 - 0.025, side, r, tyre_w))
+            parts.append(_arch_wall(x, W / 2 - 0.05 - tyre_w - 0.02, side, r, r + 0.055, "car"))
+    xs, top, half = info["xs"], info["top"], info["half_w"]
+    nose, tail_top = float(top[-1]), float(top[0])
+    hw_end = float(half[-1])
+    yl, yt = hw_end - 0.24, hw_end - 0.17
+    head = np.array([[L / 2 + PROUD_M, s * yl, nose - 0.05] for s in (1, -1)])
+    tail = np.array([[-L / 2 - PROUD_M, s * yt, tail_top - 0.05] for s in (1, -1)])
     for c in head:
-        parts.append(_light(c[0] - 0.025, c[1], c[2], (0.05, 0.3, 0.1), "car", "headlight"))
+        parts.append(box((0.16, 0.36, 0.08), "car", "headlight", (c[0] - 0.08, c[1], c[2])))
     for c in tail:
-        parts.append(_light(c[0] + 0.025, c[1], c[2], (0.05, 0.26, 0.12), "car", "taillight"))
-    parts.append(box((0.04, 2 * yl - 0.4, 0.12), "car", "rubber", (L / 2 - 0.005, 0, top_f - 0.2)))
+        parts.append(box((0.14, 0.28, 0.1), "car", "taillight", (c[0] + 0.07, c[1], c[2])))
+    bottom_f, bottom_r = float(info["bottom"][-1]), float(info["bottom"][0])
+    parts.append(box((0.08, 2 * yl - 0.42, 0.13), "car", "car_trim", (L / 2 - 0.035, 0, nose - 0.12)))  # grille
+    parts.append(box((0.03, 0.52, 0.11), "car", "licence_plate", (L / 2 + PROUD_M - 0.015, 0, bottom_f + 0.1)))
+    parts.append(box((0.03, 0.52, 0.11), "car", "licence_plate", (-L / 2 - PROUD_M + 0.015, 0, max(bottom_r + 0.1, tail_top - 0.3))))
+    i_a = int(np.searchsorted(xs, info["xa"]))
+    hw_a = float(half[min(i_a, len(half) - 1)])
     for side in (1.0, -1.0):
-        y = side * (0.9 * W / 2 + 0.06)
-        parts.append(box((0.08, 0.14, 0.1), "car", "car_paint", (xa - 0.15, y, p["belt_z"] + 0.1)))
-    out = on_ground(merge(parts))
-    out.anchors = {"headlight": head, "taillight": tail}
-    return out
+        parts.append(box((0.09, 0.12, 0.1), "car", "car_paint", (info["xa"], side * (hw_a + 0.02),
+                                                                 p["belt_z"] + 0.09)))
+    body = merge(parts)
+    body.anchors = {"headlight": head, "taillight": tail}
+    return on_ground(body)
 
 
 def truck(rng: np.random.Generator) -> Mesh:

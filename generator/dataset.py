@@ -13,7 +13,9 @@
 Frames and sweeps: the LiDAR is a 10 Hz stream and images are exposed at some of its sweeps
 (``image_frames`` of ``lidar_meta.json``); image frame ``k`` pairs with sweep ``frame.sweep``,
 whose scan and OpenLABEL boxes :meth:`Dataset.frame` returns. :meth:`Dataset.scan` and
-:meth:`Dataset.boxes` take sweep indices.
+:meth:`Dataset.boxes` take sweep indices. A dataset of many towns (``town.redraw_every_frames``)
+has one sequence per town: ``Dataset(root, "01")`` pairs town 1's images with its scans, and an
+image of another town comes with ``sweep`` None and no scan (its ``meta["town"]`` says which).
 
 Arrays and frames
 -----------------
@@ -100,7 +102,7 @@ class FrameSample:
     """Everything of image frame ``index``: its image variants, the scan and boxes of ``sweep``."""
 
     index: int
-    sweep: int
+    sweep: int | None
     images: dict[str, ImageSample] = field(default_factory=dict)
     scan: ScanSample | None = None
     boxes: list[Box] = field(default_factory=list)
@@ -130,9 +132,12 @@ class Dataset:
         #: image frame -> the sweep it was exposed with (identity without ``image_frames``)
         self._sweep_of = md.image_sweeps(md.load_metadata(meta), str(meta)) if meta and meta.exists() else {}
 
-    def sweep_of(self, frame: int) -> int:
-        """The sweep image frame ``frame`` was exposed with."""
-        return self._sweep_of.get(frame, frame)
+    def sweep_of(self, frame: int) -> int | None:
+        """The sweep image frame ``frame`` was exposed with; None for an image of another sequence
+        (a re-drawn town's, ``town.redraw_every_frames``: each town is its own sequence)."""
+        if self._sweep_of:
+            return self._sweep_of.get(frame)
+        return frame
 
     # -- images ------------------------------------------------------------------------------
     def image_names(self, frame: int | None = None) -> list[str]:
@@ -171,9 +176,9 @@ class Dataset:
         """Every image variant of image frame ``index``, with the scan and boxes of its sweep, in one call."""
         j = self.sweep_of(index)
         out = FrameSample(index, j, {n: self.image(n) for n in self.image_names(index)})
-        if self.seq is not None and j in self.seq.frames:
+        if self.seq is not None and j is not None and j in self.seq.frames:
             out.scan = self.scan(j)
-        out.boxes = self.boxes(j)
+        out.boxes = self.boxes(j) if j is not None else []
         return out
 
     def __iter__(self):

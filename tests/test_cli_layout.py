@@ -69,7 +69,8 @@ BAD = {
                        "invalid JSON at line 1 column 25: Expecting property name enclosed in double quotes"),
     "unknown_key": ('{"name": "x", "seed": 1, "town": {"blocks": 3}}',
                     "town.blocks: unknown key (allowed here: block_size_jitter_m, block_size_m, blocks_x, blocks_y, "
-                    "curb_height_m, lane_width_m, lanes_per_direction, margin_m, parking_strip_width_m, sidewalk_width_m)"),
+                    "curb_height_m, lane_width_m, lanes_per_direction, margin_m, parking_strip_width_m, "
+                    "redraw_every_frames, sidewalk_width_m)"),
     "wrong_type": ('{"name": "x", "seed": 1, "density": {"trees_per_100m": "many"}}',
                    'density.trees_per_100m: must be a number in [0, 30], got "many"'),
     "out_of_range": ('{"name": "x", "seed": 1, "town": {"lanes_per_direction": 7}}',

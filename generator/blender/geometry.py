@@ -4,8 +4,10 @@ One mesh datablock per prototype (repeated assets are linked duplicates: instanc
 built with ``foreach_set`` from the very arrays the LiDAR casts against. Every mesh
 carries the per-face ``class_id`` (INT) attribute;
 every object carries its instance id as ``pass_index``, its colour (``attrs["color"]`` or
-``attrs["facade_color"]``) in ``color`` and ``attrs["roof_color"]`` as the custom
-property ``ug_roof_color``.
+``attrs["facade_color"]``) in ``color``, ``attrs["roof_color"]`` as the custom
+property ``ug_roof_color``, every other ``attrs["<name>_color"]`` as ``ug_<name>_color``,
+``attrs["paint_metallic"]`` as ``ug_paint_metallic`` and ``ug_outfit`` = 1 where a person's
+colours are given (see :mod:`generator.blender.recipes_actors`).
 Label proxies live in their own collection, hidden in the RGB pass.
 """
 
@@ -21,7 +23,8 @@ from generator.materials import material_table
 from generator.world.scene import SceneModel
 
 #: Materials shaded smooth (organic shapes); everything else is flat (hard surfaces).
-SMOOTH_MATERIALS = frozenset({"leaves", "hedge_leaves", "bark", "skin", "hair", "clothing", "rubber"})
+SMOOTH_MATERIALS = frozenset({"leaves", "hedge_leaves", "bark", "skin", "hair", "clothing", "rubber", "car_body",
+                              "clothing_bottom"})
 
 
 @dataclass
@@ -99,6 +102,11 @@ def new_object(name: str, data: bpy.types.Mesh, transform: np.ndarray, instance_
         color = attrs.get("color", attrs.get("facade_color", (1.0, 1.0, 1.0)))
         ob.color = (float(color[0]), float(color[1]), float(color[2]), 1.0)
         ob["ug_roof_color"] = [float(c) for c in attrs.get("roof_color", (1.0, 1.0, 1.0))]
+        for key, value in attrs.items():
+            if key.endswith("_color") and key not in ("facade_color", "roof_color"):
+                ob["ug_" + key] = [float(c) for c in value]
+        ob["ug_paint_metallic"] = float(attrs.get("paint_metallic", 0.0))
+        ob["ug_outfit"] = 1.0 if "skin_color" in attrs else 0.0
         ob["ug_class"] = cls
     return ob
 

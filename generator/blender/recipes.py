@@ -6,6 +6,7 @@ shader socket. Scene-wide switches are scene custom properties read with
 ``VIEW_LAYER`` attributes (see :mod:`generator.blender.controls`); per-object colour
 is ``Object.color`` (Object Info > Color); per-pane and per-leaf-cluster variation uses
 Cycles' "Random Per Island" (every window pane and leaf cluster is its own island).
+Vehicle paint and people (their colours come per object) are in :mod:`recipes_actors`.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ import numpy as np
 
 from generator.blender.controls import CONTROL
 from generator.blender.nodes import Nodes
+from generator.blender.road_surface import road_wear
 from generator.blender.wet import wet_surface
 
 
@@ -38,7 +40,8 @@ def asphalt(g: Nodes, rng, tone=0.055, wear=0.5):
     base = g.ramp(grain, [(0.3, (tone * 0.7,) * 3), (0.7, (tone * 1.4,) * 3)])
     base = g.mix(g.mul(g.smooth(patches, 0.45, 0.6), wear), base, (tone * 1.8, tone * 1.75, tone * 1.7))
     base = g.mix(0.5, base, g.mix(cracks, (0.02, 0.02, 0.02), (1, 1, 1)), "MULTIPLY")
-    color, rough, normal = wet_surface(g, base, 0.85, g.bump(grain, 0.25, 0.01))
+    base, rough, worn = road_wear(g, co, base, tone, rng)
+    color, rough, normal = wet_surface(g, base, rough, g.bump(g.add(grain, worn), 0.25, 0.01))
     return g.principled(base_color=color, roughness=rough, normal=normal)
 
 
@@ -200,10 +203,6 @@ def hedge_leaves(g, rng):
     return _foliage(g, rng, (0.03, 0.07, 0.018))
 
 
-def car_paint(g, rng):
-    return g.principled(base_color=g.object_info("Color"), metallic=0.4, roughness=0.3, coat=1.0, coat_roughness=0.05)
-
-
 def truck_paint(g, rng):
     return g.principled(base_color=g.object_info("Color"), metallic=0.1, roughness=0.45)
 
@@ -282,19 +281,6 @@ def fence_wood(g, rng):
     grain = g.wave(g.coords("Object"), scale=3, distortion=5, detail=4, direction="Z")
     base = g.ramp(grain, [(0.2, (0.2, 0.13, 0.07)), (0.8, (0.32, 0.22, 0.13))])
     return g.principled(base_color=base, roughness=0.8)
-
-
-def skin(g, rng):
-    tone = g.mix(g.object_info("Random"), (0.45, 0.28, 0.2), (0.12, 0.07, 0.045))
-    return g.principled(base_color=tone, roughness=0.5, subsurface=0.1)
-
-
-def clothing(g, rng):
-    return g.principled(base_color=g.object_info("Color"), roughness=0.85, sheen=0.3)
-
-
-def hair(g, rng):
-    return g.principled(base_color=g.mix(g.object_info("Random"), (0.02, 0.015, 0.01), (0.25, 0.17, 0.08)), roughness=0.6)
 
 
 def default(g, rng):

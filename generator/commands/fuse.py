@@ -70,12 +70,15 @@ def dataset_actors(root: Path, ds):
     from generator.spec.load import parse_spec
     from generator.world.rig import Rig
 
-    spec = parse_spec(spec_doc, str(path))
+    from generator.spec.towns import spec_for_record
+
+    meta_src = str(ds.seq.dir / "lidar_meta.json")
+    spec = spec_for_record(parse_spec(spec_doc, str(path)), ds.meta.get("scene"), meta_src)  # the sequence's town
     if not spec.traffic.enabled:
         return None
     log.info("rebuilding the traffic of %s to de-skew its moving actors", spec.name)
     times = ds.seq.times if ds.seq.times is not None else np.array([Rig.sweep_time(j) for j in ds.seq.frames])
-    return actor_poses(sequence_world(spec, build_scene(spec), ds.meta, times, str(ds.seq.dir / "lidar_meta.json")))
+    return actor_poses(sequence_world(spec, build_scene(spec), ds.meta, times, meta_src))
 
 
 def run(args) -> int:

@@ -36,11 +36,14 @@ def run(args) -> int:
     out = r.out
     plan = make_plan(args.frames, combos=r.combos, sequence=args.sequence)
     run_rec = run_generate(r.spec, r.cfg, GenerateOptions(out, plan, args.workers, args.executor, args.ray_address))
+    sequences = [t["sequence"] for t in run_rec.get("towns", [])] or [plan.sequence]  # one per town
     if args.split:
         from generator.jobs.lidar_sequence import write_dataset_label_config
 
-        write_dataset_label_config(out / "lidar", args.split, [plan.sequence])
+        write_dataset_label_config(out / "lidar", args.split, sequences)
     rate = run_rec.get("images_per_hour")
-    print(f"dataset in {out}: {len(plan.frames)} frames x {len(plan.combos)} variants, LiDAR sequence {plan.sequence}"
+    seqs = f"LiDAR sequence {plan.sequence}" if len(sequences) == 1 else \
+        f"{len(sequences)} towns, LiDAR sequences {sequences[0]}..{sequences[-1]}"
+    print(f"dataset in {out}: {len(plan.frames)} frames x {len(plan.combos)} variants, {seqs}"
           + (f"; {rate:.0f} images/hour" if rate else "; nothing left to render"))
     return 0

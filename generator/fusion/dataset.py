@@ -160,8 +160,10 @@ class FusionDataset:
         #: image frame k -> the scan (sweep) it was exposed with; identity for the one-sweep-per-image layout
         pairs = md.image_sweeps(self.meta, str(self.seq.dir / META_NAME))
         scans = set(self.seq.frames)
-        self.scan_of = {k: pairs.get(k, k) if pairs else k for k in self.images}
-        self.frames = [k for k in sorted(self.images) if self.scan_of[k] in scans]
+        # with image_frames, only the images this sequence was exposed with (another town's images
+        # belong to another sequence); without them, the one-sweep-per-image layout
+        self.scan_of = {k: pairs[k] for k in self.images if k in pairs} if pairs else {k: k for k in self.images}
+        self.frames = [k for k in sorted(self.scan_of) if self.scan_of[k] in scans]
         if not self.frames:
             raise UserError(f"{self.root}: no frame has both an image in images/ and its scan in {self.seq.velodyne}")
         self.paired_scans = {self.scan_of[k] for k in self.frames}

@@ -45,8 +45,8 @@ class Mesh:
         self.vertices = np.asarray(self.vertices, np.float64).reshape(-1, 3)
         self.faces = np.asarray(self.faces, np.int64).reshape(-1, 3)
         m = len(self.faces)
-        self.face_class = np.broadcast_to(np.asarray(self.face_class, np.uint8), (m,)).copy()
-        self.face_material = np.broadcast_to(np.asarray(self.face_material, np.uint16), (m,)).copy()
+        self.face_class = _per_face(self.face_class, np.uint8, m)
+        self.face_material = _per_face(self.face_material, np.uint16, m)
         self.anchors = {k: np.asarray(v, np.float64).reshape(-1, 3) for k, v in self.anchors.items()}
 
     @property
@@ -76,6 +76,16 @@ class Mesh:
     def to_trimesh(self) -> trimesh.Trimesh:
         """A :class:`trimesh.Trimesh` of the geometry (labels not carried)."""
         return trimesh.Trimesh(self.vertices, self.faces, process=False)
+
+
+def _per_face(values, dtype, m: int) -> np.ndarray:
+    """A fresh (m,) ``dtype`` array of ``values`` (one value per face, or one for all)."""
+    a = np.asarray(values, dtype)
+    if a.shape == (m,):
+        return a.copy()
+    if a.ndim == 0:
+        return np.full(m, a, dtype)
+    return np.broadcast_to(a, (m,)).copy()
 
 
 def empty() -> Mesh:

@@ -8,6 +8,8 @@ from outside.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import trimesh
 
@@ -89,9 +91,20 @@ def icosphere(radius: float, cls: str | int, material: str | int, subdivisions: 
               center: tuple[float, float, float] = (0.0, 0.0, 0.0),
               scale: tuple[float, float, float] = (1.0, 1.0, 1.0)) -> Mesh:
     """An icosphere (20 * 4**subdivisions triangles), optionally scaled per axis into an ellipsoid."""
-    tm = trimesh.creation.icosphere(subdivisions=subdivisions, radius=radius)
+    vertices, faces = _unit_icosphere(int(subdivisions), float(radius))
     c, m = resolve_ids(cls, material)
-    return Mesh(tm.vertices * np.asarray(scale, float) + np.asarray(center, float), tm.faces, c, m)
+    return Mesh(vertices * np.asarray(scale, float) + np.asarray(center, float), faces.copy(), c, m)
+
+
+@functools.lru_cache(maxsize=64)
+def _unit_icosphere(subdivisions: int, radius: float) -> tuple[np.ndarray, np.ndarray]:
+    """trimesh's icosphere arrays (read-only), made once per (subdivisions, radius): trees and hedges
+    ask for a thousand identical ones per town."""
+    tm = trimesh.creation.icosphere(subdivisions=subdivisions, radius=radius)
+    vertices, faces = np.array(tm.vertices, np.float64), np.array(tm.faces, np.int64)
+    vertices.setflags(write=False)
+    faces.setflags(write=False)
+    return vertices, faces
 
 
 def prism(polygon: np.ndarray, z0: float, z1: float, cls: str | int, material: str | int,
@@ -306,6 +319,6 @@ def quads(corners: np.ndarray, cls: str | int, materials, normals: np.ndarray | 
     if isinstance(materials, (str, int, np.integer)):
         mats = np.full(n, resolve_ids(cls, materials)[1])
     else:
-        table = {}
-        mats = np.array([table.setdefault(m, resolve_ids(cls, m)[1]) for m in materials], np.int64)
+        table = {m: resolve_ids(cls, m)[1] for m in set(materials)}  # a few names, thousands of quads
+        mats = np.array([table[m] for m in materials], np.int64)
     return Mesh(corners.reshape(-1, 3), faces, c, np.repeat(mats, 2))

@@ -16,6 +16,7 @@ from generator import __version__
 from generator.imaging.exr import DEPTH_DEFINITION
 from generator.imaging.meta_fields import schema_message
 from generator.labels import class_table
+from generator.spec.towns import town_record
 from generator.spec.validate import load_schema
 
 METADATA_VERSION = 1
@@ -92,6 +93,7 @@ def image_metadata(*, image: str, files: dict, frame, k: np.ndarray, width: int,
         "scene": spec.name,
         "seed": spec.seed,
         "spec_hash": spec.spec_hash,
+        **({"town": town_record(spec)} if getattr(spec, "town_index", None) is not None else {}),
         "camera": {
             "position_m": _list(T[:3, 3]),
             "rotation_deg": {key: v for key, v in camera_angles(T).items() if key != "tilt"},

@@ -25,6 +25,7 @@ from generator.formats import semantickitti as sk
 from generator.formats.openlabel import build_openlabel, write_openlabel
 from generator.imaging import meta_fields as md
 from generator.safeload import printable
+from generator.spec.towns import spec_for_record
 from generator.world.rig import SWEEP_PERIOD_S, Rig
 
 log = logging.getLogger(__name__)
@@ -182,6 +183,7 @@ def write_sequence_openlabel(spec, root: Path, sequence: str = "00", classes=DEF
     src = str(meta_path)
     if md.field(meta, "scene.spec_hash", src, default=None) != spec.spec_hash:
         raise UserError(f"{meta_path}: cast from another spec (spec_hash differs from {spec.source})")
+    spec = spec_for_record(spec, md.field(meta, "scene", src, default=None), src)  # a re-drawn town's own spec
     if not seq.has_labels or not seq.frames:
         raise UserError(f"{seq.dir}: needs scans with labels")
     if seq.times is None:

@@ -39,14 +39,19 @@ class Drive:
     sweeps: int
 
 
-def plan_drive(spec, scene, frames) -> Drive:
-    """The drive covering image frames ``frames`` (frame numbers) of ``spec``'s route 0."""
+def plan_drive(spec, scene, frames, first: int = 0) -> Drive:
+    """The drive covering image frames ``frames`` (frame numbers) of ``spec``'s route 0.
+
+    ``first``: the frame number at the drive's start (a re-drawn town's first frame,
+    :mod:`generator.jobs.towns`); frame ``k`` is driven ``(k - first) * spacing_m`` metres.
+    """
+    from generator.jobs.towns import local_frame
     from generator.traffic.build import build_world
 
-    last = max(frames) if len(frames) else 0
+    last = max(frames) - first if len(frames) else 0
     world = build_world(spec, scene, 0.0, last * spec.paths.spacing_m + MARGIN_M)
     rig = Rig.from_world(spec, world)
-    pairs = [(int(k), Rig.sweep_of(rig.frame(int(k)))) for k in sorted(frames)]
+    pairs = [(int(k), Rig.sweep_of(local_frame(rig, int(k), first))) for k in sorted(frames)]
     sweeps = max(j for _, j in pairs) + 1 if pairs else 1
     if world.duration_s < sweeps * SWEEP_PERIOD_S + 0.2:  # a stop near the end: simulate on
         world = build_world(spec, scene, sweeps * SWEEP_PERIOD_S + 0.2, last * spec.paths.spacing_m + MARGIN_M)

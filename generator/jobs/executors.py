@@ -50,6 +50,9 @@ class RenderJob:
         The LiDAR sequence folder the stereo pairs belong to.
     parent_pid : int
         Set by the local pool: the worker exits when its parent dies.
+    first : int
+        Frame number at the start of the town's drive (``spec`` is that town's spec;
+        :mod:`generator.jobs.towns`); 0 for the one town.
     """
 
     spec: object
@@ -61,10 +64,11 @@ class RenderJob:
     stereo: tuple[int, ...] = ()
     sequence_dir: str = ""
     parent_pid: int = 0
+    first: int = 0
 
 
 def make_jobs(spec, cfg, out: Path, frames: list[int], combos, workers: int, stereo: list[int] = (),
-              sequence_dir: Path | None = None) -> list[RenderJob]:
+              sequence_dir: Path | None = None, first: int = 0) -> list[RenderJob]:
     """Deal the frames to render (``frames``: image variants, ``stereo``: stereo pairs) round-robin
     to ``workers`` jobs (fewer when there is less work).
 
@@ -76,7 +80,8 @@ def make_jobs(spec, cfg, out: Path, frames: list[int], combos, workers: int, ste
     if cfg.threads == 0 and len(parts) > 1:
         cfg = dataclasses.replace(cfg, threads=max(1, (os.cpu_count() or 1) // len(parts)))
     return [RenderJob(spec, cfg, str(out), tuple(k for k in part if k in frames), tuple(tuple(c) for c in combos),
-                      str(scratch_dir(out, i)), tuple(k for k in part if k in stereo), str(sequence_dir or ""))
+                      str(scratch_dir(out, i)), tuple(k for k in part if k in stereo), str(sequence_dir or ""),
+                      first=first)
             for i, part in enumerate(parts)]
 
 

@@ -73,11 +73,12 @@ def run(job, queue) -> None:
 
 def _run(job, queue, scratch: Path) -> None:
     from generator.blender.renderer import Renderer  # imports bpy (after the sys.path clean-up)
+    from generator.jobs.towns import local_frame
     from generator.jobs.variants import render_frame
     from generator.layout import build_scene
     from generator.world.rig import Rig
 
-    spec, cfg = job.spec, job.config
+    spec, cfg = job.spec, job.config  # a re-drawn town's own spec: build_scene makes that town
     t = time.perf_counter()
     scene = build_scene(spec)
     world = _world(spec, scene, job)
@@ -88,7 +89,7 @@ def _run(job, queue, scratch: Path) -> None:
 
     t_start = time.perf_counter()
     for n, index in enumerate(job.frames, 1):
-        images = render_frame(renderer, spec, cfg, rig.frame(index), Path(job.out), job.combos, rig)
+        images = render_frame(renderer, spec, cfg, local_frame(rig, index, job.first), Path(job.out), job.combos, rig)
         queue.put(("frame", index, {"images": images, "rss_mb": _rss_mb(), "frames_done": n}))
     if job.stereo:
         from generator.jobs.stereo import render_pair
@@ -118,7 +119,7 @@ def _world(spec, scene, job):
     from generator.traffic.build import build_world
     from generator.world.rig import SWEEP_PERIOD_S
 
-    last = max(job.frames, default=0)
+    last = max(job.frames, default=job.first) - job.first
     duration = (max(job.stereo) + 1) * SWEEP_PERIOD_S + 0.2 if job.stereo else 0.0
     return build_world(spec, scene, duration, last * spec.paths.spacing_m + MARGIN_M)
 

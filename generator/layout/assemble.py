@@ -3,7 +3,7 @@
 Order of work (each feature draws from its own named stream, so adding one does not
 shift the others): grid -> routes -> lots (blocks, then the band outside the ring road)
 -> buildings -> hedges/fences -> traffic lights
--> lamps -> street trees -> signs -> lot greenery -> parked vehicles -> lane cars ->
+-> lamps -> street trees -> verge hedges, bushes and trees -> signs -> lot greenery -> parked vehicles -> lane cars ->
 people -> ground objects. Objects accepted earlier win space; everything keeps clear of
 the routes (see :mod:`generator.layout.placement_core`). Finally the routes are verified
 against every object box, and an internal error is raised if any sample is too close.
@@ -22,6 +22,7 @@ from generator.labels import class_table
 from generator.layout import placement_lots as pl
 from generator.layout import placement_extras as px
 from generator.layout import placement_street as ps
+from generator.layout import placement_verges as pv
 from generator.layout.lots import Lot, lot_ground_mesh, make_lots
 from generator.layout.outskirts import horizon_mesh
 from generator.layout.placement_core import EGO_HALF_WIDTH_M, Keepout, Library, Placed, Placer
@@ -44,6 +45,10 @@ STEPS = (
     ("traffic lights", lambda p, s, g, lots, st: ps.place_traffic_lights(p, s, st)),
     ("lamp posts", lambda p, s, g, lots, st: ps.place_lamps(p, s, st)),
     ("street trees", lambda p, s, g, lots, st: ps.place_street_trees(p, s, st)),
+    # verges exist only in towns with a streets spec (no-ops otherwise)
+    # (residential verge hedges first: the verge trees then stand in their gaps)
+    ("verge hedges and bushes", lambda p, s, g, lots, st: pv.place_verge_bushes(p, s, st)),
+    ("verge trees", lambda p, s, g, lots, st: pv.place_verge_trees(p, s, st)),
     ("traffic signs", lambda p, s, g, lots, st: ps.place_signs(p, s, st)),
     ("lot greenery", lambda p, s, g, lots, st: pl.place_lot_greenery(p, s, lots, g.curb_h)),
     ("parked vehicles", lambda p, s, g, lots, st: ps.place_parked(p, s, st)),
@@ -113,8 +118,6 @@ def ground_pieces(grid: Grid, lots: list[Lot], placed: list[Placed] = ()) -> lis
 
 
 def _objects(grid: Grid, lots: list[Lot], placed: list[Placed], lib: Library):
-    from generator.geometry.proxy import label_proxy
-
     prototypes: dict[str, Mesh] = {}
     proxies: dict[str, Mesh] = {}
     objects: list[SceneObject] = []
@@ -143,7 +146,7 @@ def _objects(grid: Grid, lots: list[Lot], placed: list[Placed], lib: Library):
         if p.proto not in prototypes:
             mesh = lib.protos[p.proto].mesh
             prototypes[p.proto] = mesh
-            hull = label_proxy(mesh)
+            hull = lib.label_proxy(p.proto)
             if hull is not None:
                 proxies[p.proto] = hull
         objects.append(SceneObject(len(objects), name(p.kind), p.kind, p.cls, instance, p.proto, p.transform, p.box,
@@ -188,7 +191,7 @@ def build_scene(spec: SceneSpec) -> SceneModel:
     lots = make_lots(spec, grid)
     limit = spec.paths.clearance_m + EGO_HALF_WIDTH_M
     keepout = Keepout(np.concatenate([densify(r) for r in routes]), limit)
-    lib = Library(spec.seed)
+    lib = Library(spec.seed if spec.asset_seed is None else spec.asset_seed)  # re-drawn towns share the assets
     placer = Placer(lib, keepout)
     street = ps.Street(grid)
     log.info("layout %s: %d x %d blocks, %d segments, %d lots", spec.name, len(grid.xs) - 1, len(grid.ys) - 1,

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from generator.geometry import Mesh, merge, pose
+from generator.layout.districts import DISTRICTS, District, draw_districts
 from generator.layout.outskirts import outer_rows
 from generator.layout.street_meshes import rects
 from generator.layout.streets import Grid
@@ -28,6 +29,11 @@ BACK_GAP = 2.0         #: building to lot back, metres
 FRONT_GAP_M = 2.0      #: gap left in a hedge or fence for the entrance
 FRONT_B = 0.6          #: centre line of hedges/fences, metres behind the lot front
 FACADES = ("plaster", "brick", "concrete")
+GLASS_SHARE = 0.15     #: share of buildings of 5+ storeys that are glass curtain walls
+#: render (plaster) colours a building is painted in: cream, ochre, salmon, sage, blue-grey,
+#: off-white, terracotta, yellow (multiplied into the plaster shader)
+RENDER_COLOURS = ((0.86, 0.80, 0.66), (0.80, 0.62, 0.38), (0.82, 0.58, 0.50), (0.66, 0.74, 0.60),
+                  (0.62, 0.68, 0.74), (0.88, 0.86, 0.82), (0.72, 0.45, 0.34), (0.86, 0.76, 0.45))
 ROOFS = ("flat", "gable", "hip")
 
 
@@ -60,12 +66,17 @@ class BuildingPlan:
 
 @dataclass
 class FrontLine:
-    """A hedge or fence piece along the lot front: ``a0..a1`` at ``b`` (lot frame, metres)."""
+    """A hedge or fence piece along the lot front: ``a0..a1`` at ``b`` (lot frame, metres).
+
+    ``across`` pieces run along the lot's depth instead (a lot side on a street): ``b`` from
+    ``a0`` to ``a1`` at ``a = b``.
+    """
 
     kind: str        # "hedge" | "fence"
     a0: float
     a1: float
     b: float
+    across: bool = False
 
 
 @dataclass
@@ -83,6 +94,9 @@ class Lot:
     building: BuildingPlan | None = None
     front: list[FrontLine] = field(default_factory=list)
     entrance_a: float = 0.0           #: a of the door / gate (lot frame)
+    district: str = ""                #: its block's district ("" without a streets spec)
+    front_height: float | None = None  #: hedge/fence height the district drew (None: place_fronts draws it)
+    greenery: float = 1.0             #: multiplier on the lot's trees and bushes
 
     def transform(self, z: float = 0.0) -> np.ndarray:
         """(4, 4) world-from-lot transform."""
@@ -139,18 +153,25 @@ def _footprint(w: float, d: float, g: np.random.Generator) -> np.ndarray:
     return np.array([(-hw, -hd), (hw, -hd), (hw, hd), (-hw, hd)])
 
 
-def _building(spec: SceneSpec, width: float, depth: float, setback: float, g: np.random.Generator) -> BuildingPlan | None:
+def _building(spec: SceneSpec, width: float, depth: float, setback: float, g: np.random.Generator,
+              district: District | None = None, look: np.random.Generator | None = None) -> BuildingPlan | None:
+    """A building plan for a lot (shaped by its ``district`` when drawn); ``look`` (the lot's own stream)
+    draws the curtain walls and the render colours, so those draws do not shift the plans of the lots after it."""
     side = g.uniform(*SIDE_GAP, 2)
     bw = width - side.sum()
-    bd = min(g.uniform(10.0, 22.0), depth - setback - BACK_GAP)
+    bd = min(g.uniform(*(district.depth_m if district else (10.0, 22.0))), depth - setback - BACK_GAP)
     if bw < 6.0 or bd < 6.0:
         return None
     hf = spec.heights.floor_m
-    lo, hi = spec.heights.building_m
+    lo, hi = district.height_m if district else spec.heights.building_m
     floors = max(1, int(round(g.uniform(lo, hi) / hf)))
     facade = FACADES[int(g.integers(len(FACADES)))]
+    glass, colour = (look.random() < GLASS_SHARE, int(look.integers(len(RENDER_COLOURS)))) if look else (False, 0)
+    if floors >= 5 and glass:      # some tall buildings are glass curtain walls
+        facade = "glass"
     roof = "flat" if floors > 4 or g.random() < 0.35 else ROOFS[1 + int(g.integers(2))]
-    base = {"plaster": (0.85, 0.8, 0.7), "brick": (0.6, 0.32, 0.24), "concrete": (0.65, 0.65, 0.63)}[facade]
+    base = {"plaster": RENDER_COLOURS[colour], "brick": (0.6, 0.32, 0.24), "concrete": (0.65, 0.65, 0.63),
+            "glass": (0.8, 0.85, 0.9)}[facade]
     tint = np.clip(np.asarray(base) * g.uniform(0.85, 1.15, 3), 0, 1)
     roof_tint = np.clip(np.array((0.35, 0.28, 0.26) if roof != "flat" else (0.4, 0.4, 0.42)) * g.uniform(0.8, 1.2, 3), 0, 1)
     attrs = {"facade_color": [round(float(c), 4) for c in tint], "roof_color": [round(float(c), 4) for c in roof_tint]}
@@ -170,32 +191,41 @@ def make_lots(spec: SceneSpec, grid: Grid) -> list[Lot]:
     g = stream(spec.seed, "layout", "lots")
     d = spec.density
     lots: list[Lot] = []
+    nx, ny = len(grid.xs) - 1, len(grid.ys) - 1
+    sections = outer_rows(grid)
+    districts = draw_districts(spec, nx * ny + len(sections))
 
-    def row(block, corner, ua, ub, widths, depth, g):
+    def row(block, corner, ua, ub, widths, depth, g, district):
         yaw = float(np.arctan2(ub[1], ub[0]) - np.pi / 2)
         a = 0.0
         for w in widths:
             origin = np.asarray(corner) + np.asarray(ua) * (a + w / 2)
             a += w
-            lots.append(_plan_lot(spec, len(lots), block, origin, yaw, float(w), float(depth), d, g))
+            lot = _plan_lot(spec, len(lots), block, origin, yaw, float(w), float(depth), d, g, district)
+            lots.append(lot)
 
-    for j in range(len(grid.ys) - 1):
-        for i in range(len(grid.xs) - 1):
+    for j in range(ny):
+        for i in range(nx):
             for (corner, ua, ub, frontage), depth in _rows(grid.block_rect(i, j), g):
-                row((i, j), corner, ua, ub, _widths(frontage, g), depth, g)
+                row((i, j), corner, ua, ub, _widths(frontage, g), depth, g, districts[j * nx + i])
     g = stream(spec.seed, "layout", "outer_lots")
-    for side, corner, ua, ub, frontage, is_corner in outer_rows(grid):
-        row((-1, side), corner, ua, ub, [frontage] if is_corner else _widths(frontage, g), grid.outer_depth, g)
+    for k, (side, corner, ua, ub, frontage, is_corner) in enumerate(sections):
+        row((-1, side), corner, ua, ub, [frontage] if is_corner else _widths(frontage, g), grid.outer_depth, g,
+            districts[nx * ny + k])
+    line_street_edges(lots, grid)
     return lots
 
 
-def _plan_lot(spec, index, block, origin, yaw, width, depth, d, g) -> Lot:
+def _plan_lot(spec, index, block, origin, yaw, width, depth, d, g, district: str = "") -> Lot:
+    if district in DISTRICTS:
+        return _plan_district_lot(spec, index, block, origin, yaw, width, depth, DISTRICTS[district], district, g)
     r = g.random()
     front = "hedge" if r < d.hedges else ("fence" if r < d.hedges + d.fences else None)
     lot = Lot(index, block, (float(origin[0]), float(origin[1])), yaw, width, depth, "yard", "grass")
     if g.random() < d.buildings:
         setback = g.uniform(2.5, 4.0) if front else g.uniform(0.0, 4.0)
-        lot.building = _building(spec, width, depth, float(setback), g)
+        look = stream(spec.seed, "layout", "facade_look", index)
+        lot.building = _building(spec, width, depth, float(setback), g, look=look)
     if lot.building is not None:
         lot.use = "building"
         lot.ground = "grass" if g.random() < 0.7 else "paving"
@@ -207,7 +237,64 @@ def _plan_lot(spec, index, block, origin, yaw, width, depth, d, g) -> Lot:
             front = None if g.random() < 0.5 else front
     if front:
         lot.front = _front(front, width, lot.entrance_a)
+    lot.district = district
     return lot
+
+
+def _plan_district_lot(spec, index, block, origin, yaw, width, depth, dist: District, name: str, g) -> Lot:
+    """A lot planned by its district's parameters (see :mod:`generator.layout.districts`)."""
+    r = g.random()
+    front = "hedge" if r < dist.hedge else ("fence" if r < dist.hedge + dist.fence else None)
+    lot = Lot(index, block, (float(origin[0]), float(origin[1])), yaw, width, depth, "yard", "grass",
+              district=name, front_height=float(g.uniform(*dist.front_height_m)), greenery=dist.greenery)
+    if g.random() < dist.buildings:
+        setback = max(float(g.uniform(*dist.setback_m)), 1.5 if front else 0.0)   # clear of the hedge
+        lot.building = _building(spec, width, depth, setback, g, dist,
+                                 look=stream(spec.seed, "layout", "facade_look", index))
+    if lot.building is not None:
+        lot.use = "building"
+        lot.ground = "grass" if g.random() < dist.grass else "paving"
+        lot.entrance_a = lot.building.center[0]
+        lot.building.attrs["district"] = name
+    else:
+        lot.use = "park" if g.random() < dist.parks else "yard"
+        lot.entrance_a = float(g.uniform(-0.25, 0.25) * width)
+    if front:
+        lot.front = _front(front, width, lot.entrance_a)
+    return lot
+
+
+def _street_edges(lot: Lot, rect: tuple[float, float, float, float]) -> list[FrontLine]:
+    """Lines along the sides and back of a block lot that lie on its block's edge (a street), set
+    ``FRONT_B`` inside the lot, of the same kind as its front (none if the front has none)."""
+    if not lot.front:
+        return []
+    kind, w, d = lot.front[0].kind, lot.width / 2, lot.depth
+    x0, y0, x1, y1 = rect
+
+    def on_edge(p, q) -> bool:
+        for k, lo, hi in ((0, x0, x1), (1, y0, y1)):
+            for e in (lo, hi):
+                if abs(p[k] - e) < 1e-6 and abs(q[k] - e) < 1e-6:
+                    return True
+        return False
+
+    c = lot.corners_world()         # front-left, front-right, back-right, back-left
+    out = []
+    if on_edge(c[1], c[2]):
+        out.append(FrontLine(kind, FRONT_B + 0.5, d - 0.4, w - FRONT_B, True))
+    if on_edge(c[3], c[0]):
+        out.append(FrontLine(kind, FRONT_B + 0.5, d - 0.4, -w + FRONT_B, True))
+    if on_edge(c[2], c[3]):
+        out.append(FrontLine(kind, -w + 0.4, w - 0.4, d - FRONT_B))
+    return [f for f in out if f.a1 - f.a0 >= 1.0]
+
+
+def line_street_edges(lots: list[Lot], grid: Grid) -> None:
+    """District lots inside blocks: hedge or fence also along the sides and back that face a street."""
+    for lot in lots:
+        if lot.district and lot.block[0] >= 0:
+            lot.front += _street_edges(lot, grid.block_rect(*lot.block))
 
 
 def lot_ground_mesh(lot: Lot, curb_h: float) -> Mesh:

@@ -82,8 +82,11 @@ class Library:
     def __init__(self, seed: int):
         from assets_procedural import catalog  # imported lazily: the layout math does not need it
 
+        from assets_procedural.proto_cache import CACHE
+
         self.seed = seed
         self._catalog = catalog
+        self._cache = CACHE
         self.protos: dict[str, Proto] = {}
         self._unique: dict[str, int] = defaultdict(int)
 
@@ -93,7 +96,9 @@ class Library:
     def _make(self, key: str, kind: str, g: np.random.Generator, params: dict) -> Proto:
         mesh = self._catalog.build(kind, g, **params)
         lo, hi = mesh.bounds()
-        p = Proto(key, kind, mesh, lo, hi, collision_boxes(mesh, whole=kind in WHOLE_BOX_KINDS), dict(params))
+        whole = kind in WHOLE_BOX_KINDS
+        bands = self._cache.derive(mesh, f"bands/{whole}", lambda m: collision_boxes(m, whole=whole))
+        p = Proto(key, kind, mesh, lo, hi, bands, dict(params))
         self.protos[key] = p
         return p
 
@@ -117,6 +122,13 @@ class Library:
         n = self._unique[kind]
         self._unique[kind] += 1
         return self._make(f"{kind}_{n:04d}", kind, stream(self.seed, "assets", kind, n), params)
+
+    def label_proxy(self, key: str):
+        """The label hull of prototype ``key`` (:func:`generator.geometry.proxy.label_proxy`), computed
+        once per cached prototype mesh."""
+        from generator.geometry.proxy import label_proxy
+
+        return self._cache.derive(self.protos[key].mesh, "label_proxy", label_proxy)
 
     def discard(self, proto: Proto) -> None:
         """Forget a unique prototype whose object was rejected."""

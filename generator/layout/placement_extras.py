@@ -23,8 +23,9 @@ from __future__ import annotations
 import numpy as np
 
 from generator.layout.lots import Lot
-from generator.layout.placement_core import Placer, Proto
-from generator.layout.placement_street import Street, free_lane, clothing_color, vehicle_color
+from generator.geometry import pose
+from generator.layout.placement_core import Placer, Proto, oriented_box, world_boxes
+from generator.layout.placement_street import Street, free_lane, person_outfit, vehicle_paint
 from generator.layout.streets import PARKING_START_U
 from generator.rng import stream
 from generator.spec.model import SceneSpec
@@ -93,7 +94,7 @@ def place_bike_racks(placer: Placer, spec: SceneSpec, st: Street) -> None:
                 bike = bikes[int(g.integers(len(bikes)))]
                 uu = u + 1.6 + 0.75 * k
                 placer.try_place(bike, *_at(seg, uu, v, bike, to_road), st.h, to_road,
-                                 {"color": vehicle_color(g), "placement": "rack"})
+                                 {**vehicle_paint(g), "placement": "rack"})
 
 
 def place_two_wheelers(placer: Placer, spec: SceneSpec, st: Street) -> None:
@@ -105,6 +106,8 @@ def place_two_wheelers(placer: Placer, spec: SceneSpec, st: Street) -> None:
     g = stream(spec.seed, "layout", "two_wheelers")
     bikes, motos = _protos(placer, "bicycle", n=6), _protos(placer, "motorcycle")
     for seg, s in _segments(st):
+        if grid.section(seg).strip(s) != "parking":    # a verge or shoulder (streets spec): no parking
+            continue
         _, traffic = st.side_yaws(seg, s)
         u0, u1 = PARKING_START_U, seg.length - PARKING_START_U
         for _ in range(int(g.poisson(dens * max(0.0, u1 - u0) / 100))):
@@ -112,7 +115,7 @@ def place_two_wheelers(placer: Placer, spec: SceneSpec, st: Street) -> None:
             yaw = traffic + s * np.radians(g.uniform(40, 70))
             u, v = g.uniform(u0, u1), s * (grid.lane_half + grid.parking_w * 0.55)
             placer.try_place(proto, *_at(seg, u, v, proto, yaw), 0.0, yaw,
-                             {"color": vehicle_color(g), "placement": "parked"}, pad=0.1)
+                             {**vehicle_paint(g), "placement": "parked"}, pad=0.1)
 
 
 def _ridden(placer: Placer, kind: str, i: int) -> tuple[Proto, Proto]:
@@ -137,7 +140,7 @@ def place_riders(placer: Placer, spec: SceneSpec, st: Street) -> None:
         v_lane = s * (grid.lane_half - 0.9)  # the kerb side of the outer lane, where a cyclist rides
         if u1 > u0 and free_lane(placer, seg, s * (grid.lane_half - grid.lane_w / 2), u0, u1):
             spots.append((seg, traffic, v_lane, u0, u1))
-        if grid.parking_w > 0:
+        if grid.parking_w > 0 and grid.section(seg).strip(s) != "verge":
             spots.append((seg, traffic, s * (grid.lane_half + grid.parking_w / 2), u0, u1))
     if not spots:
         return
@@ -147,13 +150,13 @@ def place_riders(placer: Placer, spec: SceneSpec, st: Street) -> None:
         rider, vehicle = _ridden(placer, kind, int(g.integers(N_VAR)))
         u = g.uniform(u0, u1)
         x, y = _at(seg, u, v, vehicle, traffic)
-        color = vehicle_color(g)
-        if placer.try_place(vehicle, x, y, 0.0, traffic, {"color": color, "placement": "ridden"}, pad=0.3):
-            placer.place_on(rider, x, y, 0.0, traffic, {"color": clothing_color(g)})
+        if placer.try_place(vehicle, x, y, 0.0, traffic, {**vehicle_paint(g), "placement": "ridden"}, pad=0.3):
+            placer.place_on(rider, x, y, 0.0, traffic, person_outfit(g))
 
 
 def place_bus_stops(placer: Placer, spec: SceneSpec, st: Street) -> None:
-    """Shelters at the back of the sidewalk; a bus stands at the stop where its lane has no route."""
+    """Bus stops: a shelter at the back of the sidewalk and a bus standing at it, in a lane no route
+    drives; up to :data:`STOP_TRIES` spots along a side are tried for a pair that fits."""
     dens = spec.density.bus_stops_per_km
     grid = st.grid
     if dens <= 0:
@@ -164,18 +167,31 @@ def place_bus_stops(placer: Placer, spec: SceneSpec, st: Street) -> None:
         to_road, traffic = st.side_yaws(seg, s)
         if seg.length < 40 or g.random() >= dens * seg.length / 1000:
             continue
-        u = g.uniform(st.walk_u0 + 8.0, seg.length - st.walk_u0 - 14.0)
-        shelter = shelters[int(g.integers(2))]
-        v = s * (st.walk[1] - (shelter.hi[0] - shelter.lo[0]) / 2 - 0.2)
-        if not placer.try_place(shelter, *_at(seg, u, v, shelter, to_road), st.h, to_road):
-            continue
-        bus = buses[int(g.integers(2))]
-        for k in range(grid.lanes):  # the kerb-side lane first, else the next one out
-            v_lane = s * (grid.lane_half - (k + 0.5) * grid.lane_w)
-            if free_lane(placer, seg, v_lane, u - 7.0, u + 7.0):
-                placer.try_place(bus, *_at(seg, u, v_lane, bus, traffic), 0.0, traffic,
-                                 {"color": vehicle_color(g), "placement": "bus_stop"}, pad=0.3)
+        for _ in range(STOP_TRIES):  # the first spot along the side where the bus and its shelter both fit
+            u = g.uniform(st.walk_u0 + 8.0, seg.length - st.walk_u0 - 14.0)
+            shelter, bus, paint = shelters[int(g.integers(2))], buses[int(g.integers(2))], vehicle_paint(g)
+            xy = _bus_spot(placer, grid, seg, s, u, bus, traffic)
+            v = s * (st.walk[1] - (shelter.hi[0] - shelter.lo[0]) / 2 - 0.2)
+            if xy is not None and placer.try_place(shelter, *_at(seg, u, v, shelter, to_road), st.h, to_road):
+                placer.try_place(bus, *xy, 0.0, traffic, {**paint, "placement": "bus_stop"}, pad=BUS_PAD_M)
                 break
+
+
+STOP_TRIES = 8    #: spots tried along one side of a segment for a bus stop
+BUS_PAD_M = 0.3
+
+
+def _bus_spot(placer: Placer, grid, seg, s: int, u: float, bus: Proto, yaw: float) -> tuple[float, float] | None:
+    """World xy of a bus standing at ``u`` in the kerb-side lane (else the next one out) that no route
+    drives and where it touches nothing placed; None if there is none."""
+    for k in range(grid.lanes):
+        v_lane = s * (grid.lane_half - (k + 0.5) * grid.lane_w)
+        if free_lane(placer, seg, v_lane, u - 7.0, u + 7.0):
+            x, y = _at(seg, u, v_lane, bus, yaw)
+            T = pose(x, y, 0.0, yaw)
+            if not placer.keepout.violated(oriented_box(bus, T)) and not placer.occ.hits(world_boxes(bus.bands, T, BUS_PAD_M)):
+                return x, y
+    return None
 
 
 def place_trams(placer: Placer, spec: SceneSpec, st: Street) -> None:
@@ -197,7 +213,7 @@ def place_trams(placer: Placer, spec: SceneSpec, st: Street) -> None:
         _, traffic = st.side_yaws(seg, s)
         tram = placer.lib.variant("tram", int(g.integers(2)), lambda g2: {"sections": 3})
         if not placer.try_place(tram, *_at(seg, (u0 + u1) / 2, v, tram, traffic), 0.0, traffic,
-                                {"color": vehicle_color(g), "placement": "tram_stop"}, pad=0.3):
+                                {**vehicle_paint(g), "placement": "tram_stop"}, pad=0.3):
             continue
         rails = placer.lib.unique("tram_rails", length=float(u1 - u0))
         x, y = seg.to_world((u0 + u1) / 2, v)[0]
@@ -215,6 +231,8 @@ def place_other_vehicles(placer: Placer, spec: SceneSpec, st: Street) -> None:
              "construction_vehicle": _protos(placer, "construction_vehicle", n=2)}
     names, p = list(kinds), np.array([0.45, 0.4, 0.15])
     for seg, s in _segments(st):
+        if grid.section(seg).strip(s) == "verge":      # grass (streets spec): nothing parks there
+            continue
         _, traffic = st.side_yaws(seg, s)
         u0, u1 = PARKING_START_U, seg.length - PARKING_START_U
         for _ in range(int(g.poisson(dens * max(0.0, u1 - u0) / 100))):
@@ -223,7 +241,7 @@ def place_other_vehicles(placer: Placer, spec: SceneSpec, st: Street) -> None:
             fits = proto.hi[1] - proto.lo[1] <= grid.parking_w - 0.1
             v = s * (grid.lane_half + grid.parking_w / 2) if fits else s * (grid.lane_half - grid.lane_w / 2)
             placer.try_place(proto, *_at(seg, g.uniform(u0, u1), v, proto, traffic), 0.0, traffic,
-                             {"color": vehicle_color(g), "placement": "parked" if fits else "lane"}, pad=0.2)
+                             {**vehicle_paint(g), "placement": "parked" if fits else "lane"}, pad=0.2)
 
 
 def _in_rects(x: float, y: float, rects: np.ndarray, pad: float = 1.0) -> bool:
@@ -252,7 +270,8 @@ def place_lot_extras(placer: Placer, spec: SceneSpec, lots: list[Lot], st: Stree
                 a = float(np.clip(lot.entrance_a + g.uniform(2.5, 4.0), -lot.width / 2 + 3, lot.width / 2 - 3))
                 b = -(grid.corridor_half - grid.road_half) - depth / 2
                 x, y = lot.to_world([(a, b)])[0]
-                if not _in_rects(x, y, lanes):  # not where turning cars run at the segment ends
+                # not where turning cars run at the segment ends, nor on a raised verge
+                if not _in_rects(x, y, lanes) and not (grid.sections and grid.ground_height([(x, y)])[0] > 0):
                     placer.try_place(apron, x, y, 0.0, lot.yaw - np.pi / 2, {"lot": lot.index})
         if lot.use in ("park", "yard") and dens.gravel > 0 and g.random() < dens.gravel:
             patch = placer.lib.variant("gravel_patch", int(g.integers(N_VAR)))

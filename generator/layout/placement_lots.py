@@ -61,14 +61,19 @@ def place_fronts(placer: Placer, spec: SceneSpec, lots: list[Lot], curb_h: float
         height = float(g.uniform(0.9, 1.6))
         depth = float(g.uniform(0.6, 0.9))
         style = FENCE_STYLES[int(g.integers(len(FENCE_STYLES)))]
+        if lot.front_height is not None:        # the lot's district drew it
+            height = lot.front_height
+        attrs = {"lot": lot.index, "district": lot.district} if lot.district else {"lot": lot.index}
         for piece in lot.front:
             length = piece.a1 - piece.a0
             if piece.kind == "hedge":
                 proto = placer.lib.unique("hedge", length=length, height=height, depth=depth)
             else:
                 proto = placer.lib.unique("fence", length=length, height=height, style=style)
-            x, y = lot.to_world([((piece.a0 + piece.a1) / 2, piece.b)])[0]
-            if not placer.try_place(proto, x, y, curb_h, lot.yaw, {"lot": lot.index}):
+            mid = (piece.a0 + piece.a1) / 2
+            x, y = lot.to_world([(piece.b, mid) if piece.across else (mid, piece.b)])[0]
+            yaw = lot.yaw + np.pi / 2 if piece.across else lot.yaw
+            if not placer.try_place(proto, x, y, curb_h, yaw, dict(attrs)):
                 placer.lib.discard(proto)
 
 
@@ -95,15 +100,16 @@ def place_lot_greenery(placer: Placer, spec: SceneSpec, lots: list[Lot], curb_h:
     dens = spec.density
     for lot in lots:
         area = lot.width * lot.depth
+        green = lot.greenery            # 1 without districts (then the counts are as they always were)
         if lot.use == "park":
-            n = int(round(area / 140 * g_trees.uniform(0.7, 1.3)))
+            n = int(round(area / 140 * g_trees.uniform(0.7, 1.3) * green))
         elif lot.use == "yard":
-            n = int(g_trees.poisson(area / 400))
+            n = int(g_trees.poisson(area / 400 * green))
         else:
-            n = int(g_trees.poisson(0.4)) if lot.ground == "grass" else 0
+            n = int(g_trees.poisson(0.4 * green)) if lot.ground == "grass" else 0
         _scatter(placer, lot, lambda i: tree_variant(placer, spec, i), n, 2.5, curb_h, g_trees, pad=0.4)
         if lot.ground != "grass":
             continue
         scale = 3.0 if lot.use == "park" else 1.5
-        n = int(g_bush.poisson(dens.bushes_per_100m * (lot.width + 2 * lot.depth) / 100 * scale / 3))
+        n = int(g_bush.poisson(dens.bushes_per_100m * (lot.width + 2 * lot.depth) / 100 * scale / 3 * green))
         _scatter(placer, lot, lambda i: bush_variant(placer, i), n, 1.0, curb_h, g_bush, pad=0.2)

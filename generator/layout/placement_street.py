@@ -12,6 +12,7 @@ import logging
 
 import numpy as np
 
+from generator.layout.appearance import fleet_paint, outfit
 from generator.layout.placement_core import Placer, Proto
 from generator.layout.placement_lots import N_TREE_VARIANTS, tree_variant
 from generator.layout.streets import BAY_M, CROSSWALK_U, PARKING_START_U, Grid, Segment
@@ -21,22 +22,22 @@ from generator.spec.model import SceneSpec
 log = logging.getLogger(__name__)
 
 MIN_TREE_M = 3.0        #: the smallest tree the asset builder makes
+#: street-tree species (``assets_procedural.tree_species``), one per street-tree variant
+STREET_SPECIES = ("linden", "plane", "birch", "young")
 SIGN_SHAPES = ("circle", "triangle", "square", "octagon", "diamond")
-CAR_COLORS = np.array([(0.92, 0.92, 0.92), (0.08, 0.08, 0.09), (0.55, 0.56, 0.58), (0.75, 0.76, 0.78),
-                       (0.62, 0.08, 0.07), (0.1, 0.2, 0.5), (0.2, 0.35, 0.25), (0.85, 0.75, 0.55)])
 N_CAR, N_TRUCK, N_PEOPLE, N_LAMP, N_TL, N_STREET_TREE = 6, 3, 6, 3, 2, 4
 
 
-def _round(c) -> list[float]:
-    return [round(float(v), 4) for v in np.clip(c, 0, 1)]
+def vehicle_paint(g: np.random.Generator) -> dict:
+    """A vehicle's paint attributes (``color``, ``paint``, ``paint_metallic``) from the fleet
+    distribution of ``generator/layout/appearance.yaml``; takes 4 values from ``g``."""
+    return fleet_paint(g)
 
 
-def vehicle_color(g: np.random.Generator) -> list[float]:
-    return _round(CAR_COLORS[int(g.integers(len(CAR_COLORS)))] * g.uniform(0.9, 1.1, 3))
-
-
-def clothing_color(g: np.random.Generator) -> list[float]:
-    return _round(g.uniform(0.05, 0.9, 3))
+def person_outfit(g: np.random.Generator) -> dict:
+    """A person's colour attributes (``color`` = the top, ``bottom_color``, ``shoe_color``,
+    ``skin_color``, ``hair_color``, ``outfit``) from ``appearance.yaml``; takes 20 values from ``g``."""
+    return outfit(g)
 
 
 class Street:
@@ -97,17 +98,18 @@ def place_lamps(placer: Placer, spec: SceneSpec, st: Street) -> None:
                 placer.try_place(protos[int(g.integers(N_LAMP))], x, y, st.h, to_road, pad=0.2)
 
 
-def street_tree_variants(placer: Placer, spec: SceneSpec, half_width: float) -> list[Proto]:
+def street_tree_variants(placer: Placer, spec: SceneSpec, half_width: float, tag: str = "street") -> list[Proto]:
     """Street-tree variants whose crown stays within ``half_width`` metres of the trunk (so it
-    never reaches over a route lane); a variant that comes out too wide is rebuilt shorter."""
+    never reaches over a route lane); a variant that comes out too wide is rebuilt shorter.
+    ``tag`` names the variant family (another width limit needs its own family)."""
     lo, hi = spec.heights.tree_m
     out = []
     for i in range(N_STREET_TREE):
-        shape = ("oval", "round")[i % 2]
+        species = STREET_SPECIES[i % len(STREET_SPECIES)]
         for attempt in range(6):
-            def params(g, attempt=attempt, shape=shape):
-                return {"height": float(max(MIN_TREE_M, g.uniform(lo, hi) * 0.85 ** attempt)), "shape": shape}
-            proto = placer.lib.variant("tree", i, params, tag=f"street{attempt}")
+            def params(g, attempt=attempt, species=species):
+                return {"height": float(max(MIN_TREE_M, g.uniform(lo, hi) * 0.85 ** attempt)), "species": species}
+            proto = placer.lib.variant("tree", i, params, tag=f"{tag}{attempt}")
             if max(-proto.lo[0], proto.hi[0], -proto.lo[1], proto.hi[1]) <= half_width:
                 out.append(proto)
                 break
@@ -179,22 +181,30 @@ def place_parked(placer: Placer, spec: SceneSpec, st: Street) -> None:
     """Cars (one bay) and trucks (two bays) in the parking strips, facing the traffic of their side.
 
     A truck wider than the strip double-parks in the lane next to it instead (only where no
-    route drives that lane; the keep-out rejects it otherwise).
+    route drives that lane; the keep-out rejects it otherwise). Without ``spec.streets`` every
+    bay is taken with probability ``parked_cars_per_100m * BAY_M / 100``; with it, each strip
+    has its own share (:attr:`CrossSection.occupancy`) and strips that are verges or shoulders
+    get none.
     """
     grid = st.grid
     if grid.parking_w <= 0 or spec.density.parked_cars_per_100m <= 0:
         return
     g = stream(spec.seed, "layout", "parked")
+    paint = stream(spec.seed, "layout", "parked", "paint")      # colours never move a car
     trucks = [_vehicle(placer, "truck", i) for i in range(N_TRUCK)]
     p_occ = min(1.0, spec.density.parked_cars_per_100m * BAY_M / 100.0)
     for seg in grid.segments:
         u0, u1 = PARKING_START_U, seg.length - PARKING_START_U
         n_bays = int((u1 - u0 + 1e-6) // BAY_M)
+        sec = grid.section(seg)
         for s in (-1, 1):
+            if grid.sections and sec.strip(s) != "parking":
+                continue
+            share = sec.share(s) if grid.sections else p_occ
             _, traffic = st.side_yaws(seg, s)
             b = 0
             while b < n_bays:
-                if g.random() >= p_occ:
+                if g.random() >= share:
                     b += 1
                     continue
                 truck = b + 1 < n_bays and g.random() < spec.density.truck_fraction
@@ -209,7 +219,7 @@ def place_parked(placer: Placer, spec: SceneSpec, st: Street) -> None:
                 c = (proto.lo + proto.hi) / 2     # centre the body (not the local origin) on the spot
                 ct, sn = np.cos(traffic), np.sin(traffic)
                 x, y = seg.to_world(u, v)[0] - [c[0] * ct - c[1] * sn, c[0] * sn + c[1] * ct]
-                placer.try_place(proto, x, y, 0.0, traffic, {"color": vehicle_color(g),
+                placer.try_place(proto, x, y, 0.0, traffic, {**vehicle_paint(paint),
                                  "placement": "parked" if fits else "double_parked"}, pad=0.2)
                 b += nb
 
@@ -222,6 +232,7 @@ def place_lane_cars(placer: Placer, spec: SceneSpec, st: Street) -> None:
     if dens <= 0 or spec.traffic.enabled:  # the frozen town's stand-ins for traffic; real traffic replaces them
         return
     g = stream(spec.seed, "layout", "lane_cars")
+    paint = stream(spec.seed, "layout", "lane_cars", "paint")
     lanes = []
     for seg in grid.segments:
         u0, u1 = PARKING_START_U + 4.0, seg.length - PARKING_START_U - 4.0
@@ -240,7 +251,7 @@ def place_lane_cars(placer: Placer, spec: SceneSpec, st: Street) -> None:
         kind = "truck" if g.random() < spec.density.truck_fraction else "car"
         proto = _vehicle(placer, kind, int(g.integers(N_CAR)))
         x, y = seg.to_world(g.uniform(u0, u1), v)[0]
-        placer.try_place(proto, x, y, 0.0, heading, {"color": vehicle_color(g), "placement": "lane"}, pad=0.5)
+        placer.try_place(proto, x, y, 0.0, heading, {**vehicle_paint(paint), "placement": "lane"}, pad=0.5)
 
 
 def place_people(placer: Placer, spec: SceneSpec, st: Street) -> None:
@@ -249,6 +260,7 @@ def place_people(placer: Placer, spec: SceneSpec, st: Street) -> None:
     if spec.density.people_per_100m <= 0:
         return
     g = stream(spec.seed, "layout", "people")
+    look = stream(spec.seed, "layout", "people", "outfit")     # outfits never move a person
     lo, hi = spec.heights.person_m
     protos = [placer.lib.variant("person", i, lambda g, i=i: {"height": float(g.uniform(lo, hi)),
                                                                "pose": "standing" if i < N_PEOPLE // 2 else "walking"})
@@ -262,11 +274,11 @@ def place_people(placer: Placer, spec: SceneSpec, st: Street) -> None:
                 x, y = seg.to_world(u, s * g.uniform(*st.walk))[0]
                 yaw = seg.yaw + (0 if g.random() < 0.5 else np.pi) + g.normal(0, 0.1) if i >= N_PEOPLE // 2 \
                     else g.uniform(0, 2 * np.pi)
-                placer.try_place(protos[i], x, y, st.h, yaw, {"color": clothing_color(g)}, pad=0.15)
+                placer.try_place(protos[i], x, y, st.h, yaw, person_outfit(look), pad=0.15)
         if g.random() < 0.25 and not spec.traffic.enabled:  # someone frozen on a crosswalk (traffic: they walk)
             u = g.uniform(*CROSSWALK_U) if g.random() < 0.5 else seg.length - g.uniform(*CROSSWALK_U)
             v = g.uniform(-grid.road_half + 0.6, grid.road_half - 0.6)
             x, y = seg.to_world(u, v)[0]
             yaw = seg.yaw + (np.pi / 2 if g.random() < 0.5 else -np.pi / 2)
             i = N_PEOPLE // 2 + int(g.integers(N_PEOPLE - N_PEOPLE // 2))
-            placer.try_place(protos[i], x, y, 0.0, yaw, {"color": clothing_color(g), "placement": "crosswalk"}, pad=0.15)
+            placer.try_place(protos[i], x, y, 0.0, yaw, {**person_outfit(look), "placement": "crosswalk"}, pad=0.15)

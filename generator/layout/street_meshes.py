@@ -10,6 +10,7 @@ import numpy as np
 
 from generator.geometry import Mesh, merge, pose, slab
 from generator.labels import class_table
+from generator.layout.cross_sections import MEDIAN_W_M
 from generator.layout.streets import BAY_M, CROSSWALK_U, MARK_Z_M, PARKING_START_U, STOP_U, TREE_PIT_M, Grid, Segment
 from generator.materials import material_table
 
@@ -49,7 +50,11 @@ def segment_road_mesh(grid: Grid, seg: Segment) -> Mesh:
     parts = [rects([(0, -lh, L, lh)], 0.0, "road", "asphalt")]
     pk0, pk1 = PARKING_START_U, L - PARKING_START_U
     has_parking = p > 0 and pk1 - pk0 >= BAY_M
-    if p > 0:
+    sec = grid.section(seg)
+    varied = has_parking and sec.strips != ("parking", "parking")
+    if varied:
+        parts += _strips(grid, sec, L)
+    elif p > 0:
         sides = [(lh, rh), (-rh, -lh)]
         if has_parking:
             road = [(0, a, pk0, b) for a, b in sides] + [(pk1, a, L, b) for a, b in sides]
@@ -72,7 +77,9 @@ def segment_road_mesh(grid: Grid, seg: Segment) -> Mesh:
     marks.append(np.array([(STOP_U[0], 0.06, STOP_U[1], lh), (L - STOP_U[1], -lh, L - STOP_U[0], -0.06)]))
     if has_parking:
         bays = np.arange(pk0, pk1 + 1e-6, BAY_M)
-        for a, b in ((lh + 0.075, rh), (-rh, -lh - 0.075)):
+        for (a, b), side in zip(((lh + 0.075, rh), (-rh, -lh - 0.075)), (1, -1)):
+            if sec.strip(side) != "parking":
+                continue
             marks.append(np.stack([bays - 0.05, np.full_like(bays, a), bays + 0.05, np.full_like(bays, b)], 1))
     parts.append(rects(np.concatenate(marks), z, "road_marking", "lane_paint"))
     span = 2 * (rh - 0.25)
@@ -87,6 +94,32 @@ def segment_road_mesh(grid: Grid, seg: Segment) -> Mesh:
 
 def _curb(x0: float, y0: float, x1: float, y1: float, h: float) -> Mesh:
     return slab(min(x0, x1), min(y0, y1), max(x0, x1), max(y0, y1), 0.0, h, "curb", "curb_concrete")
+
+
+def _strips(grid: Grid, sec, L: float) -> list[Mesh]:
+    """The side strips of a street whose strips are not both parking (segment frame): asphalt at
+    the segment ends, then per side parking asphalt, a shoulder (road) or a raised grass verge
+    behind a curb; and an arterial's median island (class other_ground, curb height)."""
+    lh, rh, h, cw = grid.lane_half, grid.road_half, grid.curb_h, grid.curb_w
+    pk0, pk1 = PARKING_START_U, L - PARKING_START_U
+    sides = {1: (lh, rh), -1: (-rh, -lh)}
+    parts = [rects([(0, a, pk0, b) for a, b in sides.values()] + [(pk1, a, L, b) for a, b in sides.values()],
+                   0.0, "road", "asphalt")]
+    for side, (a, b) in sides.items():
+        kind = sec.strip(side)
+        if kind == "parking":
+            parts.append(rects([(pk0, a, pk1, b)], 0.0, "parking", "parking_asphalt"))
+        elif kind == "shoulder":
+            parts.append(rects([(pk0, a, pk1, b)], 0.0, "road", "asphalt"))
+        else:   # verge: a curb along the lane edge and both ends, grass on top at curb height
+            v_in, v_out = side * lh, side * rh
+            v_back = v_in + side * cw
+            parts += [_curb(pk0, v_in, pk1, v_back, h), _curb(pk0, v_back, pk0 + cw, v_out, h),
+                      _curb(pk1 - cw, v_back, pk1, v_out, h),
+                      rects([(pk0 + cw, v_back, pk1 - cw, v_out)], h, "terrain", "grass")]
+    if sec.median:
+        parts.append(slab(pk0, -MEDIAN_W_M / 2, pk1, MEDIAN_W_M / 2, 0.0, h, "other_ground", "curb_concrete"))
+    return parts
 
 
 def segment_walk_mesh(grid: Grid, seg: Segment, pits: np.ndarray | None = None) -> Mesh:

@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from generator.geometry import pose
+from generator.layout.cross_sections import MEDIAN_W_M, PLAIN, CrossSection, draw_sections
 from generator.rng import stream
 from generator.spec.model import SceneSpec
 
@@ -105,6 +106,18 @@ class Grid:
     margin: float
     segments: tuple[Segment, ...]
     outer_depth: float = 0.0         #: depth of the lot band outside the outer ring road
+    sections: tuple[CrossSection, ...] = ()   #: per segment; () = every street plain
+
+    def section(self, seg: Segment) -> CrossSection:
+        """The cross-section type of ``seg`` (see :mod:`generator.layout.cross_sections`)."""
+        return self.sections[seg.index] if self.sections else PLAIN
+
+    def strip_span(self, seg: Segment) -> tuple[float, float] | None:
+        """(u0, u1) of the middle stretch where ``seg``'s side strips differ (parking bays, verges,
+        shoulders, a median), or None if the segment is too short for one bay or has no strips."""
+        u0, u1 = PARKING_START_U, seg.length - PARKING_START_U
+        return (u0, u1) if self.parking_w > 0 and u1 - u0 >= BAY_M else None
+
     @property
     def lane_half(self) -> float:
         """Centre line to the outer edge of the driving lanes."""
@@ -227,20 +240,39 @@ class Grid:
             if u1 - u0 < BAY_M:
                 continue
             for side in (-1, 1):
+                if self.section(s).strip(side) != "parking":
+                    continue
                 v0, v1 = sorted((side * self.lane_half, side * self.road_half))
                 out.append((s, side, s.rect_world(u0, u1, v0, v1)))
+        return out
+
+    def raised_rects(self) -> list[tuple[Segment, str, tuple[float, float, float, float]]]:
+        """Islands raised to curb height between the curbs: ``(segment, "verge" | "median", AABB)``."""
+        out = []
+        for s in self.segments:
+            sec, span = self.section(s), self.strip_span(s)
+            if span is None:
+                continue
+            for side in (-1, 1):
+                if sec.strip(side) == "verge":
+                    v0, v1 = sorted((side * self.lane_half, side * self.road_half))
+                    out.append((s, "verge", s.rect_world(span[0], span[1], v0, v1)))
+            if sec.median:
+                out.append((s, "median", s.rect_world(span[0], span[1], -MEDIAN_W_M / 2, MEDIAN_W_M / 2)))
         return out
 
     def ground_height(self, xy: np.ndarray) -> np.ndarray:
         """(n,) float64 height of the ground surface at world points ``xy`` ((n, 2) metres).
 
-        0 on the road (kerb to kerb, intersections included), ``curb_h`` elsewhere
-        (curbs, sidewalks, lots, terrain).
+        0 on the road (kerb to kerb, intersections included, verges and median islands
+        excepted), ``curb_h`` elsewhere (curbs, sidewalks, verges, islands, lots, terrain).
         """
         xy = np.asarray(xy, np.float64).reshape(-1, 2)
         on_road = np.zeros(len(xy), bool)
         for x0, y0, x1, y1 in self.road_rects():
             on_road |= (xy[:, 0] > x0) & (xy[:, 0] < x1) & (xy[:, 1] > y0) & (xy[:, 1] < y1)
+        for _, _, (x0, y0, x1, y1) in self.raised_rects():
+            on_road &= ~((xy[:, 0] > x0) & (xy[:, 0] < x1) & (xy[:, 1] > y0) & (xy[:, 1] < y1))
         return np.where(on_road, 0.0, self.curb_h)
 
 
@@ -272,4 +304,4 @@ def make_grid(spec: SceneSpec) -> Grid:
     segments = tuple(Segment(k, ax, a, b, (float(o[0]), float(o[1])), float(n)) for k, (a, b, ax, o, n) in enumerate(segs))
     return Grid(xs, ys, t.lanes_per_direction, t.lane_width_m, t.parking_strip_width_m, CURB_WIDTH_M,
                 t.sidewalk_width_m, t.curb_height_m, t.margin_m, segments,
-                max(MIN_OUTER_DEPTH_M, t.block_size_m / 2))
+                max(MIN_OUTER_DEPTH_M, t.block_size_m / 2), draw_sections(spec, len(segments)))

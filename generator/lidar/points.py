@@ -21,32 +21,25 @@ material        uint16  material id (``scene.face_material``; an actor's ``face_
 moving          uint8   1 on an actor faster than ``MOVING_THRESHOLD_MPS`` at the firing time
 =============== ======= ==========================================================
 
-How the records are filled (:meth:`RecordTables.fill`): the fields are written in byte
-blocks through :data:`_BLOCKS`, a second view of the same 38-byte record -- ``x, y, z, range``
-as one 16-byte block (``o + r d`` computed over the chunk's contiguous (n, 4) rows whose 4th
-column is ``(0, 1)``, so ``range`` comes out as ``r`` exactly, then gathered by hit),
-``azimuth .. laser`` as one 16-byte block gathered from a per-ray template, ``class,
-instance, material, moving`` as a 4-byte block (gathered with the face normal, one 16-byte
-row per face) and a 2-byte block -- plus ``cos_incidence`` on its own. Compared with one strided write per field this halves the
-numpy passes of the labelling, which is the scanner's only cost beyond the Embree cast
-(``bench/lidar_traffic.py``). The values are the same float32 operations as a field-by-field
-fill (``x = o + r * d``; ``cos = |d0 n0 + d1 n1 + d2 n2|`` in that order), so the bytes are too.
+How the records are filled: :meth:`RecordTables.fill` runs one compiled pass over a chunk's
+hits (:func:`generator.lidar.kernels.fill_records`) from tables built once per scanner: the
+sensor's local rays and per-ray azimuth, the firing offset per column, ring and laser per
+position within a column, and one :data:`generator.lidar.kernels.FACE_DTYPE` row per face
+(normal and labels, so a hit reads one row). The values are the float32 operations of a
+field-by-field numpy fill (``x = o + r * d``; ``cos = |d0 n0 + d1 n1 + d2 n2|`` in that order).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from generator.lidar.kernels import FACE_DTYPE, fill_records
+
 POINT_DTYPE = np.dtype([
     ("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("range", "<f4"), ("azimuth", "<f4"), ("time", "<f4"),
     ("cos_incidence", "<f4"), ("ring", "u1"), ("column", "<u2"), ("laser", "u1"), ("class", "u1"),
     ("instance", "<u2"), ("material", "<u2"), ("moving", "u1"),
 ])
-
-#: The same record as byte blocks and the incidence cosine (see the module notes).
-_BLOCKS = np.dtype({"names": ["xyzr", "ray", "cos", "face4", "face2"], "formats": ["V16", "V16", "<f4", "<u4", "<u2"],
-                    "offsets": [0, 16, 24, 32, 36], "itemsize": POINT_DTYPE.itemsize})
-_FACE = np.dtype([("class", "u1"), ("instance", "<u2"), ("material", "<u2"), ("moving", "u1")])
 
 
 class RecordTables:
@@ -63,29 +56,17 @@ class RecordTables:
 
     def __init__(self, sensor, face_class, face_instance, face_material, normals):
         origins, dirs, azimuth = sensor.local_rays()
-        steps, n_l = azimuth.shape
-        self._o4 = _rows4(origins.reshape(-1, 3), 0.0)  # (n_rays, 4) float32, sensor frame
-        self._d4 = _rows4(dirs.reshape(-1, 3), 1.0)
+        self._o = np.ascontiguousarray(origins.reshape(-1, 3), np.float32)  # (rays, 3) sensor frame
+        self._d = np.ascontiguousarray(dirs.reshape(-1, 3), np.float32)
+        self._azimuth = np.ascontiguousarray(azimuth.reshape(-1), np.float32)
+        self._column_time = np.ascontiguousarray(sensor.column_time(), np.float32)
         order = sensor.by_ring
-        rec = np.zeros(steps * n_l, POINT_DTYPE)
-        rec["azimuth"] = azimuth.reshape(-1)
-        rec["ring"] = np.tile(sensor.ring[order], steps)
-        rec["column"] = np.repeat(np.arange(steps), n_l)
-        rec["laser"] = np.tile(sensor.laser_id[order], steps)
-        self._ray = {False: np.ascontiguousarray(rec.view(_BLOCKS)["ray"])}
-        rec["time"] = np.repeat(sensor.column_time(), n_l)
-        self._ray[True] = np.ascontiguousarray(rec.view(_BLOCKS)["ray"])
-        face = np.zeros(len(face_class), _FACE)
-        face["class"], face["instance"], face["material"] = face_class, face_instance, face_material
-        blocks = face.view(np.uint8).reshape(-1, 6)
-        # per face one 16-byte row: unit normal (3 x float32) + class, instance, material's low byte,
-        # so one gather serves the cosine and most of the label block; one zero row at the end: a
-        # miss (face -1) reads it, so cosines can be computed for every ray of a chunk at once
-        rows = np.zeros((len(face) + 1, 4), np.uint32)  # label bits never pass through a float
-        rows.view(np.float32)[:-1, :3] = normals
-        rows[:-1, 3] = np.ascontiguousarray(blocks[:, :4]).view("<u4").reshape(-1)
-        self._normal_face4 = rows.view("V16").reshape(-1)
-        self._face2 = np.ascontiguousarray(blocks[:, 4:]).view("<u2").reshape(-1)
+        self._ring = np.ascontiguousarray(sensor.ring[order], np.uint8)
+        self._laser = np.ascontiguousarray(sensor.laser_id[order], np.uint8)
+        faces = np.zeros(len(face_class), FACE_DTYPE)
+        faces["normal"], faces["class"] = normals, face_class
+        faces["instance"], faces["material"] = face_instance, face_material
+        self._faces = faces
 
     def fill(self, out: np.ndarray, hit: np.ndarray, ray0: int, dist: np.ndarray, face: np.ndarray,
              direction: np.ndarray, skew: bool) -> None:
@@ -102,32 +83,13 @@ class RecordTables:
         dist : (n,) float32
             Distance along each beam to its hit, metres.
         face : (n,) int
-            Face-table row of each hit (-1 on a miss).
+            Face-table row of each hit (-1 on a miss; misses are never in ``hit``).
         direction : (n, 3) float32
             Beam direction in the frame of the hit face's normal (world for the town, the
             actor's frame for an actor: the cosine is the same in either).
         skew : bool
             Fill ``time`` with the firing offsets (else 0).
         """
-        blocks = out.view(_BLOCKS)
-        n = len(dist)
-        with np.errstate(invalid="ignore"):  # misses (inf) times a zero component; dropped below
-            xyzr = self._d4[ray0:ray0 + n] * dist[:, None]
-        xyzr += self._o4[ray0:ray0 + n]
-        blocks["xyzr"] = xyzr.view("V16").reshape(-1).take(hit)
-        blocks["ray"] = self._ray[skew].take(hit + ray0)
-        row = self._normal_face4.take(face).view(np.uint32).reshape(n, 4)
-        normal = row.view(np.float32)
-        cos = direction[:, 0] * normal[:, 0]
-        cos += direction[:, 1] * normal[:, 1]
-        cos += direction[:, 2] * normal[:, 2]
-        blocks["cos"] = np.abs(cos, out=cos).take(hit)
-        blocks["face4"] = np.ascontiguousarray(row[:, 3]).take(hit)
-        blocks["face2"] = self._face2.take(face.take(hit))
-
-
-def _rows4(xyz: np.ndarray, w: float) -> np.ndarray:
-    out = np.empty((len(xyz), 4), np.float32)
-    out[:, :3] = xyz
-    out[:, 3] = w
-    return out
+        fill_records(out, np.ascontiguousarray(hit, np.int64), ray0, dist, np.ascontiguousarray(face, np.int32),
+                     np.ascontiguousarray(direction, np.float32), self._o, self._d, self._azimuth,
+                     self._column_time, self._ring, self._laser, self._faces, skew)

@@ -36,6 +36,7 @@ import numpy as np
 
 from generator.lidar.actors import ActorCaster
 from generator.lidar.caster import RayCaster, make_caster
+from generator.lidar.kernels import world_rays
 from generator.lidar.points import POINT_DTYPE, RecordTables
 from generator.lidar.sensors import Sensor
 
@@ -103,7 +104,7 @@ class Scanner:
     Notes
     -----
     Per sweep, each chunk of firing columns is rotated into the world in float32 relative
-    to the caster's re-centring point (the float64 pose translation minus the centre is
+    to the caster's re-centring point (:func:`generator.lidar.kernels.world_rays`) (the float64 pose translation minus the centre is
     taken first, so nothing large is ever rounded), cast against the town, then against the
     actors that can reach it (their plan is computed on the calling thread while the workers
     cast the town), and turned into records (:meth:`generator.lidar.points.RecordTables.fill`)
@@ -172,8 +173,12 @@ class Scanner:
             raise ValueError(f"need one pose per column ({self.sensor.azimuth_steps}), got {len(poses)}")
         if self.actors is not None and t0 is None:
             raise ValueError("this scanner has moving actors: scan(..., t0=sweep start time) is required")
-        rot_t = np.ascontiguousarray(np.swapaxes(poses[..., :3, :3], -1, -2), np.float32)
+        steps = self.sensor.azimuth_steps
+        rot_t = np.swapaxes(poses[..., :3, :3], -1, -2).astype(np.float32)
         trans = (poses[..., :3, 3] - self.caster.center).astype(np.float32)  # float64 difference first
+        # one rotation and translation per column (repeated when the whole sweep has one pose)
+        rot_t = np.ascontiguousarray(np.broadcast_to(rot_t, (steps, 3, 3)))
+        trans = np.ascontiguousarray(np.broadcast_to(trans, (steps, 3)))
         sweep = _Sweep(np.empty(self.sensor.rays_per_sweep, POINT_DTYPE), len(self._chunks), rot_t, trans, skew)
 
         def plan():  # which actors each column may see; the workers need it only after their static cast
@@ -213,16 +218,9 @@ class Scanner:
 
     def _run_chunk(self, sweep: _Sweep, i: int, cols: slice) -> None:
         try:
-            o_loc, d_loc = self._o32[cols], self._d32[cols]  # (k, L, 3) float32
-            if sweep.skew:
-                d_w = np.matmul(d_loc, sweep.rot_t[cols])
-                o_w = np.matmul(o_loc, sweep.rot_t[cols])
-                o_w += sweep.trans[cols, None, :]
-            else:
-                d_w = d_loc @ sweep.rot_t
-                o_w = o_loc @ sweep.rot_t
-                o_w += sweep.trans
-            d_w, o_w = d_w.reshape(-1, 3), o_w.reshape(-1, 3)
+            n = (cols.stop - cols.start) * self.sensor.n_lasers
+            o_w, d_w = np.empty((n, 3), np.float32), np.empty((n, 3), np.float32)
+            world_rays(self._o32, self._d32, sweep.rot_t, sweep.trans, cols.start, cols.stop, o_w, d_w)
             dist, face = self.caster.intersect_local(o_w, d_w, self.sensor.max_range_m)
             on_actor = None
             plan = sweep.get_plan()

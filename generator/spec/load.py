@@ -30,8 +30,31 @@ def parse_spec(document: object, source: str) -> SceneSpec:
     validate(document, schema, source)
     full = with_defaults(document, schema)
     check_ranges(full, source)
+    check_streets(full, source)
     spec = build(SceneSpec, full)
-    return dataclasses.replace(spec, source=source, spec_hash=canonical_hash(spec.to_dict()))
+    return dataclasses.replace(spec, source=source, spec_hash=spec_hash(spec))
+
+
+def spec_hash(spec: SceneSpec) -> str:
+    """The spec's :func:`canonical_hash`; ``town.redraw_every_frames`` counts only when set, so the
+    hash of every spec written before that option is unchanged (resumable datasets stay resumable)."""
+    d = spec.to_dict()
+    if d["town"].get("redraw_every_frames") is None:
+        d["town"].pop("redraw_every_frames", None)
+    return canonical_hash(d)
+
+
+def check_streets(full: dict, source: str) -> None:
+    """Cross-field rules of ``streets``: some weight > 0 in each choice, occupancy within [0, 1]."""
+    streets = full.get("streets")
+    if streets is None:
+        return
+    for key in ("types", "districts"):
+        if not any(w > 0 for w in streets[key].values()):
+            raise SpecError(source, f"streets.{key}", f"needs a weight > 0, got {json.dumps(streets[key])}")
+    lo, hi = streets["parking_occupancy"]
+    if lo < 0 or hi > 1:
+        raise SpecError(source, "streets.parking_occupancy", f"must lie within [0, 1], got {[lo, hi]}")
 
 
 def load_spec(path: str | Path) -> SceneSpec:

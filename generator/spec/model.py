@@ -8,6 +8,7 @@ Lengths in metres, angles in degrees (as written in the spec).
 from __future__ import annotations
 
 import dataclasses
+import types
 import typing
 from dataclasses import dataclass
 
@@ -27,6 +28,8 @@ class Town:
     sidewalk_width_m: float
     curb_height_m: float
     margin_m: float
+    #: image frames per town of a ``generate`` run; None = one town (see :mod:`generator.spec.towns`)
+    redraw_every_frames: int | None = None
 
     @property
     def road_width_m(self) -> float:
@@ -167,6 +170,23 @@ class Labels:
 
 
 @dataclass(frozen=True)
+class Streets:
+    """Street variety: weights of the cross-section types and districts, parking occupancy range.
+
+    Weights are relative (``{"plain": 1, "boulevard": 3}``: a boulevard three times as often as a
+    plain street); the draws are made in :mod:`generator.layout.streets` and
+    :mod:`generator.layout.districts`.
+    """
+
+    types: dict
+    parking_occupancy: Range
+    verge_trees_per_100m: float
+    verge_bushes_per_100m: float
+    verge_hedges: float
+    districts: dict
+
+
+@dataclass(frozen=True)
 class SceneSpec:
     """A validated scene spec (see ``schemas/scene.schema.json`` for every field's meaning).
 
@@ -175,7 +195,14 @@ class SceneSpec:
     source : str
         The file it was read from (for messages; relative paths in the spec resolve against it).
     spec_hash : str
-        SHA-256 of the canonical JSON of the spec with defaults filled in.
+        SHA-256 of the canonical JSON of the spec with defaults filled in (``town.redraw_every_frames``
+        left out while it is null, so specs written before the option keep their hash).
+    town_index : int or None
+        Set on the spec of town ``i`` of a re-drawn run (:func:`generator.spec.towns.town_spec`),
+        whose ``seed`` is then the town's seed; None for the spec as read.
+    asset_seed : int or None
+        The seed of the asset library (prototype meshes) when it differs from ``seed``: the
+        towns of one run share the library of the spec's own seed. None = ``seed``.
     """
 
     name: str
@@ -189,14 +216,19 @@ class SceneSpec:
     weather: Weather
     lidar: LidarProcessing
     labels: Labels
+    streets: Streets | None = None
     source: str = ""
     spec_hash: str = ""
+    town_index: int | None = None
+    asset_seed: int | None = None
 
     def to_dict(self) -> dict:
-        """The spec as plain JSON-able data (without ``source`` and ``spec_hash``)."""
+        """The spec as plain JSON-able data (without ``source``, ``spec_hash``, ``town_index``, ``asset_seed``)."""
         d = dataclasses.asdict(self)
-        d.pop("source")
-        d.pop("spec_hash")
+        for key in ("source", "spec_hash", "town_index", "asset_seed"):
+            d.pop(key)
+        if d["streets"] is None:      # absent: the spec (and its hash) reads as before the field existed
+            d.pop("streets")
         return _lists(d)
 
 
@@ -216,6 +248,8 @@ def build(cls, data: dict):
         if f.name not in data:
             continue
         t, v = hints[f.name], data[f.name]
+        if typing.get_origin(t) in (typing.Union, types.UnionType) and isinstance(v, dict):
+            t = next(a for a in typing.get_args(t) if dataclasses.is_dataclass(a))   # ``Streets | None`` given
         if dataclasses.is_dataclass(t):
             v = build(t, v)
         elif typing.get_origin(t) is tuple:

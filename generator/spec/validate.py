@@ -121,6 +121,8 @@ def _message(err: jsonschema.ValidationError, root: dict) -> tuple[str, str]:
     if err.validator in ("minItems", "maxItems") and isinstance(err.instance, list):
         return _field_path(path), f"must be {describe(_resolve(err.schema, root))}, got {_value(err.instance)}"
     schema = _resolve(err.schema, root)
+    if err.validator == "minProperties":
+        return _field_path(path), f"must name at least one of {', '.join(sorted(schema.get('properties', {})))}, got {{}}"
     if err.validator == "type" and schema.get("type") == "object":
         return _field_path(path), f"must be an object, got {_value(err.instance)}"
     return _field_path(path), f"must be {describe(schema)}, got {_value(err.instance)}"
@@ -140,6 +142,11 @@ def validate(document: Any, schema: dict, source: str) -> None:
     raise SpecError(source, field or "(top level)", reason)
 
 
+def _is_object(schema: dict) -> bool:
+    t = schema.get("type")
+    return t == "object" or (isinstance(t, list) and "object" in t)
+
+
 def with_defaults(document: dict, schema: dict, root: dict | None = None) -> dict:
     """Return a deep copy of ``document`` with every omitted key filled from the schema defaults."""
     root = schema if root is None else root
@@ -152,7 +159,7 @@ def with_defaults(document: dict, schema: dict, root: dict | None = None) -> dic
                 out[key] = copy.deepcopy(sub["default"])
             elif sub.get("type") == "object":
                 out[key] = {}
-        if key in out and isinstance(out[key], dict) and sub.get("type") == "object":
+        if key in out and isinstance(out[key], dict) and _is_object(sub):
             out[key] = with_defaults(out[key], sub, root)
     return out
 

@@ -22,7 +22,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from generator.layout.placement_core import Library, Proto
-from generator.layout.placement_street import N_PEOPLE, clothing_color
+from generator.layout.placement_street import N_PEOPLE, person_outfit
 from generator.layout.streets import Grid
 from generator.rng import stream
 from generator.spec.model import SceneSpec
@@ -123,7 +123,7 @@ def _walkers(spec, ww: Walkways, body: wc.Body, signals, protos, n: int, n_steps
     edges, ss, xy, pace, decide, drawn = [], [], [], [], [], []
     for k in range(n):
         g = stream(spec.seed, "traffic", "pedestrian", k)
-        proto, color = protos[int(g.integers(len(protos)))], clothing_color(g)
+        proto, look = protos[int(g.integers(len(protos)))], person_outfit(g)
         v = spec.traffic.pedestrian_speed_mps * g.uniform(1 - SPEED_JITTER, 1 + SPEED_JITTER)
         spot = _spawn(g, ww, free, weights, np.array(xy).reshape(-1, 2), gap + 0.3)
         if spot is None:
@@ -134,15 +134,15 @@ def _walkers(spec, ww: Walkways, body: wc.Body, signals, protos, n: int, n_steps
         xy.append(ww.paths[spot[0]].points[round(spot[1] / ww.paths[spot[0]].s[1]), :2])
         pace.append(v)
         decide.append(stream(spec.seed, "traffic", "pedestrian", k, "route").random(n_decide))
-        drawn.append((proto, color))
+        drawn.append((proto, look))
     if not edges:
         return []
     t0 = time.perf_counter()
     pos, yaw = ws.simulate(net, signals, np.array(edges), np.array(ss), np.array(pace), np.array(decide),
                            n_warm, n_steps, dt)
     log.debug("%d walkers, %d + %d steps: %.2f s", len(edges), n_warm, n_steps, time.perf_counter() - t0)
-    return [Mover("person", cls, proto, Track(0.0, dt, pos[k], yaw[k]), {"color": color, "role": "walking"})
-            for k, (proto, color) in enumerate(drawn)]
+    return [Mover("person", cls, proto, Track(0.0, dt, pos[k], yaw[k]), {**look, "role": "walking"})
+            for k, (proto, look) in enumerate(drawn)]
 
 
 def _spawn_mask(ww: Walkways, zones: wz.Zones, body: wc.Body, gap: float) -> list[np.ndarray]:
@@ -191,7 +191,7 @@ def _standers(spec, grid: Grid, ww: Walkways, body: wc.Body, obstacles: wc.Obsta
     lo_v, hi_v = grid.walk_inner + 0.35, grid.corridor_half - 0.35
     for k in range(n):
         g = stream(spec.seed, "traffic", "pedestrian", "standing", k)
-        proto, color = protos[int(g.integers(len(protos)))], clothing_color(g)
+        proto, look = protos[int(g.integers(len(protos)))], person_outfit(g)
         for _ in range(SPAWN_TRIES):
             seg = segs[int(g.choice(len(segs), p=w / w.sum()))]
             u0 = grid.corridor_half - grid.road_half + 0.5
@@ -209,7 +209,7 @@ def _standers(spec, grid: Grid, ww: Walkways, body: wc.Body, obstacles: wc.Obsta
             placed = np.vstack([placed, box])
             xyz = np.repeat([[x, y, grid.curb_h]], n_steps, 0)
             out.append(Mover("person", cls, proto, Track(0.0, dt, xyz, np.full(n_steps, yaw)),
-                             {"color": color, "role": "standing"}))
+                             {**look, "role": "standing"}))
             break
         else:
             log.warning("no room for standing pedestrian %d of %d; placed %d", k + 1, n, len(out))

@@ -1,0 +1,74 @@
+"""Recipes for the materials of issue 14 item 4: tree species and facade details.
+
+Same contract as :mod:`generator.blender.recipes` (one function per material name in
+``generator/materials.yaml``, receiving a :class:`Nodes` builder and a seeded generator,
+returning a shader socket); :func:`generator.blender.materials.build_materials` looks a
+name up here when :mod:`recipes` has no recipe of that name.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from generator.blender.nodes import Nodes
+from generator.blender.recipes import _emit, _foliage, _jit, _tint, _wall_coords
+from generator.blender.controls import CONTROL
+
+
+def bark_birch(g: Nodes, rng: np.random.Generator):
+    """White bark with dark horizontal lenticels."""
+    co = g.coords("Object")
+    marks = g.smooth(g.noise(g.mapping(co, scale=(9, 9, 0.9)), scale=2.5, detail=3), 0.62, 0.7)
+    base = g.mix(marks, _jit(rng, (0.72, 0.7, 0.66), 0.04), (0.05, 0.045, 0.04))
+    return g.principled(base_color=base, roughness=0.7, normal=g.bump(marks, 0.3, 0.01))
+
+
+def leaves_birch(g, rng):
+    return _foliage(g, rng, (0.07, 0.12, 0.025))
+
+
+def needles(g, rng):
+    return _foliage(g, rng, (0.02, 0.05, 0.022))
+
+
+def facade_glass(g, rng):
+    """Curtain-wall spandrels: dark tinted, glossy glass over a grid of panels (reflects the sky)."""
+    uv, co = _wall_coords(g)
+    panels = g.brick(uv, color1=(1, 1, 1), color2=(0.8, 0.85, 0.9), mortar=(0.25, 0.25, 0.25), scale=1.0,
+                     mortar_size=0.015, brick_width=1.5, row_height=1.6, offset=0.0)
+    tint = _jit(rng, (0.05, 0.075, 0.09), 0.2)
+    base = g.mix(1.0, panels, tint, "MULTIPLY")
+    return g.principled(base_color=base, roughness=0.08, metallic=0.6, specular=1.0)
+
+
+def shop_glass(g, rng):
+    """Shop windows: clear glass with a lit interior at night (the ``windows`` light group)."""
+    pane = g.math("FRACT", g.add(g.geometry("Random Per Island"), g.object_info("Random")))
+    lit = g.math("LESS_THAN", pane, g.add(g.attr(CONTROL["lit_windows"], "VIEW_LAYER"), 0.3))
+    glass = g.principled(base_color=(0.015, 0.02, 0.022), roughness=0.02, ior=1.5, specular=1.0)
+    return _emit(g, glass, (1.0, 0.9, 0.75), 8.0, "windows", lit)
+
+
+def awning(g, rng):
+    """Striped fabric; the stripe colour is drawn per object (Object Info > Random)."""
+    uv, co = _wall_coords(g)
+    stripes = g.math("GREATER_THAN", g.wave(uv, scale=2.2, kind="BANDS", direction="X"), 0.5)
+    hue = g.object_info("Random")
+    colour = g.hsv((0.45, 0.06, 0.05), hue=g.add(0.2, hue), saturation=0.9, value=1.0)
+    plain = g.math("GREATER_THAN", g.math("FRACT", g.mul(hue, 7.0)), 0.5)
+    stripe = g.mix(g.mul(stripes, plain), colour, (0.8, 0.78, 0.72))
+    return g.principled(base_color=stripe, roughness=0.85, sheen=0.3)
+
+
+def shop_sign(g, rng):
+    """A painted fascia board over the shop windows, a colour per object, faint lettering blocks."""
+    uv, co = _wall_coords(g)
+    letters = g.brick(uv, color1=(1, 1, 1), color2=(1, 1, 1), mortar=(0, 0, 0), scale=1.0, mortar_size=0.05,
+                      brick_width=0.35, row_height=0.55, out="Factor")
+    colour = g.hsv((0.05, 0.1, 0.25), hue=g.object_info("Random"), saturation=1.0, value=1.0)
+    base = g.mix(g.mul(g.math("SUBTRACT", 1.0, letters), 0.85), colour, (0.85, 0.82, 0.75))
+    return g.principled(base_color=base, roughness=0.4)
+
+
+def balcony_metal(g, rng):
+    return g.principled(base_color=_tint(g, _jit(rng, (0.12, 0.12, 0.125), 0.2)), metallic=0.6, roughness=0.45)

@@ -1,0 +1,109 @@
+"""Street cross-section types: what fills the strips between the driving lanes and the curbs.
+
+Every street keeps the grid's kerb-to-kerb width (:class:`generator.layout.streets.Grid`), so
+intersections, lanes and routes are the same for all of them; what differs is the *strip* on
+each side between the outer lane edge (``|v| = lane_half``) and the curb (``|v| = road_half``),
+over the middle of the segment (``PARKING_START_U <= u <= length - PARKING_START_U``, where
+parking bays run; the segment ends stay asphalt for the turning arcs), and whether a median
+island splits the directions there:
+
+============  ====================================  =========================================
+type          strips (side -1, side +1)             extra
+============  ====================================  =========================================
+plain         parking, parking                      (every street of a town without ``streets``)
+residential   parking or verge, each at even odds   bushes and small trees on the verges
+boulevard     verge, verge                          a tree row on each verge
+arterial      shoulder, shoulder (asphalt)          a raised median island (other-ground), where
+                                                    the lanes are wide enough that the ego on its
+                                                    lane centre keeps ``MEDIAN_CLEAR_M`` off it
+============  ====================================  =========================================
+
+A *verge* is grass (terrain) raised to curb height behind a curb along the lane edge; a
+*shoulder* is asphalt (road) with the edge line, no bays. Each parking strip draws the share of
+its bays that hold a vehicle from ``streets.parking_occupancy``, so some streets are empty and
+some full, and the ego is not always beside parked cars. Draws: stream
+``("layout", "street_types")``, one type per segment in segment order, then the strips.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from generator.rng import stream
+
+TYPES = ("plain", "residential", "boulevard", "arterial")
+STRIPS = ("parking", "verge", "shoulder")
+MEDIAN_W_M = 0.6      #: width of an arterial's median island
+MEDIAN_CLEAR_M = 0.1  #: the ego (half width EGO_HALF_WIDTH_M) on its lane centre keeps this off the island
+
+
+@dataclass(frozen=True)
+class CrossSection:
+    """The cross-section of one street segment.
+
+    Attributes
+    ----------
+    kind : str
+        One of :data:`TYPES`.
+    strips : (str, str)
+        What fills the strip at side -1 (``v < 0``) and side +1: one of :data:`STRIPS`.
+    occupancy : (float, float)
+        Share of the bays holding a vehicle, per side (meaningful where the strip is parking;
+        ``nan`` where the town has no ``streets`` and ``density.parked_cars_per_100m`` decides).
+    """
+
+    kind: str
+    strips: tuple[str, str]
+    occupancy: tuple[float, float]
+    median: bool = False     #: a median island separates the directions
+
+    def strip(self, side: int) -> str:
+        return self.strips[0 if side < 0 else 1]
+
+    def share(self, side: int) -> float:
+        return self.occupancy[0 if side < 0 else 1]
+
+
+PLAIN = CrossSection("plain", ("parking", "parking"), (float("nan"), float("nan")))
+
+
+def draw_sections(spec, n_segments: int) -> tuple[CrossSection, ...]:
+    """One :class:`CrossSection` per segment drawn from ``spec.streets`` (empty without it).
+
+    Parameters
+    ----------
+    spec : SceneSpec
+    n_segments : int
+
+    Returns
+    -------
+    tuple of CrossSection
+        ``()`` when ``spec.streets`` is None (every segment is :data:`PLAIN`) or the town has no
+        parking strips (then every strip is lane asphalt and there is nothing to vary).
+    """
+    from generator.layout.placement_core import EGO_HALF_WIDTH_M
+
+    streets = spec.streets
+    if streets is None or spec.town.parking_strip_width_m <= 0:
+        return ()
+    island = spec.town.lane_width_m / 2 - EGO_HALF_WIDTH_M - MEDIAN_W_M / 2 >= MEDIAN_CLEAR_M
+    g = stream(spec.seed, "layout", "street_types")
+    w = np.array([float(streets.types.get(t, 0.0)) for t in TYPES])
+    kinds = g.choice(len(TYPES), size=n_segments, p=w / w.sum())
+    lo, hi = streets.parking_occupancy
+    out = []
+    for k in kinds:
+        kind = TYPES[int(k)]
+        if kind == "plain":
+            strips = ("parking", "parking")
+        elif kind == "residential":
+            strips = tuple("parking" if r < 0.5 else "verge" for r in g.random(2))
+        elif kind == "boulevard":
+            strips = ("verge", "verge")
+        else:
+            strips = ("shoulder", "shoulder")
+        occ = tuple(float(x) for x in g.uniform(lo, hi, 2))
+        out.append(CrossSection(kind, strips, occ, kind == "arterial" and island))
+    return tuple(out)
