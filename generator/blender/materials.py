@@ -76,4 +76,7 @@ def label_world() -> "bpy.types.World":
     g.set(bg.inputs["Color"], (float(class_table().id("sky")), 0.0, 0.0))
     g.set(bg.inputs["Strength"], 1.0)
     g.output(bg.outputs[0], "ShaderNodeOutputWorld")
+    # Never sampled as a light (the label pass has no bounces and no BSDFs): no importance map to
+    # build for it on every label render.
+    world.cycles.sampling_method = "NONE"
     return world

@@ -3,7 +3,12 @@
 * RGB pass: the config's Cycles settings, label proxies hidden -> linear RGB.
 * Real pass: label material, 1 sample, proxies hidden -> class and instance of the real
   surface at each pixel centre and its planar depth.
-* Label pass: the same with the proxies shown -> the mask class and instance.
+* Label pass: the same with the proxies shown -> the mask class and instance. With a
+  supersampling factor ``k`` (the config's ``label_supersample``, odd) it is rendered at ``k``
+  times the resolution and each pixel takes the majority class of its ``k x k`` samples
+  (:func:`generator.labels.supersample.majority_labels`): thin markings stop flickering as the
+  camera moves, and every pixel still holds one exact class id. The real pass (depth, the
+  class a ray through the pixel centre hits) stays at 1x: depth is never voted or blended.
 
 Depth is converted from Cycles' planar Z to the distance along the pixel's ray
 (range, metres) so it compares directly with LiDAR range; sky pixels get +inf.
@@ -24,6 +29,7 @@ from generator.world import rig
 from generator.blender import geometry, session
 from generator.blender.bpy_guard import bpy
 from generator.blender.materials import label_material, label_world
+from generator.labels.supersample import majority_labels
 
 SKY_Z = 1e9
 
@@ -91,13 +97,16 @@ def _integers(rgba: np.ndarray, what: str) -> tuple[np.ndarray, np.ndarray]:
     return ints[..., 0].astype(np.uint8), ints[..., 1].astype(np.uint16)
 
 
-def render_labels(scene, bs: geometry.BlenderScene, k: np.ndarray, scratch: Path) -> LabelPasses:
+def render_labels(scene, bs: geometry.BlenderScene, k: np.ndarray, scratch: Path, supersample: int = 1) -> LabelPasses:
     """Render the real and label passes for the current camera.
 
     Parameters
     ----------
     k : (3, 3) float64
         Camera intrinsics, used to turn planar depth into range along each pixel ray.
+    supersample : int
+        Odd factor: the label pass is rendered at ``supersample`` times the resolution and
+        reduced by a per-pixel majority vote (1: one sample at each pixel centre).
     """
     session.label_state(scene, label_material(), label_world())
     secs = {}
@@ -107,12 +116,15 @@ def render_labels(scene, bs: geometry.BlenderScene, k: np.ndarray, scratch: Path
     secs["real_pass"] = time.perf_counter() - t
     geometry.set_proxies_visible(bs, True)
     t = time.perf_counter()
-    lab = _render(scene, scratch / "label.exr")
+    with session.supersampled(scene, supersample):
+        lab = _render(scene, scratch / "label.exr")
+    fine_class, fine_instance = _integers(lab["Combined"], "label pass")
+    del lab
+    class_id, instance = majority_labels(fine_class, fine_instance, supersample)
     secs["label_pass"] = time.perf_counter() - t
     geometry.set_proxies_visible(bs, False)
     real_class, real_instance = _integers(real["Combined"], "real pass")
-    class_id, instance = _integers(lab["Combined"], "label pass")
-    h, w = class_id.shape
+    h, w = real_class.shape
     z = real["Depth.Z"] if "Depth.Z" in real else real["Z"]
     cos = rig.pixel_rays(k, w, h)[..., 2]
     depth = (z / cos).astype(np.float32)

@@ -16,28 +16,12 @@ import numpy as np
 from generator.blender.controls import CONTROL
 from generator.blender.nodes import Nodes
 from generator.blender.road_surface import road_wear
+from generator.blender.wet import wet_surface
 
 
 def _jit(rng: np.random.Generator, base, spread: float):
     base = np.asarray(base, float)
     return tuple(np.clip(base * (1 + rng.uniform(-spread, spread, base.shape)), 0, 1))
-
-
-def _wet(g: Nodes, color, roughness, normal=None, puddles: bool = True):
-    """Wet-surface modifier: darker, glossier, puddles with ripples where the noise is low."""
-    wet = g.attr(CONTROL["wetness"], "VIEW_LAYER")
-    seed = g.attr(CONTROL["puddle_seed"], "VIEW_LAYER")
-    mask = wet
-    if puddles:
-        pud = g.noise(g.coords("Object"), scale=0.08, detail=3, roughness=0.6, w=seed)
-        pud = g.math("MULTIPLY", g.smooth(pud, 0.56, 0.6), wet)
-        ripple = g.math("SUBTRACT", g.voronoi(scale=6.0, w=g.mul(seed, 7.0)), g.voronoi(scale=6.5, w=g.mul(seed, 7.0)))
-        normal = g.bump(g.mul(ripple, pud), strength=0.15, distance=0.01, normal=normal)
-        mask = g.math("MAXIMUM", wet, pud)
-        roughness = g.lerp(pud, roughness, 0.02)
-    color = g.mix(g.mul(mask, 0.55), color, g.mix(0.5, color, (0, 0, 0), "MULTIPLY"))
-    roughness = g.lerp(g.mul(wet, 0.8), roughness, 0.08)
-    return color, roughness, normal
 
 
 def _emit(g: Nodes, shader, color, strength: float, group: str, factor=1.0):
@@ -57,7 +41,7 @@ def asphalt(g: Nodes, rng, tone=0.055, wear=0.5):
     base = g.mix(g.mul(g.smooth(patches, 0.45, 0.6), wear), base, (tone * 1.8, tone * 1.75, tone * 1.7))
     base = g.mix(0.5, base, g.mix(cracks, (0.02, 0.02, 0.02), (1, 1, 1)), "MULTIPLY")
     base, rough, worn = road_wear(g, co, base, tone, rng)
-    color, rough, normal = _wet(g, base, rough, g.bump(g.add(grain, worn), 0.25, 0.01))
+    color, rough, normal = wet_surface(g, base, rough, g.bump(g.add(grain, worn), 0.25, 0.01))
     return g.principled(base_color=color, roughness=rough, normal=normal)
 
 
@@ -69,7 +53,7 @@ def _paint(g, rng, color):
     co = g.coords("Object")
     dirt = g.noise(co, scale=3, detail=4)
     base = g.mix(g.mul(g.smooth(dirt, 0.5, 0.8), 0.5), _jit(rng, color, 0.05), (0.35, 0.35, 0.33))
-    col, rough, normal = _wet(g, base, 0.55, None, puddles=False)
+    col, rough, normal = wet_surface(g, base, 0.55, None, puddles=False)
     return g.principled(base_color=col, roughness=rough)
 
 
@@ -90,7 +74,7 @@ def _concrete(g, rng, tone, slabs: bool):
         joints = g.brick(xy, color1=(1, 1, 1), color2=(0.92, 0.92, 0.92), mortar=(0.45, 0.45, 0.45), scale=1.0,
                          mortar_size=0.008, brick_width=1.0, row_height=1.0, offset=0.0)
         base = g.mix(1.0, base, joints, "MULTIPLY")
-    col, rough, normal = _wet(g, base, 0.8, g.bump(n, 0.1, 0.01))
+    col, rough, normal = wet_surface(g, base, 0.8, g.bump(n, 0.1, 0.01))
     return g.principled(base_color=col, roughness=rough, normal=normal)
 
 
@@ -108,14 +92,14 @@ def grass(g, rng):
     fine = g.noise(co, scale=60, detail=2)
     base = g.ramp(n, [(0.3, _jit(rng, (0.06, 0.11, 0.025), 0.1)), (0.7, _jit(rng, (0.13, 0.17, 0.04), 0.1))])
     base = g.mix(g.mul(fine, 0.3), base, (0.2, 0.18, 0.08))
-    col, rough, normal = _wet(g, base, 0.95, g.bump(fine, 0.4, 0.02), puddles=False)
+    col, rough, normal = wet_surface(g, base, 0.95, g.bump(fine, 0.4, 0.02), puddles=False)
     return g.principled(base_color=col, roughness=rough, normal=normal)
 
 
 def soil(g, rng):
     n = g.noise(g.coords("Object"), scale=8, detail=6)
     base = g.ramp(n, [(0.3, (0.10, 0.07, 0.045)), (0.7, (0.16, 0.12, 0.08))])
-    col, rough, normal = _wet(g, base, 0.95, g.bump(n, 0.3, 0.02), puddles=False)
+    col, rough, normal = wet_surface(g, base, 0.95, g.bump(n, 0.3, 0.02), puddles=False)
     return g.principled(base_color=col, roughness=rough, normal=normal)
 
 

@@ -161,7 +161,7 @@ class Renderer:
 
     def render_labels(self) -> passes.LabelPasses:
         """The real and label passes from the current camera (independent of lighting and weather)."""
-        return passes.render_labels(self.bscene, self.handles, self.k, self.scratch)
+        return passes.render_labels(self.bscene, self.handles, self.k, self.scratch, self.cfg.label_supersample)
 
     def render(self, T_world_camera: np.ndarray, seed: int, light_info: dict,
                shutter: np.ndarray | None = None) -> RenderedFrame:

@@ -9,6 +9,7 @@ overrides).
 from __future__ import annotations
 
 import logging
+from contextlib import contextmanager
 
 from generator.blender import motion
 from generator.blender.bpy_guard import bpy
@@ -117,3 +118,25 @@ def label_state(scene: "bpy.types.Scene", material, world) -> None:
     vl = scene.view_layers[0]
     vl.material_override = material
     vl.world_override = world
+
+
+@contextmanager
+def supersampled(scene: "bpy.types.Scene", k: int):
+    """Render at ``k`` times the configured resolution inside the block (label pass).
+
+    The image plane and field of view are unchanged, so with ``k`` odd the middle sample of
+    every ``k x k`` block is the centre of the pixel it belongs to. The depth pass is switched
+    off meanwhile: only the real pass (at 1x) provides depth, and a ``k``-times larger Z
+    buffer would only cost memory.
+    """
+    if k == 1:
+        yield
+        return
+    r, vl = scene.render, scene.view_layers[0]
+    r.resolution_percentage = 100 * k
+    vl.use_pass_z = False
+    try:
+        yield
+    finally:
+        r.resolution_percentage = 100
+        vl.use_pass_z = True

@@ -49,6 +49,7 @@ class RenderConfig:
     preview: bool
     camera_model: bool = False
     motion_blur: MotionBlur = MotionBlur()
+    label_supersample: int = 1
     source: str = ""
     config_hash: str = ""
 
@@ -68,6 +69,8 @@ class RenderConfig:
             d.pop("camera_model")
         if not self.motion_blur.enabled:  # off = as every config before the switch: same hash, same records
             d.pop("motion_blur")
+        if self.label_supersample == 1:  # 1 = as every config before the option: same hash, same records
+            d.pop("label_supersample")
         d["resolution"] = list(d["resolution"])
         return d
 
@@ -97,6 +100,7 @@ def load_render_config(name_or_path: str | Path) -> RenderConfig:
     validate(doc, schema, source)
     full = with_defaults(doc, schema)
     full["resolution"] = tuple(int(v) for v in full["resolution"])
+    full["label_supersample"] = int(full["label_supersample"])  # JSON Schema counts 3.0 as an integer
     cfg = build(RenderConfig, full)
     cfg = dataclasses.replace(cfg, resolution=tuple(full["resolution"]), source=source)
     return dataclasses.replace(cfg, config_hash=canonical_hash(cfg.to_dict()))
