@@ -118,9 +118,9 @@ def test_moving_cars_burn_tail_lights_at_night_parked_ones_do_not(tmp_path, test
         out[light.time_of_day] = (r.render_rgb(seed=1)[0], labels)
     mover = world.actors[0].instance_id
 
-    def red_emitters(rgb, mask):
+    def red_emitters(rgb, mask, floor=0.02):
         px = rgb[mask]
-        return int(((px[:, 0] > 0.02) & (px[:, 0] > 6 * px[:, 1])).sum())
+        return int(((px[:, 0] > floor) & (px[:, 0] > 6 * px[:, 1])).sum())
 
     night_rgb, labels = out["night"]
     car = labels.instance == mover
@@ -130,6 +130,8 @@ def test_moving_cars_burn_tail_lights_at_night_parked_ones_do_not(tmp_path, test
 
     near = ndimage.binary_dilation(car, iterations=2)  # the pixel filter spreads the mover's lamps 1-2 px
     parked = (labels.class_id == class_table().id("car")) & ~near
-    # no lamps of their own: at most a glint of the mover's lamps in their glass (one pixel here), where lit
-    # lamps would put a few pixels on every visible front or rear
-    assert parked.sum() > 100 and red_emitters(night_rgb, parked) <= 1
+    # no lamps of their own. A glint of the mover's lamps in their glossy paint or glass is red too, but
+    # dim (measured: R 0.065 on two pixels of a curved body), where a burning tail light peaks at R 0.15-0.29
+    # (the mover's; its pixel-filter fringe is ~0.06): count only pixels brighter than a glint
+    assert red_emitters(night_rgb, car, floor=0.1) >= 2
+    assert parked.sum() > 100 and red_emitters(night_rgb, parked, floor=0.1) == 0
