@@ -35,7 +35,7 @@ from generator.safeload import printable
 ROOT = Path(__file__).resolve().parents[1]
 SPEC = str(ROOT / "scenes" / "test_town.json")
 #: Seconds one refused command may take (option errors take milliseconds; a spec load ~0.1 s).
-TIME_LIMIT_S = 5.0
+TIME_LIMIT_S = 30.0  # a hang guard (a refusal must not wait on the input), not a speed measurement
 IS_ROOT = hasattr(os, "geteuid") and os.geteuid() == 0
 
 # capsys and tmp_path_factory are shared by the examples of one test: every example works in a fresh folder.

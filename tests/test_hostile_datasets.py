@@ -54,7 +54,7 @@ MARKER = "HOSTILE-MARKER-7f3a"
 SECRET = "hunter2-SECRET-7f3a"
 PASSWD = "root:x:0:0"
 #: Seconds one command may take on the corrupted copy (the clean runs take < 0.5 s).
-TIME_LIMIT_S = 10.0
+TIME_LIMIT_S = 30.0  # a hang guard (a refusal must not wait on the input), not a speed measurement
 _settings = settings(suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
 
 

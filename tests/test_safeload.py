@@ -24,15 +24,21 @@ def _write(path: Path, data: str | bytes) -> Path:
     return path
 
 
-def _refused(fn, *args, match: str | None = None, seconds: float = 2.0, **kw) -> str:
-    """Call ``fn``; it must raise one UserError line quickly. Returns the message."""
+#: A hostile input must be refused, not waited on: without the guards a FIFO blocks for ever, /dev/zero
+#: reads until memory runs out and a billion laughs expands for minutes. This bound tells those apart from
+#: a refusal on a loaded machine; it is not a speed measurement (that is bench/'s job).
+HANG_GUARD_S = 30.0
+
+
+def _refused(fn, *args, match: str | None = None, **kw) -> str:
+    """Call ``fn``; it must raise one UserError line without hanging. Returns the message."""
     t0 = time.perf_counter()
     with pytest.raises(UserError) as e:
         fn(*args, **kw)
     elapsed = time.perf_counter() - t0
     msg = str(e.value)
     assert "\n" not in msg, msg
-    assert elapsed < seconds, f"took {elapsed:.2f} s: {msg}"
+    assert elapsed < HANG_GUARD_S, f"took {elapsed:.2f} s: {msg}"
     if match is not None:
         assert match in msg, msg
     return msg
@@ -73,14 +79,14 @@ def test_directory(tmp_path):
 def test_fifo_is_refused_without_blocking(tmp_path):
     fifo = tmp_path / "pipe.json"
     os.mkfifo(fifo)  # no writer: opening it for reading in blocking mode would hang forever
-    _refused(safeload.read_bytes, fifo, match="named pipe", seconds=1.0)
-    _refused(load_spec, fifo, match="named pipe", seconds=1.0)
+    _refused(safeload.read_bytes, fifo, match="named pipe")
+    _refused(load_spec, fifo, match="named pipe")
 
 
 @pytest.mark.skipif(not os.path.exists("/dev/zero"), reason="needs /dev/zero")
 def test_endless_device_is_refused_at_once():
-    _refused(safeload.read_bytes, "/dev/zero", match="character device", seconds=1.0)
-    _refused(load_render_config, "/dev/zero", match="/dev/zero: is a character device", seconds=1.0)
+    _refused(safeload.read_bytes, "/dev/zero", match="character device")
+    _refused(load_render_config, "/dev/zero", match="/dev/zero: is a character device")
 
 
 def test_socket_is_refused(tmp_path):
@@ -157,7 +163,7 @@ def test_byte_order_mark_is_dropped(tmp_path):
     "[" * 100_000,  # unclosed
 ])
 def test_json_deep_nesting_is_refused_quickly(text):
-    _refused(safeload.parse_json, text, "deep.json", match="nested deeper than 64 levels", seconds=1.0)
+    _refused(safeload.parse_json, text, "deep.json", match="nested deeper than 64 levels")
 
 
 def test_json_depth_limit_is_exact_and_ignores_brackets_in_strings():
@@ -192,8 +198,8 @@ def test_json_node_budget():
 
 def test_json_pathological_strings_stay_linear():
     # Many quotes/backslashes and no terminator: the depth pre-scan must not go quadratic.
-    _refused(safeload.parse_json, '"\\' * 1_000_000, "x.json", match="Unterminated string", seconds=2.0)
-    _refused(safeload.parse_json, '"' + "\\" * 2_000_000, "x.json", match="Unterminated string", seconds=2.0)
+    _refused(safeload.parse_json, '"\\' * 1_000_000, "x.json", match="Unterminated string")
+    _refused(safeload.parse_json, '"' + "\\" * 2_000_000, "x.json", match="Unterminated string")
 
 
 def test_json_error_never_quotes_the_text():
@@ -216,11 +222,11 @@ def test_yaml_plain_document():
     "".join(" " * i + "a:\n" for i in range(3000)),
 ])
 def test_yaml_deep_nesting_is_refused_quickly(text):
-    _refused(safeload.parse_yaml, text, "deep.yaml", match="nested deeper than 64 levels", seconds=1.0)
+    _refused(safeload.parse_yaml, text, "deep.yaml", match="nested deeper than 64 levels")
 
 
 def test_yaml_billion_laughs_fails_fast():
-    msg = _refused(safeload.parse_yaml, _billion_laughs(), "lol.yaml", seconds=1.0)
+    msg = _refused(safeload.parse_yaml, _billion_laughs(), "lol.yaml")
     assert "values (aliases expanded)" in msg or "aliases" in msg
 
 
@@ -433,4 +439,4 @@ def test_scene_spec_json_and_yaml(tmp_path):
     _refused(load_spec, _write(tmp_path / "d.yaml", "name: x\nseed: 1\nseed: 2\n"), match="duplicate key 'seed'")
     _refused(load_spec, _write(tmp_path / "n.json", '{"name": "x", "seed": 1, "paths": {"speed_mps": 1e999}}'),
              match="paths.speed_mps: must be a finite number, got inf")
-    _refused(load_spec, _write(tmp_path / "l.yaml", _billion_laughs()), seconds=1.0)
+    _refused(load_spec, _write(tmp_path / "l.yaml", _billion_laughs()))
