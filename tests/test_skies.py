@@ -102,6 +102,8 @@ def test_times_of_day_from_the_spec(root):
     ("times_of_day", [], "at least 1 items"),
     ("cloud_cover", [0.2, 1.5], "1.5"),
     ("dusk_sun_elevation_deg", [6, -4], "low <= high"),
+    ("dusk_sun_elevation_deg", [1e308, 1e308], "got 1e\\+308"),
+    ("sun_elevation_deg", [-10, 40], "got -10"),
 ])
 def test_bad_sky_fields_are_one_line_errors(root, field, value, reason):
     with pytest.raises(SpecError, match=rf"town.json: weather\.{field}.*({reason})") as e:
