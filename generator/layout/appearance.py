@@ -42,12 +42,15 @@ class Palette:
         The entries as written in ``appearance.yaml``.
     linear : (n, 3) float64
         The entries in linear RGB, [0, 1].
+    cdf : (n,) float64
+        Cumulative ``p``.
     """
 
     names: tuple[str, ...]
     p: np.ndarray
     srgb: np.ndarray
     linear: np.ndarray
+    cdf: np.ndarray  # cumulative p, for the inverse-CDF draw
 
     @classmethod
     def from_rows(cls, rows: list, where: str) -> "Palette":
@@ -67,11 +70,11 @@ class Palette:
             raise ValueError(f"appearance.yaml: {where}: duplicate names")
         p = np.array(shares) / np.sum(shares)
         srgb = np.array(colours, np.uint8)
-        return cls(tuple(names), p, srgb, srgb_to_linear(srgb))
+        return cls(tuple(names), p, srgb, srgb_to_linear(srgb), np.cumsum(p))
 
     def index(self, u: float) -> int:
         """The entry a uniform number ``u`` in [0, 1) picks (inverse CDF)."""
-        return int(min(np.searchsorted(np.cumsum(self.p), u, side="right"), len(self.p) - 1))
+        return int(min(np.searchsorted(self.cdf, u, side="right"), len(self.p) - 1))
 
     def draw(self, rng: np.random.Generator, jitter: float = 0.0) -> tuple[str, list[float]]:
         """(name, linear RGB as 3 floats rounded to 1e-4) of one draw; takes 4 values from ``rng``.

@@ -25,7 +25,8 @@ import numpy as np
 from generator.layout.lots import Lot
 from generator.geometry import pose
 from generator.layout.placement_core import Placer, Proto, oriented_box, world_boxes
-from generator.layout.placement_street import Street, free_lane, person_outfit, vehicle_paint
+from generator.layout.appearance import fleet_paint, outfit
+from generator.layout.placement_street import Street, free_lane
 from generator.layout.streets import PARKING_START_U
 from generator.rng import stream
 from generator.spec.model import SceneSpec
@@ -94,7 +95,7 @@ def place_bike_racks(placer: Placer, spec: SceneSpec, st: Street) -> None:
                 bike = bikes[int(g.integers(len(bikes)))]
                 uu = u + 1.6 + 0.75 * k
                 placer.try_place(bike, *_at(seg, uu, v, bike, to_road), st.h, to_road,
-                                 {**vehicle_paint(g), "placement": "rack"})
+                                 {**fleet_paint(g), "placement": "rack"})
 
 
 def place_two_wheelers(placer: Placer, spec: SceneSpec, st: Street) -> None:
@@ -115,7 +116,7 @@ def place_two_wheelers(placer: Placer, spec: SceneSpec, st: Street) -> None:
             yaw = traffic + s * np.radians(g.uniform(40, 70))
             u, v = g.uniform(u0, u1), s * (grid.lane_half + grid.parking_w * 0.55)
             placer.try_place(proto, *_at(seg, u, v, proto, yaw), 0.0, yaw,
-                             {**vehicle_paint(g), "placement": "parked"}, pad=0.1)
+                             {**fleet_paint(g), "placement": "parked"}, pad=0.1)
 
 
 def _ridden(placer: Placer, kind: str, i: int) -> tuple[Proto, Proto]:
@@ -150,8 +151,8 @@ def place_riders(placer: Placer, spec: SceneSpec, st: Street) -> None:
         rider, vehicle = _ridden(placer, kind, int(g.integers(N_VAR)))
         u = g.uniform(u0, u1)
         x, y = _at(seg, u, v, vehicle, traffic)
-        if placer.try_place(vehicle, x, y, 0.0, traffic, {**vehicle_paint(g), "placement": "ridden"}, pad=0.3):
-            placer.place_on(rider, x, y, 0.0, traffic, person_outfit(g))
+        if placer.try_place(vehicle, x, y, 0.0, traffic, {**fleet_paint(g), "placement": "ridden"}, pad=0.3):
+            placer.place_on(rider, x, y, 0.0, traffic, outfit(g))
 
 
 def place_bus_stops(placer: Placer, spec: SceneSpec, st: Street) -> None:
@@ -169,7 +170,7 @@ def place_bus_stops(placer: Placer, spec: SceneSpec, st: Street) -> None:
             continue
         for _ in range(STOP_TRIES):  # the first spot along the side where the bus and its shelter both fit
             u = g.uniform(st.walk_u0 + 8.0, seg.length - st.walk_u0 - 14.0)
-            shelter, bus, paint = shelters[int(g.integers(2))], buses[int(g.integers(2))], vehicle_paint(g)
+            shelter, bus, paint = shelters[int(g.integers(2))], buses[int(g.integers(2))], fleet_paint(g)
             xy = _bus_spot(placer, grid, seg, s, u, bus, traffic)
             v = s * (st.walk[1] - (shelter.hi[0] - shelter.lo[0]) / 2 - 0.2)
             if xy is not None and placer.try_place(shelter, *_at(seg, u, v, shelter, to_road), st.h, to_road):
@@ -213,7 +214,7 @@ def place_trams(placer: Placer, spec: SceneSpec, st: Street) -> None:
         _, traffic = st.side_yaws(seg, s)
         tram = placer.lib.variant("tram", int(g.integers(2)), lambda g2: {"sections": 3})
         if not placer.try_place(tram, *_at(seg, (u0 + u1) / 2, v, tram, traffic), 0.0, traffic,
-                                {**vehicle_paint(g), "placement": "tram_stop"}, pad=0.3):
+                                {**fleet_paint(g), "placement": "tram_stop"}, pad=0.3):
             continue
         rails = placer.lib.unique("tram_rails", length=float(u1 - u0))
         x, y = seg.to_world((u0 + u1) / 2, v)[0]
@@ -241,7 +242,7 @@ def place_other_vehicles(placer: Placer, spec: SceneSpec, st: Street) -> None:
             fits = proto.hi[1] - proto.lo[1] <= grid.parking_w - 0.1
             v = s * (grid.lane_half + grid.parking_w / 2) if fits else s * (grid.lane_half - grid.lane_w / 2)
             placer.try_place(proto, *_at(seg, g.uniform(u0, u1), v, proto, traffic), 0.0, traffic,
-                             {**vehicle_paint(g), "placement": "parked" if fits else "lane"}, pad=0.2)
+                             {**fleet_paint(g), "placement": "parked" if fits else "lane"}, pad=0.2)
 
 
 def _in_rects(x: float, y: float, rects: np.ndarray, pad: float = 1.0) -> bool:

@@ -28,18 +28,6 @@ SIGN_SHAPES = ("circle", "triangle", "square", "octagon", "diamond")
 N_CAR, N_TRUCK, N_PEOPLE, N_LAMP, N_TL, N_STREET_TREE = 6, 3, 6, 3, 2, 4
 
 
-def vehicle_paint(g: np.random.Generator) -> dict:
-    """A vehicle's paint attributes (``color``, ``paint``, ``paint_metallic``) from the fleet
-    distribution of ``generator/layout/appearance.yaml``; takes 4 values from ``g``."""
-    return fleet_paint(g)
-
-
-def person_outfit(g: np.random.Generator) -> dict:
-    """A person's colour attributes (``color`` = the top, ``bottom_color``, ``shoe_color``,
-    ``skin_color``, ``hair_color``, ``outfit``) from ``appearance.yaml``; takes 20 values from ``g``."""
-    return outfit(g)
-
-
 class Street:
     """Geometry helpers shared by the street placements."""
 
@@ -219,7 +207,7 @@ def place_parked(placer: Placer, spec: SceneSpec, st: Street) -> None:
                 c = (proto.lo + proto.hi) / 2     # centre the body (not the local origin) on the spot
                 ct, sn = np.cos(traffic), np.sin(traffic)
                 x, y = seg.to_world(u, v)[0] - [c[0] * ct - c[1] * sn, c[0] * sn + c[1] * ct]
-                placer.try_place(proto, x, y, 0.0, traffic, {**vehicle_paint(paint),
+                placer.try_place(proto, x, y, 0.0, traffic, {**fleet_paint(paint),
                                  "placement": "parked" if fits else "double_parked"}, pad=0.2)
                 b += nb
 
@@ -251,7 +239,7 @@ def place_lane_cars(placer: Placer, spec: SceneSpec, st: Street) -> None:
         kind = "truck" if g.random() < spec.density.truck_fraction else "car"
         proto = _vehicle(placer, kind, int(g.integers(N_CAR)))
         x, y = seg.to_world(g.uniform(u0, u1), v)[0]
-        placer.try_place(proto, x, y, 0.0, heading, {**vehicle_paint(paint), "placement": "lane"}, pad=0.5)
+        placer.try_place(proto, x, y, 0.0, heading, {**fleet_paint(paint), "placement": "lane"}, pad=0.5)
 
 
 def place_people(placer: Placer, spec: SceneSpec, st: Street) -> None:
@@ -274,11 +262,11 @@ def place_people(placer: Placer, spec: SceneSpec, st: Street) -> None:
                 x, y = seg.to_world(u, s * g.uniform(*st.walk))[0]
                 yaw = seg.yaw + (0 if g.random() < 0.5 else np.pi) + g.normal(0, 0.1) if i >= N_PEOPLE // 2 \
                     else g.uniform(0, 2 * np.pi)
-                placer.try_place(protos[i], x, y, st.h, yaw, person_outfit(look), pad=0.15)
+                placer.try_place(protos[i], x, y, st.h, yaw, outfit(look), pad=0.15)
         if g.random() < 0.25 and not spec.traffic.enabled:  # someone frozen on a crosswalk (traffic: they walk)
             u = g.uniform(*CROSSWALK_U) if g.random() < 0.5 else seg.length - g.uniform(*CROSSWALK_U)
             v = g.uniform(-grid.road_half + 0.6, grid.road_half - 0.6)
             x, y = seg.to_world(u, v)[0]
             yaw = seg.yaw + (np.pi / 2 if g.random() < 0.5 else -np.pi / 2)
             i = N_PEOPLE // 2 + int(g.integers(N_PEOPLE - N_PEOPLE // 2))
-            placer.try_place(protos[i], x, y, 0.0, yaw, {**person_outfit(look), "placement": "crosswalk"}, pad=0.15)
+            placer.try_place(protos[i], x, y, 0.0, yaw, {**outfit(look), "placement": "crosswalk"}, pad=0.15)

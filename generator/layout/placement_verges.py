@@ -98,10 +98,12 @@ def place_verge_bushes(placer: Placer, spec: SceneSpec, st: Street) -> None:
         u = u0 + float(g.uniform(0, 3))
         while u < u1 - 1.0:
             length = float(g.uniform(6.0, 14.0))
-            gap = length * (1 - share) / max(share, 1e-3) if share > 0 else u1 - u0
             if share > 0:
+                gap = length * (1 - share) / max(share, 1e-3)
                 length = min(length, u1 - u)
                 _hedge(placer, st, seg, v, u, u + length, g)
+            else:  # no hedges: the whole verge is for bushes
+                gap, length = u1 - u0, 0.0
             a, b = u + length, min(u1, u + length + gap)
             for _ in range(int(g.poisson(per_100 * max(0.0, b - a) / 100))):
                 x, y = seg.to_world(g.uniform(a, b), v + g.uniform(-0.3, 0.3) * grid.parking_w / 2)[0]

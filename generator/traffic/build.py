@@ -20,7 +20,7 @@ import numpy as np
 
 from generator.errors import SpecError
 from generator.geometry.mesh import merge
-from generator.layout.placement_street import vehicle_paint
+from generator.layout.appearance import fleet_paint
 from generator.layout.streets import make_grid
 from generator.rng import stream
 from generator.traffic.lanes import LaneGraph
@@ -249,7 +249,7 @@ def _drive(spec, graph, signals, lib, blocked, crossing, duration_s, distance_m)
             # other draw orders expose a slewed excavator (4.3 m wide) grazing parked cars and a turning
             # bus meeting a car at t = 0 (tests/test_traffic.py), which the simulation does not prevent
             g.integers(8), g.uniform(0.9, 1.1, 3)
-            movers.append(Mover(kind, lib.main_class(kind), proto, None, {**vehicle_paint(paint), "role": "driving"}))
+            movers.append(Mover(kind, lib.main_class(kind), proto, None, {**fleet_paint(paint), "role": "driving"}))
     sim = VehicleSim(graph, signals, vehicles, crossing)
     for v in vehicles:
         sim._extend(v)

@@ -22,7 +22,8 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from generator.layout.placement_core import Library, Proto
-from generator.layout.placement_street import N_PEOPLE, person_outfit
+from generator.layout.appearance import outfit
+from generator.layout.placement_street import N_PEOPLE
 from generator.layout.streets import Grid
 from generator.rng import stream
 from generator.spec.model import SceneSpec
@@ -123,7 +124,7 @@ def _walkers(spec, ww: Walkways, body: wc.Body, signals, protos, n: int, n_steps
     edges, ss, xy, pace, decide, drawn = [], [], [], [], [], []
     for k in range(n):
         g = stream(spec.seed, "traffic", "pedestrian", k)
-        proto, look = protos[int(g.integers(len(protos)))], person_outfit(g)
+        proto, look = protos[int(g.integers(len(protos)))], outfit(g)
         v = spec.traffic.pedestrian_speed_mps * g.uniform(1 - SPEED_JITTER, 1 + SPEED_JITTER)
         spot = _spawn(g, ww, free, weights, np.array(xy).reshape(-1, 2), gap + 0.3)
         if spot is None:
@@ -191,7 +192,7 @@ def _standers(spec, grid: Grid, ww: Walkways, body: wc.Body, obstacles: wc.Obsta
     lo_v, hi_v = grid.walk_inner + 0.35, grid.corridor_half - 0.35
     for k in range(n):
         g = stream(spec.seed, "traffic", "pedestrian", "standing", k)
-        proto, look = protos[int(g.integers(len(protos)))], person_outfit(g)
+        proto, look = protos[int(g.integers(len(protos)))], outfit(g)
         for _ in range(SPAWN_TRIES):
             seg = segs[int(g.choice(len(segs), p=w / w.sum()))]
             u0 = grid.corridor_half - grid.road_half + 0.5
