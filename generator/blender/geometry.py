@@ -108,9 +108,14 @@ def new_object(name: str, data: bpy.types.Mesh, transform: np.ndarray, instance_
         ob["ug_paint_metallic"] = float(attrs.get("paint_metallic", 0.0))
         ob["ug_outfit"] = 1.0 if "skin_color" in attrs else 0.0
         ob["ug_class"] = cls
-        # vehicle lamps burn on vehicles in use (moving traffic, ridden, at a stop), not on parked ones
-        ob["ug_lights_on"] = 0.0 if attrs.get("placement") in ("parked", "rack") else 1.0
+        ob["ug_lights_on"] = 1.0 if lights_on(attrs) else 0.0
     return ob
+
+
+def lights_on(attrs: dict) -> bool:
+    """Vehicle lamps (lenses and their spot lights) burn on vehicles in use (moving traffic, ridden,
+    at a stop), not on parked or racked ones."""
+    return attrs.get("placement") not in ("parked", "rack")
 
 
 def _matrix(t: np.ndarray) -> "mathutils.Matrix":

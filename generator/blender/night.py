@@ -22,6 +22,7 @@ import numpy as np
 
 from generator.geometry import apply
 from generator.blender.bpy_guard import bpy, mathutils
+from generator.blender.geometry import lights_on
 from generator.blender.lighting import UNITS_PER_LUX, ensure_lamp
 from generator.blender.nodes import Nodes
 from generator.world.scene import SceneModel
@@ -85,7 +86,7 @@ def build_lights(model: SceneModel, parent: "bpy.types.Collection") -> tuple["bp
             for p in apply(o.transform, anchors["lamp"]):
                 _spot(f"{o.name}_lamp", LAMP_POWER_W, LAMP_CONE_DEG, LAMP_COLOR, p, (0, 0, -1), coll)
                 counts["street_lamps"] += 1
-        if "headlight" in anchors and o.attrs.get("placement") != "parked":
+        if "headlight" in anchors and lights_on(o.attrs):
             fwd = o.transform[:3, :3] @ np.array([1.0, 0.0, -0.12])
             for p in apply(o.transform, anchors["headlight"]):
                 _spot(f"{o.name}_headlight", HEADLIGHT_POWER_W, HEADLIGHT_CONE_DEG, HEADLIGHT_COLOR, p, fwd, coll)

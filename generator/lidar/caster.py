@@ -32,7 +32,8 @@ class RayCaster(Protocol):
     #: (3,) float64 re-centring point: ``intersect_local`` takes origins minus this.
     center: np.ndarray
 
-    def intersect_local(self, origins: np.ndarray, directions: np.ndarray, max_distance: float) -> tuple[np.ndarray, np.ndarray]:
+    def intersect_local(self, origins: np.ndarray, directions: np.ndarray, max_distance: float,
+                        mark_misses: bool = True) -> tuple[np.ndarray, np.ndarray]:
         """First hits of re-centred float32 rays; see :meth:`EmbreeCaster.intersect_local`."""
 
     def intersect(self, origins: np.ndarray, directions: np.ndarray, max_distance: float) -> tuple[np.ndarray, np.ndarray]:

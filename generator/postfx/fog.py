@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from generator.postfx.filters import EMITTER_CLIP, blur_sum, emitter_mask
-from generator.weather import KOSCHMIEDER
+from generator.weather import KOSCHMIEDER, LIT_TIMES
 
 #: Day airlight, linear RGB. A preview render of the test town by day (sun 25..65 deg) has
 #: road at 0.13, sidewalk 0.6, white paint 0.9 and clear sky 0.7..1.9 (median 1.0) luminance.
@@ -39,7 +39,6 @@ NIGHT_AIRLIGHT = (0.010, 0.012, 0.018)
 #: :func:`generator.weather.light_level`), with lamp halos like at night.
 BASE_AIRLIGHT = {"day": DAY_AIRLIGHT, "dusk": DAY_AIRLIGHT, "night": NIGHT_AIRLIGHT}
 #: Times of day whose lamps are lit (halos in fog).
-LAMP_TIMES = ("dusk", "night")
 
 #: Halo widths as a fraction of the image width, and the share of the halo in each.
 HALO_WIDTHS = (0.006, 0.02, 0.06)
@@ -170,7 +169,7 @@ def airlight_for(time_of_day: str, rgb: np.ndarray | None = None, beta_per_m: fl
         base = BASE_AIRLIGHT[time_of_day]
     except KeyError:
         raise ValueError(f"unknown time of day {time_of_day!r}; known: {', '.join(BASE_AIRLIGHT)}") from None
-    if time_of_day in LAMP_TIMES and rgb is not None and depth is not None and beta_per_m > 0:
+    if time_of_day in LIT_TIMES and rgb is not None and depth is not None and beta_per_m > 0:
         glow, params = lamp_halo(rgb, depth, beta_per_m)
         return Airlight(base, glow, params)
     return Airlight(base)

@@ -27,6 +27,7 @@ import numpy as np
 from scipy import ndimage
 
 from generator.postfx.filters import block_mean, emitter_map, gaussian, upsample
+from generator.weather import LIT_TIMES
 
 #: Nearest and farthest drop distance drawn (m).
 NEAR_M, FAR_M = 0.5, 25.0
@@ -152,7 +153,7 @@ def streak_radiance(rgb: np.ndarray, time_of_day: str) -> np.ndarray:
     f = max(1, int(sigma / 3.0))  # the radiance is smooth: build it on a block-averaged grid
     src = block_mean(np.minimum(rgb, 1.0), f)  # lamps enter through the glint term
     src = 0.6 * src + 0.4 * src.mean(-1, keepdims=True)
-    if time_of_day != "day":  # lamps are lit at dusk and night
+    if time_of_day in LIT_TIMES:  # lamps are lit at dusk and night
         src += np.float32(LAMP_GLINT / STREAK_GAIN[time_of_day]) * block_mean(emitter_map(rgb), f)
     share = ENV_SHARE[time_of_day]
     small = STREAK_GAIN[time_of_day] * ((1.0 - share) * gaussian(src, sigma / f) + share * src.mean((0, 1), keepdims=True))
