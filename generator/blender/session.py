@@ -133,10 +133,10 @@ def supersampled(scene: "bpy.types.Scene", k: int):
         yield
         return
     r, vl = scene.render, scene.view_layers[0]
-    r.resolution_percentage = 100 * k
+    percentage, z = r.resolution_percentage, vl.use_pass_z
+    r.resolution_percentage = percentage * k
     vl.use_pass_z = False
     try:
         yield
     finally:
-        r.resolution_percentage = 100
-        vl.use_pass_z = True
+        r.resolution_percentage, vl.use_pass_z = percentage, z

@@ -56,8 +56,10 @@ class RecordTables:
 
     def __init__(self, sensor, face_class, face_instance, face_material, normals):
         origins, dirs, azimuth = sensor.local_rays()
-        self._o = np.ascontiguousarray(origins.reshape(-1, 3), np.float32)  # (rays, 3) sensor frame
-        self._d = np.ascontiguousarray(dirs.reshape(-1, 3), np.float32)
+        #: (steps, L, 3) float32 emission points and unit directions, sensor frame, ring order
+        self.origins = np.ascontiguousarray(origins, np.float32)
+        self.directions = np.ascontiguousarray(dirs, np.float32)
+        self._o, self._d = self.origins.reshape(-1, 3), self.directions.reshape(-1, 3)  # views, sweep ray order
         self._azimuth = np.ascontiguousarray(azimuth.reshape(-1), np.float32)
         self._column_time = np.ascontiguousarray(sensor.column_time(), np.float32)
         order = sensor.by_ring

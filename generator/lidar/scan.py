@@ -129,9 +129,7 @@ class Scanner:
             np.concatenate([scene.face_instance, *(np.zeros(m.n_faces, np.uint16) for m in protos)]),
             np.concatenate([scene.face_material, *(m.face_material for m in protos)]),
             np.concatenate([self.caster.face_normals, *(self.actors.face_normals() if protos else [])]))
-        origins, dirs, _ = sensor.local_rays()
-        self._o32 = origins.astype(np.float32)  # (steps, L, 3), ring order
-        self._d32 = dirs.astype(np.float32)
+        self._o32, self._d32 = self._records.origins, self._records.directions  # (steps, L, 3), ring order
         steps = sensor.azimuth_steps
         n_chunks = min(steps, self.threads * max(1, chunks_per_thread))
         edges = np.linspace(0, steps, n_chunks + 1).round().astype(int)
