@@ -43,6 +43,8 @@ class Street:
         """(yaw towards the road from side ``s``, yaw of the traffic next to side ``s``)."""
         to_road = seg.yaw + (np.pi / 2 if s < 0 else -np.pi / 2)
         traffic = seg.yaw if s < 0 else seg.yaw + np.pi
+        if self.grid.section(seg).one_way:   # hook: a one-way street's traffic runs one way on both sides
+            traffic = seg.yaw if self.grid.section(seg).one_way > 0 else seg.yaw + np.pi
         return to_road, traffic
 
     def along(self, seg: Segment, start: float, spacing: float, g: np.random.Generator) -> np.ndarray:
@@ -235,7 +237,7 @@ def place_lane_cars(placer: Placer, spec: SceneSpec, st: Street) -> None:
     n = int(round(dens * lengths.sum() / 100))
     for _ in range(n):
         seg, d, v, u0, u1 = lanes[int(g.choice(len(lanes), p=lengths / lengths.sum()))]
-        heading = seg.yaw if d > 0 else seg.yaw + np.pi
+        heading = seg.yaw if (grid.section(seg).one_way or d) > 0 else seg.yaw + np.pi   # one-way: its way
         kind = "truck" if g.random() < spec.density.truck_fraction else "car"
         proto = _vehicle(placer, kind, int(g.integers(N_CAR)))
         x, y = seg.to_world(g.uniform(u0, u1), v)[0]

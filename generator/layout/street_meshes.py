@@ -11,6 +11,7 @@ import numpy as np
 from generator.geometry import Mesh, merge, pose, slab
 from generator.labels import class_table
 from generator.layout.cross_sections import MEDIAN_W_M
+from generator.layout.one_way import one_way_marks
 from generator.layout.streets import BAY_M, CROSSWALK_U, MARK_Z_M, PARKING_START_U, STOP_U, TREE_PIT_M, Grid, Segment
 from generator.materials import material_table
 
@@ -65,7 +66,9 @@ def segment_road_mesh(grid: Grid, seg: Segment) -> Mesh:
     z = MARK_Z_M
     m0, m1 = STOP_U[1], L - STOP_U[1]       # markings run between the stop lines
     marks = []
-    if grid.lanes == 1:
+    if sec.one_way:    # hook: no centre line, dashed dividers between same-direction lanes, one stop line
+        marks += one_way_marks(grid, sec.one_way, L, _dashes)
+    elif grid.lanes == 1:
         marks.append(_dashes(m0, m1, -0.06, 0.06))
     else:
         marks += [np.array([(m0, -0.18, m1, -0.06), (m0, 0.06, m1, 0.18)])]
@@ -74,7 +77,8 @@ def segment_road_mesh(grid: Grid, seg: Segment) -> Mesh:
                 marks.append(_dashes(m0, m1, sgn * k * grid.lane_w - 0.06, sgn * k * grid.lane_w + 0.06))
     edge = lh if p > 0 else rh - 0.3
     marks.append(np.array([(m0, edge - 0.075, m1, edge + 0.075), (m0, -edge - 0.075, m1, -edge + 0.075)]))
-    marks.append(np.array([(STOP_U[0], 0.06, STOP_U[1], lh), (L - STOP_U[1], -lh, L - STOP_U[0], -0.06)]))
+    if not sec.one_way:
+        marks.append(np.array([(STOP_U[0], 0.06, STOP_U[1], lh), (L - STOP_U[1], -lh, L - STOP_U[0], -0.06)]))
     if has_parking:
         bays = np.arange(pk0, pk1 + 1e-6, BAY_M)
         for (a, b), side in zip(((lh + 0.075, rh), (-rh, -lh - 0.075)), (1, -1)):

@@ -127,6 +127,8 @@ class LaneGraph:
                                                                         node, k, (x, y))
         self._link()
         self.conflict = conflicts(self, CAR_BOX_M)
+        from generator.traffic.one_way import apply_one_way   # hook: one-way streets turn lanes round
+        apply_one_way(self)
 
     def _add(self, path: Path, kind: str, node, lane: int, arms) -> int:
         self.edges.append(Edge(len(self.edges), path, kind, node, lane, arms))

@@ -190,11 +190,11 @@ class VehicleSim:
             return
         if not self.signals.vehicles_may_enter(node, t):
             return
-        key = (*conn.arms, conn.lane)
+        key = conflict_key(self.g, conn)
         big = veh.length > BIG_M
         for vid, c in self.holders.get(node, {}).items():
             other = self.g.edges[c]
-            okey = (*other.arms, other.lane)
+            okey = conflict_key(self.g, other)
             if c == conn.index and not big and self.vehicles[vid].length <= BIG_M:
                 continue
             if big or self.vehicles[vid].length > BIG_M or okey in self.g.conflict[key]:
@@ -257,6 +257,12 @@ class VehicleSim:
         """((2,) xy of the box centre, heading) of ``veh`` now."""
         p, h = self.g.edges[veh.edge].path.at(veh.s)
         return p[0, :2], float(h[0])
+
+
+def conflict_key(graph: LaneGraph, conn) -> tuple:
+    """The conflict-table key of connector ``conn``: ``(arm_in, arm_out, lane)``, or the key
+    :mod:`generator.traffic.one_way` gave it (slots that differ in and out)."""
+    return getattr(graph, "conflict_keys", {}).get(conn.index, (*conn.arms, conn.lane))
 
 
 def arm_towards(node, nb) -> int:
