@@ -20,10 +20,14 @@ one_way       parking, parking                      every lane runs one way (``o
                                                     towards +u, -1 towards -u; see
                                                     :mod:`generator.layout.one_way`); no centre
                                                     line, dashed dividers between its lanes
+shared        furnished, furnished                  paved kerb to kerb (class road), no lane
+                                                    markings, bollards in the strips, 20 km/h
+                                                    (:mod:`generator.layout.shared_streets`)
 ============  ====================================  =========================================
 
 A *verge* is grass (terrain) raised to curb height behind a curb along the lane edge; a
-*shoulder* is asphalt (road) with the edge line, no bays. Each parking strip draws the share of
+*shoulder* is asphalt (road) with the edge line, no bays; a *furnished* strip is paving at road
+level (road) holding bollards. Each parking strip draws the share of
 its bays that hold a vehicle from ``streets.parking_occupancy``, so some streets are empty and
 some full, and the ego is not always beside parked cars. Draws: stream
 ``("layout", "street_types")``, one type per segment in segment order, then the strips. A
@@ -41,8 +45,8 @@ import numpy as np
 
 from generator.rng import stream
 
-TYPES = ("plain", "residential", "boulevard", "arterial", "one_way")   #: new types go last (same draws)
-STRIPS = ("parking", "verge", "shoulder")
+TYPES = ("plain", "residential", "boulevard", "arterial", "one_way", "shared")   #: new types go last (same draws)
+STRIPS = ("parking", "verge", "shoulder", "furnished")
 MEDIAN_W_M = 0.6      #: width of an arterial's median island
 MEDIAN_CLEAR_M = 0.1  #: the ego (half width EGO_HALF_WIDTH_M) on its lane centre keeps this off the island
 
@@ -119,6 +123,8 @@ def draw_sections(spec, segments) -> tuple[CrossSection, ...]:
             strips = ("parking", "parking")
         elif kind == "residential":
             strips = tuple("parking" if r < 0.5 else "verge" for r in g.random(2))
+        elif kind == "shared":
+            strips = ("furnished", "furnished")
         elif kind == "boulevard":
             strips = ("verge", "verge")
         else:

@@ -15,6 +15,7 @@ import numpy as np
 from generator.layout.appearance import fleet_paint, outfit
 from generator.layout.placement_core import Placer, Proto
 from generator.layout.placement_lots import N_TREE_VARIANTS, tree_variant
+from generator.layout.shared_streets import place_shared_bollards, place_shared_people
 from generator.layout.streets import BAY_M, CROSSWALK_U, PARKING_START_U, Grid, Segment
 from generator.rng import stream
 from generator.spec.model import SceneSpec
@@ -177,6 +178,7 @@ def place_parked(placer: Placer, spec: SceneSpec, st: Street) -> None:
     get none.
     """
     grid = st.grid
+    place_shared_bollards(placer, spec, st)    # hook: shared streets' strips hold bollards, not cars
     if grid.parking_w <= 0 or spec.density.parked_cars_per_100m <= 0:
         return
     g = stream(spec.seed, "layout", "parked")
@@ -272,3 +274,4 @@ def place_people(placer: Placer, spec: SceneSpec, st: Street) -> None:
             yaw = seg.yaw + (np.pi / 2 if g.random() < 0.5 else -np.pi / 2)
             i = N_PEOPLE // 2 + int(g.integers(N_PEOPLE - N_PEOPLE // 2))
             placer.try_place(protos[i], x, y, 0.0, yaw, {**outfit(look), "placement": "crosswalk"}, pad=0.15)
+    place_shared_people(placer, spec, st, protos, look)   # hook: people on shared carriageways

@@ -12,6 +12,7 @@ from generator.geometry import Mesh, merge, pose, slab
 from generator.labels import class_table
 from generator.layout.cross_sections import MEDIAN_W_M
 from generator.layout.one_way import one_way_marks
+from generator.layout.shared_streets import shared_road_mesh
 from generator.layout.streets import BAY_M, CROSSWALK_U, MARK_Z_M, PARKING_START_U, STOP_U, TREE_PIT_M, Grid, Segment
 from generator.materials import material_table
 
@@ -52,6 +53,8 @@ def segment_road_mesh(grid: Grid, seg: Segment) -> Mesh:
     pk0, pk1 = PARKING_START_U, L - PARKING_START_U
     has_parking = p > 0 and pk1 - pk0 >= BAY_M
     sec = grid.section(seg)
+    if sec.kind == "shared":   # hook: paved kerb to kerb, no lane markings
+        return shared_road_mesh(grid, seg)
     varied = has_parking and sec.strips != ("parking", "parking")
     if varied:
         parts += _strips(grid, sec, L)
@@ -86,14 +89,19 @@ def segment_road_mesh(grid: Grid, seg: Segment) -> Mesh:
                 continue
             marks.append(np.stack([bays - 0.05, np.full_like(bays, a), bays + 0.05, np.full_like(bays, b)], 1))
     parts.append(rects(np.concatenate(marks), z, "road_marking", "lane_paint"))
-    span = 2 * (rh - 0.25)
+    parts.append(crosswalk_bars(grid, L))
+    return merge(parts)
+
+
+def crosswalk_bars(grid: Grid, length: float) -> Mesh:
+    """The zebra bars of the crosswalks at both ends of a segment ``length`` metres long (segment frame)."""
+    span = 2 * (grid.road_half - 0.25)
     n = int((span + 0.5) // 1.0)
     v = -(n * 1.0 - 0.5) / 2 + np.arange(n) * 1.0
     bars = []
-    for u0, u1 in (CROSSWALK_U, (L - CROSSWALK_U[1], L - CROSSWALK_U[0])):
+    for u0, u1 in (CROSSWALK_U, (length - CROSSWALK_U[1], length - CROSSWALK_U[0])):
         bars.append(np.stack([np.full(n, u0), v, np.full(n, u1), v + 0.5], 1))
-    parts.append(rects(np.concatenate(bars), z, "crosswalk", "crosswalk_paint"))
-    return merge(parts)
+    return rects(np.concatenate(bars), MARK_Z_M, "crosswalk", "crosswalk_paint")
 
 
 def _curb(x0: float, y0: float, x1: float, y1: float, h: float) -> Mesh:
