@@ -242,3 +242,17 @@ def test_bad_one_way_weight_through_the_cli_exits_2_writes_nothing(tmp_path, cap
     err = capsys.readouterr().err
     assert err == f"urbangen layout: {spec}: streets.types.one_way: must be a number in [0, 100], got -2\n"
     assert not out.exists()
+
+
+def test_layout_summary_records_each_streets_draw():
+    """``urbangen layout``'s summary lists every segment's drawn type and one-way direction (and
+    nothing for a spec without ``streets``, whose summary reads as before)."""
+    from generator.commands.layout import _streets
+
+    spec = one_way_spec(0)
+    rows = _streets(spec)["streets"]
+    grid = make_grid(spec)
+    assert [r["kind"] for r in rows] == [grid.section(s).kind for s in grid.segments]
+    assert {(r["segment"], r["one_way"]) for r in rows if r["one_way"]} == \
+        {(s.index, grid.section(s).one_way) for s in grid.segments if grid.section(s).one_way}
+    assert _streets(parse_spec({"name": "x", "seed": 1}, "x.json")) == {}

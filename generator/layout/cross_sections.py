@@ -132,3 +132,12 @@ def draw_sections(spec, segments) -> tuple[CrossSection, ...]:
         occ = tuple(float(x) for x in g.uniform(lo, hi, 2))
         out.append(CrossSection(kind, strips, occ, kind == "arterial" and island, direction.get(i, 0)))
     return tuple(out)
+
+
+def sections_record(grid) -> list[dict]:
+    """The drawn cross-section of every segment of ``grid`` as JSON rows (``[]`` when all are plain
+    by default): segment index, its nodes, type, strips, occupancy, median and one-way direction
+    (+1: from node ``a`` to node ``b``)."""
+    return [{"segment": s.index, "a": list(s.a), "b": list(s.b), "kind": sec.kind, "strips": list(sec.strips),
+             "occupancy": [round(x, 4) for x in sec.occupancy], "median": sec.median, "one_way": sec.one_way}
+            for s, sec in zip(grid.segments, grid.sections)]
