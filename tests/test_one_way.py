@@ -256,3 +256,26 @@ def test_layout_summary_records_each_streets_draw():
     assert {(r["segment"], r["one_way"]) for r in rows if r["one_way"]} == \
         {(s.index, grid.section(s).one_way) for s in grid.segments if grid.section(s).one_way}
     assert _streets(parse_spec({"name": "x", "seed": 1}, "x.json")) == {}
+
+
+hypothesis = pytest.importorskip("hypothesis")
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+from test_hostile_specs import HOSTILE  # noqa: E402
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(key=st.sampled_from(["one_way", "shared"]), value=HOSTILE)
+def test_hostile_new_weights_exit_2_with_one_line_and_write_nothing(tmp_path, capsys, key, value):
+    import math
+    import uuid
+
+    if isinstance(value, float) and not math.isfinite(value):
+        value = str(value)          # JSON has no NaN/inf literal: the hostile suite splices those in as text
+    spec = tmp_path / f"{uuid.uuid4().hex}.json"
+    out = tmp_path / f"out_{spec.stem}"
+    spec.write_text(json.dumps({"name": "x", "seed": 1, "streets": {"types": {"plain": 1, key: value}}}))
+    assert main(["layout", str(spec), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith(f"urbangen layout: {spec}: streets.types"), err
+    assert not out.exists()

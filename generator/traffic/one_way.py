@@ -41,12 +41,13 @@ def one_way_of(grid) -> dict[int, int]:
     return {i: sec.one_way for i, sec in enumerate(grid.sections) if sec.one_way}
 
 
-def apply_one_way(graph) -> None:
-    """Rewrite ``graph`` (a LaneGraph, in place) for the one-way segments of its grid; no-op without."""
+def apply_one_way(graph) -> bool:
+    """Rewrite ``graph`` (a LaneGraph, in place) for the one-way segments of its grid, conflict table
+    included; False (and nothing done) when the grid has none."""
     grid = graph.grid
     ow = one_way_of(grid)
     if not ow:
-        return
+        return False
     old_edges, L = graph.edges, grid.lanes
     edges: list[Edge] = []
     lane_edge: dict = {}
@@ -93,6 +94,7 @@ def apply_one_way(graph) -> None:
                         edges[ci].succ.append(lane_edge[(seg_out.index, d_out, ko)])
     graph.edges, graph.lane_edge, graph.connector, graph.conflict_keys = edges, lane_edge, connector, ckeys
     graph.conflict = conflict_table(graph.entry_m, graph.stop_m, grid.lane_w, frozenset(ckeys.values()), CAR_BOX_M)
+    return True
 
 
 def exit_slots(k: int, s_in: list[int], s_out: list[int], left: bool) -> list[int]:
@@ -188,10 +190,9 @@ def conflict_table(entry_m: float, stop_m: float, lane_w: float, keys: frozenset
     for i in range(len(order)):
         rows, cols = np.flatnonzero(owner == i), np.flatnonzero(owner > i)   # each pair of keys once
         d = np.linalg.norm(centre[rows][:, None] - centre[cols][None], axis=-1)
-        sure = d < near
-        r, c = np.nonzero(~sure & (d <= far))
+        hit[i, owner[cols[np.nonzero(d < near)[1]]]] = True
+        r, c = np.nonzero((d >= near) & (d <= far) & ~hit[i, owner[cols]][None])   # key pairs not yet decided
         over = _pairs_overlap(quads[rows[r]], quads[cols[c]])
-        hit[i, owner[cols[np.nonzero(sure)[1]]]] = True
         hit[i, owner[cols[c[over]]]] = True
     hit |= hit.T
     np.fill_diagonal(hit, True)
