@@ -114,22 +114,53 @@ def test_shared_town_keeps_the_layout_invariants(town):
     _rests_on_ground(spec, grid, scene)
 
 
-def test_vehicles_keep_the_shared_speed_on_shared_streets():
-    traffic = {"cars_per_km": 30, "trucks_per_km": 2, "cyclists_per_km": 3, "motorcyclists_per_km": 3}
+@pytest.fixture(scope="module")
+def traffic_town():
+    traffic = {"cars_per_km": 30, "trucks_per_km": 2, "buses_per_km": 1, "cyclists_per_km": 3,
+               "motorcyclists_per_km": 3, "other_vehicles_per_km": 1, "pedestrians_per_100m": 1.0,
+               "standing_pedestrians_per_100m": 2.0}
     spec = shared_spec(6, traffic)
-    grid = make_grid(spec)
-    world = build_world(spec, build_scene(spec), 20.0)
+    return spec, make_grid(spec), build_world(spec, build_scene(spec), 20.0)
+
+
+def test_vehicles_keep_the_shared_speed_on_shared_streets(traffic_town):
+    spec, grid, world = traffic_town
     n = 0
+    vehicles = [a for a in world.actors if a.kind != "person"]
     for t in np.arange(0.0, 20.0, 0.25):
-        for a in world.actors:
+        for a in vehicles:
             hit = _shared_hit(grid, a.box(t).center[:2], STOP_U[1] + 3.0)
             if hit is not None and abs(hit[2]) < grid.lane_half:
                 n += 1
                 assert a.track.speed(t)[0] <= SHARED_SPEED_MPS + 0.05, (a.name, t)
     assert n > 20
     # elsewhere they drive faster than that
-    fast = max(a.track.speed(t)[0] for a in world.actors for t in np.arange(0.0, 20.0, 1.0))
+    fast = max(a.track.speed(t)[0] for a in vehicles for t in np.arange(0.0, 20.0, 1.0))
     assert fast > SHARED_SPEED_MPS + 2.0
+
+
+def test_people_stand_on_shared_carriageways_and_no_vehicle_touches_anyone(traffic_town):
+    """With moving traffic, people stand on the shared streets' paving beside the lanes (road level,
+    off the sidewalk); no vehicle box (ego included) meets a person's box, every 0.1 s."""
+    from generator.traffic.lanes import boxes_overlap
+    from generator.world.scene import OrientedBox
+
+    spec, grid, world = traffic_town
+    people = [a for a in world.actors if a.kind == "person"]
+    vehicles = [a for a in world.actors if a.kind != "person"]
+    on_shared = [a for a in people if a.attrs.get("placement") == "shared_street"]
+    assert len(on_shared) >= 3 and vehicles
+    for a in on_shared:
+        c = a.box(0.0).center
+        hit = _shared_hit(grid, c[:2])
+        assert hit is not None and grid.lane_half < abs(hit[2]) < grid.road_half, a.name
+        assert abs(a.track.pose(0.0)[0][2, 3]) < 1e-9       # on the road surface
+    for t in np.arange(0.0, 20.0, 0.1):
+        p = np.stack([a.box(t).corners_xy() for a in people])
+        E = world.ego.T_world_ego(t)[0]
+        ego = OrientedBox((E[0, 3], E[1, 3], 0.7), (4.6, 1.9, 1.5), float(np.arctan2(E[1, 0], E[0, 0])))
+        hit = boxes_overlap(np.stack([a.box(t).corners_xy() for a in vehicles] + [ego.corners_xy()]), p)
+        assert not hit.any(), (t, np.argwhere(hit)[:3])
 
 
 BAD = [
