@@ -209,7 +209,7 @@ def test_presets_are_reproducible(root, kitti):
 
 
 BAD = [
-    ({"types": {}}, "streets.types: must name at least one of arterial, boulevard, plain, residential, got {}"),
+    ({"types": {}}, "streets.types: must name at least one of arterial, boulevard, one_way, plain, residential, shared, got {}"),
     ({"types": {"plain": 0}}, 'streets.types: needs a weight > 0, got {"plain": 0}'),
     ({"types": {"cul_de_sac": 1}}, "streets.types.cul_de_sac: unknown key"),
     ({"types": {"plain": -1}}, "streets.types.plain: must be a number in [0, 100], got -1"),

@@ -54,7 +54,17 @@ def summary(scene, spec, build_s: float) -> dict:
         "routes": [{"name": p.name, "length_m": round(p.length(), 2), "samples": int(len(p.points)),
                     "closed": p.closed} for p in scene.paths],
         "build_seconds": round(build_s, 3),
+        **_streets(spec),
     }
+
+
+def _streets(spec) -> dict:
+    """``{"streets": [...]}``: each segment's drawn cross-section, when the spec has ``streets``."""
+    from generator.layout.cross_sections import sections_record
+    from generator.layout.streets import make_grid
+
+    rows = sections_record(make_grid(spec)) if spec.streets is not None else []
+    return {"streets": rows} if rows else {}
 
 
 def _kinds(scene) -> dict[str, int]:

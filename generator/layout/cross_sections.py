@@ -16,13 +16,25 @@ boulevard     verge, verge                          a tree row on each verge
 arterial      shoulder, shoulder (asphalt)          a raised median island (other-ground), where
                                                     the lanes are wide enough that the ego on its
                                                     lane centre keeps ``MEDIAN_CLEAR_M`` off it
+one_way       parking, parking                      every lane runs one way (``one_way`` = +1
+                                                    towards +u, -1 towards -u; see
+                                                    :mod:`generator.layout.one_way`); no centre
+                                                    line, dashed dividers between its lanes
+shared        furnished, furnished                  paved kerb to kerb (class road), no lane
+                                                    markings, bollards in the strips, 20 km/h
+                                                    (:mod:`generator.layout.shared_streets`)
 ============  ====================================  =========================================
 
 A *verge* is grass (terrain) raised to curb height behind a curb along the lane edge; a
-*shoulder* is asphalt (road) with the edge line, no bays. Each parking strip draws the share of
+*shoulder* is asphalt (road) with the edge line, no bays; a *furnished* strip is paving at road
+level (road) holding bollards. Each parking strip draws the share of
 its bays that hold a vehicle from ``streets.parking_occupancy``, so some streets are empty and
 some full, and the ego is not always beside parked cars. Draws: stream
-``("layout", "street_types")``, one type per segment in segment order, then the strips.
+``("layout", "street_types")``, one type per segment in segment order, then the strips. A
+segment drawn ``one_way`` that cannot be (the routes drive it both ways, or its direction would
+cut the network apart) takes a two-way type drawn again from the other weights (stream
+``("layout", "street_types", "two_way")``, one draw per such segment in segment order; plain if
+no other type has weight); its strips are then drawn as that type's.
 """
 
 from __future__ import annotations
@@ -33,8 +45,8 @@ import numpy as np
 
 from generator.rng import stream
 
-TYPES = ("plain", "residential", "boulevard", "arterial")
-STRIPS = ("parking", "verge", "shoulder")
+TYPES = ("plain", "residential", "boulevard", "arterial", "one_way", "shared")   #: new types go last (same draws)
+STRIPS = ("parking", "verge", "shoulder", "furnished")
 MEDIAN_W_M = 0.6      #: width of an arterial's median island
 MEDIAN_CLEAR_M = 0.1  #: the ego (half width EGO_HALF_WIDTH_M) on its lane centre keeps this off the island
 
@@ -58,6 +70,7 @@ class CrossSection:
     strips: tuple[str, str]
     occupancy: tuple[float, float]
     median: bool = False     #: a median island separates the directions
+    one_way: int = 0         #: 0 two-way; +1 every lane runs towards +u; -1 towards -u
 
     def strip(self, side: int) -> str:
         return self.strips[0 if side < 0 else 1]
@@ -69,13 +82,14 @@ class CrossSection:
 PLAIN = CrossSection("plain", ("parking", "parking"), (float("nan"), float("nan")))
 
 
-def draw_sections(spec, n_segments: int) -> tuple[CrossSection, ...]:
+def draw_sections(spec, segments) -> tuple[CrossSection, ...]:
     """One :class:`CrossSection` per segment drawn from ``spec.streets`` (empty without it).
 
     Parameters
     ----------
     spec : SceneSpec
-    n_segments : int
+    segments : sequence of Segment
+        Every segment of the grid, in index order (one-way directions depend on the routes).
 
     Returns
     -------
@@ -83,27 +97,47 @@ def draw_sections(spec, n_segments: int) -> tuple[CrossSection, ...]:
         ``()`` when ``spec.streets`` is None (every segment is :data:`PLAIN`) or the town has no
         parking strips (then every strip is lane asphalt and there is nothing to vary).
     """
+    from generator.layout.one_way import one_way_directions
     from generator.layout.placement_core import EGO_HALF_WIDTH_M
 
+    n_segments = len(segments)
     streets = spec.streets
     if streets is None or spec.town.parking_strip_width_m <= 0:
         return ()
     island = spec.town.lane_width_m / 2 - EGO_HALF_WIDTH_M - MEDIAN_W_M / 2 >= MEDIAN_CLEAR_M
     g = stream(spec.seed, "layout", "street_types")
     w = np.array([float(streets.types.get(t, 0.0)) for t in TYPES])
-    kinds = g.choice(len(TYPES), size=n_segments, p=w / w.sum())
+    kinds = [TYPES[int(k)] for k in g.choice(len(TYPES), size=n_segments, p=w / w.sum())]
+    cand = [i for i, k in enumerate(kinds) if k == "one_way"]
+    direction = one_way_directions(spec.seed, segments, cand, spec.town.blocks_x, spec.town.blocks_y)
+    refused = [i for i in cand if i not in direction]
+    if refused:
+        two = np.array([0.0 if t == "one_way" else x for t, x in zip(TYPES, w)])
+        redraw = stream(spec.seed, "layout", "street_types", "two_way")
+        for i in refused:
+            kinds[i] = TYPES[int(redraw.choice(len(TYPES), p=two / two.sum()))] if two.sum() > 0 else "plain"
     lo, hi = streets.parking_occupancy
     out = []
-    for k in kinds:
-        kind = TYPES[int(k)]
-        if kind == "plain":
+    for i, kind in enumerate(kinds):
+        if kind in ("plain", "one_way"):
             strips = ("parking", "parking")
         elif kind == "residential":
             strips = tuple("parking" if r < 0.5 else "verge" for r in g.random(2))
+        elif kind == "shared":
+            strips = ("furnished", "furnished")
         elif kind == "boulevard":
             strips = ("verge", "verge")
         else:
             strips = ("shoulder", "shoulder")
         occ = tuple(float(x) for x in g.uniform(lo, hi, 2))
-        out.append(CrossSection(kind, strips, occ, kind == "arterial" and island))
+        out.append(CrossSection(kind, strips, occ, kind == "arterial" and island, direction.get(i, 0)))
     return tuple(out)
+
+
+def sections_record(grid) -> list[dict]:
+    """The drawn cross-section of every segment of ``grid`` as JSON rows (``[]`` when all are plain
+    by default): segment index, its nodes, type, strips, occupancy, median and one-way direction
+    (+1: from node ``a`` to node ``b``)."""
+    return [{"segment": s.index, "a": list(s.a), "b": list(s.b), "kind": sec.kind, "strips": list(sec.strips),
+             "occupancy": [round(x, 4) for x in sec.occupancy], "median": sec.median, "one_way": sec.one_way}
+            for s, sec in zip(grid.segments, grid.sections)]

@@ -15,6 +15,7 @@ import numpy as np
 from generator.layout.appearance import fleet_paint, outfit
 from generator.layout.placement_core import Placer, Proto
 from generator.layout.placement_lots import N_TREE_VARIANTS, tree_variant
+from generator.layout.shared_streets import place_shared_bollards, place_shared_people
 from generator.layout.streets import BAY_M, CROSSWALK_U, PARKING_START_U, Grid, Segment
 from generator.rng import stream
 from generator.spec.model import SceneSpec
@@ -43,6 +44,8 @@ class Street:
         """(yaw towards the road from side ``s``, yaw of the traffic next to side ``s``)."""
         to_road = seg.yaw + (np.pi / 2 if s < 0 else -np.pi / 2)
         traffic = seg.yaw if s < 0 else seg.yaw + np.pi
+        if self.grid.section(seg).one_way:   # hook: a one-way street's traffic runs one way on both sides
+            traffic = seg.yaw if self.grid.section(seg).one_way > 0 else seg.yaw + np.pi
         return to_road, traffic
 
     def along(self, seg: Segment, start: float, spacing: float, g: np.random.Generator) -> np.ndarray:
@@ -175,6 +178,7 @@ def place_parked(placer: Placer, spec: SceneSpec, st: Street) -> None:
     get none.
     """
     grid = st.grid
+    place_shared_bollards(placer, spec, st)    # hook: shared streets' strips hold bollards, not cars
     if grid.parking_w <= 0 or spec.density.parked_cars_per_100m <= 0:
         return
     g = stream(spec.seed, "layout", "parked")
@@ -235,7 +239,7 @@ def place_lane_cars(placer: Placer, spec: SceneSpec, st: Street) -> None:
     n = int(round(dens * lengths.sum() / 100))
     for _ in range(n):
         seg, d, v, u0, u1 = lanes[int(g.choice(len(lanes), p=lengths / lengths.sum()))]
-        heading = seg.yaw if d > 0 else seg.yaw + np.pi
+        heading = seg.yaw if (grid.section(seg).one_way or d) > 0 else seg.yaw + np.pi   # one-way: its way
         kind = "truck" if g.random() < spec.density.truck_fraction else "car"
         proto = _vehicle(placer, kind, int(g.integers(N_CAR)))
         x, y = seg.to_world(g.uniform(u0, u1), v)[0]
@@ -270,3 +274,4 @@ def place_people(placer: Placer, spec: SceneSpec, st: Street) -> None:
             yaw = seg.yaw + (np.pi / 2 if g.random() < 0.5 else -np.pi / 2)
             i = N_PEOPLE // 2 + int(g.integers(N_PEOPLE - N_PEOPLE // 2))
             placer.try_place(protos[i], x, y, 0.0, yaw, {**outfit(look), "placement": "crosswalk"}, pad=0.15)
+    place_shared_people(placer, spec, st, protos, look)   # hook: people on shared carriageways

@@ -11,6 +11,8 @@ import numpy as np
 from generator.geometry import Mesh, merge, pose, slab
 from generator.labels import class_table
 from generator.layout.cross_sections import MEDIAN_W_M
+from generator.layout.one_way import one_way_marks
+from generator.layout.shared_streets import shared_road_mesh
 from generator.layout.streets import BAY_M, CROSSWALK_U, MARK_Z_M, PARKING_START_U, STOP_U, TREE_PIT_M, Grid, Segment
 from generator.materials import material_table
 
@@ -51,6 +53,8 @@ def segment_road_mesh(grid: Grid, seg: Segment) -> Mesh:
     pk0, pk1 = PARKING_START_U, L - PARKING_START_U
     has_parking = p > 0 and pk1 - pk0 >= BAY_M
     sec = grid.section(seg)
+    if sec.kind == "shared":   # hook: paved kerb to kerb, no lane markings
+        return shared_road_mesh(grid, seg)
     varied = has_parking and sec.strips != ("parking", "parking")
     if varied:
         parts += _strips(grid, sec, L)
@@ -65,7 +69,9 @@ def segment_road_mesh(grid: Grid, seg: Segment) -> Mesh:
     z = MARK_Z_M
     m0, m1 = STOP_U[1], L - STOP_U[1]       # markings run between the stop lines
     marks = []
-    if grid.lanes == 1:
+    if sec.one_way:    # hook: no centre line, dashed dividers between same-direction lanes, one stop line
+        marks += one_way_marks(grid, sec.one_way, L, _dashes)
+    elif grid.lanes == 1:
         marks.append(_dashes(m0, m1, -0.06, 0.06))
     else:
         marks += [np.array([(m0, -0.18, m1, -0.06), (m0, 0.06, m1, 0.18)])]
@@ -74,7 +80,8 @@ def segment_road_mesh(grid: Grid, seg: Segment) -> Mesh:
                 marks.append(_dashes(m0, m1, sgn * k * grid.lane_w - 0.06, sgn * k * grid.lane_w + 0.06))
     edge = lh if p > 0 else rh - 0.3
     marks.append(np.array([(m0, edge - 0.075, m1, edge + 0.075), (m0, -edge - 0.075, m1, -edge + 0.075)]))
-    marks.append(np.array([(STOP_U[0], 0.06, STOP_U[1], lh), (L - STOP_U[1], -lh, L - STOP_U[0], -0.06)]))
+    if not sec.one_way:
+        marks.append(np.array([(STOP_U[0], 0.06, STOP_U[1], lh), (L - STOP_U[1], -lh, L - STOP_U[0], -0.06)]))
     if has_parking:
         bays = np.arange(pk0, pk1 + 1e-6, BAY_M)
         for (a, b), side in zip(((lh + 0.075, rh), (-rh, -lh - 0.075)), (1, -1)):
@@ -82,14 +89,19 @@ def segment_road_mesh(grid: Grid, seg: Segment) -> Mesh:
                 continue
             marks.append(np.stack([bays - 0.05, np.full_like(bays, a), bays + 0.05, np.full_like(bays, b)], 1))
     parts.append(rects(np.concatenate(marks), z, "road_marking", "lane_paint"))
-    span = 2 * (rh - 0.25)
+    parts.append(crosswalk_bars(grid, L))
+    return merge(parts)
+
+
+def crosswalk_bars(grid: Grid, length: float) -> Mesh:
+    """The zebra bars of the crosswalks at both ends of a segment ``length`` metres long (segment frame)."""
+    span = 2 * (grid.road_half - 0.25)
     n = int((span + 0.5) // 1.0)
     v = -(n * 1.0 - 0.5) / 2 + np.arange(n) * 1.0
     bars = []
-    for u0, u1 in (CROSSWALK_U, (L - CROSSWALK_U[1], L - CROSSWALK_U[0])):
+    for u0, u1 in (CROSSWALK_U, (length - CROSSWALK_U[1], length - CROSSWALK_U[0])):
         bars.append(np.stack([np.full(n, u0), v, np.full(n, u1), v + 0.5], 1))
-    parts.append(rects(np.concatenate(bars), z, "crosswalk", "crosswalk_paint"))
-    return merge(parts)
+    return rects(np.concatenate(bars), MARK_Z_M, "crosswalk", "crosswalk_paint")
 
 
 def _curb(x0: float, y0: float, x1: float, y1: float, h: float) -> Mesh:

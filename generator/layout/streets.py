@@ -304,4 +304,4 @@ def make_grid(spec: SceneSpec) -> Grid:
     segments = tuple(Segment(k, ax, a, b, (float(o[0]), float(o[1])), float(n)) for k, (a, b, ax, o, n) in enumerate(segs))
     return Grid(xs, ys, t.lanes_per_direction, t.lane_width_m, t.parking_strip_width_m, CURB_WIDTH_M,
                 t.sidewalk_width_m, t.curb_height_m, t.margin_m, segments,
-                max(MIN_OUTER_DEPTH_M, t.block_size_m / 2), draw_sections(spec, len(segments)))
+                max(MIN_OUTER_DEPTH_M, t.block_size_m / 2), draw_sections(spec, segments))

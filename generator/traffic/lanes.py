@@ -126,7 +126,9 @@ class LaneGraph:
                             self.connector[(node, x, y, k)] = self._add(self._connector_path(node, x, y, k), "connector",
                                                                         node, k, (x, y))
         self._link()
-        self.conflict = conflicts(self, CAR_BOX_M)
+        from generator.traffic.one_way import apply_one_way   # hook: one-way streets turn lanes round
+        if not apply_one_way(self):
+            self.conflict = conflicts(self, CAR_BOX_M)
 
     def _add(self, path: Path, kind: str, node, lane: int, arms) -> int:
         self.edges.append(Edge(len(self.edges), path, kind, node, lane, arms))

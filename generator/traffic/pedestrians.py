@@ -4,7 +4,8 @@
 (:mod:`generator.traffic.walkways`), puts ``traffic.pedestrians_per_100m`` walkers on it and
 walks them (:mod:`generator.traffic.walk_sim`), and places
 ``traffic.standing_pedestrians_per_100m`` people standing on the pavement clear of the
-walking lines and of every static object. Prototypes are the layout's own person variants
+walking lines and of every static object (and, on shared streets, beside the lanes on the
+carriageway: :mod:`generator.traffic.walk_shared`). Prototypes are the layout's own person variants
 (:func:`person_protos`, as :func:`generator.layout.placement_street.place_people` makes
 them): walking poses for walkers, standing poses for standers.
 
@@ -33,6 +34,7 @@ from generator.traffic import walk_sim as ws
 from generator.traffic import walk_zones as wz
 from generator.traffic.movers import DT_S, Mover
 from generator.traffic.walk_lines import R_TURN
+from generator.traffic.walk_shared import shared_standers
 from generator.traffic.walkways import Walkways, build_walkways, obstacles_of
 from generator.world.actors import Track
 
@@ -106,6 +108,7 @@ def simulate_pedestrians(spec: SceneSpec, grid: Grid, scene, signals, lib: Libra
     movers = _walkers(spec, ww, body, signals, walking, n_walk, n_steps, dt, cls) if n_walk and ww.paths else []
     t2 = time.perf_counter()
     movers += _standers(spec, grid, ww, body, obstacles, standing, n_stand, n_steps, dt, cls)
+    movers += shared_standers(spec, grid, obstacles, standing, n_steps, dt, cls, _proto_box)   # shared streets
     log.info("pedestrians: %d walking, %d standing, %d steps (network %.2f s, walking %.2f s, standing %.2f s)",
              sum(m.attrs["role"] == "walking" for m in movers), sum(m.attrs["role"] == "standing" for m in movers),
              n_steps, t1 - t0, t2 - t1, time.perf_counter() - t2)

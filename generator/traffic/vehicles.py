@@ -6,7 +6,8 @@ planned edges of the :class:`~generator.traffic.lanes.LaneGraph`, with
 * **car-following** by the Intelligent Driver Model (IDM: desired speed, safe time gap
   ``T``, minimum gap ``s0``, comfortable braking ``b``) against the nearest vehicle ahead on
   its plan (a vehicle whose rear still hangs over the previous edge counts there too);
-* **turn speeds**: at most ``sqrt(a_lat r)`` on an arc, approached at comfortable braking;
+* **turn speeds**: at most ``sqrt(a_lat r)`` on an arc, approached at comfortable braking; the
+  same for an edge's speed limit (shared streets, :mod:`generator.traffic.shared`);
 * **intersections**: a vehicle stops with its front at the stop line until it is *granted*
   its connector: the node's signal lets vehicles in (:mod:`generator.traffic.signals`), no
   vehicle holds a conflicting connector (:func:`generator.traffic.lanes.conflicts`; a bus or
@@ -27,6 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from generator.traffic.lanes import ARM_DIRS, LaneGraph
+from generator.traffic.shared import speed_caps
 from generator.traffic.signals import CLEAR_S
 
 log = logging.getLogger(__name__)
@@ -84,6 +86,7 @@ class VehicleSim:
     def __init__(self, graph: LaneGraph, signals, vehicles: list[Vehicle], crossing=None):
         self.g, self.signals, self.vehicles, self.crossing = graph, signals, vehicles, crossing
         self.holders: dict = {}   # node -> {vehicle index: connector edge}
+        self.caps = speed_caps(graph)   # edge -> speed limit (shared streets), m/s
 
     # -- plans ---------------------------------------------------------------------------------
     def _extend(self, veh: Vehicle) -> None:
@@ -173,6 +176,8 @@ class VehicleSim:
                 r = edge.length / (np.pi / 2)
                 v_turn = np.sqrt(A_LAT * r)
                 v0 = min(v0, np.sqrt(v_turn ** 2 + 2 * B_COMF * max(0.0, ahead - veh.length / 2)))
+            if e in self.caps:   # a shared street's limit, reached at comfortable braking with the front
+                v0 = min(v0, np.sqrt(self.caps[e] ** 2 + 2 * B_COMF * max(0.0, ahead - veh.length / 2)))
             ahead += edge.length
         return v0
 
@@ -190,11 +195,11 @@ class VehicleSim:
             return
         if not self.signals.vehicles_may_enter(node, t):
             return
-        key = (*conn.arms, conn.lane)
+        key = conflict_key(self.g, conn)
         big = veh.length > BIG_M
         for vid, c in self.holders.get(node, {}).items():
             other = self.g.edges[c]
-            okey = (*other.arms, other.lane)
+            okey = conflict_key(self.g, other)
             if c == conn.index and not big and self.vehicles[vid].length <= BIG_M:
                 continue
             if big or self.vehicles[vid].length > BIG_M or okey in self.g.conflict[key]:
@@ -257,6 +262,12 @@ class VehicleSim:
         """((2,) xy of the box centre, heading) of ``veh`` now."""
         p, h = self.g.edges[veh.edge].path.at(veh.s)
         return p[0, :2], float(h[0])
+
+
+def conflict_key(graph: LaneGraph, conn) -> tuple:
+    """The conflict-table key of connector ``conn``: ``(arm_in, arm_out, lane)``, or the key
+    :mod:`generator.traffic.one_way` gave it (slots that differ in and out)."""
+    return getattr(graph, "conflict_keys", {}).get(conn.index, (*conn.arms, conn.lane))
 
 
 def arm_towards(node, nb) -> int:

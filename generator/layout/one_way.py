@@ -1,0 +1,186 @@
+"""Which way a one-way street runs: the routes' driving directions and a connected network.
+
+A street segment drawn ``one_way`` (:mod:`generator.layout.cross_sections`) carries all its
+lanes in one direction, ``+1`` (towards its ``+u``, from node ``a`` to node ``b``) or ``-1``.
+The direction is not free:
+
+* a segment a route drives (:mod:`generator.layout.routes`: route 0 "comb", route 1 the outer
+  ring the other way) runs in the route's direction; a segment both routes drive in opposite
+  directions cannot be one-way and keeps a two-way type;
+* the street network stays *strongly connected* (from every intersection a vehicle can reach
+  every other one legally), so no lane is a dead end and no vehicle is trapped. Candidates are
+  accepted one by one in segment order; one that would break connectivity stays two-way.
+
+Draws: the free directions come from stream ``("layout", "one_way")``, one per candidate in
+segment order (none when no segment is drawn one-way, so other towns draw as before).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from generator.rng import stream
+
+
+def route_node_cycles(nx: int, ny: int) -> list[list[tuple[int, int]]]:
+    """Every node each route passes, in driving order (closed cycles, first node not repeated).
+
+    Parameters
+    ----------
+    nx, ny : int
+        Blocks along x and y.
+    """
+    from generator.layout.routes import _turning, comb_nodes, ring_nodes
+
+    out = []
+    for corners in (comb_nodes(nx, ny), ring_nodes(nx, ny, clockwise=True)):
+        corners = _turning(corners)
+        nodes = []
+        for i, a in enumerate(corners):
+            b = corners[(i + 1) % len(corners)]
+            step = np.sign(np.subtract(b, a)).astype(int)
+            n = a
+            while n != b:
+                nodes.append(n)
+                n = (n[0] + int(step[0]), n[1] + int(step[1]))
+        out.append(nodes)
+    return out
+
+
+def driven_directions(segments: Sequence, nx: int, ny: int) -> dict[int, set[int]]:
+    """``segment index -> {+1, -1, ...}``: the directions the routes drive each segment in.
+
+    Segments no route drives are absent.
+    """
+    index = {(s.a, s.b): s.index for s in segments}
+    out: dict[int, set[int]] = {}
+    for cyc in route_node_cycles(nx, ny):
+        for i, a in enumerate(cyc):
+            b = cyc[(i + 1) % len(cyc)]
+            if (a, b) in index:
+                out.setdefault(index[(a, b)], set()).add(1)
+            elif (b, a) in index:
+                out.setdefault(index[(b, a)], set()).add(-1)
+    return out
+
+
+def strongly_connected(segments: Sequence, direction: dict[int, int]) -> bool:
+    """True when a vehicle can get from every street to every other one along legal directions
+    without U-turns: the graph of directed segment traversals ``(p, q)``, each followed by any
+    legal ``(q, r)`` with ``r != p``, is strongly connected (so every lane has a way on, too).
+
+    Parameters
+    ----------
+    segments : sequence of Segment
+    direction : dict
+        ``segment index -> +1 | -1`` for one-way segments; every other segment is two-way.
+    """
+    legal = []
+    for s in segments:
+        d = direction.get(s.index, 0)
+        legal += [(s.a, s.b)] if d > 0 else [(s.b, s.a)] if d < 0 else [(s.a, s.b), (s.b, s.a)]
+    if not legal:
+        return True
+    leaving: dict = {}
+    arriving: dict = {}
+    for p, q in legal:
+        leaving.setdefault(p, []).append((p, q))
+        arriving.setdefault(q, []).append((p, q))
+    nexts = {t: [u for u in leaving.get(t[1], ()) if u[1] != t[0]] for t in legal}
+    prevs = {t: [u for u in arriving.get(t[0], ()) if u[0] != t[1]] for t in legal}
+    for adj in (nexts, prevs):
+        seen, todo = {legal[0]}, [legal[0]]
+        while todo:
+            for u in adj[todo.pop()]:
+                if u not in seen:
+                    seen.add(u)
+                    todo.append(u)
+        if len(seen) != len(legal):
+            return False
+    return True
+
+
+def one_way_directions(seed: int, segments: Sequence, candidates: Sequence[int], nx: int, ny: int) -> dict[int, int]:
+    """Directions of the candidate segments that can be one-way.
+
+    Parameters
+    ----------
+    seed : int
+        The spec's seed.
+    segments : sequence of Segment
+        Every segment of the grid.
+    candidates : sequence of int
+        Indices of the segments drawn ``one_way``, in segment order.
+    nx, ny : int
+        Blocks along x and y.
+
+    Returns
+    -------
+    dict
+        ``segment index -> +1 | -1`` for the candidates accepted; the others (driven both ways
+        by the routes, or breaking connectivity) are left out and fall back to a two-way type.
+    """
+    if not candidates:
+        return {}
+    g = stream(seed, "layout", "one_way")
+    driven = driven_directions(segments, nx, ny)
+    out: dict[int, int] = {}
+    for i in candidates:
+        free = 1 if g.random() < 0.5 else -1       # drawn for every candidate: later draws never shift
+        dirs = driven.get(i, set())
+        if len(dirs) > 1:
+            continue
+        trial = {**out, i: next(iter(dirs)) if dirs else free}
+        if strongly_connected(segments, trial):
+            out = trial
+    return out
+
+
+def one_way_marks(grid, direction: int, length: float, dashes) -> list[np.ndarray]:
+    """Lane markings of a one-way segment (segment frame, ``(u0, v0, u1, v1)`` rectangles, metres).
+
+    Dashed dividers between its ``2 * lanes`` same-direction lanes (the one at ``v = 0`` included:
+    no centre line), a stop line across the whole carriageway at the end the traffic arrives at,
+    and an arrow on every lane after the start's crosswalk, pointing the way the lanes run.
+
+    Parameters
+    ----------
+    grid : Grid
+    direction : int
+        +1 (traffic towards +u) or -1.
+    length : float
+        Segment length, metres.
+    dashes : callable
+        ``dashes(u0, u1, v0, v1) -> (k, 4)`` dash rectangles (the street meshes' pattern).
+    """
+    from generator.layout.streets import STOP_U
+
+    lh, w = grid.lane_half, grid.lane_w
+    m0, m1 = STOP_U[1], length - STOP_U[1]
+    out = [dashes(m0, m1, k * w - 0.06, k * w + 0.06) for k in range(-grid.lanes + 1, grid.lanes)]
+    u0, u1 = (length - STOP_U[1], length - STOP_U[0]) if direction > 0 else STOP_U
+    out.append(np.array([(u0, -lh, u1, lh)]))
+    u_arrow = STOP_U[1] + 2.0 if direction > 0 else length - STOP_U[1] - 2.0
+    if m1 - m0 > 12.0:
+        for k in range(-grid.lanes, grid.lanes):
+            out.append(arrow_rects(u_arrow, (k + 0.5) * w, direction))
+    return out
+
+
+def arrow_rects(u: float, v: float, direction: int, length: float = 5.0) -> np.ndarray:
+    """(k, 4) rectangles drawing a straight-ahead arrow on a lane: a 0.15 m shaft and a stepped head,
+    from ``u`` along ``direction`` (segment frame, metres), centred on the lane at ``v``."""
+    shaft = length * 0.6
+    rows = [(0.0, shaft, -0.075, 0.075)]
+    steps = 6
+    head = length - shaft
+    for i in range(steps):
+        a, b = shaft + head * i / steps, shaft + head * (i + 1) / steps
+        half = 0.45 * (1 - i / steps)
+        rows.append((a, b, -half, half))
+    r = np.array(rows)
+    if direction > 0:
+        return np.stack([u + r[:, 0], v + r[:, 2], u + r[:, 1], v + r[:, 3]], 1)
+    return np.stack([u - r[:, 1], v + r[:, 2], u - r[:, 0], v + r[:, 3]], 1)

@@ -1,0 +1,199 @@
+"""One-way streets in the lane graph: every lane of a one-way segment runs its one direction.
+
+:class:`~generator.traffic.lanes.LaneGraph` builds ``lanes`` lanes per direction on every
+segment; :func:`apply_one_way` then rewrites it for the segments whose cross-section is one-way
+(:attr:`generator.layout.cross_sections.CrossSection.one_way`):
+
+* the lanes of the contra side turn round. Lane numbers are *signed slots*: slot ``k`` is
+  centred ``(k + 0.5) * lane_w`` right of the centre line seen in the driving direction, so a
+  two-way street has slots ``0 .. lanes - 1`` per direction and a one-way street
+  ``-lanes .. lanes - 1`` in its direction (the negative ones left of the centre line) and none
+  against it;
+* connectors are rebuilt at every node: from each lane arriving at a node to every other arm
+  that has lanes *leaving* the node (so no connector enters a one-way street against it),
+  into the same slot when the exit has it (the quarter circles of
+  :func:`~generator.traffic.lanes.connector_path`) or else into the nearest slot it has (a lane
+  of a one-way street left of the centre line merging into a two-way street: a cubic curve
+  with the same end tangents);
+* the conflict table gains the keys ``(arm_in, arm_out, slot_in, slot_out)`` of the merging
+  connectors and the negative slots, measured as :func:`~generator.traffic.lanes.conflicts`
+  does (one table still serves every node); ``graph.conflict_keys`` maps a connector's edge
+  index to its key.
+
+Every lane keeps a successor as long as every node has an arm leaving it, which the layout
+guarantees (:mod:`generator.layout.one_way` keeps the network strongly connected).
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+import numpy as np
+
+from generator.traffic.lanes import ARM_DIRS, CAR_BOX_M, STEP_M, Edge, _corners, boxes_overlap, connector_path
+from generator.world.scene import Path
+
+KAPPA = 0.5523   #: cubic Bezier handle of a quarter circle, as a share of the radius
+
+
+def one_way_of(grid) -> dict[int, int]:
+    """``segment index -> +1 | -1`` for the one-way segments of ``grid`` (empty if none)."""
+    return {i: sec.one_way for i, sec in enumerate(grid.sections) if sec.one_way}
+
+
+def apply_one_way(graph) -> bool:
+    """Rewrite ``graph`` (a LaneGraph, in place) for the one-way segments of its grid, conflict table
+    included; False (and nothing done) when the grid has none."""
+    grid = graph.grid
+    ow = one_way_of(grid)
+    if not ow:
+        return False
+    old_edges, L = graph.edges, grid.lanes
+    edges: list[Edge] = []
+    lane_edge: dict = {}
+    slots: dict = {}      # (segment, direction) -> sorted signed slots
+    for (si, d, k), ei in sorted(graph.lane_edge.items(), key=lambda kv: kv[1]):
+        e = old_edges[ei]
+        D = ow.get(si, 0)
+        if D == 0 or d == D:
+            key, path, node, arms = (si, d, k), e.path, e.node, e.arms
+        else:   # the contra lane k turns round: slot -1 - k of direction D
+            seg = grid.segments[si]
+            key, path = (si, D, -1 - k), _reversed(e.path, f"lane_{si}_{D}_{-1 - k}")
+            node = seg.b if D > 0 else seg.a
+            arms = (int(np.argmax(ARM_DIRS @ np.array([np.cos(path.headings[0]), np.sin(path.headings[0])]))), -1)
+        lane_edge[key] = len(edges)
+        slots.setdefault(key[:2], []).append(key[2])
+        edges.append(Edge(len(edges), path, "lane", node, key[2], arms))
+    slots = {k: sorted(v) for k, v in slots.items()}
+    connector, ckeys = {}, {}
+    for node in grid.nodes:
+        c0 = grid.node_xy(node)
+        arms = grid.arms(node)
+        for x in arms:
+            seg_in, d_in = graph._segment_of(node, x)
+            s_in = slots.get((seg_in.index, -d_in), [])
+            for y in arms:
+                if y == x:
+                    continue
+                seg_out, d_out = graph._segment_of(node, y)
+                s_out = slots.get((seg_out.index, d_out), [])
+                if not s_out:
+                    continue      # the arm is one-way towards this node: nothing may enter it
+                left = x != (y + 2) % 4 and (y - x) % 4 == 3      # arm y is left of the arriving traffic
+                for k in s_in:
+                    for n, ko in enumerate(exit_slots(k, s_in, s_out, left)):
+                        name = f"conn_{node[0]}_{node[1]}_{x}{y}_{k}" + (f"_{ko}" if n else "")
+                        path = connector_path(c0, graph.entry_m, grid.lane_w, x, y, k, name) if ko == k else \
+                            merge_path(c0, graph.entry_m, grid.lane_w, x, y, k, ko, name)
+                        ci = len(edges)
+                        edges.append(Edge(ci, path, "connector", node, ko, (x, y)))
+                        connector[(node, x, y, k) if n == 0 else (node, x, y, k, ko)] = ci
+                        ckeys[ci] = (x, y, k) if ko == k else (x, y, k, ko)
+                        edges[lane_edge[(seg_in.index, -d_in, k)]].succ.append(ci)
+                        edges[ci].succ.append(lane_edge[(seg_out.index, d_out, ko)])
+    graph.edges, graph.lane_edge, graph.connector, graph.conflict_keys = edges, lane_edge, connector, ckeys
+    graph.conflict = conflict_table(graph.entry_m, graph.stop_m, grid.lane_w, frozenset(ckeys.values()), CAR_BOX_M)
+    return True
+
+
+def exit_slots(k: int, s_in: list[int], s_out: list[int], left: bool) -> list[int]:
+    """The slots of the exit lanes that slot ``k`` arriving at a node continues into (first: the one
+    the routes use, the same slot where the exit has it).
+
+    * same slot where the exit has it; a two-way street's lane entering a one-way street also
+      continues into the mirrored slot ``-1 - k`` left of the centre line, so the one-way street's
+      left lanes carry traffic too;
+    * a one-way street's left lane (``k < 0``) entering a two-way street: the mirrored slot
+      ``-1 - k`` on a left turn (the turn stays inside the one of the lanes to its right), else the
+      nearest slot the exit has (it merges).
+    """
+    if k in s_out:
+        return [k, -1 - k] if s_in[0] >= 0 and s_out[0] < 0 else [k]
+    if left and -1 - k in s_out:
+        return [-1 - k]
+    return [int(min(max(k, s_out[0]), s_out[-1]))]
+
+
+def _reversed(p: Path, name: str) -> Path:
+    """``p`` driven the other way (same points, reversed; headings turned round)."""
+    return Path(name, p.points[::-1].copy(), np.angle(np.exp(1j * (p.headings[::-1] + np.pi))), p.s[-1] - p.s[::-1])
+
+
+def merge_path(c0: np.ndarray, entry_m: float, lane_w: float, x: int, y: int, k_in: int, k_out: int,
+               name: str = "") -> Path:
+    """A connector from slot ``k_in`` of arm ``x`` to slot ``k_out`` of arm ``y`` of a node centred on
+    ``c0`` ((2,) world xy, metres): a cubic Bezier tangent to both lanes (a quarter-circle-like turn,
+    or an S-bend across lanes when straight on)."""
+    a, b = -ARM_DIRS[x], ARM_DIRS[y]
+    right_a, right_b = np.array([a[1], -a[0]]), np.array([b[1], -b[0]])
+    p0 = c0 - entry_m * a + (k_in + 0.5) * lane_w * right_a
+    p3 = c0 + entry_m * b + (k_out + 0.5) * lane_w * right_b
+    if abs(a[0] * b[1] - a[1] * b[0]) < 1e-9:        # straight on: handles a third of the way
+        h = float(np.dot(p3 - p0, a)) / 3
+        p1, p2 = p0 + h * a, p3 - h * b
+    else:                                              # turn: handles towards the tangents' crossing
+        s, t = np.linalg.solve(np.stack([a, b], 1), p3 - p0)
+        p1, p2 = p0 + KAPPA * s * a, p3 - KAPPA * t * b
+    n = max(8, int(np.ceil(np.linalg.norm(p3 - p0) * 1.6 / STEP_M)))
+    u = np.linspace(0.0, 1.0, n + 1)[:, None]
+    pts = (1 - u) ** 3 * p0 + 3 * (1 - u) ** 2 * u * p1 + 3 * (1 - u) * u ** 2 * p2 + u ** 3 * p3
+    der = 3 * (1 - u) ** 2 * (p1 - p0) + 6 * (1 - u) * u * (p2 - p1) + 3 * u ** 2 * (p3 - p2)
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
+    return Path(name, np.c_[pts, np.zeros(n + 1)], np.arctan2(der[:, 1], der[:, 0]), s)
+
+
+def _extended(entry_m: float, lane_w: float, key: tuple, ext: float) -> np.ndarray:
+    """(n, 3) x, y, heading samples of the connector ``key`` at a node on the origin, with ``ext``
+    metres of its lanes on each side (as :func:`generator.traffic.lanes._extended`)."""
+    x, y, k_in = key[:3]
+    k_out = key[3] if len(key) > 3 else k_in
+    p = (connector_path(np.zeros(2), entry_m, lane_w, x, y, k_in) if k_out == k_in
+         else merge_path(np.zeros(2), entry_m, lane_w, x, y, k_in, k_out))
+    a, b = -ARM_DIRS[x], ARM_DIRS[y]
+    n = int(np.ceil(ext / 0.5))
+    before = p.points[0, :2] - a * np.linspace(ext, 0.5, n)[:, None]
+    after = p.points[-1, :2] + b * np.linspace(0.5, ext, n)[:, None]
+    hb, ha = np.full(n, np.arctan2(a[1], a[0])), np.full(n, np.arctan2(b[1], b[0]))
+    keep = np.r_[0:len(p.s):2, len(p.s) - 1]
+    mid = np.c_[p.points[keep, :2], p.headings[keep]]
+    return np.vstack([np.c_[before, hb], mid, np.c_[after, ha]])
+
+
+def _pairs_overlap(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(p,) bool: do the convex quads ``a[i]`` and ``b[i]`` ((p, 4, 2) each) overlap (separating axes)."""
+    sep = np.zeros(len(a), bool)
+    for q in (a, b):
+        e = np.roll(q, -1, axis=1) - q
+        for j in range(2):
+            ax = np.stack([-e[:, j, 1], e[:, j, 0]], -1)[:, None, :]      # (p, 1, 2)
+            pa, pb = (a * ax).sum(-1), (b * ax).sum(-1)
+            sep |= (pa.max(1) < pb.min(1)) | (pb.max(1) < pa.min(1))
+    return ~sep
+
+
+@lru_cache(maxsize=16)
+def conflict_table(entry_m: float, stop_m: float, lane_w: float, keys: frozenset, size) -> dict:
+    """``key -> set of keys`` that conflict: a car of ``size`` (length, width, metres) on one connector,
+    from the stop line to past the far crosswalk, can touch one on the other. The same answer as
+    :func:`generator.traffic.lanes.conflicts` on its keys; box pairs whose centres are farther apart
+    than the boxes' diameter are skipped, those closer than their width overlap without a test."""
+    order = sorted(keys, key=repr)
+    ext = stop_m - entry_m + size[0] / 2
+    geo = [_corners(_extended(entry_m, lane_w, k, ext), size) for k in order]
+    owner = np.concatenate([np.full(len(g), i) for i, g in enumerate(geo)])
+    quads = np.concatenate(geo)
+    centre = quads.mean(1)
+    far = np.linalg.norm(quads[0] - centre[0], axis=1).max() * 2
+    near = min(np.linalg.norm(quads[0, 1] - quads[0, 0]), np.linalg.norm(quads[0, 2] - quads[0, 1]))
+    hit = np.zeros((len(order), len(order)), bool)
+    for i in range(len(order)):
+        rows, cols = np.flatnonzero(owner == i), np.flatnonzero(owner > i)   # each pair of keys once
+        d = np.linalg.norm(centre[rows][:, None] - centre[cols][None], axis=-1)
+        hit[i, owner[cols[np.nonzero(d < near)[1]]]] = True
+        r, c = np.nonzero((d >= near) & (d <= far) & ~hit[i, owner[cols]][None])   # key pairs not yet decided
+        over = _pairs_overlap(quads[rows[r]], quads[cols[c]])
+        hit[i, owner[cols[c[over]]]] = True
+    hit |= hit.T
+    np.fill_diagonal(hit, True)
+    return {k: {order[j] for j in np.flatnonzero(hit[i])} for i, k in enumerate(order)}
