@@ -4,6 +4,11 @@ Writes ``<name>_map.png`` (top-down class map with route 0, legend and scale bar
 ``<name>.glb`` (the scene for any 3D viewer) and ``<name>_summary.json`` (objects and
 triangles per class, totals, bounds, seed, spec hash, route lengths, build time). Nothing
 is written until the scene is built and every file is ready; each file is written atomically.
+
+A spec with ``town.redraw_every_frames`` shows a new town every N frames, none of them drawn from
+the spec's own seed; ``--town I`` builds town ``I`` (as ``generate`` draws it, files named
+``<name>_town<I>_*``), and without it the command refuses the spec (one line, exit 2) rather
+than show a town no dataset of the spec contains. ``lidar`` takes the same option.
 """
 
 from __future__ import annotations
@@ -16,8 +21,9 @@ import time
 
 from generator import __version__
 from generator.atomic import inside, staging, write_bytes, write_json
-from generator.commands.options import Number, path, text_path
+from generator.commands.options import Integer, Number, path, text_path
 from generator.commands.preflight import output_dir
+from generator.errors import UserError
 from generator.spec import load_spec
 
 log = logging.getLogger("urbangen.layout")
@@ -30,18 +36,54 @@ def register(subparsers) -> None:
     p.add_argument("--out", required=True, type=path, help="output folder (created if missing)")
     p.add_argument("--ppm", type=Number(0.5, 20), default=None,
                    help="map pixels per metre, in [0.5, 20] (default: 8, less for big towns)")
+    add_town_argument(p)
     p.set_defaults(func=run)
+
+
+MAX_TOWN = 100_000   #: as town.redraw_every_frames: no run has more towns than frames
+
+
+def add_town_argument(p) -> None:
+    """``--town I``: town ``I`` of a spec with ``town.redraw_every_frames`` (``layout`` and ``lidar``)."""
+    p.add_argument("--town", type=Integer(0, MAX_TOWN), default=None,
+                   help="with a spec that sets town.redraw_every_frames (a new town every N frames): build "
+                        "town I, drawn as generate draws it (its own seed); required for such a spec")
+
+
+def spec_for_town(spec, town: int | None):
+    """The spec of the town ``--town`` names (``spec`` itself for a spec that re-draws no town).
+
+    Raises
+    ------
+    UserError
+        One line when a re-drawing spec comes without ``--town`` or ``--town`` comes with a spec
+        that re-draws no town (either would build a town the user did not ask for).
+    """
+    from generator.spec.towns import redraw_every, town_spec
+
+    n = redraw_every(spec)
+    if n is None:
+        if town is not None:
+            raise UserError(f"--town: {spec.source} re-draws no town (town.redraw_every_frames is null); "
+                            "leave --town out")
+        return spec
+    if town is None:
+        raise UserError(f"{spec.source}: town.redraw_every_frames = {n} draws a new town every {n} frames, none "
+                        "from the spec's own seed: pass --town I for town I (frames I*N..) as generate draws it")
+    return town_spec(spec, town)
 
 
 def summary(scene, spec, build_s: float) -> dict:
     """The JSON summary of a built scene."""
     from generator.layout.assemble import class_counts
+    from generator.spec.towns import town_record
 
     counts = class_counts(scene)
     return {
         "name": spec.name,
         "urbangen": __version__,
         "seed": spec.seed,
+        **({"town": town_record(spec)} if spec.town_index is not None else {}),
         "spec_hash": spec.spec_hash,
         "digest": scene.digest(),
         "bounds_m": [[round(float(v), 3) for v in row] for row in scene.bounds],
@@ -79,16 +121,17 @@ def run(args: argparse.Namespace) -> int:
     from generator.previews.layout_map import render_map
     from generator.layout.assemble import build_scene
 
-    spec = load_spec(args.spec)
+    spec = spec_for_town(load_spec(args.spec), args.town)
     out = output_dir(args.out, "--out")
-    files = {k: out / f"{spec.name}{suffix}" for k, suffix in
+    stem = spec.name if spec.town_index is None else f"{spec.name}_town{spec.town_index}"
+    files = {k: out / f"{stem}{suffix}" for k, suffix in
              (("map", "_map.png"), ("glb", ".glb"), ("summary", "_summary.json"))}
     t0 = time.perf_counter()
     log.info("building %s from %s", spec.name, args.spec)
     scene = build_scene(spec)
     build_s = time.perf_counter() - t0
     log.info("rendering the map")
-    img = render_map(scene, ppm=args.ppm, marker_spacing_m=spec.paths.spacing_m, title=spec.name)
+    img = render_map(scene, ppm=args.ppm, marker_spacing_m=spec.paths.spacing_m, title=stem)
     png = io.BytesIO()
     img.save(png, format="PNG", optimize=False)
     log.info("exporting GLB")

@@ -7,6 +7,10 @@ bird's-eye PNG per scan in ``bev/``, and the dataset label config ``DIR/semantic
 whose split lists every sequence in DIR: --split puts this one under train, valid or test
 (default: the split it already has there, else valid, the split semantic-kitti-api evaluates
 without -s).
+
+A spec with ``town.redraw_every_frames`` needs ``--town I``: the sequence is then town ``I``'s, drawn
+and driven as ``generate`` does (its own seed, from its own start), and ``lidar_meta.json`` records
+the town (see :func:`generator.commands.layout.spec_for_town`).
 """
 
 from __future__ import annotations
@@ -17,6 +21,7 @@ from pathlib import Path
 
 from generator.atomic import staging
 from generator.commands.intensity import add_processing_args, spec_with_processing_args
+from generator.commands.layout import add_town_argument, spec_for_town
 from generator.commands.options import Integer, path, sequence_id, text_path
 from generator.commands.preflight import output_dir
 from generator.formats.label_config import SPLITS
@@ -48,12 +53,14 @@ def register(sub) -> None:
                    help="split of this sequence in DIR/semantic-kitti.yaml: train, valid or test "
                         "(default: the one it has there, else valid)")
     add_processing_args(p, weather=True)
+    add_town_argument(p)
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
     # Every check on user input comes before anything is built or written.
-    spec = spec_with_processing_args(load_spec(args.spec), args)
+    # the town last: re-parsing the spec (processing options) would drop its town index and asset seed
+    spec = spec_for_town(spec_with_processing_args(load_spec(args.spec), args), args.town)
     cfg = load_render_config(args.render_config)
     sensor = sensor_for_spec(spec)
     intensity_fn = intensity_fn_for_spec(spec)

@@ -6,6 +6,10 @@ channel per class + depth + instance), a metadata JSON and a preview PNG, in
 (``weather.times_of_day``; default day and night: 12 combinations, 6 RGB renders; fog and rain
 in post). Images whose metadata already
 exists are skipped (rerun = resume).
+
+A spec with ``town.redraw_every_frames = N`` is rendered as ``generate`` renders it: frame ``k``
+shows town ``k // N`` (its own seed, driven from its own start; :mod:`generator.spec.towns`), so
+the images are those of a ``generate`` run of the same spec and frames.
 """
 
 from __future__ import annotations
@@ -124,16 +128,33 @@ def run(args) -> int:
     check_free_space(out, n_images * per_image, f"{n_images} images at {cfg.width}x{cfg.height}")
     created = not out.exists()
     try:
-        jobs = make_jobs(r.spec, cfg, out, todo, combos, args.workers)
-        res = run_jobs(args.executor, jobs, len(todo), None, args.ray_address)
+        done, wall = {}, 0.0
+        for tspec, first, frames in towns_of(r.spec, todo):  # one town unless the spec re-draws towns
+            jobs = make_jobs(tspec, cfg, out, frames, combos, args.workers, first=first)
+            res = run_jobs(args.executor, jobs, len(frames), None, args.ray_address)
+            done.update(res.frame_seconds)
+            wall += res.wall_s
     except BaseException:
         _remove_unfinished(out, plan, created)
         raise
     finally:
         shutil.rmtree(out / ".scratch", ignore_errors=True)
-    n = sum(len(msg["images"]) for msg in res.frame_seconds.values())
-    print(f"rendered {n} images of {len(res.frame_seconds)} frames into {out / 'images'} in {res.wall_s:.1f} s")
+    n = sum(len(msg["images"]) for msg in done.values())
+    print(f"rendered {n} images of {len(done)} frames into {out / 'images'} in {wall:.1f} s")
     return 0
+
+
+def towns_of(spec, frames: list[int]) -> list[tuple[object, int, list[int]]]:
+    """(town spec, frame number of the start of its drive, its frames) per town the ``frames`` show:
+    the spec itself with every frame when it re-draws no town, else town ``k // N`` for frame ``k``."""
+    from generator.spec.towns import first_frame, redraw_every, town_of, town_spec
+
+    if redraw_every(spec) is None:
+        return [(spec, 0, sorted(frames))]
+    groups: dict[int, list[int]] = {}
+    for k in sorted(frames):
+        groups.setdefault(town_of(spec, k), []).append(k)
+    return [(town_spec(spec, i), first_frame(spec, i), ks) for i, ks in sorted(groups.items())]
 
 
 def _remove_unfinished(out: Path, plan, created: bool) -> None:

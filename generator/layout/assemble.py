@@ -22,6 +22,7 @@ from generator.labels import class_table
 from generator.layout import placement_lots as pl
 from generator.layout import placement_extras as px
 from generator.layout import placement_street as ps
+from generator.layout import placement_tracks as pt
 from generator.layout import placement_verges as pv
 from generator.layout.lots import Lot, lot_ground_mesh, make_lots
 from generator.layout.outskirts import horizon_mesh
@@ -64,6 +65,8 @@ STEPS = (
     ("other vehicles", lambda p, s, g, lots, st: px.place_other_vehicles(p, s, st)),
     ("riders", lambda p, s, g, lots, st: px.place_riders(p, s, st)),
     ("lot extras", lambda p, s, g, lots, st: px.place_lot_extras(p, s, lots, st)),
+    # where trams run, their line also leaves the street on a ballast bed (a no-op at trams = 0)
+    ("tram track", lambda p, s, g, lots, st: pt.place_tram_track(p, s, lots, st)),
 )
 
 

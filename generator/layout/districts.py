@@ -7,8 +7,9 @@ and how many trees and bushes stand on the lots (a multiplier on the lot greener
 is the town without districts: ``density`` and ``heights`` decide as before.
 
 The lot band outside the outer ring road draws one district per section (the stretch facing a
-block or an intersection). Draws: stream ``("layout", "districts")``, blocks row-major in
-``(j, i)``, then the outer sections in :func:`generator.layout.outskirts.outer_rows` order.
+block or an intersection). Draws: stream ``("layout", "districts")``, the blocks (row-major in
+``(j, i)``) as one balanced draw, then the outer sections (in
+:func:`generator.layout.outskirts.outer_rows` order) as another (:func:`draw_districts`).
 """
 
 from __future__ import annotations
@@ -66,17 +67,37 @@ DISTRICTS: dict[str, District] = {
 NAMES = ("mixed", *DISTRICTS)
 
 
-def draw_districts(spec, n: int) -> list[str]:
+def draw_districts(spec, n: int, groups: tuple[int, ...] | None = None) -> list[str]:
     """``n`` district names drawn from ``spec.streets.districts`` (all ``""`` without ``streets``).
+
+    Each group of consecutive slots (default: one group of all ``n``) gets a *balanced* draw: the
+    count of each district is ``floor`` or ``ceil`` of its weight share times the group size
+    (systematic sampling on the weights' cumulative sum from one uniform draw), and the slots are
+    then shuffled. Every slot still has the weight share as its probability, but a town can no longer
+    draw, say, light industry on most blocks of a spec that asks for a fifth: with i.i.d. draws a 3x3
+    town's mix swung by more than the gap the presets are tuned to (issue 13, ``bench/class_mix.py``).
 
     Parameters
     ----------
     spec : SceneSpec
     n : int
         Blocks plus outer sections, in the order of the module docstring.
+    groups : tuple of int, optional
+        Sizes of the groups drawn apart (summing to ``n``), e.g. ``(blocks, outer sections)``.
     """
     if spec.streets is None:
         return [""] * n
+    groups = (n,) if groups is None else tuple(int(m) for m in groups)
+    if sum(groups) != n:
+        raise ValueError(f"district groups {groups} do not add up to {n} slots")
     w = np.array([float(spec.streets.districts.get(k, 0.0)) for k in NAMES])
+    cdf = np.cumsum(w / w.sum())
     g = stream(spec.seed, "layout", "districts")
-    return [NAMES[int(k)] for k in g.choice(len(NAMES), size=n, p=w / w.sum())]
+    out: list[str] = []
+    for m in groups:
+        if m <= 0:
+            continue
+        pos = (g.random() + np.arange(m)) / m
+        picks = np.minimum(np.searchsorted(cdf, pos, side="right"), len(NAMES) - 1)
+        out += [NAMES[int(k)] for k in g.permutation(picks)]
+    return out

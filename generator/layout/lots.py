@@ -193,7 +193,7 @@ def make_lots(spec: SceneSpec, grid: Grid) -> list[Lot]:
     lots: list[Lot] = []
     nx, ny = len(grid.xs) - 1, len(grid.ys) - 1
     sections = outer_rows(grid)
-    districts = draw_districts(spec, nx * ny + len(sections))
+    districts = draw_districts(spec, nx * ny + len(sections), (nx * ny, len(sections)))
 
     def row(block, corner, ua, ub, widths, depth, g, district):
         yaw = float(np.arctan2(ub[1], ub[0]) - np.pi / 2)
