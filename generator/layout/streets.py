@@ -22,7 +22,7 @@ towards +u uses the lanes at ``v < 0``.
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -107,10 +107,29 @@ class Grid:
     segments: tuple[Segment, ...]
     outer_depth: float = 0.0         #: depth of the lot band outside the outer ring road
     sections: tuple[CrossSection, ...] = ()   #: per segment; () = every street plain
+    roundabouts: frozenset = frozenset()       #: nodes ``(i, j)`` that are roundabouts (:mod:`.roundabouts`)
 
     def section(self, seg: Segment) -> CrossSection:
         """The cross-section type of ``seg`` (see :mod:`generator.layout.cross_sections`)."""
         return self.sections[seg.index] if self.sections else PLAIN
+
+    def is_roundabout(self, node: tuple[int, int]) -> bool:
+        """Whether ``node`` is a roundabout (an island at its centre, no signals)."""
+        return tuple(node) in self.roundabouts
+
+    @property
+    def ring(self):
+        """The :class:`generator.layout.roundabouts.Ring` of this cross-section, or None."""
+        from generator.layout.roundabouts import grid_ring
+
+        return grid_ring(self)
+
+    def islands(self) -> np.ndarray:
+        """(k, 3) float64 ``(x, y, radius)`` of the roundabout islands (raised to curb height)."""
+        if not self.roundabouts:
+            return np.zeros((0, 3))
+        r = self.ring.island_r
+        return np.array([(*self.node_xy(n), r) for n in sorted(self.roundabouts)], np.float64)
 
     def strip_span(self, seg: Segment) -> tuple[float, float] | None:
         """(u0, u1) of the middle stretch where ``seg``'s side strips differ (parking bays, verges,
@@ -264,8 +283,8 @@ class Grid:
     def ground_height(self, xy: np.ndarray) -> np.ndarray:
         """(n,) float64 height of the ground surface at world points ``xy`` ((n, 2) metres).
 
-        0 on the road (kerb to kerb, intersections included, verges and median islands
-        excepted), ``curb_h`` elsewhere (curbs, sidewalks, verges, islands, lots, terrain).
+        0 on the road (kerb to kerb, intersections included, verges, median and roundabout
+        islands excepted), ``curb_h`` elsewhere (curbs, sidewalks, verges, islands, lots, terrain).
         """
         xy = np.asarray(xy, np.float64).reshape(-1, 2)
         on_road = np.zeros(len(xy), bool)
@@ -273,11 +292,14 @@ class Grid:
             on_road |= (xy[:, 0] > x0) & (xy[:, 0] < x1) & (xy[:, 1] > y0) & (xy[:, 1] < y1)
         for _, _, (x0, y0, x1, y1) in self.raised_rects():
             on_road &= ~((xy[:, 0] > x0) & (xy[:, 0] < x1) & (xy[:, 1] > y0) & (xy[:, 1] < y1))
+        for x, y, r in self.islands():
+            on_road &= (xy[:, 0] - x) ** 2 + (xy[:, 1] - y) ** 2 >= r * r
         return np.where(on_road, 0.0, self.curb_h)
 
 
 def make_grid(spec: SceneSpec) -> Grid:
-    """Draw the block sizes (stream ``("layout", "grid")``) and build the :class:`Grid`.
+    """Draw the block sizes (stream ``("layout", "grid")``) and build the :class:`Grid` (with the
+    cross-sections and roundabouts drawn from ``spec.streets``).
 
     The town is centred on the world origin.
     """
@@ -302,6 +324,9 @@ def make_grid(spec: SceneSpec) -> Grid:
         for j in range(len(ys) - 1):
             segs.append(((i, j), (i, j + 1), 1, (xs[i], ys[j] + road_half), ys[j + 1] - ys[j] - 2 * road_half))
     segments = tuple(Segment(k, ax, a, b, (float(o[0]), float(o[1])), float(n)) for k, (a, b, ax, o, n) in enumerate(segs))
-    return Grid(xs, ys, t.lanes_per_direction, t.lane_width_m, t.parking_strip_width_m, CURB_WIDTH_M,
+    grid = Grid(xs, ys, t.lanes_per_direction, t.lane_width_m, t.parking_strip_width_m, CURB_WIDTH_M,
                 t.sidewalk_width_m, t.curb_height_m, t.margin_m, segments,
                 max(MIN_OUTER_DEPTH_M, t.block_size_m / 2), draw_sections(spec, len(segments)))
+    from generator.layout.roundabouts import draw_roundabouts   # it needs the routes' radii, which need Grid
+
+    return replace(grid, roundabouts=draw_roundabouts(spec, grid))

@@ -36,11 +36,14 @@ def parse_spec(document: object, source: str) -> SceneSpec:
 
 
 def spec_hash(spec: SceneSpec) -> str:
-    """The spec's :func:`canonical_hash`; ``town.redraw_every_frames`` counts only when set, so the
-    hash of every spec written before that option is unchanged (resumable datasets stay resumable)."""
+    """The spec's :func:`canonical_hash`; ``town.redraw_every_frames`` and ``streets.roundabouts`` count
+    only when set, so the hash of every spec written before those options is unchanged (resumable
+    datasets stay resumable)."""
     d = spec.to_dict()
     if d["town"].get("redraw_every_frames") is None:
         d["town"].pop("redraw_every_frames", None)
+    if d.get("streets") is not None and not d["streets"].get("roundabouts"):
+        d["streets"].pop("roundabouts", None)    # likewise streets.roundabouts while 0
     return canonical_hash(d)
 
 

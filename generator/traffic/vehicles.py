@@ -169,8 +169,8 @@ class VehicleSim:
         ahead = -veh.s
         for e in veh.plan[:3]:
             edge = self.g.edges[e]
-            if edge.kind == "connector" and edge.arms[0] != (edge.arms[1] + 2) % 4:
-                r = edge.length / (np.pi / 2)
+            r = self.g.turn_radius(edge)
+            if r is not None:
                 v_turn = np.sqrt(A_LAT * r)
                 v0 = min(v0, np.sqrt(v_turn ** 2 + 2 * B_COMF * max(0.0, ahead - veh.length / 2)))
             ahead += edge.length
@@ -197,7 +197,7 @@ class VehicleSim:
             okey = (*other.arms, other.lane)
             if c == conn.index and not big and self.vehicles[vid].length <= BIG_M:
                 continue
-            if big or self.vehicles[vid].length > BIG_M or okey in self.g.conflict[key]:
+            if big or self.vehicles[vid].length > BIG_M or okey in self.g.conflicts_at(node)[key]:
                 return
         if not self._room(veh, conn, occ):
             return
