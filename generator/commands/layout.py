@@ -38,7 +38,7 @@ def summary(scene, spec, build_s: float) -> dict:
     from generator.layout.assemble import class_counts
 
     counts = class_counts(scene)
-    return {
+    info = {
         "name": spec.name,
         "urbangen": __version__,
         "seed": spec.seed,
@@ -55,6 +55,13 @@ def summary(scene, spec, build_s: float) -> dict:
                     "closed": p.closed} for p in scene.paths],
         "build_seconds": round(build_s, 3),
     }
+    from generator.layout.roundabouts import roundabout_record
+    from generator.layout.streets import make_grid
+
+    ring = roundabout_record(make_grid(spec))
+    if ring is not None:     # only towns with roundabouts: the others' summaries read as before
+        info["roundabouts"] = ring
+    return info
 
 
 def _kinds(scene) -> dict[str, int]:

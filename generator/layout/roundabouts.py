@@ -13,13 +13,16 @@ the exit lane. Tangency fixes the ring radius once ``f`` is chosen::
 so with ``f = MIN_RADIUS_M`` (the tightest turn the routes ever make) every arc of every path
 has radius >= ``MIN_RADIUS_M``, and the ring is as large as that allows (5.28 m for the default
 cross-section: 1 lane of 3.5 m, 2.4 m parking, so ``entry_m`` = 7.75 m). The island keeps
-``EGO_HALF_WIDTH_M + ISLAND_CLEAR_M`` inside the innermost ring, so the widest vehicle that
-drives a route keeps ``ISLAND_CLEAR_M`` off its kerb (3.78 m for the default cross-section).
+``ISLAND_CLEAR_M`` inside the closest approach of a box as long as the standard car and as wide
+as the ego (``2 EGO_HALF_WIDTH_M``) on any path -- the ring radius less the half width, or a corner
+where a fillet meets the ring -- so the widest vehicle that drives a route keeps ``ISLAND_CLEAR_M``
+off its kerb (3.33 m for the default cross-section).
 
 Only four-arm (interior) nodes can be roundabouts: a ring needs the asphalt of all four arms
 round it (at a three-arm node the ring would run into the kerb closing the missing arm). A
 cross-section whose ring would need arcs tighter than ``MIN_RADIUS_M``, or whose standard car
-(4.8 x 2.1 m) would leave the kerb lines anywhere on a path, gets no roundabouts (warning).
+(4.8 x 2.1 m) would leave the kerb lines anywhere on a path, cannot have roundabouts: asking for
+them there is a spec error (``streets.roundabouts``, exit 2).
 
 Draws: stream ``("layout", "roundabouts")``, one uniform draw per interior node in
 :attr:`Grid.nodes` order; a node is a roundabout when its draw is below ``streets.roundabouts``.
@@ -33,6 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from generator.errors import SpecError
 from generator.layout.routes import MIN_RADIUS_M, RIGHT_RADIUS_M
 from generator.rng import stream
 from generator.world.scene import Path
@@ -98,16 +102,23 @@ def ring_geometry(lanes: int, lane_w: float, road_half: float) -> Ring | None:
     e, f = entry_distance(lanes, lane_w, road_half), FILLET_M
     o = (np.arange(lanes) + 0.5) * lane_w
     ring_r = -f + np.sqrt(f * f + e * e + o * o + 2 * o * f)
-    island_r = float(ring_r[0] - EGO_HALF_WIDTH_M - ISLAND_CLEAR_M)
-    if ring_r[0] < MIN_RADIUS_M or island_r <= 0.5:
+    if ring_r[0] < MIN_RADIUS_M:
         return None
-    ring = Ring(tuple(float(r) for r in ring_r), f, island_r, e, lane_w)
+    ring = Ring(tuple(float(r) for r in ring_r), f, 0.0, e, lane_w)
+    inner = float(ring_r[0] - EGO_HALF_WIDTH_M)
     for k in range(lanes):
         for x in range(4):
             for y in range(4):
-                if x != y and not _inside_kerbs(ring_path(ring, np.zeros(2), x, y, k), road_half):
+                if x == y:
+                    continue
+                p = ring_path(ring, np.zeros(2), x, y, k)
+                if not _inside_kerbs(p, road_half):
                     return None
-    return ring
+                # where a fillet meets the ring the box's inner corners come closer than its side
+                corners = _corners(p, (STANDARD_CAR_M[0], 2 * EGO_HALF_WIDTH_M))
+                inner = min(inner, float(np.hypot(corners[..., 0], corners[..., 1]).min()))
+    island_r = inner - ISLAND_CLEAR_M
+    return Ring(ring.ring_r, f, island_r, e, lane_w) if island_r > 0.5 else None
 
 
 def grid_ring(grid) -> Ring | None:
@@ -115,21 +126,30 @@ def grid_ring(grid) -> Ring | None:
     return ring_geometry(grid.lanes, float(grid.lane_w), float(grid.road_half))
 
 
+def _corners(path: Path, size: tuple[float, float]) -> np.ndarray:
+    """(n, 4, 2) corners of a box of ``size`` (length, width) metres centred on every sample of ``path``."""
+    hl, hw = size[0] / 2, size[1] / 2
+    c, s = np.cos(path.headings)[:, None], np.sin(path.headings)[:, None]
+    dl, dw = np.array([hl, hl, -hl, -hl]), np.array([hw, -hw, hw, -hw])
+    return path.points[:, None, :2] + np.stack([c * dl - s * dw, s * dl + c * dw], -1)
+
+
 def _inside_kerbs(path: Path, road_half: float) -> bool:
     """Whether the standard car's corners along ``path`` (node at the origin) stay on the asphalt
     cross ``|x| < road_half or |y| < road_half`` with ``KERB_CLEAR_M`` to spare."""
-    hl, hw = STANDARD_CAR_M[0] / 2, STANDARD_CAR_M[1] / 2
-    c, s = np.cos(path.headings), np.sin(path.headings)
+    p = _corners(path, STANDARD_CAR_M)
     lim = road_half - KERB_CLEAR_M
-    for dl, dw in ((hl, hw), (hl, -hw), (-hl, hw), (-hl, -hw)):
-        p = path.points[:, :2] + np.stack([c * dl - s * dw, s * dl + c * dw], 1)
-        if not np.all((np.abs(p[:, 0]) < lim) | (np.abs(p[:, 1]) < lim)):
-            return False
-    return True
+    return bool(np.all((np.abs(p[..., 0]) < lim) | (np.abs(p[..., 1]) < lim)))
 
 
 def draw_roundabouts(spec, grid) -> frozenset:
-    """The roundabout nodes of ``grid`` drawn from ``spec.streets.roundabouts`` (empty without it)."""
+    """The roundabout nodes of ``grid`` drawn from ``spec.streets.roundabouts`` (empty without it).
+
+    Raises
+    ------
+    SpecError
+        Roundabouts asked for in a town with interior nodes whose cross-section fits none.
+    """
     share = 0.0 if spec.streets is None else float(spec.streets.roundabouts)
     if share <= 0:
         return frozenset()
@@ -137,12 +157,20 @@ def draw_roundabouts(spec, grid) -> frozenset:
     interior = [n for n in grid.nodes if 0 < n[0] < nx and 0 < n[1] < ny]
     draws = stream(spec.seed, "layout", "roundabouts").random(len(interior))
     chosen = frozenset(n for n, r in zip(interior, draws) if r < share)
-    if chosen and grid_ring(grid) is None:
-        log.warning("%s: streets.roundabouts: no roundabout fits this cross-section (%d lanes of %.2f m, "
-                    "%.2f m kerb to centre); the %d drawn nodes stay plain intersections",
-                    spec.source or spec.name, grid.lanes, grid.lane_w, grid.road_half, len(chosen))
-        return frozenset()
+    if interior and grid_ring(grid) is None:
+        raise SpecError(spec.source or spec.name, "streets.roundabouts",
+                        f"no roundabout fits streets of {grid.lanes} lane(s) of {grid.lane_w:g} m and "
+                        f"{grid.parking_w:g} m parking (its arcs would be tighter than {MIN_RADIUS_M:g} m or leave "
+                        f"the kerbs); widen town.lane_width_m or town.parking_strip_width_m, or set 0, got {share:g}")
+    log.info("%s: %d of %d interior nodes are roundabouts", spec.name, len(chosen), len(interior))
     return chosen
+
+
+def roundabout_record(grid) -> dict | None:
+    """What was drawn, for metadata: the roundabout nodes and their ring geometry (None without any)."""
+    if not grid.roundabouts:
+        return None
+    return {"nodes": [list(n) for n in sorted(grid.roundabouts)], **grid.ring.to_dict()}
 
 
 # -- paths ---------------------------------------------------------------------------------------
