@@ -16,9 +16,10 @@ from generator.errors import SpecError
 from generator.labels import class_table
 from generator.layout.assemble import build_scene
 from generator.layout.placement_core import EGO_HALF_WIDTH_M
-from generator.layout.roundabouts import ARM_DIRS, STANDARD_CAR_M, ring_geometry, ring_path
+from generator.layout.roundabouts import (ARM_DIRS, DESIGN_VEHICLES_M, STANDARD_CAR_M, _closest, ring_geometry,
+                                          ring_path)
 from generator.layout.routes import MIN_RADIUS_M, make_routes
-from generator.layout.streets import make_grid
+from generator.layout.streets import APRON_H_M, make_grid
 from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
 from generator.traffic.lanes import LaneGraph, boxes_overlap
@@ -73,6 +74,9 @@ def test_every_ring_connector_clears_the_island_turns_no_tighter_than_the_routes
                     cy = xy[:, 1] + np.sin(h) * dl + np.cos(h) * dw
                     assert np.hypot(cx, cy).min() >= ring.island_r + 0.3 - 1e-9
                 assert _radii(h, p.s).min() >= MIN_RADIUS_M * (1 - 1e-3)    # chords of 5 m arcs
+                # a 12 m bus and a 4.3 m wide excavator roll over the apron, never the raised centre
+                for size in DESIGN_VEHICLES_M:
+                    assert _closest(p, size) >= ring.core_r + 0.3 - 1e-9
                 # headings are the direction of travel, continuous, and circulate anticlockwise
                 chord = np.arctan2(*np.diff(xy, axis=0).T[::-1])
                 assert np.abs(np.angle(np.exp(1j * (chord - h[:-1])))).max() < np.radians(3)
@@ -241,11 +245,14 @@ def test_the_island_is_raised_other_ground_with_grass_and_nothing_but_vehicles_o
     table = class_table()
     tri = scene.vertices[scene.faces]                    # (f, 3, 3)
     centre = tri.mean(1)
-    on_island = np.hypot(*(centre[:, :2] - c).T) < ring.island_r - 0.05
-    cls = scene.face_class[on_island & (centre[:, 2] > grid.curb_h - 0.01) & (centre[:, 2] < grid.curb_h + 0.01)]
-    names = {table.names[i] for i in np.unique(cls)}
-    assert names == {"other_ground", "terrain"}, names
+    r = np.hypot(*(centre[:, :2] - c).T)
+    assert 0 < ring.core_r < ring.island_r
+    top = scene.face_class[(r < ring.core_r - 0.05) & (np.abs(centre[:, 2] - grid.curb_h) < 0.01)]
+    assert {table.names[i] for i in np.unique(top)} == {"other_ground", "terrain"}      # kerb band, grass
+    apron = scene.face_class[(r > ring.core_r + 0.05) & (r < ring.island_r - 0.05) & (np.abs(centre[:, 2] - APRON_H_M) < 0.01)]
+    assert {table.names[i] for i in np.unique(apron)} == {"other_ground"}
     assert grid.ground_height(c[None])[0] == grid.curb_h
+    assert grid.ground_height(c[None] + [(ring.core_r + ring.island_r) / 2, 0])[0] == APRON_H_M
     ground = ("street", "sidewalk", "intersection", "corner", "lot_ground", "terrain", "horizon")
     placed = [o for o in scene.objects if o.kind not in ground]
     assert not [o.name for o in placed if o.cls == "traffic_light" and np.hypot(*(o.transform[:2, 3] - c)) < 15]
@@ -256,9 +263,9 @@ def test_the_island_is_raised_other_ground_with_grass_and_nothing_but_vehicles_o
     bushes = 0
     for o in placed:
         x, y = o.transform[:2, 3]
-        if np.hypot(x - c[0], y - c[1]) < ring.island_r:      # on the island: planting, wholly on it
+        if np.hypot(x - c[0], y - c[1]) < ring.island_r:      # on the island: planting, wholly on the grass
             assert o.cls == "vegetation", o.name
-            assert np.hypot(*(o.box.corners_xy() - c).T).max() < ring.island_r, o.name
+            assert np.hypot(*(o.box.corners_xy() - c).T).max() < ring.core_r, o.name
             bushes += 1
         elif ((x > lanes[:, 0]) & (x < lanes[:, 2]) & (y > lanes[:, 1]) & (y < lanes[:, 3])).any():
             assert o.cls in on_lanes or o.attrs.get("placement") == "crosswalk", (o.name, o.cls)
@@ -273,6 +280,20 @@ def test_the_island_is_raised_other_ground_with_grass_and_nothing_but_vehicles_o
     assert not ov.any()
     square = np.array([[c + ring.island_r * np.array(d) for d in ((-1, -1), (1, -1), (1, 1), (-1, 1))]])
     assert not boxes_overlap(square, np.stack([o.box.corners_xy() for o in rest])).any()
+
+
+def test_no_vehicle_touches_a_pedestrian_at_an_unsignalled_roundabout(town):
+    """No signals hold vehicles back at the roundabout: they give way to people on the crosswalks."""
+    _, _, world = town
+    people = [a for a in world.actors if a.kind == "person"]
+    vehicles = [a for a in world.actors if a.kind != "person"]
+    assert len(people) > 10 and len(vehicles) > 10
+    for t in np.arange(0.0, MINUTE_S, 0.1):
+        p = np.stack([a.box(t).corners_xy() for a in people])
+        E = world.ego.T_world_ego(t)[0]
+        ego = OrientedBox((E[0, 3], E[1, 3], 0.7), (4.6, 1.9, 1.5), float(np.arctan2(E[1, 0], E[0, 0])))
+        hit = boxes_overlap(np.stack([a.box(t).corners_xy() for a in vehicles] + [ego.corners_xy()]), p)
+        assert not hit.any(), (t, np.argwhere(hit)[:3])
 
 
 def test_a_minute_of_traffic_through_a_roundabout_never_touches(town):
@@ -292,11 +313,14 @@ def test_a_minute_of_traffic_through_a_roundabout_never_touches(town):
         assert not boxes_overlap(ego.corners_xy()[None], q).any(), f"an actor touches the ego at t={t:.1f}"
         assert not boxes_overlap(q, parked).any(), f"an actor touches a static object at t={t:.1f}"
         for a in vehicles:
-            corners = a.box(t).corners_xy() - c
+            box = a.box(t)
+            corners = box.corners_xy() - c
             # the box edges' closest point to the centre: sample the edges
-            edges = corners[:, None] + (np.roll(corners, -1, 0) - corners)[:, None] * np.linspace(0, 1, 9)[None, :, None]
+            edges = corners[:, None] + (np.roll(corners, -1, 0) - corners)[:, None] * np.linspace(0, 1, 41)[None, :, None]
             r = np.hypot(*edges.reshape(-1, 2).T).min()
-            assert r > ring.island_r, f"{a.name} drives over the island at t={t:.1f}"
+            assert r > ring.core_r, f"{a.name} drives over the raised island at t={t:.1f}"
+            if box.size[0] <= STANDARD_CAR_M[0] and box.size[1] <= 2 * EGO_HALF_WIDTH_M:
+                assert r > ring.island_r, f"{a.name} ({a.kind}) drives over the apron at t={t:.1f}"
             if r < ring.ring_r[0] + 0.5:
                 through.add(a.name)
-    assert len(through) >= 3, through                      # traffic does use the roundabout
+    assert len(through) >= 4, through                      # traffic does use the roundabout

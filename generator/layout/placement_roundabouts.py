@@ -31,7 +31,7 @@ def plant_island(placer: Placer, grid, node: tuple[int, int], seed: int, z: floa
         a = phase + 2 * np.pi * k / n + float(g.uniform(-0.2, 0.2))
         proto, yaw, f = bush_variant(placer, int(g.integers(1 << 16))), float(g.uniform(0.0, 2 * np.pi)), float(g.random())
         half = float(np.hypot(*np.maximum(np.abs(proto.lo[:2]), np.abs(proto.hi[:2]))))   # any yaw
-        reach = ring.island_r - KERB_BAND_M - half
+        reach = ring.core_r - KERB_BAND_M - half
         if reach <= 0.0:
             continue
         x, y = c + reach * (0.4 + 0.6 * f) * np.array([np.cos(a), np.sin(a)])

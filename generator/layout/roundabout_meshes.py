@@ -1,7 +1,8 @@
 """Meshes of roundabouts: the raised island and the give-way lines at its entries.
 
-The island (:attr:`generator.layout.streets.Grid.islands`) is a kerbed disc raised to curb height,
-class ``other_ground`` (the class table's traffic islands and medians), with a grass top (class
+The island (:attr:`generator.layout.streets.Grid.islands`), class ``other_ground`` (the class
+table's traffic islands and medians): a mountable apron ``APRON_H_M`` high out to ``island_r``
+and, inside it, a kerbed centre raised to curb height out to ``core_r``, with a grass top (class
 ``terrain``) set back by a kerb band when it is large enough (:attr:`Ring.grass`). Entries get a
 give-way line (two rows of short dashes across the entry lanes) where plain ends get a solid stop
 line; crosswalks stay where they are (zebra crossings on the arms).
@@ -13,7 +14,7 @@ import numpy as np
 
 from generator.geometry import Mesh, merge
 from generator.geometry.primitives import polygon, prism
-from generator.layout.streets import STOP_U, Grid, Segment
+from generator.layout.streets import APRON_H_M, STOP_U, Grid, Segment
 
 SIDES = 48             #: polygon sides of the island
 KERB_BAND_M = 0.3      #: concrete band round the grass top
@@ -26,9 +27,11 @@ def island_mesh(grid: Grid) -> Mesh:
     ring = grid.ring
     a = np.linspace(0.0, 2 * np.pi, SIDES, endpoint=False)
     circle = np.stack([np.cos(a), np.sin(a)], 1)
-    parts = [prism(ring.island_r * circle, 0.0, grid.curb_h, "other_ground", "curb_concrete")]
+    parts = [prism(ring.island_r * circle, 0.0, APRON_H_M, "other_ground", "curb_concrete")]
+    if ring.core_r > 0:
+        parts.append(prism(ring.core_r * circle, APRON_H_M, grid.curb_h, "other_ground", "curb_concrete"))
     if ring.grass:
-        top = np.c_[(ring.island_r - KERB_BAND_M) * circle, np.full(SIDES, grid.curb_h + 0.003)]
+        top = np.c_[(ring.core_r - KERB_BAND_M) * circle, np.full(SIDES, grid.curb_h + 0.003)]
         parts.append(polygon(top, "terrain", "grass", normal=(0.0, 0.0, 1.0)))
     return merge(parts)
 

@@ -16,7 +16,12 @@ cross-section: 1 lane of 3.5 m, 2.4 m parking, so ``entry_m`` = 7.75 m). The isl
 ``ISLAND_CLEAR_M`` inside the closest approach of a box as long as the standard car and as wide
 as the ego (``2 EGO_HALF_WIDTH_M``) on any path -- the ring radius less the half width, or a corner
 where a fillet meets the ring -- so the widest vehicle that drives a route keeps ``ISLAND_CLEAR_M``
-off its kerb (3.33 m for the default cross-section).
+off its kerb (3.33 m for the default cross-section). Buses and trucks cannot follow a ring that
+small: their boxes cut across the island, as on real compact roundabouts, so the island is a
+*truck apron* (a mountable ring :data:`generator.layout.streets.APRON_H_M` high that only long vehicles roll over) round a
+raised centre that the largest design vehicles (:data:`DESIGN_VEHICLES_M`) keep
+``ISLAND_CLEAR_M`` off (1.3 m for the default cross-section; none if it would be under
+``CORE_MIN_R_M``: a mini-roundabout, all apron).
 
 Only four-arm (interior) nodes can be roundabouts: a ring needs the asphalt of all four arms
 round it (at a three-arm node the ring would run into the kerb closing the missing arm). A
@@ -49,7 +54,10 @@ FILLET_M = MIN_RADIUS_M    #: radius of the entry and exit arcs
 ISLAND_CLEAR_M = 0.3       #: the ego (half width EGO_HALF_WIDTH_M) on the inner ring keeps this off the island
 KERB_CLEAR_M = 0.2         #: the standard car keeps this off the kerb lines on every path
 STANDARD_CAR_M = (4.8, 2.1)
-GRASS_MIN_R_M = 2.0        #: islands at least this large carry grass (smaller ones: concrete)
+GRASS_MIN_R_M = 1.2        #: raised centres at least this large carry grass (smaller ones: concrete)
+CORE_MIN_R_M = 0.5         #: a raised centre smaller than this is left out (the island is all apron)
+#: the largest boxes (length, width) that drive the ring: a 12 m bus, a 4.3 m wide slewed excavator
+DESIGN_VEHICLES_M = ((12.0, 2.55), (6.0, 4.3))
 
 
 @dataclass(frozen=True)
@@ -63,7 +71,11 @@ class Ring:
     fillet_r : float
         Radius of the entry and exit arcs, metres.
     island_r : float
-        Radius of the raised island, metres.
+        Outer radius of the island (its mountable apron), metres: every car keeps off it.
+    core_r : float
+        Radius of the raised centre inside the apron, metres (0: the whole island is apron, a
+        mini-roundabout): long and wide vehicles, whose boxes cut across the apron on the ring,
+        keep off it.
     entry_m : float
         Distance from the node centre to where a connector starts and ends (the lane edges' ends).
     lane_w : float
@@ -74,16 +86,18 @@ class Ring:
     island_r: float
     entry_m: float
     lane_w: float
+    core_r: float = 0.0
 
     @property
     def grass(self) -> bool:
-        """Whether the island is large enough to carry grass (and bushes)."""
-        return self.island_r >= GRASS_MIN_R_M
+        """Whether the raised centre is large enough to carry grass (and bushes)."""
+        return self.core_r >= GRASS_MIN_R_M
 
     def to_dict(self) -> dict:
         """Plain numbers for metadata."""
         return {"ring_radius_m": [round(r, 3) for r in self.ring_r], "fillet_radius_m": round(self.fillet_r, 3),
-                "island_radius_m": round(self.island_r, 3), "entry_m": round(self.entry_m, 3)}
+                "island_radius_m": round(self.island_r, 3), "raised_core_radius_m": round(self.core_r, 3),
+                "entry_m": round(self.entry_m, 3)}
 
 
 def entry_distance(lanes: int, lane_w: float, road_half: float) -> float:
@@ -106,6 +120,7 @@ def ring_geometry(lanes: int, lane_w: float, road_half: float) -> Ring | None:
         return None
     ring = Ring(tuple(float(r) for r in ring_r), f, 0.0, e, lane_w)
     inner = float(ring_r[0] - EGO_HALF_WIDTH_M)
+    core = inner
     for k in range(lanes):
         for x in range(4):
             for y in range(4):
@@ -115,10 +130,22 @@ def ring_geometry(lanes: int, lane_w: float, road_half: float) -> Ring | None:
                 if not _inside_kerbs(p, road_half):
                     return None
                 # where a fillet meets the ring the box's inner corners come closer than its side
-                corners = _corners(p, (STANDARD_CAR_M[0], 2 * EGO_HALF_WIDTH_M))
-                inner = min(inner, float(np.hypot(corners[..., 0], corners[..., 1]).min()))
+                inner = min(inner, _closest(p, (STANDARD_CAR_M[0], 2 * EGO_HALF_WIDTH_M)))
+                if k == 0:
+                    core = min([core] + [_closest(p, size) for size in DESIGN_VEHICLES_M])
     island_r = inner - ISLAND_CLEAR_M
-    return Ring(ring.ring_r, f, island_r, e, lane_w) if island_r > 0.5 else None
+    core_r = core - ISLAND_CLEAR_M
+    core_r = core_r if core_r >= CORE_MIN_R_M else 0.0
+    return Ring(ring.ring_r, f, island_r, e, lane_w, core_r) if island_r > 0.5 else None
+
+
+def _closest(path: Path, size: tuple[float, float]) -> float:
+    """Closest approach to the node centre (the origin) of a box of ``size`` along ``path``, metres
+    (its edges sampled every ~0.25 m: a long box's side passes closer than its corners)."""
+    c = _corners(path, size)
+    n = int(np.ceil(max(size) / 0.25)) + 1
+    edges = c[:, :, None] + (np.roll(c, -1, axis=1) - c)[:, :, None] * np.linspace(0.0, 1.0, n)[None, None, :, None]
+    return float(np.hypot(edges[..., 0], edges[..., 1]).min())
 
 
 def grid_ring(grid) -> Ring | None:

@@ -42,6 +42,7 @@ BAY_M = 6.0                #: parking bay length
 MIN_BLOCK_M = 15.0         #: blocks never shrink below this (jitter can be large)
 MIN_OUTER_DEPTH_M = 15.0   #: the lot band outside the outer ring road is at least this deep
 TREE_PIT_M = 1.2           #: side of the soil square around a street tree
+APRON_H_M = 0.05           #: a roundabout island's mountable apron (:mod:`generator.layout.roundabouts`)
 
 
 @dataclass(frozen=True)
@@ -125,11 +126,11 @@ class Grid:
         return grid_ring(self)
 
     def islands(self) -> np.ndarray:
-        """(k, 3) float64 ``(x, y, radius)`` of the roundabout islands (raised to curb height)."""
+        """(k, 4) float64 ``(x, y, apron radius, raised centre radius)`` of the roundabout islands."""
         if not self.roundabouts:
-            return np.zeros((0, 3))
-        r = self.ring.island_r
-        return np.array([(*self.node_xy(n), r) for n in sorted(self.roundabouts)], np.float64)
+            return np.zeros((0, 4))
+        ring = self.ring
+        return np.array([(*self.node_xy(n), ring.island_r, ring.core_r) for n in sorted(self.roundabouts)], np.float64)
 
     def strip_span(self, seg: Segment) -> tuple[float, float] | None:
         """(u0, u1) of the middle stretch where ``seg``'s side strips differ (parking bays, verges,
@@ -284,7 +285,7 @@ class Grid:
         """(n,) float64 height of the ground surface at world points ``xy`` ((n, 2) metres).
 
         0 on the road (kerb to kerb, intersections included, verges, median and roundabout
-        islands excepted), ``curb_h`` elsewhere (curbs, sidewalks, verges, islands, lots, terrain).
+        islands excepted), ``APRON_H_M`` on a roundabout's apron, ``curb_h`` elsewhere (curbs, sidewalks, verges, islands, lots, terrain).
         """
         xy = np.asarray(xy, np.float64).reshape(-1, 2)
         on_road = np.zeros(len(xy), bool)
@@ -292,9 +293,12 @@ class Grid:
             on_road |= (xy[:, 0] > x0) & (xy[:, 0] < x1) & (xy[:, 1] > y0) & (xy[:, 1] < y1)
         for _, _, (x0, y0, x1, y1) in self.raised_rects():
             on_road &= ~((xy[:, 0] > x0) & (xy[:, 0] < x1) & (xy[:, 1] > y0) & (xy[:, 1] < y1))
-        for x, y, r in self.islands():
-            on_road &= (xy[:, 0] - x) ** 2 + (xy[:, 1] - y) ** 2 >= r * r
-        return np.where(on_road, 0.0, self.curb_h)
+        h = np.where(on_road, 0.0, self.curb_h)
+        for x, y, r, core in self.islands():
+            d2 = (xy[:, 0] - x) ** 2 + (xy[:, 1] - y) ** 2
+            h[d2 < r * r] = APRON_H_M
+            h[d2 < core * core] = self.curb_h
+        return h
 
 
 def make_grid(spec: SceneSpec) -> Grid:

@@ -11,6 +11,12 @@ can touch a standard car on the other, measured with the same padded boxes as th
 table (:func:`generator.traffic.lanes.conflicts`); vehicles following each other on the *same*
 connector are kept apart by car-following.
 
+People on the crosswalks of the arms: with no signal to hold vehicles back, a vehicle asks for its
+connector only within ``GIVE_WAY_REQUEST_M`` of the give-way line, and is granted it only if no
+person is on, or will step onto, either crosswalk it crosses in the next ``GIVE_WAY_CLEAR_S``
+seconds -- long enough to clear both from a near stop. The people's own schedule is the node's
+walk phase (:class:`generator.traffic.signals.Signals`), which vehicles see but no longer obey.
+
 The table is the same for every roundabout (one cross-section, one :class:`Ring`), keyed like
 the plain table: ``(arm_in, arm_out, lane) -> set of (arm_in, arm_out, lane)``.
 """
@@ -20,6 +26,9 @@ from __future__ import annotations
 import numpy as np
 
 from generator.layout.roundabouts import ARM_DIRS, ring_path
+
+GIVE_WAY_REQUEST_M = 8.0   #: at a roundabout a vehicle asks for its connector this close to the give-way line
+GIVE_WAY_CLEAR_S = 14.0    #: ... and only when nobody is on or steps onto its crosswalks this long
 
 
 def _extended(graph, x: int, y: int, k: int, ext: float) -> np.ndarray:

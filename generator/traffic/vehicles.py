@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from generator.traffic.lanes import ARM_DIRS, LaneGraph
+from generator.traffic.roundabout_lanes import GIVE_WAY_CLEAR_S, GIVE_WAY_REQUEST_M
 from generator.traffic.signals import CLEAR_S
 
 log = logging.getLogger(__name__)
@@ -188,7 +189,8 @@ class VehicleSim:
         node = conn.node
         if veh.ego_route is not None and not self._ego_dwell(veh, t, stop, node):
             return
-        if not self.signals.vehicles_may_enter(node, t):
+        give_way = self.g.grid.is_roundabout(node)     # no signals: asks late, looks further ahead for people
+        if (give_way and stop > GIVE_WAY_REQUEST_M) or not self.signals.vehicles_may_enter(node, t):
             return
         key = (*conn.arms, conn.lane)
         big = veh.length > BIG_M
@@ -203,8 +205,9 @@ class VehicleSim:
             return
         # the signals keep vehicles from entering CLEAR_S before a walk phase: only people on (or
         # stepping onto) the crosswalks within that time can meet this vehicle
-        if self.crossing is not None and (self.crossing(node, conn.arms[0], t, t + CLEAR_S)
-                                          or self.crossing(node, conn.arms[1], t, t + CLEAR_S)):
+        window = GIVE_WAY_CLEAR_S if give_way else CLEAR_S
+        if self.crossing is not None and (self.crossing(node, conn.arms[0], t, t + window)
+                                          or self.crossing(node, conn.arms[1], t, t + window)):
             return
         veh.grant = conn.index
         self.holders.setdefault(node, {})[veh.index] = conn.index
