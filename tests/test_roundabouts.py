@@ -256,6 +256,10 @@ def test_the_island_is_raised_other_ground_with_grass_and_nothing_but_vehicles_o
     ground = ("street", "sidewalk", "intersection", "corner", "lot_ground", "terrain", "horizon")
     placed = [o for o in scene.objects if o.kind not in ground]
     assert not [o.name for o in placed if o.cls == "traffic_light" and np.hypot(*(o.transform[:2, 3] - c)) < 15]
+    signs = np.array([o.transform[:2, 3] for o in placed if o.cls == "traffic_sign"])
+    q = grid.walk_inner + min(0.5, grid.sidewalk_w / 2)     # the kerb line, where signals stand elsewhere
+    for corner in ((1, 1), (-1, 1), (-1, -1), (1, -1)):   # a round sign at each approach instead
+        assert np.hypot(*(signs - (c + q * np.array(corner))).T).min() < 0.05, corner
     assert [o for o in placed if o.cls == "traffic_light"]                # the plain nodes keep theirs
     lanes = grid.drivable_rects()
     on_lanes = ("car", "truck", "bus", "on_rails", "other_vehicle", "ridden_bicycle", "ridden_motorcycle",

@@ -1,7 +1,8 @@
-"""Planting on roundabout islands: a few bushes on the grass, clear of every route's keep-out.
+"""Roundabout furniture: a round sign at every approach, bushes on the island.
 
 A roundabout has no signal heads (:func:`generator.layout.placement_street.place_traffic_lights`
-skips it); islands with a grass top (:attr:`generator.layout.roundabouts.Ring.grass`) get bushes
+skips it): where a signal would stand, on the near-right corner of each approach, stands a round
+sign facing the approaching traffic (the town's circle sign prototype). Islands with a grass top (:attr:`generator.layout.roundabouts.Ring.grass`) get bushes
 in a ring, each wholly on the grass whatever its yaw. Stream ``("layout", "roundabout_planting", i, j)`` per node.
 """
 
@@ -35,5 +36,18 @@ def plant_island(placer: Placer, grid, node: tuple[int, int], seed: int, z: floa
         if reach <= 0.0:
             continue
         x, y = c + reach * (0.4 + 0.6 * f) * np.array([np.cos(a), np.sin(a)])
+        placed += bool(placer.try_place(proto, x, y, z, yaw))
+    return placed
+
+
+def place_approach_signs(placer: Placer, grid, node: tuple[int, int], kerb_line: float, z: float) -> int:
+    """A round sign on the near-right corner of every approach of roundabout ``node``, where a signal
+    would stand at a plain node, facing the traffic; returns how many stood."""
+    proto = placer.lib.variant("traffic_sign", 0, lambda g: {"shape": "circle"})
+    c, placed = grid.node_xy(node), 0
+    for d in grid.arms(node):
+        yaw = d * np.pi / 2
+        e = np.array([np.cos(yaw), np.sin(yaw)])
+        x, y = c + e * kerb_line + np.array([-e[1], e[0]]) * kerb_line
         placed += bool(placer.try_place(proto, x, y, z, yaw))
     return placed

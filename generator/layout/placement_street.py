@@ -15,7 +15,7 @@ import numpy as np
 from generator.layout.appearance import fleet_paint, outfit
 from generator.layout.placement_core import Placer, Proto
 from generator.layout.placement_lots import N_TREE_VARIANTS, tree_variant
-from generator.layout.placement_roundabouts import plant_island
+from generator.layout.placement_roundabouts import place_approach_signs, plant_island
 from generator.layout.streets import BAY_M, CROSSWALK_U, PARKING_START_U, Grid, Segment
 from generator.rng import stream
 from generator.spec.model import SceneSpec
@@ -55,13 +55,14 @@ class Street:
 
 
 def place_traffic_lights(placer: Placer, spec: SceneSpec, st: Street) -> None:
-    """One signal per approach on its near-right corner, facing the approaching traffic (none at a
-    roundabout, whose island is planted instead)."""
+    """One signal per approach on its near-right corner, facing the approaching traffic (at a
+    roundabout a round sign instead, and bushes on its island)."""
     grid = st.grid
     protos = [placer.lib.variant("traffic_light", i, lambda g: {"arm": 0.0}) for i in range(N_TL)]
     q = st.kerb_line
     for n_i, node in enumerate(grid.nodes):
-        if grid.is_roundabout(node):        # no signal heads: bushes on the island instead
+        if grid.is_roundabout(node):        # no signal heads: round signs, bushes on the island
+            place_approach_signs(placer, grid, node, q, st.h)
             plant_island(placer, grid, node, spec.seed, st.h)
             continue
         c = grid.node_xy(node)
