@@ -328,3 +328,56 @@ def test_a_minute_of_traffic_through_a_roundabout_never_touches(town):
             if r < ring.ring_r[0] + 0.5:
                 through.add(a.name)
     assert len(through) >= 4, through                      # traffic does use the roundabout
+
+
+def test_lidar_rays_see_the_apron_and_the_raised_grass_at_their_heights(town):
+    """Embree (what the LiDAR casts with) hits the island where the meshes say: grass on the raised
+    centre at curb height, other-ground on the apron 5 cm up, road beyond it."""
+    from generator.lidar.caster import EmbreeCaster
+
+    spec, scene, _ = town
+    grid = make_grid(spec)
+    c, ring = grid.node_xy((1, 1)), grid.ring
+    table = class_table()
+    radii = {"terrain": 0.0, "other_ground": (ring.core_r + ring.island_r) / 2, "road": ring.island_r + 0.5}
+    heights = {"terrain": grid.curb_h + 0.003, "other_ground": APRON_H_M, "road": 0.0}
+    caster = EmbreeCaster.from_scene(scene)
+    for cls, r in radii.items():
+        a = np.linspace(0.0, 2 * np.pi, 16, endpoint=False) + 0.1
+        xy = c + r * np.stack([np.cos(a), np.sin(a)], 1)
+        if cls == "terrain":      # the whole grass disc
+            g = np.stack(np.meshgrid(*[np.linspace(-1, 1, 21)] * 2), -1).reshape(-1, 2) * (ring.core_r - 0.35)
+            xy = c + g[np.hypot(*g.T) < ring.core_r - 0.35]
+        o = np.c_[xy, np.full(len(xy), 0.6)]             # below the bushes' crowns, above the kerbs
+        d = np.tile([0.0, 0.0, -1.0], (len(o), 1))
+        dist, prim = caster.intersect(o, d, 5.0)[:2]
+        hit = np.isfinite(dist)
+        assert hit.all()
+        z = 0.6 - dist
+        if cls == "terrain":      # a bush may stand on the grass: the rays that reach the ground see grass
+            ground = np.abs(z - heights[cls]) < 1e-3
+            assert ground.sum() >= 10
+            assert {table.names[i] for i in scene.face_class[prim[ground]]} == {"terrain"}
+            assert {table.names[i] for i in scene.face_class[prim[~ground]]} <= {"vegetation"}
+        else:
+            np.testing.assert_allclose(z, heights[cls], atol=1e-3)
+            assert {table.names[i] for i in scene.face_class[prim]} == {cls}
+
+
+@pytest.mark.blender
+def test_blender_builds_the_roundabout_as_the_scene_model(tmp_path):
+    """The island (apron, raised centre, grass), give-way lines and approach signs reach Blender
+    triangle for triangle."""
+    from generator.blender.renderer import Renderer
+    from generator.spec.render import load_render_config
+
+    spec = parse_spec({"name": "roundabout_tiny", "seed": 2,
+                       "town": {"blocks_x": 2, "blocks_y": 2, "block_size_m": 30, "block_size_jitter_m": 0,
+                                "margin_m": 8},
+                       "streets": {"roundabouts": 1}}, "roundabout_tiny.json")
+    scene = build_scene(spec)
+    assert make_grid(spec).roundabouts == {(1, 1)}
+    n, bounds = Renderer(scene, spec, load_render_config("test"), tmp_path).evaluated_geometry()
+    assert n == len(scene.faces)
+    v = scene.vertices.astype(np.float64)
+    assert np.allclose(bounds, [v.min(0), v.max(0)], atol=1e-3)
