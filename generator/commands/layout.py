@@ -55,12 +55,16 @@ def summary(scene, spec, build_s: float) -> dict:
                     "closed": p.closed} for p in scene.paths],
         "build_seconds": round(build_s, 3),
     }
+    from generator.layout.closures import closed_record
     from generator.layout.roundabouts import roundabout_record
     from generator.layout.streets import make_grid
 
-    ring = roundabout_record(make_grid(spec))
-    if ring is not None:     # only towns with roundabouts: the others' summaries read as before
+    grid = make_grid(spec)
+    ring, closed = roundabout_record(grid), closed_record(grid)
+    if ring is not None:     # only towns with roundabouts or closed streets: the others' summaries read as before
         info["roundabouts"] = ring
+    if closed is not None:
+        info["closed_streets"] = closed
     return info
 
 

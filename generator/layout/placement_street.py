@@ -15,6 +15,7 @@ import numpy as np
 from generator.layout.appearance import fleet_paint, outfit
 from generator.layout.placement_core import Placer, Proto
 from generator.layout.placement_lots import N_TREE_VARIANTS, tree_variant
+from generator.layout.placement_parks import plant_parks
 from generator.layout.placement_roundabouts import place_approach_signs, plant_island
 from generator.layout.streets import BAY_M, CROSSWALK_U, PARKING_START_U, Grid, Segment
 from generator.rng import stream
@@ -115,7 +116,8 @@ def street_tree_variants(placer: Placer, spec: SceneSpec, half_width: float, tag
 
 def place_street_trees(placer: Placer, spec: SceneSpec, st: Street) -> None:
     """Trees on the kerb line, ``trees_per_100m`` per sidewalk with jittered spacing, crowns
-    narrow enough to keep clear of the route lanes."""
+    narrow enough to keep clear of the route lanes; and the pocket parks of closed streets."""
+    plant_parks(placer, spec, st.grid, st.h)
     if spec.density.trees_per_100m <= 0:
         return
     grid = st.grid

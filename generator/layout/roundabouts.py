@@ -193,6 +193,14 @@ def draw_roundabouts(spec, grid) -> frozenset:
     return chosen
 
 
+def islands(grid) -> np.ndarray:
+    """(k, 4) float64 ``(x, y, apron radius, raised centre radius)`` of ``grid``'s roundabout islands."""
+    if not grid.roundabouts:
+        return np.zeros((0, 4))
+    ring = grid.ring
+    return np.array([(*grid.node_xy(n), ring.island_r, ring.core_r) for n in sorted(grid.roundabouts)], np.float64)
+
+
 def roundabout_record(grid) -> dict | None:
     """What was drawn, for metadata: the roundabout nodes and their ring geometry (None without any)."""
     if not grid.roundabouts:

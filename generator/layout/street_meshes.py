@@ -11,6 +11,7 @@ import numpy as np
 from generator.geometry import Mesh, merge, pose, slab
 from generator.labels import class_table
 from generator.layout.cross_sections import MEDIAN_W_M
+from generator.layout.closures import park_mesh
 from generator.layout.roundabout_meshes import island_mesh, stop_marks
 from generator.layout.streets import BAY_M, CROSSWALK_U, MARK_Z_M, PARKING_START_U, STOP_U, TREE_PIT_M, Grid, Segment
 from generator.materials import material_table
@@ -156,7 +157,8 @@ def intersection_road_mesh(grid: Grid) -> Mesh:
 
 def intersection_walk_mesh(grid: Grid, node: tuple[int, int]) -> Mesh:
     """Corner squares (L-shaped curb + sidewalk), where an arm is missing a curb closing it, and at a
-    roundabout its island (:func:`generator.layout.roundabout_meshes.island_mesh`) (node frame)."""
+    roundabout its island (:func:`generator.layout.roundabout_meshes.island_mesh`), and the pocket park
+    of every closed segment starting here (:func:`generator.layout.closures.park_mesh`) (node frame)."""
     rh, wi, ch, h = grid.road_half, grid.walk_inner, grid.corridor_half, grid.curb_h
     parts = []
     arms = grid.arms(node)
@@ -178,6 +180,7 @@ def intersection_walk_mesh(grid: Grid, node: tuple[int, int]) -> Mesh:
         parts.append(cap.transformed(pose(yaw=d * np.pi / 2)))
     if grid.is_roundabout(node):
         parts.append(island_mesh(grid))
+    parts += [park_mesh(grid, seg, node) for seg in grid.closed if seg.a == node]   # closed streets
     return merge(parts)
 
 

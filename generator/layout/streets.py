@@ -39,6 +39,7 @@ CROSSWALK_U = (0.6, 3.6)   #: crosswalk band, metres from the intersection edge
 STOP_U = (4.6, 5.0)        #: stop line band, metres from the intersection edge
 PARKING_START_U = 7.0      #: parking strips start this far from the intersection edge
 BAY_M = 6.0                #: parking bay length
+ARM_STEP = ((1, 0), (0, 1), (-1, 0), (0, -1))   #: node index step of arms east, north, west, south
 MIN_BLOCK_M = 15.0         #: blocks never shrink below this (jitter can be large)
 MIN_OUTER_DEPTH_M = 15.0   #: the lot band outside the outer ring road is at least this deep
 TREE_PIT_M = 1.2           #: side of the soil square around a street tree
@@ -109,6 +110,7 @@ class Grid:
     outer_depth: float = 0.0         #: depth of the lot band outside the outer ring road
     sections: tuple[CrossSection, ...] = ()   #: per segment; () = every street plain
     roundabouts: frozenset = frozenset()       #: nodes ``(i, j)`` that are roundabouts (:mod:`.roundabouts`)
+    closed: tuple = ()                         #: closed segments, not in ``segments`` (:mod:`.closures`)
 
     def section(self, seg: Segment) -> CrossSection:
         """The cross-section type of ``seg`` (see :mod:`generator.layout.cross_sections`)."""
@@ -124,13 +126,6 @@ class Grid:
         from generator.layout.roundabouts import grid_ring
 
         return grid_ring(self)
-
-    def islands(self) -> np.ndarray:
-        """(k, 4) float64 ``(x, y, apron radius, raised centre radius)`` of the roundabout islands."""
-        if not self.roundabouts:
-            return np.zeros((0, 4))
-        ring = self.ring
-        return np.array([(*self.node_xy(n), ring.island_r, ring.core_r) for n in sorted(self.roundabouts)], np.float64)
 
     def strip_span(self, seg: Segment) -> tuple[float, float] | None:
         """(u0, u1) of the middle stretch where ``seg``'s side strips differ (parking bays, verges,
@@ -213,11 +208,16 @@ class Grid:
             out.append(2)
         if j > 0:
             out.append(3)
-        return out
+        shut = {c.b if c.a == node else c.a for c in self.closed if node in (c.a, c.b)}
+        return [d for d in out if (i + int(ARM_STEP[d][0]), j + int(ARM_STEP[d][1])) not in shut]
 
     # -- areas used by placement and tests ---------------------------------------------------
     def road_rects(self) -> np.ndarray:
         """(k, 4) float64 world AABBs (x0, y0, x1, y1) of kerb-to-kerb road (streets + intersections)."""
+        if self.closed:
+            from generator.layout.closures import open_road_rects
+
+            return open_road_rects(self)
         r = self.road_half
         rows = [(self.xs[0] - r, y - r, self.xs[-1] + r, y + r) for y in self.ys]
         cols = [(x - r, self.ys[0] - r, x + r, self.ys[-1] + r) for x in self.xs]
@@ -294,7 +294,8 @@ class Grid:
         for _, _, (x0, y0, x1, y1) in self.raised_rects():
             on_road &= ~((xy[:, 0] > x0) & (xy[:, 0] < x1) & (xy[:, 1] > y0) & (xy[:, 1] < y1))
         h = np.where(on_road, 0.0, self.curb_h)
-        for x, y, r, core in self.islands():
+        from generator.layout.roundabouts import islands
+        for x, y, r, core in islands(self):
             d2 = (xy[:, 0] - x) ** 2 + (xy[:, 1] - y) ** 2
             h[d2 < r * r] = APRON_H_M
             h[d2 < core * core] = self.curb_h
@@ -331,6 +332,10 @@ def make_grid(spec: SceneSpec) -> Grid:
     grid = Grid(xs, ys, t.lanes_per_direction, t.lane_width_m, t.parking_strip_width_m, CURB_WIDTH_M,
                 t.sidewalk_width_m, t.curb_height_m, t.margin_m, segments,
                 max(MIN_OUTER_DEPTH_M, t.block_size_m / 2), draw_sections(spec, len(segments)))
-    from generator.layout.roundabouts import draw_roundabouts   # it needs the routes' radii, which need Grid
+    from generator.layout.closures import draw_closures         # they need the routes, which need Grid
+    from generator.layout.roundabouts import draw_roundabouts
 
-    return replace(grid, roundabouts=draw_roundabouts(spec, grid))
+    closed = draw_closures(spec, grid)
+    if closed:
+        grid = replace(grid, segments=tuple(s for s in grid.segments if s not in closed), closed=closed)
+    return replace(grid, roundabouts=frozenset(n for n in draw_roundabouts(spec, grid) if len(grid.arms(n)) == 4))

@@ -36,14 +36,15 @@ def parse_spec(document: object, source: str) -> SceneSpec:
 
 
 def spec_hash(spec: SceneSpec) -> str:
-    """The spec's :func:`canonical_hash`; ``town.redraw_every_frames`` and ``streets.roundabouts`` count
+    """The spec's :func:`canonical_hash`; ``town.redraw_every_frames``, ``streets.roundabouts`` and ``streets.closed_streets`` count
     only when set, so the hash of every spec written before those options is unchanged (resumable
     datasets stay resumable)."""
     d = spec.to_dict()
     if d["town"].get("redraw_every_frames") is None:
         d["town"].pop("redraw_every_frames", None)
-    if d.get("streets") is not None and not d["streets"].get("roundabouts"):
-        d["streets"].pop("roundabouts", None)    # likewise streets.roundabouts while 0
+    for key in ("roundabouts", "closed_streets"):    # likewise these streets fields while 0
+        if d.get("streets") is not None and not d["streets"].get(key):
+            d["streets"].pop(key, None)
     return canonical_hash(d)
 
 

@@ -189,6 +189,8 @@ class Streets:
     districts: dict
     #: share of the four-arm intersections that are roundabouts (:mod:`generator.layout.roundabouts`)
     roundabouts: float = 0.0
+    #: share of the eligible interior segments closed and made pocket parks (:mod:`generator.layout.closures`)
+    closed_streets: float = 0.0
 
 
 @dataclass(frozen=True)
