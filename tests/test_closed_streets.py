@@ -173,3 +173,21 @@ def test_a_minute_of_traffic_and_walkers_round_the_closed_streets(town):
             x0, y0, x1, y1 = seg.rect_world(cap, seg.length - cap, -(grid.road_half - 0.3), grid.road_half - 0.3)
             park = (xyz[:, 0] > x0) & (xyz[:, 0] < x1) & (xyz[:, 1] > y0) & (xyz[:, 1] < y1)
             assert not park.any(), f"{a.name} walks in a park"
+
+
+@pytest.mark.blender
+def test_blender_builds_the_pocket_parks_as_the_scene_model(tmp_path):
+    """The parks (grass, footpath, kept sidewalks) and the T-junction caps reach Blender triangle for triangle."""
+    from generator.blender.renderer import Renderer
+    from generator.spec.render import load_render_config
+
+    spec = parse_spec({"name": "closed_tiny", "seed": 2,
+                       "town": {"blocks_x": 2, "blocks_y": 2, "block_size_m": 30, "block_size_jitter_m": 0,
+                                "margin_m": 8},
+                       "streets": {"closed_streets": 1}}, "closed_tiny.json")
+    scene = build_scene(spec)
+    assert make_grid(spec).closed
+    n, bounds = Renderer(scene, spec, load_render_config("test"), tmp_path).evaluated_geometry()
+    assert n == len(scene.faces)
+    v = scene.vertices.astype(np.float64)
+    assert np.allclose(bounds, [v.min(0), v.max(0)], atol=1e-3)

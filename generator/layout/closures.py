@@ -2,9 +2,9 @@
 
 Where a segment is closed, the two blocks on either side are joined by a park: its sidewalks and
 kerbs stay (people still walk along them), the carriageway between the kerbs becomes grass at
-kerb height with a footpath along the middle (:func:`generator.layout.roundabout_meshes`-style
-hook in :func:`generator.layout.street_meshes.intersection_walk_mesh`), and its two end nodes lose
-that arm: they become T-junctions (or, on the outer ring, straight-through nodes), capped by a
+kerb height with a footpath along the middle (:func:`park_mesh`, built with the start node's
+corner pieces by :func:`generator.layout.street_meshes.intersection_walk_mesh`; trees by
+:mod:`generator.layout.placement_parks`), and its two end nodes lose that arm: they become T-junctions (or, on the outer ring, straight-through nodes), capped by a
 kerb like the outer ring's. No lane, connector, crosswalk, parking bay or route uses it.
 
 Eligible segments: not on the outer ring, not driven by routes 0 and 1

@@ -16,7 +16,9 @@ the town (:mod:`generator.layout.outskirts`); the *built area* (:attr:`Grid.buil
 there, the terrain margin surrounds it, and flat terrain continues to the horizon. A *segment* is the stretch of one
 street between two adjacent intersections; its local frame has ``u`` along the street (from
 the start intersection's edge, metres) and ``v`` to the left, so right-hand traffic driving
-towards +u uses the lanes at ``v < 0``.
+towards +u uses the lanes at ``v < 0``. With ``streets.roundabouts`` some four-arm nodes are
+roundabouts (:mod:`generator.layout.roundabouts`); with ``streets.closed_streets`` some segments
+are closed (:attr:`Grid.closed`, not in :attr:`Grid.segments`; :mod:`generator.layout.closures`).
 """
 
 from __future__ import annotations
