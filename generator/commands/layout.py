@@ -79,7 +79,7 @@ def summary(scene, spec, build_s: float) -> dict:
     from generator.spec.towns import town_record
 
     counts = class_counts(scene)
-    return {
+    info = {
         "name": spec.name,
         "urbangen": __version__,
         "seed": spec.seed,
@@ -98,6 +98,17 @@ def summary(scene, spec, build_s: float) -> dict:
         "build_seconds": round(build_s, 3),
         **_streets(spec),
     }
+    from generator.layout.closures import closed_record
+    from generator.layout.roundabouts import roundabout_record
+    from generator.layout.streets import make_grid
+
+    grid = make_grid(spec)
+    ring, closed = roundabout_record(grid), closed_record(grid)
+    if ring is not None:     # only towns with roundabouts or closed streets: the others' summaries read as before
+        info["roundabouts"] = ring
+    if closed is not None:
+        info["closed_streets"] = closed
+    return info
 
 
 def _streets(spec) -> dict:

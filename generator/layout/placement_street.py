@@ -15,6 +15,8 @@ import numpy as np
 from generator.layout.appearance import fleet_paint, outfit
 from generator.layout.placement_core import Placer, Proto
 from generator.layout.placement_lots import N_TREE_VARIANTS, tree_variant
+from generator.layout.placement_parks import plant_parks
+from generator.layout.placement_roundabouts import place_approach_signs, plant_island
 from generator.layout.shared_streets import place_shared_bollards, place_shared_people
 from generator.layout.streets import BAY_M, CROSSWALK_U, PARKING_START_U, Grid, Segment
 from generator.rng import stream
@@ -57,11 +59,16 @@ class Street:
 
 
 def place_traffic_lights(placer: Placer, spec: SceneSpec, st: Street) -> None:
-    """One signal per approach on its near-right corner, facing the approaching traffic."""
+    """One signal per approach on its near-right corner, facing the approaching traffic (at a
+    roundabout a round sign instead, and bushes on its island)."""
     grid = st.grid
     protos = [placer.lib.variant("traffic_light", i, lambda g: {"arm": 0.0}) for i in range(N_TL)]
     q = st.kerb_line
     for n_i, node in enumerate(grid.nodes):
+        if grid.is_roundabout(node):        # no signal heads: round signs, bushes on the island
+            place_approach_signs(placer, grid, node, q, st.h)
+            plant_island(placer, grid, node, spec.seed, st.h)
+            continue
         c = grid.node_xy(node)
         for d in grid.arms(node):
             yaw = d * np.pi / 2
@@ -112,7 +119,8 @@ def street_tree_variants(placer: Placer, spec: SceneSpec, half_width: float, tag
 
 def place_street_trees(placer: Placer, spec: SceneSpec, st: Street) -> None:
     """Trees on the kerb line, ``trees_per_100m`` per sidewalk with jittered spacing, crowns
-    narrow enough to keep clear of the route lanes."""
+    narrow enough to keep clear of the route lanes; and the pocket parks of closed streets."""
+    plant_parks(placer, spec, st.grid, st.h)
     if spec.density.trees_per_100m <= 0:
         return
     grid = st.grid

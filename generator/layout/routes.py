@@ -7,7 +7,8 @@ intersection is tight; left turns concentric with it), and the result is sampled
 
 Route 0, the one :class:`generator.world.rig.Rig` follows, is a "comb" that drives the outer
 ring and snakes through the inner north-south streets; route 1 is the outer ring in the
-opposite direction.
+opposite direction. In a town with roundabouts, a route goes round the island of every
+roundabout it passes (:mod:`generator.layout.roundabout_routes`).
 """
 
 from __future__ import annotations
@@ -66,6 +67,10 @@ def route_from_nodes(grid: Grid, nodes: list[tuple[int, int]], name: str, step: 
         ``s`` (n,) arc length; ``closed=True``. It starts where the turn at ``nodes[0]`` ends,
         at the beginning of a straight leg.
     """
+    if grid.roundabouts:    # towns without roundabouts keep this construction (and their bytes)
+        from generator.layout.roundabout_routes import route_with_roundabouts
+
+        return route_with_roundabouts(grid, _turning(nodes), name, step)
     nodes = _turning(nodes)
     xy = np.array([grid.node_xy(n) for n in nodes])
     k = len(xy)

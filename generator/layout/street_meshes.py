@@ -11,6 +11,8 @@ import numpy as np
 from generator.geometry import Mesh, merge, pose, slab
 from generator.labels import class_table
 from generator.layout.cross_sections import MEDIAN_W_M
+from generator.layout.closures import park_mesh
+from generator.layout.roundabout_meshes import island_mesh, stop_marks
 from generator.layout.one_way import one_way_marks
 from generator.layout.shared_streets import shared_road_mesh
 from generator.layout.streets import BAY_M, CROSSWALK_U, MARK_Z_M, PARKING_START_U, STOP_U, TREE_PIT_M, Grid, Segment
@@ -81,7 +83,7 @@ def segment_road_mesh(grid: Grid, seg: Segment) -> Mesh:
     edge = lh if p > 0 else rh - 0.3
     marks.append(np.array([(m0, edge - 0.075, m1, edge + 0.075), (m0, -edge - 0.075, m1, -edge + 0.075)]))
     if not sec.one_way:
-        marks.append(np.array([(STOP_U[0], 0.06, STOP_U[1], lh), (L - STOP_U[1], -lh, L - STOP_U[0], -0.06)]))
+        marks.append(stop_marks(grid, seg))     # stop lines, or give-way lines at roundabouts
     if has_parking:
         bays = np.arange(pk0, pk1 + 1e-6, BAY_M)
         for (a, b), side in zip(((lh + 0.075, rh), (-rh, -lh - 0.075)), (1, -1)):
@@ -166,7 +168,9 @@ def intersection_road_mesh(grid: Grid) -> Mesh:
 
 
 def intersection_walk_mesh(grid: Grid, node: tuple[int, int]) -> Mesh:
-    """Corner squares (L-shaped curb + sidewalk) and, where an arm is missing, a curb closing it (node frame)."""
+    """Corner squares (L-shaped curb + sidewalk), where an arm is missing a curb closing it, and at a
+    roundabout its island (:func:`generator.layout.roundabout_meshes.island_mesh`), and the pocket park
+    of every closed segment starting here (:func:`generator.layout.closures.park_mesh`) (node frame)."""
     rh, wi, ch, h = grid.road_half, grid.walk_inner, grid.corridor_half, grid.curb_h
     parts = []
     arms = grid.arms(node)
@@ -186,6 +190,9 @@ def intersection_walk_mesh(grid: Grid, node: tuple[int, int]) -> Mesh:
             continue
         cap = merge([_curb(rh, -rh, wi, rh, h), rects([(wi, -rh, ch, rh)], h, "sidewalk", "sidewalk_concrete")])
         parts.append(cap.transformed(pose(yaw=d * np.pi / 2)))
+    if grid.is_roundabout(node):
+        parts.append(island_mesh(grid))
+    parts += [park_mesh(grid, seg, node) for seg in grid.closed if seg.a == node]   # closed streets
     return merge(parts)
 
 

@@ -16,13 +16,15 @@ the town (:mod:`generator.layout.outskirts`); the *built area* (:attr:`Grid.buil
 there, the terrain margin surrounds it, and flat terrain continues to the horizon. A *segment* is the stretch of one
 street between two adjacent intersections; its local frame has ``u`` along the street (from
 the start intersection's edge, metres) and ``v`` to the left, so right-hand traffic driving
-towards +u uses the lanes at ``v < 0``.
+towards +u uses the lanes at ``v < 0``. With ``streets.roundabouts`` some four-arm nodes are
+roundabouts (:mod:`generator.layout.roundabouts`); with ``streets.closed_streets`` some segments
+are closed (:attr:`Grid.closed`, not in :attr:`Grid.segments`; :mod:`generator.layout.closures`).
 """
 
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -39,9 +41,11 @@ CROSSWALK_U = (0.6, 3.6)   #: crosswalk band, metres from the intersection edge
 STOP_U = (4.6, 5.0)        #: stop line band, metres from the intersection edge
 PARKING_START_U = 7.0      #: parking strips start this far from the intersection edge
 BAY_M = 6.0                #: parking bay length
+ARM_STEP = ((1, 0), (0, 1), (-1, 0), (0, -1))   #: node index step of arms east, north, west, south
 MIN_BLOCK_M = 15.0         #: blocks never shrink below this (jitter can be large)
 MIN_OUTER_DEPTH_M = 15.0   #: the lot band outside the outer ring road is at least this deep
 TREE_PIT_M = 1.2           #: side of the soil square around a street tree
+APRON_H_M = 0.05           #: a roundabout island's mountable apron (:mod:`generator.layout.roundabouts`)
 
 
 @dataclass(frozen=True)
@@ -107,10 +111,23 @@ class Grid:
     segments: tuple[Segment, ...]
     outer_depth: float = 0.0         #: depth of the lot band outside the outer ring road
     sections: tuple[CrossSection, ...] = ()   #: per segment; () = every street plain
+    roundabouts: frozenset = frozenset()       #: nodes ``(i, j)`` that are roundabouts (:mod:`.roundabouts`)
+    closed: tuple = ()                         #: closed segments, not in ``segments`` (:mod:`.closures`)
 
     def section(self, seg: Segment) -> CrossSection:
         """The cross-section type of ``seg`` (see :mod:`generator.layout.cross_sections`)."""
         return self.sections[seg.index] if self.sections else PLAIN
+
+    def is_roundabout(self, node: tuple[int, int]) -> bool:
+        """Whether ``node`` is a roundabout (an island at its centre, no signals)."""
+        return tuple(node) in self.roundabouts
+
+    @property
+    def ring(self):
+        """The :class:`generator.layout.roundabouts.Ring` of this cross-section, or None."""
+        from generator.layout.roundabouts import grid_ring
+
+        return grid_ring(self)
 
     def strip_span(self, seg: Segment) -> tuple[float, float] | None:
         """(u0, u1) of the middle stretch where ``seg``'s side strips differ (parking bays, verges,
@@ -193,11 +210,16 @@ class Grid:
             out.append(2)
         if j > 0:
             out.append(3)
-        return out
+        shut = {c.b if c.a == node else c.a for c in self.closed if node in (c.a, c.b)}
+        return [d for d in out if (i + int(ARM_STEP[d][0]), j + int(ARM_STEP[d][1])) not in shut]
 
     # -- areas used by placement and tests ---------------------------------------------------
     def road_rects(self) -> np.ndarray:
         """(k, 4) float64 world AABBs (x0, y0, x1, y1) of kerb-to-kerb road (streets + intersections)."""
+        if self.closed:
+            from generator.layout.closures import open_road_rects
+
+            return open_road_rects(self)
         r = self.road_half
         rows = [(self.xs[0] - r, y - r, self.xs[-1] + r, y + r) for y in self.ys]
         cols = [(x - r, self.ys[0] - r, x + r, self.ys[-1] + r) for x in self.xs]
@@ -264,8 +286,8 @@ class Grid:
     def ground_height(self, xy: np.ndarray) -> np.ndarray:
         """(n,) float64 height of the ground surface at world points ``xy`` ((n, 2) metres).
 
-        0 on the road (kerb to kerb, intersections included, verges and median islands
-        excepted), ``curb_h`` elsewhere (curbs, sidewalks, verges, islands, lots, terrain).
+        0 on the road (kerb to kerb, intersections included, verges, median and roundabout
+        islands excepted), ``APRON_H_M`` on a roundabout's apron, ``curb_h`` elsewhere (curbs, sidewalks, verges, islands, lots, terrain).
         """
         xy = np.asarray(xy, np.float64).reshape(-1, 2)
         on_road = np.zeros(len(xy), bool)
@@ -273,11 +295,18 @@ class Grid:
             on_road |= (xy[:, 0] > x0) & (xy[:, 0] < x1) & (xy[:, 1] > y0) & (xy[:, 1] < y1)
         for _, _, (x0, y0, x1, y1) in self.raised_rects():
             on_road &= ~((xy[:, 0] > x0) & (xy[:, 0] < x1) & (xy[:, 1] > y0) & (xy[:, 1] < y1))
-        return np.where(on_road, 0.0, self.curb_h)
+        h = np.where(on_road, 0.0, self.curb_h)
+        from generator.layout.roundabouts import islands
+        for x, y, r, core in islands(self):
+            d2 = (xy[:, 0] - x) ** 2 + (xy[:, 1] - y) ** 2
+            h[d2 < r * r] = APRON_H_M
+            h[d2 < core * core] = self.curb_h
+        return h
 
 
 def make_grid(spec: SceneSpec) -> Grid:
-    """Draw the block sizes (stream ``("layout", "grid")``) and build the :class:`Grid`.
+    """Draw the block sizes (stream ``("layout", "grid")``) and build the :class:`Grid` (with the
+    cross-sections and roundabouts drawn from ``spec.streets``).
 
     The town is centred on the world origin.
     """
@@ -302,6 +331,13 @@ def make_grid(spec: SceneSpec) -> Grid:
         for j in range(len(ys) - 1):
             segs.append(((i, j), (i, j + 1), 1, (xs[i], ys[j] + road_half), ys[j + 1] - ys[j] - 2 * road_half))
     segments = tuple(Segment(k, ax, a, b, (float(o[0]), float(o[1])), float(n)) for k, (a, b, ax, o, n) in enumerate(segs))
-    return Grid(xs, ys, t.lanes_per_direction, t.lane_width_m, t.parking_strip_width_m, CURB_WIDTH_M,
+    grid = Grid(xs, ys, t.lanes_per_direction, t.lane_width_m, t.parking_strip_width_m, CURB_WIDTH_M,
                 t.sidewalk_width_m, t.curb_height_m, t.margin_m, segments,
                 max(MIN_OUTER_DEPTH_M, t.block_size_m / 2), draw_sections(spec, segments))
+    from generator.layout.closures import draw_closures         # they need the routes, which need Grid
+    from generator.layout.roundabouts import draw_roundabouts
+
+    closed = draw_closures(spec, grid)
+    if closed:
+        grid = replace(grid, segments=tuple(s for s in grid.segments if s not in closed), closed=closed)
+    return replace(grid, roundabouts=frozenset(n for n in draw_roundabouts(spec, grid) if len(grid.arms(n)) == 4))

@@ -36,16 +36,21 @@ def parse_spec(document: object, source: str) -> SceneSpec:
 
 
 def spec_hash(spec: SceneSpec) -> str:
-    """The spec's :func:`canonical_hash`; ``town.redraw_every_frames`` counts only when set, so the
-    hash of every spec written before that option is unchanged (resumable datasets stay resumable)."""
+    """The spec's :func:`canonical_hash`; ``town.redraw_every_frames``, ``streets.roundabouts`` and ``streets.closed_streets`` count
+    only when set, so the hash of every spec written before those options is unchanged (resumable
+    datasets stay resumable)."""
     d = spec.to_dict()
     if d["town"].get("redraw_every_frames") is None:
         d["town"].pop("redraw_every_frames", None)
+    for key in ("roundabouts", "closed_streets"):    # likewise these streets fields while 0
+        if d.get("streets") is not None and not d["streets"].get(key):
+            d["streets"].pop(key, None)
     return canonical_hash(d)
 
 
 def check_streets(full: dict, source: str) -> None:
-    """Cross-field rules of ``streets``: some weight > 0 in each choice, occupancy within [0, 1]."""
+    """Cross-field rules of ``streets``: some weight > 0 in each choice, occupancy within [0, 1], no
+    one-way streets in a town with roundabouts or closed streets."""
     streets = full.get("streets")
     if streets is None:
         return
@@ -55,6 +60,13 @@ def check_streets(full: dict, source: str) -> None:
     lo, hi = streets["parking_occupancy"]
     if lo < 0 or hi > 1:
         raise SpecError(source, "streets.parking_occupancy", f"must lie within [0, 1], got {[lo, hi]}")
+    if streets["types"].get("one_way", 0) > 0:
+        # one-way lane graphs rebuild every intersection's connectors and index segments by number:
+        # neither a roundabout's ring connectors nor a closed street's gap in the numbering survives that
+        for key in ("roundabouts", "closed_streets"):
+            if streets.get(key, 0) > 0:
+                raise SpecError(source, f"streets.{key}", "cannot be combined with one-way streets "
+                                "(streets.types.one_way > 0) yet; set one of them to 0")
 
 
 def load_spec(path: str | Path) -> SceneSpec:

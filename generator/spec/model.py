@@ -187,6 +187,10 @@ class Streets:
     verge_bushes_per_100m: float
     verge_hedges: float
     districts: dict
+    #: share of the four-arm intersections that are roundabouts (:mod:`generator.layout.roundabouts`)
+    roundabouts: float = 0.0
+    #: share of the eligible interior segments closed and made pocket parks (:mod:`generator.layout.closures`)
+    closed_streets: float = 0.0
 
 
 @dataclass(frozen=True)

@@ -75,7 +75,7 @@ def build_world(spec, scene, duration_s: float, distance_m: float = 0.0) -> Worl
 
     grid = make_grid(spec)
     graph = LaneGraph(grid)
-    signals = Signals(spec.seed, grid.nodes)
+    signals = Signals(spec.seed, grid.nodes, grid.roundabouts)
     lib = Library(spec.seed)
     horizon_s = duration_s + 1.0 + LOOKAHEAD_S
     if distance_m > 0:  # the drive may take longer than asked: cover a slow ego

@@ -13,6 +13,8 @@ Vehicles stop with their front at the stop line (:attr:`LaneGraph.stop_m` from t
 centre) until they may enter. Two connectors *conflict* when a standard car on one (from the
 stop line to past the far crosswalk) can touch a standard car on the other
 (:func:`conflicts`); one table serves every node, as every node has the same cross-section.
+At a roundabout node (:mod:`generator.layout.roundabouts`) the connectors run round the island
+instead, and the roundabouts share a second table (:mod:`generator.traffic.roundabout_lanes`).
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from generator.layout.roundabouts import ring_path
 from generator.layout.routes import MIN_RADIUS_M, RIGHT_RADIUS_M
 from generator.layout.streets import STOP_U, Grid
 from generator.world.scene import Path
@@ -129,12 +132,19 @@ class LaneGraph:
         from generator.traffic.one_way import apply_one_way   # hook: one-way streets turn lanes round
         if not apply_one_way(self):
             self.conflict = conflicts(self, CAR_BOX_M)
+        self.ring_conflict: dict = {}
+        if grid.roundabouts:
+            from generator.traffic.roundabout_lanes import ring_conflicts   # it reuses this module's boxes
+
+            self.ring_conflict = ring_conflicts(self, CAR_BOX_M)
 
     def _add(self, path: Path, kind: str, node, lane: int, arms) -> int:
         self.edges.append(Edge(len(self.edges), path, kind, node, lane, arms))
         return len(self.edges) - 1
 
     def _connector_path(self, node, x: int, y: int, k: int) -> Path:
+        if self.grid.is_roundabout(node):
+            return ring_path(self.grid.ring, self.grid.node_xy(node), x, y, k, f"ring_{node[0]}_{node[1]}_{x}{y}_{k}")
         return connector_path(self.grid.node_xy(node), self.entry_m, self.grid.lane_w, x, y, k,
                               f"conn_{node[0]}_{node[1]}_{x}{y}_{k}")
 
@@ -160,6 +170,20 @@ class LaneGraph:
 
     def lanes(self) -> list[Edge]:
         return [e for e in self.edges if e.kind == "lane"]
+
+    def conflicts_at(self, node) -> dict:
+        """The conflict table of ``node``: :attr:`conflict`, or the roundabouts' own."""
+        return self.ring_conflict if self.grid.is_roundabout(node) else self.conflict
+
+    def turn_radius(self, edge: Edge) -> float | None:
+        """Tightest radius of a connector's arcs, metres (None: a straight connector or a lane)."""
+        if edge.kind != "connector":
+            return None
+        if self.grid.is_roundabout(edge.node):
+            return min(self.grid.ring.fillet_r, self.grid.ring.ring_r[edge.lane])
+        if edge.arms[0] == (edge.arms[1] + 2) % 4:
+            return None
+        return edge.length / (np.pi / 2)
 
     @property
     def stop_s_from_end(self) -> float:

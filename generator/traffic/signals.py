@@ -30,10 +30,15 @@ class Signals:
         The spec's seed.
     nodes : list of (int, int)
         Intersections ``(i, j)``.
+    unsignalled : set of (int, int)
+        Nodes without signal heads (roundabouts): vehicles may always enter, giving way to people on
+        the crosswalks (:mod:`generator.traffic.roundabout_lanes`); people still cross in the walk
+        phase of the node's cycle, as at a pedestrian-called crossing.
     """
 
-    def __init__(self, seed: int, nodes: list[tuple[int, int]]):
+    def __init__(self, seed: int, nodes: list[tuple[int, int]], unsignalled=frozenset()):
         self.offset = {n: float(stream(seed, "traffic", "signal", n[0], n[1]).uniform(0.0, CYCLE_S)) for n in nodes}
+        self.unsignalled = frozenset(unsignalled)
 
     def phase(self, node: tuple[int, int], t: float) -> float:
         """Seconds since the node's current cycle started, in ``[0, CYCLE_S)``."""
@@ -44,7 +49,10 @@ class Signals:
         return max(0.0, WALK_S - self.phase(node, t))
 
     def vehicles_may_enter(self, node: tuple[int, int], t: float) -> bool:
-        """True when a vehicle may enter the node at ``t``: no walk phase now or within ``CLEAR_S``."""
+        """True when a vehicle may enter the node at ``t``: no walk phase now or within ``CLEAR_S``
+        (always at an unsignalled node: a roundabout, where vehicles give way instead)."""
+        if node in self.unsignalled:
+            return True
         p = self.phase(node, t)
         return WALK_S <= p < CYCLE_S - CLEAR_S
 

@@ -29,6 +29,7 @@ import numpy as np
 
 from generator.traffic.lanes import ARM_DIRS, LaneGraph
 from generator.traffic.shared import speed_caps
+from generator.traffic.roundabout_lanes import GIVE_WAY_CLEAR_S, GIVE_WAY_REQUEST_M
 from generator.traffic.signals import CLEAR_S
 
 log = logging.getLogger(__name__)
@@ -172,8 +173,8 @@ class VehicleSim:
         ahead = -veh.s
         for e in veh.plan[:3]:
             edge = self.g.edges[e]
-            if edge.kind == "connector" and edge.arms[0] != (edge.arms[1] + 2) % 4:
-                r = edge.length / (np.pi / 2)
+            r = self.g.turn_radius(edge)
+            if r is not None:
                 v_turn = np.sqrt(A_LAT * r)
                 v0 = min(v0, np.sqrt(v_turn ** 2 + 2 * B_COMF * max(0.0, ahead - veh.length / 2)))
             if e in self.caps:   # a shared street's limit, reached at comfortable braking with the front
@@ -193,7 +194,8 @@ class VehicleSim:
         node = conn.node
         if veh.ego_route is not None and not self._ego_dwell(veh, t, stop, node):
             return
-        if not self.signals.vehicles_may_enter(node, t):
+        give_way = self.g.grid.is_roundabout(node)     # no signals: asks late, looks further ahead for people
+        if (give_way and stop > GIVE_WAY_REQUEST_M) or not self.signals.vehicles_may_enter(node, t):
             return
         key = conflict_key(self.g, conn)
         big = veh.length > BIG_M
@@ -202,14 +204,15 @@ class VehicleSim:
             okey = conflict_key(self.g, other)
             if c == conn.index and not big and self.vehicles[vid].length <= BIG_M:
                 continue
-            if big or self.vehicles[vid].length > BIG_M or okey in self.g.conflict[key]:
+            if big or self.vehicles[vid].length > BIG_M or okey in self.g.conflicts_at(node)[key]:
                 return
         if not self._room(veh, conn, occ):
             return
         # the signals keep vehicles from entering CLEAR_S before a walk phase: only people on (or
         # stepping onto) the crosswalks within that time can meet this vehicle
-        if self.crossing is not None and (self.crossing(node, conn.arms[0], t, t + CLEAR_S)
-                                          or self.crossing(node, conn.arms[1], t, t + CLEAR_S)):
+        window = GIVE_WAY_CLEAR_S if give_way else CLEAR_S
+        if self.crossing is not None and (self.crossing(node, conn.arms[0], t, t + window)
+                                          or self.crossing(node, conn.arms[1], t, t + window)):
             return
         veh.grant = conn.index
         self.holders.setdefault(node, {})[veh.index] = conn.index

@@ -91,7 +91,12 @@ def street_distance(grid: Grid, xy: np.ndarray) -> np.ndarray:
     out_y = np.maximum.reduce([ys[0] - xy[:, 1], xy[:, 1] - ys[-1], np.zeros(len(xy))])
     d_ew = np.maximum(np.abs(xy[:, 1, None] - ys[None]), out_x[:, None]).min(1)
     d_ns = np.maximum(np.abs(xy[:, 0, None] - xs[None]), out_y[:, None]).min(1)
-    return np.minimum(d_ew, d_ns)
+    d = np.minimum(d_ew, d_ns)
+    for seg in grid.closed:     # a closed street (a park at kerb height) is no street: as far as its sidewalks
+        x0, y0, x1, y1 = seg.rect_world(0.0, seg.length, -grid.corridor_half, grid.corridor_half)
+        inside = (xy[:, 0] > x0) & (xy[:, 0] < x1) & (xy[:, 1] > y0) & (xy[:, 1] < y1)
+        d[inside] = np.maximum(d[inside], grid.corridor_half)
+    return d
 
 
 def lines(grid: Grid, offs: tuple[float, ...]) -> dict[tuple[int, int, int, int], Line]:

@@ -1,0 +1,383 @@
+"""Roundabouts (issue 13 item 2): the island, the paths round it, right of way, traffic, the spec field.
+
+Towns without ``streets.roundabouts`` (every shipped preset) are unchanged: the default town's
+digest pin lives in test_layout.py; here the spec hash and the routes of a town with the field at 0
+are checked equal to those without it.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from generator.errors import SpecError
+from generator.labels import class_table
+from generator.layout.assemble import build_scene
+from generator.layout.placement_core import EGO_HALF_WIDTH_M
+from generator.layout.roundabouts import (ARM_DIRS, DESIGN_VEHICLES_M, STANDARD_CAR_M, _closest, ring_geometry,
+                                          ring_path)
+from generator.layout.routes import MIN_RADIUS_M, make_routes
+from generator.layout.streets import APRON_H_M, make_grid
+from generator.spec.load import parse_spec
+from generator.traffic.build import build_world
+from generator.traffic.lanes import LaneGraph, boxes_overlap
+from generator.traffic.signals import Signals
+from generator.traffic.vehicles import Vehicle, VehicleSim
+from generator.world.scene import OrientedBox
+
+TRAFFIC = {"cars_per_km": 25, "trucks_per_km": 2, "buses_per_km": 1, "cyclists_per_km": 3, "motorcyclists_per_km": 2,
+           "other_vehicles_per_km": 1, "pedestrians_per_100m": 1.0, "standing_pedestrians_per_100m": 0.5}
+MINUTE_S = 60.0
+
+
+def spec_with(blocks: int = 2, share: float = 1.0, seed: int = 11, traffic: dict | None = None, **town):
+    doc = {"name": "roundabout_town", "seed": seed,
+           "town": {"blocks_x": blocks, "blocks_y": blocks, "block_size_m": 45, "block_size_jitter_m": 6,
+                    "margin_m": 10, **town},
+           "density": {"moving_cars_per_100m": 0}, "streets": {"roundabouts": share}}
+    if traffic is not None:
+        doc["traffic"] = traffic
+    return parse_spec(doc, "roundabout_town.json")
+
+
+def _radii(headings: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """Radius of curvature between consecutive samples (inf on straights)."""
+    dh = np.abs(np.angle(np.exp(1j * np.diff(headings))))
+    return np.where(dh > 1e-9, np.diff(s) / np.maximum(dh, 1e-12), np.inf)
+
+
+# -- geometry ------------------------------------------------------------------------------------
+CROSS_SECTIONS = [(1, 3.5, 2.4), (2, 3.5, 2.4), (1, 4.0, 2.0), (3, 3.5, 2.4), (1, 5.0, 2.0), (2, 3.0, 2.4)]
+
+
+@pytest.mark.parametrize("lanes, lane_w, parking", CROSS_SECTIONS)
+def test_every_ring_connector_clears_the_island_turns_no_tighter_than_the_routes_and_goes_anticlockwise(
+        lanes, lane_w, parking):
+    ring = ring_geometry(lanes, lane_w, lanes * lane_w + parking)
+    assert ring is not None and ring.island_r > 1.0
+    hw, hl = STANDARD_CAR_M[1] / 2, STANDARD_CAR_M[0] / 2
+    for k in range(lanes):
+        o = (k + 0.5) * lane_w
+        for x in range(4):
+            for y in range(4):
+                if x == y:
+                    continue
+                p = ring_path(ring, np.zeros(2), x, y, k)
+                xy, h = p.points[:, :2], p.headings
+                # the car's centre line keeps its half width (and the ego's, plus a margin) off the island
+                assert np.hypot(*xy.T).min() >= ring.island_r + EGO_HALF_WIDTH_M + 0.3 - 1e-9
+                # so do the car's corners (its body is a rectangle)
+                for dl, dw in ((hl, hw), (hl, -hw), (-hl, hw), (-hl, -hw)):
+                    cx = xy[:, 0] + np.cos(h) * dl - np.sin(h) * dw
+                    cy = xy[:, 1] + np.sin(h) * dl + np.cos(h) * dw
+                    assert np.hypot(cx, cy).min() >= ring.island_r + 0.3 - 1e-9
+                assert _radii(h, p.s).min() >= MIN_RADIUS_M * (1 - 1e-3)    # chords of 5 m arcs
+                # a 12 m bus and a 4.3 m wide excavator roll over the apron, never the raised centre
+                for size in DESIGN_VEHICLES_M:
+                    assert _closest(p, size) >= ring.core_r + 0.3 - 1e-9
+                # headings are the direction of travel, continuous, and circulate anticlockwise
+                chord = np.arctan2(*np.diff(xy, axis=0).T[::-1])
+                assert np.abs(np.angle(np.exp(1j * (chord - h[:-1])))).max() < np.radians(3)
+                assert (xy[:, 0] * np.sin(h) - xy[:, 1] * np.cos(h)).min() > 0
+                # it starts on the arriving lane's centre and ends on the leaving lane's, along them
+                a, b = -ARM_DIRS[x], ARM_DIRS[y]
+                np.testing.assert_allclose(xy[0], -ring.entry_m * a + o * np.array([a[1], -a[0]]), atol=1e-9)
+                np.testing.assert_allclose(xy[-1], ring.entry_m * b + o * np.array([b[1], -b[0]]), atol=1e-9)
+                assert abs(np.angle(np.exp(1j * (h[0] - np.arctan2(a[1], a[0]))))) < 1e-9
+                assert abs(np.angle(np.exp(1j * (h[-1] - np.arctan2(b[1], b[0]))))) < 1e-9
+
+
+def test_no_roundabout_where_none_fits_is_a_spec_error():
+    assert ring_geometry(1, 3.5, 3.5) is None         # no parking strips: the ring would need 4.6 m arcs
+    with pytest.raises(SpecError) as e:
+        make_grid(spec_with(lane_width_m=3.5, parking_strip_width_m=0))
+    msg = str(e.value)
+    assert msg.startswith("roundabout_town.json: streets.roundabouts: no roundabout fits") and "\n" not in msg
+
+
+# -- the draw and the spec -----------------------------------------------------------------------
+def test_roundabouts_are_drawn_on_interior_nodes_only_and_reproducibly():
+    grid = make_grid(spec_with(blocks=4, share=0.5, seed=3))
+    interior = {(i, j) for i in range(1, 4) for j in range(1, 4)}
+    assert grid.roundabouts <= interior and 0 < len(grid.roundabouts) < 9
+    assert make_grid(spec_with(blocks=4, share=0.5, seed=3)).roundabouts == grid.roundabouts
+    assert make_grid(spec_with(blocks=4, share=1.0)).roundabouts == interior
+    assert make_grid(spec_with(blocks=4, share=0.0)).roundabouts == frozenset()
+    assert make_grid(spec_with(blocks=1, share=1.0)).roundabouts == frozenset()     # no interior node
+
+
+def test_the_field_at_zero_changes_neither_the_hash_nor_the_routes(default_spec):
+    assert make_grid(default_spec).roundabouts == frozenset()
+    base = {"name": "x", "seed": 5, "streets": {"types": {"plain": 1, "boulevard": 1}}}
+    zero = json.loads(json.dumps(base))
+    zero["streets"]["roundabouts"] = 0
+    a, b = parse_spec(base, "a.json"), parse_spec(zero, "a.json")
+    assert a.spec_hash == b.spec_hash
+    assert parse_spec({**zero, "streets": {**zero["streets"], "roundabouts": 0.3}}, "a.json").spec_hash != a.spec_hash
+    for ra, rb in zip(make_routes(make_grid(a)), make_routes(make_grid(b))):
+        np.testing.assert_array_equal(ra.points, rb.points)
+
+
+BAD = [(-0.1, "streets.roundabouts: must be a number in [0, 1], got -0.1"),
+       (1.5, "streets.roundabouts: must be a number in [0, 1], got 1.5"),
+       ("half", 'streets.roundabouts: must be a number in [0, 1], got "half"'),
+       (None, "streets.roundabouts: must be a number in [0, 1], got null")]
+
+
+@pytest.mark.parametrize("value, expected", BAD, ids=[str(b[0]) for b in BAD])
+def test_bad_roundabouts_field_is_one_line(value, expected):
+    with pytest.raises(SpecError) as e:
+        parse_spec({"name": "x", "seed": 1, "streets": {"roundabouts": value}}, "scenes/x.json")
+    assert str(e.value).startswith("scenes/x.json: " + expected) and "\n" not in str(e.value)
+
+
+@pytest.mark.parametrize("streets, town", [({"roundabouts": 2}, {}),
+                                           ({"roundabouts": 0.5}, {"parking_strip_width_m": 0})])
+def test_bad_roundabouts_through_the_cli_exits_2_one_line_nothing_written(tmp_path, capsys, streets, town):
+    from generator.cli import main
+
+    spec = tmp_path / "bad.json"
+    spec.write_text(json.dumps({"name": "x", "seed": 1, "town": town, "streets": streets}))
+    out = tmp_path / "out"
+    assert main(["layout", str(spec), "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"urbangen layout: {spec}: streets.roundabouts: ") and "\n" not in err, err
+    assert not out.exists()
+
+
+# -- lanes and routes ----------------------------------------------------------------------------
+def test_lane_graph_connectors_at_a_roundabout_join_their_lanes_and_yield_to_the_ring():
+    grid = make_grid(spec_with(blocks=2))
+    graph = LaneGraph(grid)
+    node = (1, 1)
+    assert grid.roundabouts == {node}
+    n = 0
+    for (nd, x, y, k), ci in graph.connector.items():
+        if nd != node:
+            continue
+        conn, lin, lout = graph.edges[ci], graph.lane_in(node, x, k), graph.lane_out(node, y, k)
+        np.testing.assert_allclose(conn.path.points[0], lin.path.points[-1], atol=1e-6)
+        np.testing.assert_allclose(conn.path.points[-1], lout.path.points[0], atol=1e-6)
+        assert graph.turn_radius(conn) == pytest.approx(min(grid.ring.fillet_r, grid.ring.ring_r[k]))
+        assert (x, y, k) in graph.conflicts_at(node)[(x, y, k)]
+        n += 1
+    assert n == 12
+    # every entry meets the ring traffic coming from its left: the left neighbour's straight on
+    for x in range(4):
+        assert ((x + 3) % 4, (x + 1) % 4, 0) in graph.ring_conflict[(x, (x + 2) % 4, 0)]
+
+
+def test_an_entering_vehicle_waits_while_a_vehicle_on_the_ring_holds_a_conflicting_connector():
+    grid = make_grid(spec_with(blocks=2))
+    graph = LaneGraph(grid)
+    node = (1, 1)
+    signals = Signals(11, grid.nodes)
+    t0 = next(t for t in np.arange(0.0, 40.0, 0.5) if all(signals.vehicles_may_enter(node, t + d) for d in range(12)))
+    ring_car = graph.connector[(node, 0, 2, 0)]       # from the east, straight on round the island
+    entering = graph.connector[(node, 1, 3, 0)]       # from the north, straight on: meets it on the ring
+    rng = np.random.default_rng(0)
+    a = Vehicle(0, 4.5, 1.9, 6.0, 1.5, [ring_car, graph.lane_out(node, 2, 0).index], 1.0, rng, v=4.0)
+    lane_n = graph.lane_in(node, 1, 0)
+    b = Vehicle(1, 4.5, 1.9, 8.0, 1.5, [lane_n.index, entering, graph.lane_out(node, 3, 0).index],
+                lane_n.length - graph.stop_s_from_end - 6.0, rng)
+    sim = VehicleSim(graph, signals, [a, b])
+    a.grant = ring_car
+    sim.holders[node] = {0: ring_car}
+    released = granted = None
+    for i in range(200):
+        t = t0 + i * 0.05
+        sim.step(t, 0.05)
+        if released is None and a.grant is None:
+            released = t
+        if granted is None and b.grant == entering:
+            granted = t
+        pa, ha = sim.pose(a)
+        pb, hb = sim.pose(b)
+        qa = OrientedBox((*pa, 0.7), (4.5, 1.9, 1.5), ha).corners_xy()[None]
+        qb = OrientedBox((*pb, 0.7), (4.5, 1.9, 1.5), hb).corners_xy()[None]
+        assert not boxes_overlap(qa, qb).any(), t
+    assert released is not None and granted is not None and granted >= released
+
+
+def test_routes_go_round_the_islands_smoothly():
+    grid = make_grid(spec_with(blocks=3))
+    ring = grid.ring
+    route = make_routes(grid)[0]
+    xy, h, s = route.points[:, :2], route.headings, route.s
+    assert _radii(np.r_[h, h[0]], np.r_[s, route.length()]).min() >= 0.97 * MIN_RADIUS_M   # resampled arcs
+    step = np.linalg.norm(np.diff(np.vstack([xy, xy[:1]]), axis=0), axis=1)
+    assert step.max() <= 1.01 and step.min() > 0.5                       # no jumps, no stalls
+    chord = np.arctan2(*np.diff(np.vstack([xy, xy[:1]]), axis=0).T[::-1])
+    assert np.abs(np.angle(np.exp(1j * (chord - h)))).max() < np.radians(6)
+    drive = grid.drivable_rects()
+    inside = ((xy[:, None, 0] >= drive[:, 0]) & (xy[:, None, 0] <= drive[:, 2])
+              & (xy[:, None, 1] >= drive[:, 1]) & (xy[:, None, 1] <= drive[:, 3])).any(1)
+    assert inside.all()
+    swept = {}
+    for node in grid.roundabouts:
+        d = xy - grid.node_xy(node)
+        r = np.hypot(*d.T)
+        assert r.min() >= ring.island_r + EGO_HALF_WIDTH_M + 0.25
+        near = r < ring.ring_r[-1] + 0.5
+        if near.any():
+            ang = np.unwrap(np.arctan2(d[near, 1], d[near, 0]))
+            swept[node] = float(ang.max() - ang.min())
+            assert np.all(d[near, 0] * np.sin(h[near]) - d[near, 1] * np.cos(h[near]) > 0)   # anticlockwise
+    # route 0 goes straight on at (1, 2) and (2, 2): round the island, about a half circle
+    assert swept[(1, 2)] > np.radians(90) and swept[(2, 2)] > np.radians(90)
+
+
+# -- the built town and its traffic --------------------------------------------------------------
+@pytest.fixture(scope="module")
+def town():
+    spec = spec_with(blocks=2, traffic=TRAFFIC)
+    scene = build_scene(spec)
+    return spec, scene, build_world(spec, scene, MINUTE_S)
+
+
+def test_the_island_is_raised_other_ground_with_grass_and_nothing_but_vehicles_on_the_lanes(town):
+    spec, scene, _ = town
+    grid = make_grid(spec)
+    node, ring = (1, 1), grid.ring
+    c = grid.node_xy(node)
+    table = class_table()
+    tri = scene.vertices[scene.faces]                    # (f, 3, 3)
+    centre = tri.mean(1)
+    r = np.hypot(*(centre[:, :2] - c).T)
+    assert 0 < ring.core_r < ring.island_r
+    top = scene.face_class[(r < ring.core_r - 0.05) & (np.abs(centre[:, 2] - grid.curb_h) < 0.01)]
+    assert {table.names[i] for i in np.unique(top)} == {"other_ground", "terrain"}      # kerb band, grass
+    apron = scene.face_class[(r > ring.core_r + 0.05) & (r < ring.island_r - 0.05) & (np.abs(centre[:, 2] - APRON_H_M) < 0.01)]
+    assert {table.names[i] for i in np.unique(apron)} == {"other_ground"}
+    assert grid.ground_height(c[None])[0] == grid.curb_h
+    assert grid.ground_height(c[None] + [(ring.core_r + ring.island_r) / 2, 0])[0] == APRON_H_M
+    ground = ("street", "sidewalk", "intersection", "corner", "lot_ground", "terrain", "horizon")
+    placed = [o for o in scene.objects if o.kind not in ground]
+    assert not [o.name for o in placed if o.cls == "traffic_light" and np.hypot(*(o.transform[:2, 3] - c)) < 15]
+    signs = np.array([o.transform[:2, 3] for o in placed if o.cls == "traffic_sign"])
+    q = grid.walk_inner + min(0.5, grid.sidewalk_w / 2)     # the kerb line, where signals stand elsewhere
+    for corner in ((1, 1), (-1, 1), (-1, -1), (1, -1)):   # a round sign at each approach instead
+        assert np.hypot(*(signs - (c + q * np.array(corner))).T).min() < 0.05, corner
+    assert [o for o in placed if o.cls == "traffic_light"]                # the plain nodes keep theirs
+    lanes = grid.drivable_rects()
+    on_lanes = ("car", "truck", "bus", "on_rails", "other_vehicle", "ridden_bicycle", "ridden_motorcycle",
+                "bicyclist", "motorcyclist")
+    bushes = 0
+    for o in placed:
+        x, y = o.transform[:2, 3]
+        if np.hypot(x - c[0], y - c[1]) < ring.island_r:      # on the island: planting, wholly on the grass
+            assert o.cls == "vegetation", o.name
+            assert np.hypot(*(o.box.corners_xy() - c).T).max() < ring.core_r, o.name
+            bushes += 1
+        elif ((x > lanes[:, 0]) & (x < lanes[:, 2]) & (y > lanes[:, 1]) & (y < lanes[:, 3])).any():
+            assert o.cls in on_lanes or o.attrs.get("placement") == "crosswalk", (o.name, o.cls)
+    assert bushes >= 1
+    # the planting intersects nothing else, and no other object reaches over the island
+    isl = [o for o in placed if np.hypot(*(o.transform[:2, 3] - c)) < ring.island_r]
+    rest = [o for o in placed if np.hypot(*(o.transform[:2, 3] - c)) >= ring.island_r]
+    ov = boxes_overlap(np.stack([o.box.corners_xy() for o in isl]), np.stack([o.box.corners_xy() for o in rest]))
+    assert not ov.any()
+    ov = boxes_overlap(np.stack([o.box.corners_xy() for o in isl]), np.stack([o.box.corners_xy() for o in isl]))
+    np.fill_diagonal(ov, False)
+    assert not ov.any()
+    square = np.array([[c + ring.island_r * np.array(d) for d in ((-1, -1), (1, -1), (1, 1), (-1, 1))]])
+    assert not boxes_overlap(square, np.stack([o.box.corners_xy() for o in rest])).any()
+
+
+def test_no_vehicle_touches_a_pedestrian_at_an_unsignalled_roundabout(town):
+    """No signals hold vehicles back at the roundabout: they give way to people on the crosswalks."""
+    _, _, world = town
+    people = [a for a in world.actors if a.kind == "person"]
+    vehicles = [a for a in world.actors if a.kind != "person"]
+    assert len(people) > 10 and len(vehicles) > 10
+    for t in np.arange(0.0, MINUTE_S, 0.1):
+        p = np.stack([a.box(t).corners_xy() for a in people])
+        E = world.ego.T_world_ego(t)[0]
+        ego = OrientedBox((E[0, 3], E[1, 3], 0.7), (4.6, 1.9, 1.5), float(np.arctan2(E[1, 0], E[0, 0])))
+        hit = boxes_overlap(np.stack([a.box(t).corners_xy() for a in vehicles] + [ego.corners_xy()]), p)
+        assert not hit.any(), (t, np.argwhere(hit)[:3])
+
+
+def test_a_minute_of_traffic_through_a_roundabout_never_touches(town):
+    spec, scene, world = town
+    grid = make_grid(spec)
+    c, ring = grid.node_xy((1, 1)), grid.ring
+    parked = np.stack([o.box.corners_xy() for o in scene.objects if o.instance_id > 0])
+    vehicles = [a for a in world.actors if a.kind != "person"]
+    through = set()
+    for t in np.arange(0.0, MINUTE_S, 0.1):
+        q = np.stack([b.corners_xy() for b in world.boxes(t)])
+        ov = boxes_overlap(q, q)
+        np.fill_diagonal(ov, False)
+        assert not ov.any(), f"actors {np.argwhere(ov)[0]} overlap at t={t:.1f}"
+        E = world.ego.T_world_ego(t)[0]
+        ego = OrientedBox((E[0, 3], E[1, 3], 0.7), (4.6, 1.9, 1.5), float(np.arctan2(E[1, 0], E[0, 0])))
+        assert not boxes_overlap(ego.corners_xy()[None], q).any(), f"an actor touches the ego at t={t:.1f}"
+        assert not boxes_overlap(q, parked).any(), f"an actor touches a static object at t={t:.1f}"
+        for a in vehicles:
+            box = a.box(t)
+            corners = box.corners_xy() - c
+            # the box edges' closest point to the centre: sample the edges
+            edges = corners[:, None] + (np.roll(corners, -1, 0) - corners)[:, None] * np.linspace(0, 1, 41)[None, :, None]
+            r = np.hypot(*edges.reshape(-1, 2).T).min()
+            assert r > ring.core_r, f"{a.name} drives over the raised island at t={t:.1f}"
+            if box.size[0] <= STANDARD_CAR_M[0] and box.size[1] <= 2 * EGO_HALF_WIDTH_M:
+                assert r > ring.island_r, f"{a.name} ({a.kind}) drives over the apron at t={t:.1f}"
+            if r < ring.ring_r[0] + 0.5:
+                through.add(a.name)
+    assert len(through) >= 4, through                      # traffic does use the roundabout
+
+
+def test_lidar_rays_see_the_apron_and_the_raised_grass_at_their_heights(town):
+    """Embree (what the LiDAR casts with) hits the island where the meshes say: grass on the raised
+    centre at curb height, other-ground on the apron 5 cm up, road beyond it."""
+    from generator.lidar.caster import EmbreeCaster
+
+    spec, scene, _ = town
+    grid = make_grid(spec)
+    c, ring = grid.node_xy((1, 1)), grid.ring
+    table = class_table()
+    radii = {"terrain": 0.0, "other_ground": (ring.core_r + ring.island_r) / 2, "road": ring.island_r + 0.5}
+    heights = {"terrain": grid.curb_h + 0.003, "other_ground": APRON_H_M, "road": 0.0}
+    caster = EmbreeCaster.from_scene(scene)
+    for cls, r in radii.items():
+        a = np.linspace(0.0, 2 * np.pi, 16, endpoint=False) + 0.1
+        xy = c + r * np.stack([np.cos(a), np.sin(a)], 1)
+        if cls == "terrain":      # the whole grass disc
+            g = np.stack(np.meshgrid(*[np.linspace(-1, 1, 21)] * 2), -1).reshape(-1, 2) * (ring.core_r - 0.35)
+            xy = c + g[np.hypot(*g.T) < ring.core_r - 0.35]
+        o = np.c_[xy, np.full(len(xy), 0.6)]             # below the bushes' crowns, above the kerbs
+        d = np.tile([0.0, 0.0, -1.0], (len(o), 1))
+        dist, prim = caster.intersect(o, d, 5.0)[:2]
+        hit = np.isfinite(dist)
+        assert hit.all()
+        z = 0.6 - dist
+        if cls == "terrain":      # a bush may stand on the grass: the rays that reach the ground see grass
+            ground = np.abs(z - heights[cls]) < 1e-3
+            assert ground.sum() >= 10
+            assert {table.names[i] for i in scene.face_class[prim[ground]]} == {"terrain"}
+            assert {table.names[i] for i in scene.face_class[prim[~ground]]} <= {"vegetation"}
+        else:
+            np.testing.assert_allclose(z, heights[cls], atol=1e-3)
+            assert {table.names[i] for i in scene.face_class[prim]} == {cls}
+
+
+@pytest.mark.blender
+def test_blender_builds_the_roundabout_as_the_scene_model(tmp_path):
+    """The island (apron, raised centre, grass), give-way lines and approach signs reach Blender
+    triangle for triangle."""
+    from generator.blender.renderer import Renderer
+    from generator.spec.render import load_render_config
+
+    spec = parse_spec({"name": "roundabout_tiny", "seed": 2,
+                       "town": {"blocks_x": 2, "blocks_y": 2, "block_size_m": 30, "block_size_jitter_m": 0,
+                                "margin_m": 8},
+                       "streets": {"roundabouts": 1}}, "roundabout_tiny.json")
+    scene = build_scene(spec)
+    assert make_grid(spec).roundabouts == {(1, 1)}
+    n, bounds = Renderer(scene, spec, load_render_config("test"), tmp_path).evaluated_geometry()
+    assert n == len(scene.faces)
+    v = scene.vertices.astype(np.float64)
+    assert np.allclose(bounds, [v.min(0), v.max(0)], atol=1e-3)
