@@ -19,6 +19,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from generator.geometry import Mesh, pose
+from generator.layout.overlap_kernel import any_overlap
 from generator.rng import stream
 from generator.world.scene import OrientedBox
 
@@ -179,6 +180,8 @@ class Occupancy:
     def __init__(self, cell: float = 8.0):
         self.cell = cell
         self._buf = np.zeros((256, 7))
+        self._cos = np.zeros(256)  # numpy's cos and sin of each accepted box's yaw, made once
+        self._sin = np.zeros(256)
         self._n = 0
         self._cells: dict[tuple[int, int], list[int]] = defaultdict(list)
 
@@ -196,13 +199,23 @@ class Occupancy:
     def hits(self, boxes: np.ndarray) -> bool:
         """True if any of ``boxes`` (k, 7) overlaps an accepted box."""
         idx = sorted({i for key in self._keys(boxes) for i in self._cells.get(key, ())})
-        return bool(idx) and bool(overlaps(boxes, self.boxes[idx]).any())
+        if not idx:
+            return False
+        # overlaps(boxes, self.boxes[idx]).any(), compiled (the same float operations)
+        yaw = np.ascontiguousarray(boxes, np.float64)[:, 4]
+        return bool(any_overlap(np.ascontiguousarray(boxes, np.float64), np.cos(yaw), np.sin(yaw),
+                                self._buf[idx], self._cos[idx], self._sin[idx]))
 
     def add(self, boxes: np.ndarray) -> None:
         start = self._n
         while start + len(boxes) > len(self._buf):
             self._buf = np.concatenate([self._buf, np.zeros_like(self._buf)])
+            self._cos = np.concatenate([self._cos, np.zeros_like(self._cos)])
+            self._sin = np.concatenate([self._sin, np.zeros_like(self._sin)])
         self._buf[start:start + len(boxes)] = boxes
+        yaw = np.ascontiguousarray(boxes, np.float64)[:, 4]
+        self._cos[start:start + len(boxes)] = np.cos(yaw)
+        self._sin[start:start + len(boxes)] = np.sin(yaw)
         self._n += len(boxes)
         for k in range(len(boxes)):
             for key in self._keys(boxes[k:k + 1]):
