@@ -28,18 +28,20 @@ BAND_M = 0.5             #: height of a collision band
 WHOLE_BOX_KINDS = frozenset({"building", "hedge", "fence"})
 
 
-def collision_boxes(mesh: Mesh, whole: bool = False, band: float = BAND_M, tol: float = 0.15) -> np.ndarray:
+def collision_boxes(mesh: Mesh, whole: bool = False, band: float = BAND_M, tol: float = 0.15,
+                    bounds: np.ndarray | None = None) -> np.ndarray:
     """Conservative local AABBs of ``mesh`` cut into height bands.
 
     Every triangle whose z-range meets a band contributes its full xy extent to that band;
-    consecutive bands with nearly equal extents are merged.
+    consecutive bands with nearly equal extents are merged. ``bounds`` ((2, 3), optional) is
+    ``mesh.bounds()`` when the caller has it already.
 
     Returns
     -------
     (b, 6) float64
         ``(x0, y0, z0, x1, y1, z1)`` per box, local frame, metres.
     """
-    lo, hi = mesh.bounds()
+    lo, hi = mesh.bounds() if bounds is None else bounds
     if whole or mesh.n_faces == 0:
         return np.array([[*lo, *hi]])
     tri = mesh.vertices[mesh.faces]
@@ -96,9 +98,9 @@ class Library:
 
     def _make(self, key: str, kind: str, g: np.random.Generator, params: dict) -> Proto:
         mesh = self._catalog.build(kind, g, **params)
-        lo, hi = mesh.bounds()
+        lo, hi = bounds = mesh.bounds()
         whole = kind in WHOLE_BOX_KINDS
-        bands = self._cache.derive(mesh, f"bands/{whole}", lambda m: collision_boxes(m, whole=whole))
+        bands = self._cache.derive(mesh, f"bands/{whole}", lambda m: collision_boxes(m, whole=whole, bounds=bounds))
         p = Proto(key, kind, mesh, lo, hi, bands, dict(params))
         self.protos[key] = p
         return p
