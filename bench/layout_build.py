@@ -41,6 +41,8 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
+
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
@@ -133,9 +135,12 @@ def _median(runs: list[dict], pick) -> float:
     return statistics.median(pick(r) for r in runs)
 
 
-def cache_table(spec_path: str, sizes: list[int], towns: int, baseline: str | None = None, repeat: int = 1) -> None:
+def cache_table(spec_path: str, sizes: list[int], towns: int, baseline: str | None = None,
+                repeat: int = 1) -> list[dict]:
     """Cold, again and new-town builds of each size, this checkout beside ``baseline`` (see the module
-    docstring); the runs of the two alternate, ``repeat`` times, and the medians are shown."""
+    docstring); the runs of the two alternate, ``repeat`` times, and the medians are shown and returned
+    (one dict per size and code: ``{"n", "code", "<cold|again|new>_<wall|cpu>"}``, seconds)."""
+    results = []
     print()
     print(f"cold (empty prototype cache) / again (same town, warm) / new town (towns 1..{towns - 1} of a re-drawn run, "
           f"warm); wall and CPU seconds, median of {repeat} fresh process(es) each")
@@ -159,12 +164,52 @@ def cache_table(spec_path: str, sizes: list[int], towns: int, baseline: str | No
             rate = f"{100 * hits['hits'] / max(hits['hits'] + hits['misses'], 1):.0f} %" if hits else "-"
             same = ("the baseline's" if digests[code] == digests.get("baseline") else "DIFFER from the baseline") \
                 if baseline and code == "this" else ""
+            row = {"n": n, "code": code, "new_wall": statistics.median(t["wall"] for t in new),
+                   "new_cpu": statistics.median(t["cpu"] for t in new)}
+            for k in ("cold", "again"):
+                row[f"{k}_wall"] = _median(runs, lambda r: r[k]["wall"])
+                row[f"{k}_cpu"] = _median(runs, lambda r: r[k]["cpu"])
+            results.append(row)
             print(f"{f'{n}x{n}':>5} {code:>9} {_median(runs, lambda r: r['cold']['wall']):>10.2f} "
                   f"{_median(runs, lambda r: r['cold']['cpu']):>6.2f} {_median(runs, lambda r: r['again']['wall']):>11.2f} "
                   f"{_median(runs, lambda r: r['again']['cpu']):>6.2f} {statistics.median(t['wall'] for t in new):>14.2f} "
                   f"{statistics.median(t['cpu'] for t in new):>6.2f} "
                   f"{rate:>6}  {same}",
                   flush=True)
+    return results
+
+
+def plot(results: list[dict], path: str, title: str) -> None:
+    """Bars of :func:`cache_table`'s results (CPU seconds solid, wall seconds hatched) to a PNG."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    sizes = sorted({r["n"] for r in results})
+    codes = list(dict.fromkeys(r["code"] for r in results))
+    fig, axes = plt.subplots(1, len(sizes), figsize=(5.5 * len(sizes), 4), squeeze=False)
+    for ax, n in zip(axes[0], sizes):
+        x = np.arange(3)
+        width = 0.8 / len(codes)
+        for k, code in enumerate(codes):
+            r = next(r for r in results if r["n"] == n and r["code"] == code)
+            cpu = [r["cold_cpu"], r["again_cpu"], r["new_cpu"]]
+            wall = [r["cold_wall"], r["again_wall"], r["new_wall"]]
+            pos = x + (k - (len(codes) - 1) / 2) * width
+            ax.bar(pos, wall, width * 0.9, color=f"C{k}", alpha=0.3, hatch="//", label=f"{code} wall")
+            ax.bar(pos, cpu, width * 0.9, color=f"C{k}", label=f"{code} CPU")
+            for px, v in zip(pos, cpu):
+                ax.text(px, v, f"{v:.2f}", ha="center", va="bottom", fontsize=8)
+        ax.axhline(1.5, color="k", lw=0.8, ls="--")
+        ax.text(2.45, 1.52, "1.5 s target", ha="right", va="bottom", fontsize=8)
+        ax.set_xticks(x, ["cold", "again", "new town"])
+        ax.set_ylabel("seconds per build_scene")
+        ax.set_title(f"{title} {n}x{n}")
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -175,6 +220,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--towns", type=int, default=3, help="towns of the re-drawn run in the cache table (0: no table)")
     ap.add_argument("--baseline", default=None, help="another checkout whose build is timed beside (see above)")
     ap.add_argument("--skip-breakdown", action="store_true", help="only the cache table")
+    ap.add_argument("--png", default=None, help="also draw the cache table's bars to this PNG")
     args = ap.parse_args(argv)
     base = load_spec(args.spec)
     print(f"spec {args.spec} (seed {base.seed}), median of {args.repeat} run(s) per size")
@@ -194,7 +240,11 @@ def main(argv: list[str] | None = None) -> int:
               f"{med['build'] - med['assets']:>9.2f} {med['flatten']:>10.3f} "
               f"{1e6 * med['build'] / max(med['triangles'], 1):>7.1f}", flush=True)
     if args.towns > 0:
-        cache_table(str(Path(args.spec).resolve()), args.sizes, max(args.towns, 2), args.baseline, args.repeat)
+        results = cache_table(str(Path(args.spec).resolve()), args.sizes, max(args.towns, 2), args.baseline,
+                              args.repeat)
+        if args.png:
+            plot(results, args.png, f"{Path(args.spec).stem} (load {os.getloadavg()[0]:.1f} on {os.cpu_count()} CPUs)")
+            print(f"wrote {args.png}")
     return 0
 
 
