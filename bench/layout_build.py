@@ -1,7 +1,8 @@
 """Time ``build_scene`` for 1x1 .. 4x4 towns and print a table.
 
     python bench/layout_build.py [--spec scenes/default_town.json] [--sizes 1 2 3 4] [--repeat 1]
-                                 [--towns 3] [--baseline DIR] [--skip-breakdown]
+                                 [--towns 3] [--baseline DIR] [--skip-breakdown] [--png PATH]
+    python bench/layout_build.py --profile [--spec ...] [--sizes 3]
 
 Every town is the spec (default: the default town) with ``blocks_x = blocks_y = n``: the
 street grid, the band of lots round the outer ring road, and the ground to the horizon.
@@ -212,6 +213,29 @@ def plot(results: list[dict], path: str, title: str) -> None:
     plt.close(fig)
 
 
+def profile_new_town(spec_path: str, n: int, top: int = 25) -> None:
+    """cProfile one new town (town 2 of a re-drawn run, after towns 0 and 1 warmed the cache) and print
+    its top costs by own time and by cumulative time (pyinstrument is not a dependency)."""
+    import cProfile
+    import pstats
+
+    from generator.spec.towns import town_spec
+
+    base = load_spec(spec_path)
+    spec = dataclasses.replace(base, town=dataclasses.replace(base.town, blocks_x=n, blocks_y=n,
+                                                              redraw_every_frames=1))
+    for i in (0, 1):
+        assemble.build_scene(town_spec(spec, i))
+    prof = cProfile.Profile()
+    prof.enable()
+    assemble.build_scene(town_spec(spec, 2))
+    prof.disable()
+    print(f"\ncProfile of a new {n}x{n} town of {Path(spec_path).stem} (town 2, warm cache):")
+    stats = pstats.Stats(prof)
+    stats.sort_stats("tottime").print_stats(top)
+    stats.sort_stats("cumulative").print_stats(top)
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--spec", default=str(ROOT / "scenes" / "default_town.json"))
@@ -221,7 +245,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--baseline", default=None, help="another checkout whose build is timed beside (see above)")
     ap.add_argument("--skip-breakdown", action="store_true", help="only the cache table")
     ap.add_argument("--png", default=None, help="also draw the cache table's bars to this PNG")
+    ap.add_argument("--profile", action="store_true", help="cProfile a new town of the first size and print the top costs")
     args = ap.parse_args(argv)
+    if args.profile:
+        profile_new_town(args.spec, args.sizes[0])
+        return 0
     base = load_spec(args.spec)
     print(f"spec {args.spec} (seed {base.seed}), median of {args.repeat} run(s) per size")
     head = f"{'town':>5} {'objects':>8} {'things':>7} {'protos':>7} {'triangles':>10} {'build s':>8} " \
