@@ -17,7 +17,7 @@ from __future__ import annotations
 from numba import njit
 
 
-@njit(nogil=True, cache=True, boundscheck=False)
+@njit(inline="always")
 def _separated(nx, ny, ax0, ax1, ay0, ay1, bx0, bx1, by0, by1, ahx, ahy, bhx, bhy, dx, dy):  # pragma: no cover
     ra = ahx * abs(nx * ax0 + ny * ax1) + ahy * abs(nx * ay0 + ny * ay1)
     rb = bhx * abs(nx * bx0 + ny * bx1) + bhy * abs(nx * by0 + ny * by1)
