@@ -181,7 +181,8 @@ def cache_table(spec_path: str, sizes: list[int], towns: int, baseline: str | No
 
 
 def plot(results: list[dict], path: str, title: str) -> None:
-    """Bars of :func:`cache_table`'s results (CPU seconds solid, wall seconds hatched) to a PNG."""
+    """Bars of :func:`cache_table`'s results to a PNG: per size, CPU seconds (left, with the 1.5 s
+    target) and wall seconds (right), each code side by side."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -189,25 +190,26 @@ def plot(results: list[dict], path: str, title: str) -> None:
 
     sizes = sorted({r["n"] for r in results})
     codes = list(dict.fromkeys(r["code"] for r in results))
-    fig, axes = plt.subplots(1, len(sizes), figsize=(5.5 * len(sizes), 4), squeeze=False)
-    for ax, n in zip(axes[0], sizes):
-        x = np.arange(3)
-        width = 0.8 / len(codes)
-        for k, code in enumerate(codes):
-            r = next(r for r in results if r["n"] == n and r["code"] == code)
-            cpu = [r["cold_cpu"], r["again_cpu"], r["new_cpu"]]
-            wall = [r["cold_wall"], r["again_wall"], r["new_wall"]]
-            pos = x + (k - (len(codes) - 1) / 2) * width
-            ax.bar(pos, wall, width * 0.9, color=f"C{k}", alpha=0.3, hatch="//", label=f"{code} wall")
-            ax.bar(pos, cpu, width * 0.9, color=f"C{k}", label=f"{code} CPU")
-            for px, v in zip(pos, cpu):
-                ax.text(px, v, f"{v:.2f}", ha="center", va="bottom", fontsize=8)
-        ax.axhline(1.5, color="k", lw=0.8, ls="--")
-        ax.text(2.45, 1.52, "1.5 s target", ha="right", va="bottom", fontsize=8)
-        ax.set_xticks(x, ["cold", "again", "new town"])
-        ax.set_ylabel("seconds per build_scene")
-        ax.set_title(f"{title} {n}x{n}")
-        ax.legend(fontsize=7)
+    fig, axes = plt.subplots(len(sizes), 2, figsize=(10, 3.8 * len(sizes)), squeeze=False)
+    x = np.arange(3)
+    width = 0.8 / len(codes)
+    for row, n in zip(axes, sizes):
+        for ax, clock in zip(row, ("cpu", "wall")):
+            for k, code in enumerate(codes):
+                r = next(r for r in results if r["n"] == n and r["code"] == code)
+                v = [r[f"cold_{clock}"], r[f"again_{clock}"], r[f"new_{clock}"]]
+                pos = x + (k - (len(codes) - 1) / 2) * width
+                ax.bar(pos, v, width * 0.9, color=f"C{k}", label=code)
+                for px, val in zip(pos, v):
+                    ax.text(px, val, f"{val:.2f}", ha="center", va="bottom", fontsize=8)
+            if clock == "cpu":
+                ax.axhline(1.5, color="k", lw=0.8, ls="--")
+                ax.text(-0.45, 1.5, " 1.5 s target", ha="left", va="bottom", fontsize=8)
+            ax.set_xticks(x, ["cold", "again", "new town"])
+            ax.set_ylabel(f"{'CPU' if clock == 'cpu' else 'wall'} seconds per build_scene")
+            ax.set_title(f"{title} {n}x{n}: {'process CPU' if clock == 'cpu' else 'wall clock'}", fontsize=10)
+            ax.set_ylim(0, ax.get_ylim()[1] * 1.2)
+            ax.legend(fontsize=8, loc="upper center", ncol=len(codes))
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
