@@ -25,7 +25,6 @@ import trimesh
 from scipy.spatial import ConvexHull, QhullError
 from scipy.spatial import cKDTree
 from trimesh import geometry as tm_geometry
-from trimesh import graph as tm_graph
 from trimesh import triangles as tm_triangles
 from trimesh import util as tm_util
 from trimesh.constants import tol
@@ -42,6 +41,17 @@ def _by_trimesh(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]
     hull = trimesh.convex.convex_hull(points)
     return np.asarray(hull.vertices, np.float64), np.asarray(hull.faces, np.int64), \
         np.asarray(hull.vertex_normals, np.float64)
+
+
+def _closed_and_consistent(faces: np.ndarray, n_vertices: int) -> bool:
+    """Every directed edge once and its reverse once: what ``trimesh.graph.is_watertight`` calls
+    watertight (each edge in exactly two faces) with a consistent winding (opposite directions)."""
+    a = faces.reshape(-1)
+    b = faces[:, [1, 2, 0]].reshape(-1)
+    edges = np.sort(a * n_vertices + b)
+    if len(edges) > 1 and not np.all(edges[1:] != edges[:-1]):
+        return False
+    return bool(np.array_equal(np.sort(b * n_vertices + a), edges))
 
 
 def _fast(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
@@ -78,11 +88,12 @@ def _fast(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | Non
     check, ok = tm_triangles.normals(vertices[faces[:20]])
     compare = np.zeros((len(ok), 3))
     compare[ok] = check
-    if not np.isfinite(ptp) or ptp < tol.merge or not np.allclose(compare, normals[:20]):
+    head = normals[:20]
+    # np.allclose(compare, head) for finite arrays (anything else fails, and falls back)
+    if not np.isfinite(ptp) or ptp < tol.merge or compare.shape != head.shape \
+            or not np.all(np.abs(compare - head) <= 1e-08 + 1e-05 * np.abs(head)):
         return None                               # the face_normals setter would ignore ours
-    edges = faces[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2)
-    watertight, winding = tm_graph.is_watertight(edges, np.sort(edges, axis=1))
-    if not (watertight and winding):
+    if not _closed_and_consistent(faces, len(vertices)):
         return None                               # fix_winding would traverse and flip
     tri = vertices[faces]
     volume = np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])).sum() / 6.0
