@@ -197,14 +197,18 @@ class _Facade:
         fmat = np.broadcast_to(mats[:, None], keep.shape)[keep]
         return [Mesh(verts.reshape(-1, 3), faces, resolve_ids(CLS, "default")[0], fmat)]
 
-    def mesh(self) -> Mesh:
+    def meshes(self) -> list[Mesh]:
+        """The wall's quads, sills and boxes (merged by the caller with the other walls: one
+        concatenation per building instead of one per wall and one per building)."""
         if self.quads:
             corners = self.pts(np.array(self.quads, float).reshape(-1, 3)).reshape(-1, 4, 3)
             normals = np.array(self._normals)[self.facing]
         else:
             corners, normals = np.zeros((0, 4, 3)), np.zeros((0, 3))
-        return merge([quads(corners, CLS, self.materials, normals)] + self._sill_mesh()
-                     + self._box_mesh())
+        return [quads(corners, CLS, self.materials, normals)] + self._sill_mesh() + self._box_mesh()
+
+    def mesh(self) -> Mesh:
+        return merge(self.meshes())
 
 
 def _opening(fc: _Facade, h: Hole, st: Style, facade_mat: str) -> np.ndarray:
@@ -310,7 +314,7 @@ def building(rng: np.random.Generator, footprint: np.ndarray, height: float, flo
             if h.kind == "balcony":
                 balcony(fc, h, st, facade_mat)
         shop_front(fc, [h for h in openings if h.kind == "shop"], st, fc.length, rng)
-        parts.append(fc.mesh())
+        parts += fc.meshes()
     if roof == "flat":
         parts.append(flat_roof(rng, poly, height, parapet, facade_mat))
     else:
