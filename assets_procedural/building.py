@@ -207,9 +207,6 @@ class _Facade:
             corners, normals = np.zeros((0, 4, 3)), np.zeros((0, 3))
         return [quads(corners, CLS, self.materials, normals)] + self._sill_mesh() + self._box_mesh()
 
-    def mesh(self) -> Mesh:
-        return merge(self.meshes())
-
 
 def _opening(fc: _Facade, h: Hole, st: Style, facade_mat: str) -> np.ndarray:
     """Reveals, frame, glass (or door leaf) of one hole; returns the pane centre (3,)."""
