@@ -20,7 +20,8 @@ import numpy as np
 from assets_procedural.building_roof import flat_roof, pitched_roof, rectangle_of
 from assets_procedural.facade_details import balcony, shop_front
 from assets_procedural.facade_layout import Hole, Style, draw_style, holes, wall_rects
-from generator.geometry import Mesh, box, merge, quads
+from generator.geometry import Mesh, box, merge, quads, resolve_ids
+from generator.geometry.primitives import _UNIT_BOX_FACES, _UNIT_BOX_VERTICES as _UNIT_BOX
 
 log = logging.getLogger(__name__)
 
@@ -66,27 +67,44 @@ class _Facade:
         self.o = np.array([p0[0], p0[1], 0.0])
         self._axes = [tuple(float(x) for x in c) for c in zip(self.o, self.d, (0.0, 0.0, 1.0), self.n)]
         self._up, self._down, self._back = np.array([0, 0, 1.0]), -np.array([0, 0, 1.0]), -self.d
-        self.uvw: list[list[tuple[float, float, float]]] = []  # 4 corners per quad, mapped in mesh()
+        # quads are collected as 12 facade coordinates each (4 corners of (u, v, w)), mapped in mesh();
+        # the direction each faces is an index into _normals (one array per direction, not per quad)
+        self.quads: list[tuple] = []
         self.materials: list[str] = []
-        self.facing: list[np.ndarray] = []
+        self.facing: list[int] = []
+        self._normals: list[np.ndarray] = [self.n, self._down, self.d, self._back, self._up]
+        self._normal_of: dict[int, int] = {id(a): i for i, a in enumerate(self._normals)}
         self.sills: list[tuple[Hole, str]] = []
-        self.extra: list[Mesh] = []  # boxes proud of the wall (balconies, sign bands, awnings)
+        self.boxes: list[tuple] = []  # boxes proud of the wall (balconies, sign bands), built in mesh()
+
+    def point(self, u: float, v: float, w: float) -> tuple[float, float, float]:
+        """One point (a pane centre, the door) in the local frame: the float operations of :meth:`pts`
+        (o + u d + v z + w n, left to right), without arrays."""
+        u, v, w = float(u), float(v), float(w)
+        return tuple(o + u * d + v * z + w * n for o, d, z, n in self._axes)
 
     def pts(self, uvw: list[tuple[float, float, float]]) -> np.ndarray:
-        if len(uvw) == 1:  # one point (a pane centre, the door): the same float operations, without arrays
-            u, v, w = (float(x) for x in uvw[0])
-            return np.array([[o + u * d + v * z + w * n for o, d, z, n in self._axes]])
+        """(k, 3) local points of facade coordinates ``uvw`` (k triples)."""
+        if len(uvw) == 1:
+            return np.array([self.point(*uvw[0])])
         a = np.asarray(uvw, float)
         return self.o + a[:, :1] * self.d + a[:, 1:2] * np.array([0, 0, 1.0]) + a[:, 2:3] * self.n
 
     def add(self, uvw: list[tuple[float, float, float]], material: str, facing: np.ndarray) -> None:
-        self.uvw.append(uvw)
+        """A quad of 4 corners (u, v, w), wound to face ``facing`` ((3,) local frame)."""
+        k = self._normal_of.get(id(facing))
+        if k is None:  # a new direction (awnings): kept referenced, so its id stays its own
+            k = self._normal_of[id(facing)] = len(self._normals)
+            self._normals.append(np.asarray(facing, float))
+        self.quads.append(tuple(x for p in uvw for x in p))
         self.materials.append(material)
-        self.facing.append(facing)
+        self.facing.append(k)
 
     def rect(self, u0, u1, v0, v1, w, material) -> None:
         """Quad in the plane at offset ``w``, facing outward."""
-        self.add([(u0, v0, w), (u1, v0, w), (u1, v1, w), (u0, v1, w)], material, self.n)
+        self.quads.append((u0, v0, w, u1, v0, w, u1, v1, w, u0, v1, w))
+        self.materials.append(material)
+        self.facing.append(0)
 
     def ring(self, u0, u1, v0, v1, w, width, material) -> None:
         """A flat frame ring of ``width`` inside the rectangle, facing outward."""
@@ -97,11 +115,17 @@ class _Facade:
 
     def reveals(self, h: Hole, depth: float, material: str) -> None:
         """The four (three for a door) inner faces of the opening, facing into it."""
-        self.add([(h.u0, h.v1, 0), (h.u1, h.v1, 0), (h.u1, h.v1, -depth), (h.u0, h.v1, -depth)], material, self._down)
-        self.add([(h.u0, h.v0, 0), (h.u0, h.v1, 0), (h.u0, h.v1, -depth), (h.u0, h.v0, -depth)], material, self.d)
-        self.add([(h.u1, h.v0, 0), (h.u1, h.v1, 0), (h.u1, h.v1, -depth), (h.u1, h.v0, -depth)], material, self._back)
-        if h.v0 > 0:
-            self.add([(h.u0, h.v0, 0), (h.u1, h.v0, 0), (h.u1, h.v0, -depth), (h.u0, h.v0, -depth)], material, self._up)
+        u0, u1, v0, v1, d = h.u0, h.u1, h.v0, h.v1, -depth
+        q = [(u0, v1, 0, u1, v1, 0, u1, v1, d, u0, v1, d),       # top, facing down
+             (u0, v0, 0, u0, v1, 0, u0, v1, d, u0, v0, d),       # left, facing along the wall
+             (u1, v0, 0, u1, v1, 0, u1, v1, d, u1, v0, d)]       # right, facing back
+        facing = [1, 2, 3]
+        if v0 > 0:
+            q.append((u0, v0, 0, u1, v0, 0, u1, v0, d, u0, v0, d))  # bottom, facing up
+            facing.append(4)
+        self.quads += q
+        self.materials += [material] * len(q)
+        self.facing += facing
 
     def sill(self, h: Hole, material: str) -> None:
         """A stone sill under a window, proud of the wall (top, front, bottom, ends); built in :meth:`mesh`."""
@@ -115,44 +139,80 @@ class _Facade:
         # box frame (x along u, -y outward, z up) -> local frame (right-handed: d x -n = z)
         m = np.eye(4)
         m[:3, 0], m[:3, 1], m[:3, 2] = self.d, -self.n, (0, 0, 1.0)
-        shapes: dict[tuple[float, str], tuple] = {}
-        verts, faces, fcls, fmat = [], [], [], []
+        shapes: dict[tuple[float, str], int] = {}
+        built = []
+        which = np.empty(len(self.sills), np.int64)
         for i, (h, material) in enumerate(self.sills):
             w = h.u1 - h.u0 + 0.1
             if (w, material) not in shapes:
                 s = box((w, 0.07, 0.06), CLS, material, center=(0, 0, 0))
                 keep = s.vertices[s.faces].mean(1)[:, 1] < 0.035 - 1e-9  # drop the face against the wall
-                shapes[(w, material)] = (s.vertices @ m[:3, :3].T, s.faces[keep], s.face_class[keep],
-                                         s.face_material[keep])
-            rotated, f, c, mat = shapes[(w, material)]
-            uc = (h.u0 + h.u1) / 2
-            verts.append(rotated + (self.o + uc * self.d + 0.035 * self.n + (h.v0 - 0.03) * np.array([0, 0, 1.0])))
-            faces.append(f + 8 * i)
-            fcls.append(c)
-            fmat.append(mat)
-        return [Mesh(np.concatenate(verts), np.concatenate(faces), np.concatenate(fcls), np.concatenate(fmat))]
+                shapes[(w, material)] = len(built)
+                built.append((s.vertices @ m[:3, :3].T, s.faces[keep], s.face_class[keep], s.face_material[keep]))
+            which[i] = shapes[(w, material)]
+        sills = np.array([((h.u0 + h.u1) / 2, h.v0 - 0.03) for h, _ in self.sills])
+        # the sill centres, operation by operation as o + uc * d + 0.035 * n + (v0 - 0.03) * z
+        centre = self.o + sills[:, :1] * self.d + 0.035 * self.n + sills[:, 1:] * np.array([0, 0, 1.0])
+        verts = np.stack([b[0] for b in built])[which] + centre[:, None, :]
+        offsets = 8 * np.arange(len(which))
+        if len({len(b[1]) for b in built}) == 1:  # the usual case: every shape keeps the same faces
+            faces = (np.stack([b[1] for b in built])[which] + offsets[:, None, None]).reshape(-1, 3)
+            fcls = np.stack([b[2] for b in built])[which].ravel()
+            fmat = np.stack([b[3] for b in built])[which].ravel()
+        else:
+            faces = np.concatenate([built[k][1] + o for k, o in zip(which, offsets)])
+            fcls = np.concatenate([built[k][2] for k in which])
+            fmat = np.concatenate([built[k][3] for k in which])
+        return [Mesh(verts.reshape(-1, 3), faces, fcls, fmat)]
 
     def box(self, u0, u1, v0, v1, w0, w1, material) -> None:
-        """A box spanning [u0, u1] x [v0, v1] x [w0, w1] in facade coordinates (no face against the wall)."""
-        b = box((u1 - u0, w1 - w0, v1 - v0), CLS, material, center=(0, 0, 0))
-        if w0 <= 1e-9:
-            keep = b.vertices[b.faces].mean(1)[:, 1] < (w1 - w0) / 2 - 1e-9
-            b = Mesh(b.vertices, b.faces[keep], b.face_class[keep], b.face_material[keep])
+        """A box spanning [u0, u1] x [v0, v1] x [w0, w1] in facade coordinates (no face against the wall);
+        built in :meth:`mesh`."""
+        self.boxes.append((u0, u1, v0, v1, w0, w1, material))
+
+    def _box_mesh(self) -> list[Mesh]:
+        """Every box at once, in the order drawn. Per box the same arithmetic as building it alone
+        (``box(size).transformed(m)``: unit-box corners scaled, the 8 x 3 corners times the wall's
+        rotation -- the same (8, 3) @ (3, 3) product per box, stacked --, plus its centre), without
+        three intermediate meshes per box: a town draws ~8k of them."""
+        if not self.boxes:
+            return []
+        b = np.array([r[:6] for r in self.boxes], np.float64)
+        u0, u1, v0, v1, w0, w1 = b.T
+        size = np.stack([u1 - u0, w1 - w0, v1 - v0], 1)
+        verts = (_UNIT_BOX - 0.5)[None] * size[:, None, :] + np.zeros(3)
+        faces = np.broadcast_to(_UNIT_BOX_FACES, (len(b), 12, 3))
+        keep = np.ones((len(b), 12), bool)
+        wall = w0 <= 1e-9  # the face against the wall is dropped
+        if wall.any():
+            centroid_y = verts[wall][:, _UNIT_BOX_FACES].mean(2)[..., 1]
+            keep[wall] = centroid_y < (size[wall, 1:2] / 2 - 1e-9)
         m = np.eye(4)
         m[:3, 0], m[:3, 1], m[:3, 2] = self.d, -self.n, (0, 0, 1.0)
-        m[:3, 3] = self.o + (u0 + u1) / 2 * self.d + (w0 + w1) / 2 * self.n + (v0 + v1) / 2 * np.array([0, 0, 1.0])
-        self.extra.append(b.transformed(m))
+        centre = (self.o + ((u0 + u1) / 2)[:, None] * self.d + ((w0 + w1) / 2)[:, None] * self.n
+                  + ((v0 + v1) / 2)[:, None] * np.array([0, 0, 1.0]))
+        verts = verts @ m[:3, :3].T + centre[:, None, :]
+        faces = (faces + 8 * np.arange(len(b))[:, None, None])[keep]
+        mats = np.array([resolve_ids(CLS, r[6])[1] for r in self.boxes])
+        fmat = np.broadcast_to(mats[:, None], keep.shape)[keep]
+        return [Mesh(verts.reshape(-1, 3), faces, resolve_ids(CLS, "default")[0], fmat)]
 
-    def mesh(self) -> Mesh:
-        corners = self.pts([p for q in self.uvw for p in q]).reshape(-1, 4, 3) if self.uvw else np.zeros((0, 4, 3))
-        return merge([quads(corners, CLS, self.materials, np.array(self.facing))] + self._sill_mesh() + self.extra)
+    def meshes(self) -> list[Mesh]:
+        """The wall's quads, sills and boxes (merged by the caller with the other walls: one
+        concatenation per building instead of one per wall and one per building)."""
+        if self.quads:
+            corners = self.pts(np.array(self.quads, float).reshape(-1, 3)).reshape(-1, 4, 3)
+            normals = np.array(self._normals)[self.facing]
+        else:
+            corners, normals = np.zeros((0, 4, 3)), np.zeros((0, 3))
+        return [quads(corners, CLS, self.materials, normals)] + self._sill_mesh() + self._box_mesh()
 
 
 def _opening(fc: _Facade, h: Hole, st: Style, facade_mat: str) -> np.ndarray:
     """Reveals, frame, glass (or door leaf) of one hole; returns the pane centre (3,)."""
     depth = st.recess
     fc.reveals(h, depth, facade_mat)
-    centre = fc.pts([((h.u0 + h.u1) / 2, (h.v0 + h.v1) / 2, -depth)])[0]
+    centre = fc.point((h.u0 + h.u1) / 2, (h.v0 + h.v1) / 2, -depth)
     wf = -depth + FRAME_FROM_GLASS
     if h.kind == "door":
         fc.rect(h.u0, h.u1, h.v0, h.v1, -depth, "door")
@@ -251,7 +311,7 @@ def building(rng: np.random.Generator, footprint: np.ndarray, height: float, flo
             if h.kind == "balcony":
                 balcony(fc, h, st, facade_mat)
         shop_front(fc, [h for h in openings if h.kind == "shop"], st, fc.length, rng)
-        parts.append(fc.mesh())
+        parts += fc.meshes()
     if roof == "flat":
         parts.append(flat_roof(rng, poly, height, parapet, facade_mat))
     else:

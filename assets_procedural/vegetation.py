@@ -195,20 +195,32 @@ def hedge(rng: np.random.Generator, length: float, height: float = 1.2, depth: f
     n = max(1, int(round(length / spacing)))
     rx = length / n / 2
     xs = -length / 2 + rx + np.arange(n) * 2 * rx
-    parts = []
-    for x in xs:
-        radii = np.array([rx * rng.uniform(1.1, 1.3), depth / 2 * rng.uniform(0.9, 1.0),
-                          height / 2 * rng.uniform(0.92, 1.0)])
-        c = np.array([x + rng.uniform(-0.05, 0.05) * rx, rng.uniform(-0.04, 0.04) * depth, radii[2]])
-        m = _blob(rng, c, radii, "vegetation", "hedge_leaves", 0.12)
-        # clipped hedges are boxy: push the blob toward its bounding box (superellipsoid look)
-        rel = (m.vertices - c) / radii
-        m.vertices = c + np.sign(rel) * np.abs(rel) ** 0.6 * radii
-        # squeeze the end clumps along x so the hedge spans exactly [-length/2, length/2]
-        reach = np.abs(m.vertices[:, 0] - c[0]).max()
-        room = length / 2 - abs(c[0])
-        if reach > room:
-            m.vertices[:, 0] = c[0] + (m.vertices[:, 0] - c[0]) * (room / reach)
-        parts.append(m)
+    # All clumps at once, with the draws and float operations of one _blob per clump in turn: each
+    # clump takes 5 uniforms (3 radii, 2 centre offsets) then one jitter per sphere vertex, and
+    # Generator.uniform(a, b) is a + (b - a) * random(), so one random((n, 5 + k)) block is the same stream.
+    sphere = icosphere(1.0, "vegetation", "hedge_leaves", 1)
+    k = len(sphere.vertices)
+    u = rng.random((n, 5 + k))
+
+    def uniform(a: float, b: float, x: np.ndarray) -> np.ndarray:
+        return a + (b - a) * x
+
+    radii = np.stack([rx * uniform(1.1, 1.3, u[:, 0]), depth / 2 * uniform(0.9, 1.0, u[:, 1]),
+                      height / 2 * uniform(0.92, 1.0, u[:, 2])], 1)
+    c = np.stack([xs + uniform(-0.05, 0.05, u[:, 3]) * rx, uniform(-0.04, 0.04, u[:, 4]) * depth, radii[:, 2]], 1)
+    r = 1.0 + uniform(-0.12, 0.12, u[:, 5:])                       # _blob's radial noise (jitter 0.12)
+    v = sphere.vertices[None] * r[:, :, None] * radii[:, None, :]
+    cy, sy = np.cos(0.0), np.sin(0.0)                               # _blob's yaw 0
+    v = np.stack([cy * v[..., 0] - sy * v[..., 1], sy * v[..., 0] + cy * v[..., 1], v[..., 2]], -1) + c[:, None, :]
+    # clipped hedges are boxy: push the blob toward its bounding box (superellipsoid look)
+    rel = (v - c[:, None, :]) / radii[:, None, :]
+    v = c[:, None, :] + np.sign(rel) * np.abs(rel) ** 0.6 * radii[:, None, :]
+    # squeeze the end clumps along x so the hedge spans exactly [-length/2, length/2]
+    reach = np.abs(v[..., 0] - c[:, None, 0]).max(1)
+    room = length / 2 - np.abs(c[:, 0])
+    for i in np.nonzero(reach > room)[0]:
+        v[i, :, 0] = c[i, 0] + (v[i, :, 0] - c[i, 0]) * (room[i] / reach[i])
+    faces = (sphere.faces[None] + k * np.arange(n)[:, None, None]).reshape(-1, 3)
+    parts = [Mesh(v.reshape(-1, 3), faces, np.tile(sphere.face_class, n), np.tile(sphere.face_material, n))]
     out = on_ground(merge(parts))
     return out

@@ -13,6 +13,7 @@ import functools
 import numpy as np
 import trimesh
 
+from generator.geometry.hull import hull_arrays
 from generator.geometry.mesh import Mesh
 from generator.labels import class_table
 from generator.materials import material_table
@@ -171,10 +172,9 @@ def convex_hull(mesh: Mesh, cls: str | int, inflate: float = 0.02) -> Mesh:
     The hull is inflated so that it contains every vertex of the object strictly and
     wins the depth test against the object's own surface in the label pass.
     """
-    hull = trimesh.convex.convex_hull(mesh.vertices)
-    normals = hull.vertex_normals
+    vertices, faces, normals = hull_arrays(mesh.vertices)  # trimesh's hull, bit for bit, faster
     c, _ = resolve_ids(cls, "default")
-    return Mesh(hull.vertices + normals * inflate, hull.faces, c, 0)
+    return Mesh(vertices + normals * inflate, faces, c, 0)
 
 
 # -- primitives added for the asset families (additive; nothing above changed) ---------------

@@ -19,6 +19,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from generator.geometry import Mesh, pose
+from generator.layout.overlap_kernel import any_overlap
 from generator.rng import stream
 from generator.world.scene import OrientedBox
 
@@ -27,18 +28,20 @@ BAND_M = 0.5             #: height of a collision band
 WHOLE_BOX_KINDS = frozenset({"building", "hedge", "fence"})
 
 
-def collision_boxes(mesh: Mesh, whole: bool = False, band: float = BAND_M, tol: float = 0.15) -> np.ndarray:
+def collision_boxes(mesh: Mesh, whole: bool = False, band: float = BAND_M, tol: float = 0.15,
+                    bounds: np.ndarray | None = None) -> np.ndarray:
     """Conservative local AABBs of ``mesh`` cut into height bands.
 
     Every triangle whose z-range meets a band contributes its full xy extent to that band;
-    consecutive bands with nearly equal extents are merged.
+    consecutive bands with nearly equal extents are merged. ``bounds`` ((2, 3), optional) is
+    ``mesh.bounds()`` when the caller has it already.
 
     Returns
     -------
     (b, 6) float64
         ``(x0, y0, z0, x1, y1, z1)`` per box, local frame, metres.
     """
-    lo, hi = mesh.bounds()
+    lo, hi = mesh.bounds() if bounds is None else bounds
     if whole or mesh.n_faces == 0:
         return np.array([[*lo, *hi]])
     tri = mesh.vertices[mesh.faces]
@@ -95,9 +98,9 @@ class Library:
 
     def _make(self, key: str, kind: str, g: np.random.Generator, params: dict) -> Proto:
         mesh = self._catalog.build(kind, g, **params)
-        lo, hi = mesh.bounds()
+        lo, hi = bounds = mesh.bounds()
         whole = kind in WHOLE_BOX_KINDS
-        bands = self._cache.derive(mesh, f"bands/{whole}", lambda m: collision_boxes(m, whole=whole))
+        bands = self._cache.derive(mesh, f"bands/{whole}", lambda m: collision_boxes(m, whole=whole, bounds=bounds))
         p = Proto(key, kind, mesh, lo, hi, bands, dict(params))
         self.protos[key] = p
         return p
@@ -179,6 +182,8 @@ class Occupancy:
     def __init__(self, cell: float = 8.0):
         self.cell = cell
         self._buf = np.zeros((256, 7))
+        self._cos = np.zeros(256)  # numpy's cos and sin of each accepted box's yaw, made once
+        self._sin = np.zeros(256)
         self._n = 0
         self._cells: dict[tuple[int, int], list[int]] = defaultdict(list)
 
@@ -196,13 +201,23 @@ class Occupancy:
     def hits(self, boxes: np.ndarray) -> bool:
         """True if any of ``boxes`` (k, 7) overlaps an accepted box."""
         idx = sorted({i for key in self._keys(boxes) for i in self._cells.get(key, ())})
-        return bool(idx) and bool(overlaps(boxes, self.boxes[idx]).any())
+        if not idx:
+            return False
+        # overlaps(boxes, self.boxes[idx]).any(), compiled (the same float operations)
+        yaw = np.ascontiguousarray(boxes, np.float64)[:, 4]
+        return bool(any_overlap(np.ascontiguousarray(boxes, np.float64), np.cos(yaw), np.sin(yaw),
+                                self._buf[idx], self._cos[idx], self._sin[idx]))
 
     def add(self, boxes: np.ndarray) -> None:
         start = self._n
         while start + len(boxes) > len(self._buf):
             self._buf = np.concatenate([self._buf, np.zeros_like(self._buf)])
+            self._cos = np.concatenate([self._cos, np.zeros_like(self._cos)])
+            self._sin = np.concatenate([self._sin, np.zeros_like(self._sin)])
         self._buf[start:start + len(boxes)] = boxes
+        yaw = np.ascontiguousarray(boxes, np.float64)[:, 4]
+        self._cos[start:start + len(boxes)] = np.cos(yaw)
+        self._sin[start:start + len(boxes)] = np.sin(yaw)
         self._n += len(boxes)
         for k in range(len(boxes)):
             for key in self._keys(boxes[k:k + 1]):
