@@ -1,15 +1,9 @@
 """The label-pass material: one scene state that yields the mask labels (proxies shown) and the
 real surface (proxies seen through) without a re-sync of Cycles between the two.
 
-Every camera sample's colour holds exact integers (float32 is exact below 2**24, emission
-strength 1, one sample, no bounces):
-
-* R, G -- class id and instance id of the surface the ray stops at (a real surface, the sky, or
-  an opaque label proxy);
-* B -- ``class + 256 * instance`` of the first label proxy (convex hull) the ray met, if that
-  proxy was the first thing it hit; 0 otherwise (instance ids are < 65536, so B < 2**24).
-
-The mask label of a sample is B's proxy where B > 0, else (R, G) (:func:`decode`).
+Every camera sample's colour holds exact integer ids in the code of
+:mod:`generator.labels.label_colour` (R, G: the surface the ray stopped at; B: the first label
+proxy, if the ray hit one first), decoded there.
 
 A proxy is transparent to rays through a pixel centre of the configured (1x) image and opaque
 to every other ray. So, with the proxies visible:
@@ -22,16 +16,15 @@ to every other ray. So, with the proxies visible:
 
 Both renders share material, visibility and BVH; only the resolution changes between them.
 The Window texture coordinate tells a shader where on the image a ray is: ``frac(x * W)`` is
-0.5 at the pixel centres of a ``W`` pixel wide image, 1/(2k) or more away from it on every
-other sample of a ``k`` times finer image.
+0.5 at the pixel centres of a ``W`` pixel wide image and at least 1/k away from it on every
+other sample of a ``k`` times finer image (``k`` odd).
 """
 
 from __future__ import annotations
 
-import numpy as np
-
 from generator.blender.bpy_guard import bpy
 from generator.blender.nodes import Nodes
+from generator.labels.label_colour import CODE_BASE
 
 LABEL_MATERIAL = "urbangen_label_v2"
 #: Object custom property marking a label proxy (set by :func:`mark_proxies`).
@@ -40,8 +33,6 @@ PROXY_PROPERTY = "ug_label_proxy"
 CENTRE_TOLERANCE_PX = 0.05
 #: Proxies a pixel-centre ray may pass before Cycles stops it (a row of street-tree crowns).
 MAX_PROXY_CROSSINGS = 128
-#: B = class + CODE_BASE * instance.
-CODE_BASE = 256
 
 
 def mark_proxies(objects) -> None:
@@ -94,40 +85,3 @@ def _build(g: Nodes) -> None:
     clear = g.node("ShaderNodeBsdfTransparent").outputs[0]
     seen_through = g.mix_shader(centre, glow, g.add_shader(g.emission(proxy_ids.outputs[0], 1.0), clear))
     g.output(g.mix_shader(proxy, g.emission(real_ids.outputs[0], 1.0), seen_through))
-
-
-def decode(rgb: np.ndarray, what: str) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Split a label-material render into mask labels and the stopping surface's ids.
-
-    Parameters
-    ----------
-    rgb : (H, W, >=3) float32
-        The render's combined pass.
-    what : str
-        Named in the error if a value is not an integer.
-
-    Returns
-    -------
-    label_class : (H, W) uint8
-    label_instance : (H, W) uint16
-        The first label proxy where the ray met one first, else the surface it stopped at.
-    class_id : (H, W) uint8
-    instance : (H, W) uint16
-        The surface the ray stopped at (R, G).
-
-    Raises
-    ------
-    RuntimeError
-        If a value is not an integer (labels would be blended).
-    """
-    vals = rgb[..., :3]
-    ints = np.rint(vals)
-    bad = np.abs(vals - ints) > 1e-3
-    if bad.any():
-        raise RuntimeError(f"{what}: {int(bad.sum())} pixel values are not integers: labels would be blended")
-    ints = ints.astype(np.int64)
-    cls, inst, code = ints[..., 0].astype(np.uint8), ints[..., 1].astype(np.uint16), ints[..., 2]
-    met = code > 0
-    label_cls = np.where(met, code % CODE_BASE, cls).astype(np.uint8)
-    label_inst = np.where(met, code // CODE_BASE, inst).astype(np.uint16)
-    return label_cls, label_inst, cls, inst

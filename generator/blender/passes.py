@@ -21,6 +21,7 @@ Background mode has no pixels in "Render Result", so each render is saved with
 
 from __future__ import annotations
 
+import logging
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -32,9 +33,12 @@ from generator.world import rig
 from generator.blender import geometry, label_shader, session
 from generator.blender.bpy_guard import bpy
 from generator.blender.materials import label_world
+from generator.labels import label_colour
 from generator.labels.supersample import majority_labels
 
 SKY_Z = 1e9
+
+log = logging.getLogger(__name__)
 
 
 @dataclass
@@ -131,7 +135,7 @@ def render_labels(scene, bs: geometry.BlenderScene, k: np.ndarray, scratch: Path
             t = time.perf_counter()
             with session.supersampled(scene, supersample):
                 fine = _render(scene, scratch / "label.exr")
-            fine_class, fine_instance, _, _ = label_shader.decode(fine["Combined"], "label pass")
+            fine_class, fine_instance, _, _ = label_colour.decode(fine["Combined"], "label pass")
             del fine
             class_id, instance = majority_labels(fine_class, fine_instance, supersample)
             secs["label_pass"] = time.perf_counter() - t
@@ -140,9 +144,13 @@ def render_labels(scene, bs: geometry.BlenderScene, k: np.ndarray, scratch: Path
         secs["real_pass"] = time.perf_counter() - t
     finally:
         geometry.set_proxies_visible(bs, False)
-    centre_class, centre_instance, real_class, real_instance = label_shader.decode(real["Combined"], "real pass")
+    centre_class, centre_instance, real_class, real_instance = label_colour.decode(real["Combined"], "real pass")
     if supersample == 1:
         class_id, instance = centre_class, centre_instance
+    lost = int(np.count_nonzero(real_class == 0))
+    if lost:  # every surface and the sky have a class: 0 means Cycles stopped the ray inside the proxies
+        log.warning("real pass: %d pixel-centre rays crossed more than %d label proxies and found no surface",
+                    lost, label_shader.MAX_PROXY_CROSSINGS)
     z = real["Depth.Z"] if "Depth.Z" in real else real["Z"]
     cos = rig.pixel_rays(k, w, h)[..., 2]
     depth = (z / cos).astype(np.float32)
