@@ -12,7 +12,8 @@ Printed per factor, over consecutive frame pairs and pixels near markings:
   moved, the label did -- that is flicker;
 * wrong vs coverage: marked with coverage <= 0.3, or unmarked with coverage >= 0.7;
 * marking area: mean and relative spread of the marking pixel count over the frames;
-* seconds of the label pass (Cycles + vote) beside the dry RGB pass of the same pose.
+* seconds of the label passes (real + supersampled: Cycles, read back, vote) beside the dry RGB
+  pass of the same pose.
 
 A PNG strip (crop of distant markings, frames left to right; rows 1x, 3x, reference coverage)
 goes to ``--png``.

@@ -52,16 +52,18 @@ def decode(rgb: np.ndarray, what: str) -> tuple[np.ndarray, np.ndarray, np.ndarr
     RuntimeError
         If a value is not an integer (labels would be blended) or outside its id range.
     """
-    vals = rgb[..., :3]
-    ints = np.rint(vals)
-    bad = np.abs(vals - ints) > 1e-3
-    if bad.any():
-        raise RuntimeError(f"{what}: {int(bad.sum())} pixel values are not integers: labels would be blended")
-    ints = ints.astype(np.int64)
-    cls, inst, code = ints[..., 0], ints[..., 1], ints[..., 2]
-    if cls.min(initial=0) < 0 or cls.max(initial=0) > 255 or inst.min(initial=0) < 0 or inst.max(initial=0) > 65535 \
-            or code.min(initial=0) < 0 or code.max(initial=0) > MAX_CODE:
-        raise RuntimeError(f"{what}: ids out of range (class 0..255, instance 0..65535, proxy code 0..{MAX_CODE})")
+    limits = (255, 65535, MAX_CODE)
+    ids = []
+    for ch, top in enumerate(limits):  # a plane at a time: a paper-size 5x label image is 1.2 GB of float32
+        vals = rgb[..., ch]
+        ints = np.rint(vals)
+        bad = int(np.count_nonzero(np.abs(vals - ints) > 1e-3))
+        if bad:
+            raise RuntimeError(f"{what}: {bad} pixel values are not integers: labels would be blended")
+        if ints.size and (ints.min() < 0 or ints.max() > top):
+            raise RuntimeError(f"{what}: ids out of range (class 0..255, instance 0..65535, proxy code 0..{MAX_CODE})")
+        ids.append(ints.astype(np.int32))
+    cls, inst, code = ids
     met = code > 0
     label_cls = np.where(met, code % CODE_BASE, cls).astype(np.uint8)
     label_inst = np.where(met, code // CODE_BASE, inst).astype(np.uint16)
