@@ -14,10 +14,12 @@ state before each label measurement: a 1-sample RGB render (same resolution, mat
 visibility as the real one, so Cycles has the same re-sync to do when the labels start).
 
 Each label measurement is split into stages from Blender's render-stats callbacks and timers
-around the code: ``sync`` (depsgraph and Cycles object sync), ``update`` (shaders, meshes,
+around the code: ``prepare`` (the render operator until its render_pre handler: depsgraph
+evaluation of the state switch), ``sync`` (Cycles object sync), ``update`` (shaders, meshes,
 attributes, device copies), ``bvh`` (scene BVH build), ``trace`` (the samples), ``finish``
 (end of the render call), ``readback`` (save_render to the scratch EXR and reading it back),
-``vote`` (majority vote) and ``rest`` (everything else: state switches, decoding, depth).
+``vote`` (majority vote) and ``rest`` (everything else: Python state switches, decoding,
+depth).
 
 ``--rss paper`` instead runs one 3x label pass at the paper preset in a fresh process per
 version and prints the process's peak RSS after building the scene and after the pass.
@@ -42,7 +44,7 @@ from pathlib import Path
 
 import numpy as np
 
-STAGES = ("sync", "update", "bvh", "trace", "finish", "readback", "vote", "rest")
+STAGES = ("prepare", "sync", "update", "bvh", "trace", "finish", "readback", "vote", "rest")
 
 
 def _legacy_integers(rgba, what):
@@ -54,11 +56,38 @@ def _legacy_integers(rgba, what):
     return ints[..., 0].astype(np.uint8), ints[..., 1].astype(np.uint16)
 
 
+def _legacy_vote(values, eligible, centre):
+    n = values.shape[-1]
+    count = np.zeros(values.shape, np.int16)
+    for j in range(n):
+        count += (values == values[..., j:j + 1]) & eligible[..., j:j + 1]
+    score = 2 * count
+    score[..., centre] += 1
+    score[~eligible] = -1
+    return np.argmax(score, axis=-1)
+
+
+def legacy_majority_labels(class_id, instance, k):
+    """The numpy majority vote at 2ae07a5 (verbatim but for the argument checks)."""
+    if k == 1:
+        return class_id, instance
+    from generator.labels.supersample import _blocks
+
+    cls, inst = _blocks(class_id, k), _blocks(instance, k)
+    centre = (k * k) // 2
+    everywhere = np.ones(cls.shape, bool)
+    win = _legacy_vote(cls, everywhere, centre)
+    out_cls = np.take_along_axis(cls, win[..., None], -1)[..., 0]
+    same_class = cls == out_cls[..., None]
+    win_inst = _legacy_vote(inst, same_class, centre)
+    out_inst = np.take_along_axis(inst, win_inst[..., None], -1)[..., 0]
+    return np.ascontiguousarray(out_cls), np.ascontiguousarray(out_inst)
+
+
 def legacy_render_labels(scene, bs, k, scratch, supersample=1):
     """The label passes at 2ae07a5 (verbatim but for imports), for the "before" rows."""
     from generator.blender import geometry, passes, session
     from generator.blender.materials import label_material, label_world
-    from generator.labels import supersample as ss
     from generator.world import rig
 
     session.label_state(scene, label_material(), label_world())
@@ -74,7 +103,7 @@ def legacy_render_labels(scene, bs, k, scratch, supersample=1):
         lab = passes._render(scene, scratch / "label.exr")
     fine_class, fine_instance = _legacy_integers(lab["Combined"], "label pass")
     del lab
-    class_id, instance = ss.majority_labels(fine_class, fine_instance, supersample)
+    class_id, instance = _timed_legacy_vote(fine_class, fine_instance, supersample)
     secs["label_pass"] = time.perf_counter() - t
     geometry.set_proxies_visible(bs, False)
     real_class, real_instance = _legacy_integers(real["Combined"], "real pass")
@@ -84,6 +113,10 @@ def legacy_render_labels(scene, bs, k, scratch, supersample=1):
     depth = (z / cos).astype(np.float32)
     depth[z >= passes.SKY_Z] = np.inf
     return passes.LabelPasses(class_id, instance, real_class, real_instance, depth, secs)
+
+
+def _timed_legacy_vote(*a):
+    return legacy_majority_labels(*a)  # replaced by StageClock with a timed wrapper
 
 
 class StageClock:
@@ -98,12 +131,14 @@ class StageClock:
         self.acc: dict = defaultdict(float)
         self._events: list = []
         self._orig_render, self._orig_vote = passes._render, supersample.majority_labels
+        self._orig_legacy = legacy_majority_labels
         h = bpy.app.handlers
         h.render_pre.append(self._pre)
         h.render_stats.append(self._stat)
 
         def render(*a, **kw):
             t0 = time.perf_counter()
+            self._events = [(t0, "prepare")]
             c0 = sum(passes.CYCLES_SECONDS.values())
             out = self._orig_render(*a, **kw)
             cycles = sum(passes.CYCLES_SECONDS.values()) - c0
@@ -111,20 +146,25 @@ class StageClock:
             self.acc["readback"] += time.perf_counter() - t0 - cycles
             return out
 
-        def vote(*a, **kw):
-            t0 = time.perf_counter()
-            out = self._orig_vote(*a, **kw)
-            self.acc["vote"] += time.perf_counter() - t0
-            return out
+        def timed(fn):
+            def vote(*a, **kw):
+                t0 = time.perf_counter()
+                out = fn(*a, **kw)
+                self.acc["vote"] += time.perf_counter() - t0
+                return out
+            return vote
 
-        passes._render, passes.majority_labels, supersample.majority_labels = render, vote, vote
+        passes._render, passes.majority_labels = render, timed(self._orig_vote)
+        globals()["_timed_legacy_vote"] = timed(self._orig_legacy)
+        tiny = np.zeros((3, 3), np.uint8)
+        self._orig_vote(tiny, tiny.astype(np.uint16), 3)  # load the compiled vote before anything is timed
 
     def _pre(self, *a):
-        self._events = [(time.perf_counter(), "sync")]
+        self._events.append((time.perf_counter(), "sync"))
 
     def _stat(self, stats, *a):
         s = str(stats)
-        cat = ("bvh" if "BVH" in s else "trace" if "| Sample" in s else "finish" if s.endswith("Finished")
+        cat = ("bvh" if "BVH" in s else "trace" if ("Sample" in s or "Tile" in s) else "finish" if s.endswith("Finished")
                else "sync" if "Synchroniz" in s else "update")
         if self._events and self._events[-1][1] == "trace" and cat == "trace":
             return
