@@ -66,3 +66,50 @@ def test_supersampling_changes_only_the_labels_and_only_at_edges(renders):
         for dx in (-1, 0, 1):
             edge |= c[1 + dy:65 + dy, 1 + dx:97 + dx] != l1.class_id
     assert not (differ & ~edge).any()
+
+
+def _two_scene_states(r, k):
+    """The label passes the plain way, two scene states: the real pass with the proxies hidden and
+    the label pass with opaque proxies at ``k`` times the resolution (each sample the first hit)."""
+    from generator.blender import geometry, passes, session
+    from generator.blender.materials import label_material, label_world
+    from generator.labels.label_colour import decode
+
+    session.label_state(r.bscene, label_material(), label_world())
+    geometry.set_proxies_visible(r.handles, False)
+    real = passes._render(r.bscene, r.scratch / "ref_real.exr")
+    geometry.set_proxies_visible(r.handles, True)
+    with session.supersampled(r.bscene, k):
+        fine = passes._render(r.bscene, r.scratch / "ref_label.exr")
+    geometry.set_proxies_visible(r.handles, False)
+    _, _, real_c, real_i = decode(real["Combined"], "reference real pass")
+    _, _, fine_c, fine_i = decode(fine["Combined"], "reference label pass")
+    return real_c, real_i, real["Depth.Z"], fine_c, fine_i
+
+
+@pytest.mark.parametrize("k", [1, 3])
+def test_one_scene_state_gives_what_hiding_and_showing_the_proxies_gives(test_spec, test_scene, tmp_path, k):
+    """Proxies transparent to pixel-centre rays only: the real pass sees the real geometry behind
+    them, the label pass stops at them, exactly as two renders with the proxies hidden / shown."""
+    from generator.blender import passes
+    from generator.blender.renderer import Renderer
+    from generator.spec.render import load_render_config
+    from generator.world import rig
+
+    cfg = dataclasses.replace(load_render_config("test"), resolution=(96, 64), label_supersample=k)
+    r = Renderer(test_scene, test_spec, cfg, tmp_path)
+    r.place_camera(Rig.from_spec(test_spec, test_scene).frame(1).T_world_camera)
+    got = r.render_labels()
+    real_c, real_i, z, fine_c, fine_i = _two_scene_states(r, k)
+    assert np.array_equal(got.real_class, real_c) and np.array_equal(got.real_instance, real_i)
+    c, i = majority_labels(fine_c, fine_i, k)
+    assert np.array_equal(got.class_id, c) and np.array_equal(got.instance, i)
+    depth = z / rig.pixel_rays(r.k, 96, 64)[..., 2]
+    sky = z >= passes.SKY_Z
+    assert np.array_equal(np.isinf(got.depth), sky)
+    # the scene's BVH now holds the (transparent) proxies too: allow float32 rounding, no more
+    assert np.allclose(got.depth[~sky], depth[~sky], rtol=1e-6, atol=0)
+    # not vacuous: proxies cover some pixel centres, and the real pass saw through them there
+    hull = got.class_id != got.real_class
+    assert hull.mean() > 0.01
+    assert np.isfinite(got.depth[hull]).any()
