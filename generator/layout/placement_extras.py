@@ -141,7 +141,7 @@ def place_riders(placer: Placer, spec: SceneSpec, st: Street) -> None:
         v_lane = s * (grid.lane_half - 0.9)  # the kerb side of the outer lane, where a cyclist rides
         if u1 > u0 and free_lane(placer, seg, s * (grid.lane_half - grid.lane_w / 2), u0, u1):
             spots.append((seg, traffic, v_lane, u0, u1))
-        if grid.parking_w > 0 and grid.section(seg).strip(s) != "verge":
+        if grid.parking_w > 0 and grid.section(seg).strip(s) not in ("verge", "furnished"):  # grass, bollards
             spots.append((seg, traffic, s * (grid.lane_half + grid.parking_w / 2), u0, u1))
     if not spots:
         return
@@ -232,8 +232,8 @@ def place_other_vehicles(placer: Placer, spec: SceneSpec, st: Street) -> None:
              "construction_vehicle": _protos(placer, "construction_vehicle", n=2)}
     names, p = list(kinds), np.array([0.45, 0.4, 0.15])
     for seg, s in _segments(st):
-        if grid.section(seg).strip(s) == "verge":      # grass (streets spec): nothing parks there
-            continue
+        if grid.section(seg).strip(s) in ("verge", "furnished"):   # grass or a shared street's bollards:
+            continue                                                 # nothing parks there
         _, traffic = st.side_yaws(seg, s)
         u0, u1 = PARKING_START_U, seg.length - PARKING_START_U
         for _ in range(int(g.poisson(dens * max(0.0, u1 - u0) / 100))):
