@@ -147,14 +147,11 @@ def run(args) -> int:
 def towns_of(spec, frames: list[int]) -> list[tuple[object, int, list[int]]]:
     """(town spec, frame number of the start of its drive, its frames) per town the ``frames`` show:
     the spec itself with every frame when it re-draws no town, else town ``k // N`` for frame ``k``."""
-    from generator.spec.towns import first_frame, redraw_every, town_of, town_spec
+    from generator.spec.towns import first_frame, frames_by_town, redraw_every, town_spec
 
     if redraw_every(spec) is None:
         return [(spec, 0, sorted(frames))]
-    groups: dict[int, list[int]] = {}
-    for k in sorted(frames):
-        groups.setdefault(town_of(spec, k), []).append(k)
-    return [(town_spec(spec, i), first_frame(spec, i), ks) for i, ks in sorted(groups.items())]
+    return [(town_spec(spec, i), first_frame(spec, i), ks) for i, ks in frames_by_town(spec, frames).items()]
 
 
 def _remove_unfinished(out: Path, plan, created: bool) -> None:

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 from generator.errors import UserError
 from generator.jobs.plan import Plan
-from generator.spec.towns import first_frame, redraw_every, town_of, town_spec
+from generator.spec.towns import first_frame, frames_by_town, redraw_every, town_spec
 
 #: SemanticKITTI sequence folders are two digits.
 MAX_SEQUENCE = 99
@@ -50,9 +50,7 @@ def town_runs(spec, plan: Plan, flag: str = "--frames") -> list[TownRun]:
     """The towns of ``plan`` in order; a plan whose towns need sequences beyond 99 is one-line refused."""
     if redraw_every(spec) is None:
         return [TownRun(None, spec, plan, 0)]
-    groups: dict[int, list[int]] = {}
-    for k in sorted(plan.frames):
-        groups.setdefault(town_of(spec, k), []).append(k)
+    groups = frames_by_town(spec, plan.frames)
     base = int(plan.sequence)
     last = base + max(groups)
     if last > MAX_SEQUENCE:
@@ -61,7 +59,7 @@ def town_runs(spec, plan: Plan, flag: str = "--frames") -> list[TownRun]:
                         f"{last}; sequence folders stop at {MAX_SEQUENCE} (fewer frames, a larger "
                         f"redraw_every_frames or a lower --sequence)")
     return [TownRun(i, town_spec(spec, i), dataclasses.replace(plan, frames=tuple(ks), sequence=f"{base + i:02d}"),
-                    first_frame(spec, i)) for i, ks in sorted(groups.items())]
+                    first_frame(spec, i)) for i, ks in groups.items()]
 
 
 def local_frame(rig, k: int, first: int = 0):

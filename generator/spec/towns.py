@@ -47,6 +47,15 @@ def first_frame(spec, index: int | None) -> int:
     return 0 if index is None else int(index) * redraw_every(spec)
 
 
+def frames_by_town(spec, frames) -> dict[int, list[int]]:
+    """Image frames grouped by the town that shows them: ``{town index: sorted frames}`` (a spec that
+    re-draws no town must not be asked: every frame is then of the one town)."""
+    groups: dict[int, list[int]] = {}
+    for k in sorted(frames):
+        groups.setdefault(town_of(spec, k), []).append(k)
+    return dict(sorted(groups.items()))
+
+
 def town_spec(spec, index: int | None):
     """The spec of town ``index`` (see the module docstring); ``spec`` itself for None.
 
