@@ -124,7 +124,7 @@ def test_routes_drive_one_way_streets_forwards_only(seed):
                 continue
             n += 1
             assert np.dot([np.cos(h), np.sin(h)], _forward(hit[0], grid.section(hit[0]).one_way)) > 0.99, path.name
-    assert n > 0 or seed > 0
+    assert n > 0          # the routes do drive one-way streets (else this test checks nothing)
 
 
 def test_both_way_streets_of_the_routes_are_never_one_way():
@@ -267,15 +267,15 @@ from test_hostile_specs import HOSTILE  # noqa: E402
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(key=st.sampled_from(["one_way", "shared"]), value=HOSTILE)
 def test_hostile_new_weights_exit_2_with_one_line_and_write_nothing(tmp_path, capsys, key, value):
-    import math
     import uuid
 
-    if isinstance(value, float) and not math.isfinite(value):
-        value = str(value)          # JSON has no NaN/inf literal: the hostile suite splices those in as text
     spec = tmp_path / f"{uuid.uuid4().hex}.json"
     out = tmp_path / f"out_{spec.stem}"
+    # non-finite floats go in as the Infinity/NaN tokens Python's json reads (a user's file may hold them)
     spec.write_text(json.dumps({"name": "x", "seed": 1, "streets": {"types": {"plain": 1, key: value}}}))
     assert main(["layout", str(spec), "--out", str(out)]) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and err.startswith(f"urbangen layout: {spec}: streets.types"), err
+    where = "invalid JSON" if isinstance(value, float) and value != value or value in (float("inf"), float("-inf")) \
+        else "streets.types"       # a NaN/Infinity token is refused as the file's JSON, before any field
+    assert err.count("\n") == 1 and err.startswith(f"urbangen layout: {spec}: {where}"), err
     assert not out.exists()
