@@ -151,6 +151,20 @@ def test_one_way_with_shared_roundabouts_and_closures_builds_a_lane_graph_that_o
     assert again.sections == grid.sections and again.roundabouts == grid.roundabouts
 
 
+def test_layout_summary_rows_name_each_open_segment_with_its_own_section():
+    """``urbangen layout``'s street rows: one per open segment, with that segment's nodes and type
+    (they were zipped against the full section list, so one row in the wrong place per closure)."""
+    from generator.layout.cross_sections import sections_record
+
+    grid = make_grid(full_spec(5))
+    rows = sections_record(grid)
+    assert grid.closed and len(rows) == len(grid.segments)
+    for row, seg in zip(rows, grid.segments):
+        sec = grid.section(seg)
+        assert (row["segment"], tuple(row["a"]), tuple(row["b"])) == (seg.index, seg.a, seg.b)
+        assert (row["kind"], row["one_way"]) == (sec.kind, sec.one_way)
+
+
 @pytest.mark.parametrize("seed", [1, 5])
 def test_routes_in_a_full_mix_town_are_smooth_on_the_lanes_and_one_way_forwards(seed):
     grid = make_grid(full_spec(seed))
