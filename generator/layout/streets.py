@@ -336,9 +336,7 @@ def make_grid(spec: SceneSpec) -> Grid:
     from generator.layout.closures import draw_closures         # they need the routes, which need Grid
     from generator.layout.roundabouts import draw_roundabouts
 
-    # closures and roundabouts depend on neither the cross-sections nor each other's streams, so the
-    # sections are drawn last: one-way directions then know which streets are shut and which nodes
-    # are roundabouts (every stream is named, so this order draws every town as before)
+    # sections last (named streams: same bytes): one-way directions know the closures and roundabouts
     closed = draw_closures(spec, grid)
     if closed:
         grid = replace(grid, segments=tuple(s for s in grid.segments if s not in closed), closed=closed)
