@@ -82,14 +82,20 @@ class CrossSection:
 PLAIN = CrossSection("plain", ("parking", "parking"), (float("nan"), float("nan")))
 
 
-def draw_sections(spec, segments) -> tuple[CrossSection, ...]:
+def draw_sections(spec, segments, closed=(), roundabouts=frozenset()) -> tuple[CrossSection, ...]:
     """One :class:`CrossSection` per segment drawn from ``spec.streets`` (empty without it).
 
     Parameters
     ----------
     spec : SceneSpec
     segments : sequence of Segment
-        Every segment of the grid, in index order (one-way directions depend on the routes).
+        Every segment of the grid, closed ones included, in index order (one-way directions
+        depend on the routes).
+    closed : sequence of Segment
+        The closed segments (:mod:`generator.layout.closures`): never one-way, and the one-way
+        network's connectivity is that of the open streets.
+    roundabouts : frozenset of (int, int)
+        Roundabout nodes: a segment ending at one is never one-way (its ring keeps every arm two-way).
 
     Returns
     -------
@@ -109,7 +115,8 @@ def draw_sections(spec, segments) -> tuple[CrossSection, ...]:
     w = np.array([float(streets.types.get(t, 0.0)) for t in TYPES])
     kinds = [TYPES[int(k)] for k in g.choice(len(TYPES), size=n_segments, p=w / w.sum())]
     cand = [i for i, k in enumerate(kinds) if k == "one_way"]
-    direction = one_way_directions(spec.seed, segments, cand, spec.town.blocks_x, spec.town.blocks_y)
+    direction = one_way_directions(spec.seed, segments, cand, spec.town.blocks_x, spec.town.blocks_y,
+                                   closed, roundabouts)
     refused = [i for i in cand if i not in direction]
     if refused:
         two = np.array([0.0 if t == "one_way" else x for t, x in zip(TYPES, w)])
@@ -137,7 +144,7 @@ def draw_sections(spec, segments) -> tuple[CrossSection, ...]:
 def sections_record(grid) -> list[dict]:
     """The drawn cross-section of every segment of ``grid`` as JSON rows (``[]`` when all are plain
     by default): segment index, its nodes, type, strips, occupancy, median and one-way direction
-    (+1: from node ``a`` to node ``b``)."""
+    (+1: from node ``a`` to node ``b``), for the open segments (closed ones are parks)."""
     return [{"segment": s.index, "a": list(s.a), "b": list(s.b), "kind": sec.kind, "strips": list(sec.strips),
              "occupancy": [round(x, 4) for x in sec.occupancy], "median": sec.median, "one_way": sec.one_way}
-            for s, sec in zip(grid.segments, grid.sections)]
+            for s, sec in ((s, grid.section(s)) for s in grid.segments) if grid.sections]

@@ -9,7 +9,15 @@ The direction is not free:
   directions cannot be one-way and keeps a two-way type;
 * the street network stays *strongly connected* (from every intersection a vehicle can reach
   every other one legally), so no lane is a dead end and no vehicle is trapped. Candidates are
-  accepted one by one in segment order; one that would break connectivity stays two-way.
+  accepted one by one in segment order; one that would break connectivity stays two-way;
+* with closed streets (:mod:`generator.layout.closures`) a closed segment is never one-way and
+  connectivity is that of the open streets;
+* a segment ending at a roundabout (:mod:`generator.layout.roundabouts`) stays two-way: the ring's
+  connectors, its island clearances and its conflict table are built for the slots ``0 .. lanes - 1``
+  of two-way arms, and a one-way arm's left slots would have to merge on or off the ring.
+
+Both fallbacks are deterministic (they depend on the drawn closures and roundabouts only, which
+:func:`generator.layout.streets.make_grid` draws before the cross-sections).
 
 Draws: the free directions come from stream ``("layout", "one_way")``, one per candidate in
 segment order (none when no segment is drawn one-way, so other towns draw as before).
@@ -102,7 +110,8 @@ def strongly_connected(segments: Sequence, direction: dict[int, int]) -> bool:
     return True
 
 
-def one_way_directions(seed: int, segments: Sequence, candidates: Sequence[int], nx: int, ny: int) -> dict[int, int]:
+def one_way_directions(seed: int, segments: Sequence, candidates: Sequence[int], nx: int, ny: int,
+                       closed: Sequence = (), roundabouts=frozenset()) -> dict[int, int]:
     """Directions of the candidate segments that can be one-way.
 
     Parameters
@@ -110,30 +119,38 @@ def one_way_directions(seed: int, segments: Sequence, candidates: Sequence[int],
     seed : int
         The spec's seed.
     segments : sequence of Segment
-        Every segment of the grid.
+        Every segment of the grid, closed ones included (``Segment.index`` order).
     candidates : sequence of int
         Indices of the segments drawn ``one_way``, in segment order.
     nx, ny : int
         Blocks along x and y.
+    closed : sequence of Segment
+        Closed segments: never one-way, left out of the connectivity check.
+    roundabouts : collection of (int, int)
+        Roundabout nodes: a segment ending at one is never one-way.
 
     Returns
     -------
     dict
-        ``segment index -> +1 | -1`` for the candidates accepted; the others (driven both ways
-        by the routes, or breaking connectivity) are left out and fall back to a two-way type.
+        ``segment index -> +1 | -1`` for the candidates accepted; the others (closed, ending at a
+        roundabout, driven both ways by the routes, or breaking connectivity) are left out and fall
+        back to a two-way type.
     """
     if not candidates:
         return {}
     g = stream(seed, "layout", "one_way")
-    driven = driven_directions(segments, nx, ny)
+    shut = {c.index for c in closed}
+    open_segments = [s for s in segments if s.index not in shut]
+    by_index = {s.index: s for s in segments}
+    driven = driven_directions(open_segments, nx, ny)
     out: dict[int, int] = {}
     for i in candidates:
         free = 1 if g.random() < 0.5 else -1       # drawn for every candidate: later draws never shift
         dirs = driven.get(i, set())
-        if len(dirs) > 1:
+        if len(dirs) > 1 or i in shut or by_index[i].a in roundabouts or by_index[i].b in roundabouts:
             continue
         trial = {**out, i: next(iter(dirs)) if dirs else free}
-        if strongly_connected(segments, trial):
+        if strongly_connected(open_segments, trial):
             out = trial
     return out
 

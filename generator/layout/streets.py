@@ -332,12 +332,13 @@ def make_grid(spec: SceneSpec) -> Grid:
             segs.append(((i, j), (i, j + 1), 1, (xs[i], ys[j] + road_half), ys[j + 1] - ys[j] - 2 * road_half))
     segments = tuple(Segment(k, ax, a, b, (float(o[0]), float(o[1])), float(n)) for k, (a, b, ax, o, n) in enumerate(segs))
     grid = Grid(xs, ys, t.lanes_per_direction, t.lane_width_m, t.parking_strip_width_m, CURB_WIDTH_M,
-                t.sidewalk_width_m, t.curb_height_m, t.margin_m, segments,
-                max(MIN_OUTER_DEPTH_M, t.block_size_m / 2), draw_sections(spec, segments))
+                t.sidewalk_width_m, t.curb_height_m, t.margin_m, segments, max(MIN_OUTER_DEPTH_M, t.block_size_m / 2))
     from generator.layout.closures import draw_closures         # they need the routes, which need Grid
     from generator.layout.roundabouts import draw_roundabouts
 
+    # sections last (named streams: same bytes): one-way directions know the closures and roundabouts
     closed = draw_closures(spec, grid)
     if closed:
         grid = replace(grid, segments=tuple(s for s in grid.segments if s not in closed), closed=closed)
-    return replace(grid, roundabouts=frozenset(n for n in draw_roundabouts(spec, grid) if len(grid.arms(n)) == 4))
+    rings = frozenset(n for n in draw_roundabouts(spec, grid) if len(grid.arms(n)) == 4)
+    return replace(grid, roundabouts=rings, sections=draw_sections(spec, segments, closed, rings))

@@ -49,8 +49,10 @@ def spec_hash(spec: SceneSpec) -> str:
 
 
 def check_streets(full: dict, source: str) -> None:
-    """Cross-field rules of ``streets``: some weight > 0 in each choice, occupancy within [0, 1], no
-    one-way streets in a town with roundabouts or closed streets."""
+    """Cross-field rules of ``streets``: some weight > 0 in each choice, occupancy within [0, 1].
+
+    One-way streets combine with roundabouts and closed streets: the layout keeps a closed street
+    and a roundabout's arms two-way (:mod:`generator.layout.one_way`)."""
     streets = full.get("streets")
     if streets is None:
         return
@@ -60,13 +62,6 @@ def check_streets(full: dict, source: str) -> None:
     lo, hi = streets["parking_occupancy"]
     if lo < 0 or hi > 1:
         raise SpecError(source, "streets.parking_occupancy", f"must lie within [0, 1], got {[lo, hi]}")
-    if streets["types"].get("one_way", 0) > 0:
-        # one-way lane graphs rebuild every intersection's connectors and index segments by number:
-        # neither a roundabout's ring connectors nor a closed street's gap in the numbering survives that
-        for key in ("roundabouts", "closed_streets"):
-            if streets.get(key, 0) > 0:
-                raise SpecError(source, f"streets.{key}", "cannot be combined with one-way streets "
-                                "(streets.types.one_way > 0) yet; set one of them to 0")
 
 
 def load_spec(path: str | Path) -> SceneSpec:

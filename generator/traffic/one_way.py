@@ -9,7 +9,7 @@ segment; :func:`apply_one_way` then rewrites it for the segments whose cross-sec
   two-way street has slots ``0 .. lanes - 1`` per direction and a one-way street
   ``-lanes .. lanes - 1`` in its direction (the negative ones left of the centre line) and none
   against it;
-* connectors are rebuilt at every node: from each lane arriving at a node to every other arm
+* connectors are rebuilt at every plain node: from each lane arriving at a node to every other arm
   that has lanes *leaving* the node (so no connector enters a one-way street against it),
   into the same slot when the exit has it (the quarter circles of
   :func:`~generator.traffic.lanes.connector_path`) or else into the nearest slot it has (a lane
@@ -20,8 +20,15 @@ segment; :func:`apply_one_way` then rewrites it for the segments whose cross-sec
   does (one table still serves every node); ``graph.conflict_keys`` maps a connector's edge
   index to its key.
 
+Roundabout nodes keep their ring connectors as :class:`~generator.traffic.lanes.LaneGraph` built
+them (same paths, keys ``(node, arm_in, arm_out, lane)``, linked to the rebuilt lane edges) and keep
+the roundabouts' own conflict table: the layout never makes a segment ending at a roundabout one-way
+(:mod:`generator.layout.one_way`), so every ring arm keeps its slots ``0 .. lanes - 1`` both ways.
+Segments are looked up by :attr:`~generator.layout.streets.Segment.index` (with closed streets
+``grid.segments`` is not in index order of the full numbering).
+
 Every lane keeps a successor as long as every node has an arm leaving it, which the layout
-guarantees (:mod:`generator.layout.one_way` keeps the network strongly connected).
+guarantees (:mod:`generator.layout.one_way` keeps the open network strongly connected).
 """
 
 from __future__ import annotations
@@ -37,8 +44,10 @@ KAPPA = 0.5523   #: cubic Bezier handle of a quarter circle, as a share of the r
 
 
 def one_way_of(grid) -> dict[int, int]:
-    """``segment index -> +1 | -1`` for the one-way segments of ``grid`` (empty if none)."""
-    return {i: sec.one_way for i, sec in enumerate(grid.sections) if sec.one_way}
+    """``segment index -> +1 | -1`` for the open one-way segments of ``grid`` (empty if none)."""
+    if not grid.sections:
+        return {}
+    return {s.index: grid.sections[s.index].one_way for s in grid.segments if grid.sections[s.index].one_way}
 
 
 def apply_one_way(graph) -> bool:
@@ -48,7 +57,7 @@ def apply_one_way(graph) -> bool:
     ow = one_way_of(grid)
     if not ow:
         return False
-    old_edges, L = graph.edges, grid.lanes
+    old_edges, segs = graph.edges, {s.index: s for s in grid.segments}
     edges: list[Edge] = []
     lane_edge: dict = {}
     slots: dict = {}      # (segment, direction) -> sorted signed slots
@@ -58,7 +67,7 @@ def apply_one_way(graph) -> bool:
         if D == 0 or d == D:
             key, path, node, arms = (si, d, k), e.path, e.node, e.arms
         else:   # the contra lane k turns round: slot -1 - k of direction D
-            seg = grid.segments[si]
+            seg = segs[si]
             key, path = (si, D, -1 - k), _reversed(e.path, f"lane_{si}_{D}_{-1 - k}")
             node = seg.b if D > 0 else seg.a
             arms = (int(np.argmax(ARM_DIRS @ np.array([np.cos(path.headings[0]), np.sin(path.headings[0])]))), -1)
@@ -67,7 +76,14 @@ def apply_one_way(graph) -> bool:
         edges.append(Edge(len(edges), path, "lane", node, key[2], arms))
     slots = {k: sorted(v) for k, v in slots.items()}
     connector, ckeys = {}, {}
+    rings: dict = {}      # roundabout node -> its ring connectors, kept as built
+    for key, ei in graph.connector.items():
+        if grid.is_roundabout(key[0]):
+            rings.setdefault(key[0], []).append((key, ei))
     for node in grid.nodes:
+        if grid.is_roundabout(node):
+            _keep_ring(graph, node, rings.get(node, []), edges, lane_edge, connector)
+            continue
         c0 = grid.node_xy(node)
         arms = grid.arms(node)
         for x in arms:
@@ -95,6 +111,28 @@ def apply_one_way(graph) -> bool:
     graph.edges, graph.lane_edge, graph.connector, graph.conflict_keys = edges, lane_edge, connector, ckeys
     graph.conflict = conflict_table(graph.entry_m, graph.stop_m, grid.lane_w, frozenset(ckeys.values()), CAR_BOX_M)
     return True
+
+
+def _keep_ring(graph, node, ring: list, edges: list, lane_edge: dict, connector: dict) -> None:
+    """Copy the ring connectors ``ring`` (``[(key, old edge index)]``) of roundabout ``node`` into the
+    rebuilt ``edges`` and link them to the rebuilt lane edges (in place).
+
+    Raises
+    ------
+    ValueError
+        An arm of ``node`` is one-way (the layout never draws one: see :mod:`generator.layout.one_way`).
+    """
+    for (_, x, y, k), old in ring:
+        seg_in, d_in = graph._segment_of(node, x)
+        seg_out, d_out = graph._segment_of(node, y)
+        k_in, k_out = (seg_in.index, -d_in, k), (seg_out.index, d_out, k)
+        if k_in not in lane_edge or k_out not in lane_edge:
+            raise ValueError(f"roundabout {node}: arm {x if k_in not in lane_edge else y} is one-way")
+        ci = len(edges)
+        edges.append(Edge(ci, graph.edges[old].path, "connector", node, k, (x, y)))
+        connector[(node, x, y, k)] = ci
+        edges[lane_edge[k_in]].succ.append(ci)
+        edges[ci].succ.append(lane_edge[k_out])
 
 
 def exit_slots(k: int, s_in: list[int], s_out: list[int], left: bool) -> list[int]:
