@@ -9,6 +9,8 @@ roundabout and is never closed (:mod:`generator.layout.one_way`).
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -280,3 +282,21 @@ def test_blender_builds_a_town_with_every_street_kind_as_the_scene_model(tmp_pat
     assert n == len(scene.faces)
     v = scene.vertices.astype(np.float64)
     assert np.allclose(bounds, [v.min(0), v.max(0)], atol=1e-3)
+
+
+@pytest.mark.parametrize("kind", ["residential", "boulevard", "arterial", "one_way", "shared"])
+def test_street_types_in_a_town_without_strips_are_refused_not_ignored(tmp_path, capsys, kind):
+    """Every type but plain lives in the strips between lanes and kerbs: asked for in a town whose
+    strips are 0 m wide it is one line and exit 2, not a town silently built plain."""
+    from generator.cli import main
+
+    spec = tmp_path / "nostrips.json"
+    spec.write_text(json.dumps({"name": "x", "seed": 1, "town": {"parking_strip_width_m": 0},
+                                "streets": {"types": {"plain": 1, kind: 1}}}))
+    out = tmp_path / "out"
+    assert main(["layout", str(spec), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith(f"urbangen layout: {spec}: streets.types: {kind} need(s) the strips")
+    assert not out.exists()
+    ok = {"name": "x", "seed": 1, "town": {"parking_strip_width_m": 0}, "streets": {"types": {"plain": 1, kind: 0}}}
+    parse_spec(ok, "ok.json")

@@ -49,7 +49,8 @@ def spec_hash(spec: SceneSpec) -> str:
 
 
 def check_streets(full: dict, source: str) -> None:
-    """Cross-field rules of ``streets``: some weight > 0 in each choice, occupancy within [0, 1].
+    """Cross-field rules of ``streets``: some weight > 0 in each choice, occupancy within [0, 1], and
+    street types other than plain only where the town has strips between the lanes and kerbs.
 
     One-way streets combine with roundabouts and closed streets: the layout keeps a closed street
     and a roundabout's arms two-way (:mod:`generator.layout.one_way`)."""
@@ -62,6 +63,12 @@ def check_streets(full: dict, source: str) -> None:
     lo, hi = streets["parking_occupancy"]
     if lo < 0 or hi > 1:
         raise SpecError(source, "streets.parking_occupancy", f"must lie within [0, 1], got {[lo, hi]}")
+    varied = sorted(k for k, w in streets["types"].items() if k != "plain" and w > 0)
+    if varied and full["town"]["parking_strip_width_m"] <= 0:
+        # every type but plain fills or turns the strips between the lanes and the kerbs
+        # (generator.layout.cross_sections); without them the weights would be silently ignored
+        raise SpecError(source, "streets.types", f"{', '.join(varied)} need(s) the strips between lanes and kerbs, "
+                        "but town.parking_strip_width_m is 0; give the strips a width or use plain only")
 
 
 def load_spec(path: str | Path) -> SceneSpec:
