@@ -206,20 +206,6 @@ def connector_path(c0: np.ndarray, entry_m: float, lane_w: float, x: int, y: int
     return _arc(centre, r, float(np.arctan2(a[1], a[0])), sign, name)
 
 
-def _extended(graph: LaneGraph, x: int, y: int, k: int, ext: float) -> np.ndarray:
-    """(n, 3) x, y, heading samples of a connector at a node centred on the origin, with ``ext``
-    metres of its lanes on each side."""
-    p = connector_path(np.zeros(2), graph.entry_m, graph.grid.lane_w, x, y, k)
-    a, b = -ARM_DIRS[x], ARM_DIRS[y]
-    n = int(np.ceil(ext / 0.5))
-    before = p.points[0, :2] - a * np.linspace(ext, 0.5, n)[:, None]
-    after = p.points[-1, :2] + b * np.linspace(0.5, ext, n)[:, None]
-    hb, ha = np.full(n, np.arctan2(a[1], a[0])), np.full(n, np.arctan2(b[1], b[0]))
-    step = max(1, round(0.5 / STEP_M))
-    mid = np.c_[p.points[::step, :2], p.headings[::step]]
-    return np.vstack([np.c_[before, hb], mid, np.c_[after, ha]])
-
-
 def _corners(samples: np.ndarray, size) -> np.ndarray:
     """(n, 4, 2) corners of boxes of ``size`` centred on the (n, 3) x, y, heading samples."""
     hl, hw = size[0] / 2 + CONFLICT_PAD_M, size[1] / 2 + CONFLICT_PAD_M
@@ -250,16 +236,13 @@ def conflicts(graph: LaneGraph, size) -> dict:
     """Which connector kinds ``(arm_in, arm_out, lane)`` conflict, measured at a four-arm node.
 
     The table is the same for every node: every node has the same cross-section and entry
-    distance, and a node with fewer arms simply lacks some connectors.
+    distance, and a node with fewer arms simply lacks some connectors. It is
+    :func:`generator.traffic.one_way.conflict_table` on the keys of a two-way node (one
+    implementation for both; cached per cross-section).
     """
+    from generator.traffic.one_way import conflict_table    # it builds on this module's paths and boxes
+
     lanes = graph.grid.lanes
-    keys = [(x, y, k) for x in range(4) for y in range(4) if x != y for k in range(lanes)]
-    ext = graph.stop_m - graph.entry_m + size[0] / 2
-    geo = {key: _corners(_extended(graph, *key, ext), size) for key in keys}
-    out = {k: set() for k in keys}
-    for i, ka in enumerate(keys):
-        for kb in keys[i:]:
-            if ka == kb or boxes_overlap(geo[ka], geo[kb]).any():
-                out[ka].add(kb)
-                out[kb].add(ka)
-    return out
+    keys = frozenset((x, y, k) for x in range(4) for y in range(4) if x != y for k in range(lanes))
+    table = conflict_table(graph.entry_m, graph.stop_m, graph.grid.lane_w, keys, tuple(size))
+    return {k: set(v) for k, v in table.items()}

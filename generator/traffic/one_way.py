@@ -183,7 +183,7 @@ def merge_path(c0: np.ndarray, entry_m: float, lane_w: float, x: int, y: int, k_
 
 def _extended(entry_m: float, lane_w: float, key: tuple, ext: float) -> np.ndarray:
     """(n, 3) x, y, heading samples of the connector ``key`` at a node on the origin, with ``ext``
-    metres of its lanes on each side (as :func:`generator.traffic.lanes._extended`)."""
+    metres of its lanes on each side."""
     x, y, k_in = key[:3]
     k_out = key[3] if len(key) > 3 else k_in
     p = (connector_path(np.zeros(2), entry_m, lane_w, x, y, k_in) if k_out == k_in
@@ -213,9 +213,9 @@ def _pairs_overlap(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 @lru_cache(maxsize=16)
 def conflict_table(entry_m: float, stop_m: float, lane_w: float, keys: frozenset, size) -> dict:
     """``key -> set of keys`` that conflict: a car of ``size`` (length, width, metres) on one connector,
-    from the stop line to past the far crosswalk, can touch one on the other. The same answer as
-    :func:`generator.traffic.lanes.conflicts` on its keys; box pairs whose centres are farther apart
-    than the boxes' diameter are skipped, those closer than their width overlap without a test."""
+    from the stop line to past the far crosswalk, can touch one on the other; also the table of
+    two-way nodes (:func:`generator.traffic.lanes.conflicts`). Box pairs whose centres are farther
+    apart than the boxes' diameter are skipped, those closer than their width overlap without a test."""
     order = sorted(keys, key=repr)
     ext = stop_m - entry_m + size[0] / 2
     geo = [_corners(_extended(entry_m, lane_w, k, ext), size) for k in order]
