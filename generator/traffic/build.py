@@ -197,19 +197,11 @@ def _prune(graph: LaneGraph, blocked: set[int], keep: set[int]) -> set[int]:
 
 def _ego_route(graph: LaneGraph) -> list[int]:
     """Route 0 (the comb loop of :mod:`generator.layout.routes`) as a cycle of edges of ``graph``."""
-    from generator.layout.routes import _turning, comb_nodes
+    from generator.layout.one_way import route_node_cycles
     from generator.traffic.vehicles import arm_towards
 
     grid = graph.grid
-    corners = _turning(comb_nodes(len(grid.xs) - 1, len(grid.ys) - 1))
-    nodes = []
-    for i, a in enumerate(corners):
-        b = corners[(i + 1) % len(corners)]
-        step = np.sign(np.subtract(b, a)).astype(int)
-        n = a
-        while n != b:
-            nodes.append(n)
-            n = (n[0] + int(step[0]), n[1] + int(step[1]))
+    nodes = route_node_cycles(len(grid.xs) - 1, len(grid.ys) - 1)[0]
     k = grid.lanes - 1
     out = []
     for i, a in enumerate(nodes):
