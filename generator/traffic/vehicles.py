@@ -29,6 +29,7 @@ import numpy as np
 
 from generator.traffic.lanes import ARM_DIRS, LaneGraph
 from generator.traffic.shared import speed_caps
+from generator.traffic.ring_clearance import held_setback, waiting_clear
 from generator.traffic.roundabout_lanes import GIVE_WAY_CLEAR_S, GIVE_WAY_REQUEST_M
 from generator.traffic.signals import CLEAR_S
 
@@ -153,7 +154,8 @@ class VehicleSim:
             return edge.length - (veh.s + veh.length / 2)
         if edge.kind != "lane" or veh.grant == veh.plan[1]:
             return np.inf
-        return edge.length - self.g.stop_s_from_end - (veh.s + veh.length / 2)
+        # at a roundabout, short of where a long vehicle on the ring swings over the line (ring_clearance)
+        return edge.length - self.g.stop_s_from_end - (veh.s + veh.length / 2) - held_setback(self, veh)
 
     def _accel(self, veh: Vehicle, t: float, occ: dict) -> float:
         v0 = self._desired(veh)
@@ -206,7 +208,7 @@ class VehicleSim:
                 continue
             if big or self.vehicles[vid].length > BIG_M or okey in self.g.conflicts_at(node)[key]:
                 return
-        if not self._room(veh, conn, occ):
+        if not self._room(veh, conn, occ) or (give_way and not waiting_clear(self, veh, conn, occ, B_COMF)):
             return
         # the signals keep vehicles from entering CLEAR_S before a walk phase: only people on (or
         # stepping onto) the crosswalks within that time can meet this vehicle

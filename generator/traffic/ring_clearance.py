@@ -1,0 +1,153 @@
+"""Where vehicles wait at a roundabout's give-way lines while a long or wide vehicle drives the ring.
+
+A 12 m bus (or the 4.3 m wide slewed excavator) cannot follow a compact ring the way a car does:
+its box centre keeps to the car's path, so its front overhang swings outwards on the exit fillet
+and crosses the give-way line of the arm it leaves by (and a wide box reaches over the lines of
+arms it passes). Real drivers see this coming: whoever arrives at a give-way line while a bus is
+turning out over it holds back short of the line until the bus has gone, and a bus driver does
+not pull onto the ring while a vehicle sits at the give-way line it would swing over. The
+simulator (:class:`generator.traffic.vehicles.VehicleSim`) does both, from one table computed
+here: the *setback* of every approach lane, the distance its vehicles must keep their front back
+from the give-way line so that a box waiting there stays clear of a vehicle of a given size on a
+given ring connector.
+
+Setbacks are measured at a roundabout centred on the origin (every roundabout of a town has the
+same cross-section), on the connector's own samples: the holder's box (with
+:data:`SETBACK_PAD_M` all round) swept along the ring connector against a waiting box of the
+waiting vehicle's width whose front is on the line. The holder's own approach lane is left out
+(a follower there is kept behind it by car-following). For a standard car every setback is 0, so
+towns whose roundabouts see only cars drive exactly as before.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+from generator.layout.roundabouts import ARM_DIRS, ring_path
+
+SETBACK_PAD_M = 0.3   #: clearance kept between a waiting box and a box on the ring, metres
+
+
+def approach_arm(graph, lane) -> int:
+    """The arm of ``lane.node`` (a node it arrives at) that the lane edge ``lane`` comes in by."""
+    d = lane.path.points[-1, :2] - graph.grid.node_xy(lane.node)
+    return int(np.argmax(ARM_DIRS @ d))
+
+
+@functools.lru_cache(maxsize=256)
+def _setbacks(ring, stop_m: float, lanes: int, key: tuple, size: tuple, wait_w: float) -> dict:
+    x, y, k = key
+    p = ring_path(ring, np.zeros(2), x, y, k)
+    hl, hw = size[0] / 2 + SETBACK_PAD_M, size[1] / 2 + SETBACK_PAD_M
+    c, s = np.cos(p.headings)[:, None], np.sin(p.headings)[:, None]
+    dl, dw = np.array([hl, hl, -hl, -hl]), np.array([hw, -hw, -hw, hw])
+    corners = p.points[:, None, :2] + np.stack([c * dl - s * dw, s * dl + c * dw], -1)      # (n, 4, 2)
+    n = int(np.ceil(2 * max(hl, hw) / 0.1)) + 1                                             # edges every <= 0.1 m
+    pts = (corners[:, :, None] + (np.roll(corners, -1, 1) - corners)[:, :, None]
+           * np.linspace(0.0, 1.0, n)[None, None, :, None]).reshape(-1, 2)
+    out = {}
+    for z in range(4):
+        a = -ARM_DIRS[z]                           # direction of travel towards the node
+        right = np.array([a[1], -a[0]])
+        u = pts @ ARM_DIRS[z]                      # distance out along the arm
+        for k2 in range(lanes):
+            if (z, k2) == (x, k):
+                continue
+            v = pts @ right - (k2 + 0.5) * ring.lane_w
+            near = np.abs(v) < wait_w / 2
+            d = float(u[near].max() - stop_m) if near.any() else -np.inf
+            if d > 0:
+                out[(z, k2)] = round(d, 3)
+    return out
+
+
+def setbacks(graph, key: tuple, size: tuple[float, float], wait_w: float) -> dict:
+    """Setbacks of the approach lanes of a roundabout while a vehicle of ``size`` holds ring connector ``key``.
+
+    Parameters
+    ----------
+    graph : generator.traffic.lanes.LaneGraph
+    key : (int, int, int)
+        ``(arm_in, arm_out, lane)`` of the ring connector held.
+    size : (float, float)
+        Length and width of the holder's box, metres.
+    wait_w : float
+        Width of the waiting vehicle's box, metres.
+
+    Returns
+    -------
+    dict
+        ``(arm, lane) -> metres`` (> 0) the front of a vehicle waiting on that approach lane must
+        keep back from the give-way line; lanes not listed need none.
+    """
+    return _setbacks(graph.grid.ring, round(float(graph.stop_m), 3), graph.grid.lanes, tuple(int(i) for i in key),
+                     (round(float(size[0]), 2), round(float(size[1]), 2)), round(float(wait_w), 2))
+
+
+def _key(graph, conn) -> tuple:
+    return getattr(graph, "conflict_keys", {}).get(conn.index, (*conn.arms, conn.lane))
+
+
+def _approaches(graph, node) -> list:
+    """``[(lane edge, arm)]`` of the lane edges arriving at roundabout ``node`` (cached on the graph)."""
+    table = graph.__dict__.setdefault("_ring_approaches", {})
+    if not table:
+        for e in graph.lanes():
+            if graph.grid.is_roundabout(e.node):
+                table.setdefault(e.node, []).append((e, approach_arm(graph, e)))
+    return table.get(node, [])
+
+
+def held_setback(sim, veh) -> float:
+    """Metres ``veh`` must now stop short of its give-way line: the largest setback of its approach
+    lane among the vehicles holding ring connectors of the roundabout ahead (0 almost always).
+
+    Parameters
+    ----------
+    sim : generator.traffic.vehicles.VehicleSim
+    veh : generator.traffic.vehicles.Vehicle
+        On a lane edge.
+    """
+    edge = sim.g.edges[veh.edge]
+    holders = sim.holders.get(edge.node)
+    if not holders or not sim.g.grid.is_roundabout(edge.node):
+        return 0.0
+    arm, best = approach_arm(sim.g, edge), 0.0
+    for vid, c in holders.items():
+        if vid != veh.index:
+            h = sim.vehicles[vid]
+            sb = setbacks(sim.g, _key(sim.g, sim.g.edges[c]), (h.length, h.width), veh.width)
+            best = max(best, sb.get((arm, edge.lane), 0.0))
+    return best
+
+
+def waiting_clear(sim, veh, conn, occ: dict, brake: float) -> bool:
+    """Whether ``veh`` may take ring connector ``conn``: every vehicle on an approach lane its box would
+    swing over (a positive setback) is not granted and can still stop short of that setback at
+    ``brake`` m/s^2 (so nobody already sits, or is about to sit, where it will pass).
+
+    Parameters
+    ----------
+    sim : generator.traffic.vehicles.VehicleSim
+    veh : generator.traffic.vehicles.Vehicle
+    conn : generator.traffic.lanes.Edge
+        The ring connector asked for.
+    occ : dict
+        ``edge -> [(s, vehicle)]`` (:meth:`VehicleSim._occupancy`).
+    brake : float
+        Deceleration the waiting vehicles are expected to manage, m/s^2.
+    """
+    key = _key(sim.g, conn)
+    for lane, arm in _approaches(sim.g, conn.node):
+        for s, other in occ.get(lane.index, ()):
+            if other is veh or other.edge != lane.index or other.grant is not None:
+                continue
+            d = setbacks(sim.g, key, (veh.length, veh.width), other.width).get((arm, lane.lane), 0.0)
+            if d <= 0:
+                continue
+            gap = lane.length - sim.g.stop_s_from_end - (s + other.length / 2) - d
+            if gap < other.v ** 2 / (2 * brake):
+                return False
+    return True
