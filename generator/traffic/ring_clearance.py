@@ -28,6 +28,8 @@ import numpy as np
 from generator.layout.roundabouts import ARM_DIRS, ring_path
 
 SETBACK_PAD_M = 0.3   #: clearance kept between a waiting box and a box on the ring, metres
+STOP_TOL_M = 0.2   #: a vehicle stopped this little past its setback still counts as clear (inside the pad)
+ABOUT_TO_ENTER_M = 10.0  #: a vehicle this close to its give-way line counts as about to take its connector
 
 
 def approach_arm(graph, lane) -> int:
@@ -102,7 +104,10 @@ def _approaches(graph, node) -> list:
 
 def held_setback(sim, veh) -> float:
     """Metres ``veh`` must now stop short of its give-way line: the largest setback of its approach
-    lane among the vehicles holding ring connectors of the roundabout ahead (0 almost always).
+    lane among the vehicles holding ring connectors of the roundabout ahead, or about to ask for one
+    (front within :data:`ABOUT_TO_ENTER_M` of their own line; 0 almost always). Counting the ones
+    about to enter keeps two buses from meeting at the lines of each other's exit arms and each
+    waiting for the other to go first: both hang back, and whichever is granted first goes.
 
     Parameters
     ----------
@@ -111,11 +116,16 @@ def held_setback(sim, veh) -> float:
         On a lane edge.
     """
     edge = sim.g.edges[veh.edge]
-    holders = sim.holders.get(edge.node)
-    if not holders or not sim.g.grid.is_roundabout(edge.node):
+    if not sim.g.grid.is_roundabout(edge.node):
         return 0.0
+    users = dict(sim.holders.get(edge.node, {}))
+    for lane, _ in _approaches(sim.g, edge.node):
+        for _, other in sim.occ.get(lane.index, ()):
+            if (other.edge == lane.index and other.grant is None and len(other.plan) > 1
+                    and lane.length - sim.g.stop_s_from_end - (other.s + other.length / 2) < ABOUT_TO_ENTER_M):
+                users.setdefault(other.index, other.plan[1])
     arm, best = approach_arm(sim.g, edge), 0.0
-    for vid, c in holders.items():
+    for vid, c in users.items():
         if vid != veh.index:
             h = sim.vehicles[vid]
             sb = setbacks(sim.g, _key(sim.g, sim.g.edges[c]), (h.length, h.width), veh.width)
@@ -148,6 +158,6 @@ def waiting_clear(sim, veh, conn, occ: dict, brake: float) -> bool:
             if d <= 0:
                 continue
             gap = lane.length - sim.g.stop_s_from_end - (s + other.length / 2) - d
-            if gap < other.v ** 2 / (2 * brake):
+            if gap < other.v ** 2 / (2 * brake) - STOP_TOL_M:
                 return False
     return True

@@ -89,6 +89,7 @@ class VehicleSim:
         self.g, self.signals, self.vehicles, self.crossing = graph, signals, vehicles, crossing
         self.holders: dict = {}   # node -> {vehicle index: connector edge}
         self.caps = speed_caps(graph)   # edge -> speed limit (shared streets), m/s
+        self.occ: dict = {}             # this step's occupancy (edge -> [(s, vehicle)]), for ring_clearance
 
     # -- plans ---------------------------------------------------------------------------------
     def _extend(self, veh: Vehicle) -> None:
@@ -110,7 +111,7 @@ class VehicleSim:
 
     # -- one step -------------------------------------------------------------------------------
     def step(self, t: float, dt: float) -> None:
-        occ = self._occupancy()
+        occ = self.occ = self._occupancy()
         for veh in self.vehicles:
             self._maybe_grant(veh, t, occ)
         acc = [self._accel(veh, t, occ) for veh in self.vehicles]
