@@ -26,6 +26,7 @@ import functools
 import numpy as np
 
 from generator.layout.roundabouts import ARM_DIRS, ring_path
+from generator.traffic.lanes import CAR_BOX_M
 
 SETBACK_PAD_M = 0.3   #: clearance kept between a waiting box and a box on the ring, metres
 STOP_TOL_M = 0.2   #: a vehicle stopped this little past its setback still counts as clear (inside the pad)
@@ -84,8 +85,13 @@ def setbacks(graph, key: tuple, size: tuple[float, float], wait_w: float) -> dic
         ``(arm, lane) -> metres`` (> 0) the front of a vehicle waiting on that approach lane must
         keep back from the give-way line; lanes not listed need none.
     """
-    return _setbacks(graph.grid.ring, round(float(graph.stop_m), 3), graph.grid.lanes, tuple(int(i) for i in key),
-                     (round(float(size[0]), 2), round(float(size[1]), 2)), round(float(wait_w), 2))
+    memo = graph.__dict__.setdefault("_setback_memo", {})   # asked every step: skip the rounding
+    got = memo.get((key, size[0], size[1], wait_w))
+    if got is None:
+        got = memo[(key, size[0], size[1], wait_w)] = _setbacks(
+            graph.grid.ring, round(float(graph.stop_m), 3), graph.grid.lanes, tuple(int(i) for i in key),
+            (round(float(size[0]), 2), round(float(size[1]), 2)), round(float(wait_w), 2))
+    return got
 
 
 def _key(graph, conn) -> tuple:
@@ -118,18 +124,25 @@ def held_setback(sim, veh) -> float:
     edge = sim.g.edges[veh.edge]
     if not sim.g.grid.is_roundabout(edge.node):
         return 0.0
-    users = dict(sim.holders.get(edge.node, {}))
-    for lane, _ in _approaches(sim.g, edge.node):
-        for _, other in sim.occ.get(lane.index, ()):
-            if (other.edge == lane.index and other.grant is None and len(other.plan) > 1
-                    and lane.length - sim.g.stop_s_from_end - (other.s + other.length / 2) < ABOUT_TO_ENTER_M):
-                users.setdefault(other.index, other.plan[1])
+    cache = sim.__dict__.setdefault("_ring_users", {})
+    if cache.get("occ") is not sim.occ:     # once per step (occupancy is rebuilt every step)
+        cache.clear()
+        cache["occ"] = sim.occ
+    if edge.node not in cache:
+        users = dict(sim.holders.get(edge.node, {}))
+        for lane, _ in _approaches(sim.g, edge.node):
+            for _, other in sim.occ.get(lane.index, ()):
+                if (other.edge == lane.index and other.grant is None and len(other.plan) > 1
+                        and lane.length - sim.g.stop_s_from_end - (other.s + other.length / 2) < ABOUT_TO_ENTER_M):
+                    users.setdefault(other.index, other.plan[1])
+        # a standard car needs no setback anywhere: keep only the vehicles larger than it
+        cache[edge.node] = [(vid, _key(sim.g, sim.g.edges[c])) for vid, c in users.items()
+                            if sim.vehicles[vid].length > CAR_BOX_M[0] or sim.vehicles[vid].width > CAR_BOX_M[1]]
     arm, best = approach_arm(sim.g, edge), 0.0
-    for vid, c in users.items():
+    for vid, key in cache[edge.node]:
         if vid != veh.index:
             h = sim.vehicles[vid]
-            sb = setbacks(sim.g, _key(sim.g, sim.g.edges[c]), (h.length, h.width), veh.width)
-            best = max(best, sb.get((arm, edge.lane), 0.0))
+            best = max(best, setbacks(sim.g, key, (h.length, h.width), veh.width).get((arm, edge.lane), 0.0))
     return best
 
 
