@@ -1,6 +1,6 @@
 """Where vehicles wait at a roundabout's give-way lines while a long or wide vehicle drives the ring.
 
-A 12 m bus (or the 4.3 m wide slewed excavator) cannot follow a compact ring the way a car does:
+A 12 m bus (or any box much wider than a car) cannot follow a compact ring the way a car does:
 its box centre keeps to the car's path, so its front overhang swings outwards on the exit fillet
 and crosses the give-way line of the arm it leaves by (and a wide box reaches over the lines of
 arms it passes). Real drivers see this coming: whoever arrives at a give-way line while a bus is
@@ -9,7 +9,10 @@ not pull onto the ring while a vehicle sits at the give-way line it would swing 
 simulator (:class:`generator.traffic.vehicles.VehicleSim`) does both, from one table computed
 here: the *setback* of every approach lane, the distance its vehicles must keep their front back
 from the give-way line so that a box waiting there stays clear of a vehicle of a given size on a
-given ring connector.
+given ring connector. Vehicles hang back for a large vehicle on the ring and for one about to take
+its connector (so two buses at each other's exit arms do not each wait for the other). This is
+chosen over moving the give-way line back for everyone: the painted line is laid out for cars
+(which need no setback), and only the rare long vehicle should cost the others room.
 
 Setbacks are measured at a roundabout centred on the origin (every roundabout of a town has the
 same cross-section), on the connector's own samples: the holder's box (with

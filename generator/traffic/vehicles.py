@@ -13,7 +13,9 @@ planned edges of the :class:`~generator.traffic.lanes.LaneGraph`, with
   vehicle holds a conflicting connector (:func:`generator.traffic.lanes.conflicts`; a bus or
   truck longer than 6 m holds the whole node), the exit lane has room for it to clear the
   far crosswalk, and no pedestrian is on or about to step onto a crosswalk it crosses. It
-  holds the grant until its rear is past the far crosswalk;
+  holds the grant until its rear is past the far crosswalk. At a roundabout, vehicles wait clear
+  of where a long vehicle on the ring swings over their give-way line, and it is granted only
+  while nobody sits there (:mod:`generator.traffic.ring_clearance`);
 * **the ego** is one of them: it drives route 0's walk on the graph at ``paths.speed_mps``,
   and at an intersection comes to a full stop for 1-3 s with ``traffic.ego_stop_probability``.
 
