@@ -115,8 +115,9 @@ def test_bad_closed_streets_through_the_cli_exits_2_writes_nothing(tmp_path, cap
 
 @pytest.fixture(scope="module")
 def town():
-    # seed 11 draws a slewed excavator into a parked car at t = 0: the fleet's known latent defect
-    # (a 4.3 m wide vehicle in a 3.5 m lane, tests/test_traffic.py), not the closures'
+    # seed 11 drove a slewed excavator into a parked car (fixed: moving excavators travel straight,
+    # generator/traffic/fleet.py); its vehicles now keep clear, but one walker there steps below kerb
+    # height inside a closed street's corridor (actor_person_0036, last sample): not yet looked into
     spec = spec_with(blocks=2, seed=5, traffic=TRAFFIC)
     scene = build_scene(spec)
     return spec, scene, build_world(spec, scene, 60.0)

@@ -381,3 +381,30 @@ def test_blender_builds_the_roundabout_as_the_scene_model(tmp_path):
     assert n == len(scene.faces)
     v = scene.vertices.astype(np.float64)
     assert np.allclose(bounds, [v.min(0), v.max(0)], atol=1e-3)
+
+
+def test_a_vehicle_at_its_setback_keeps_clear_of_a_bus_swinging_out_over_its_give_way_line():
+    """ring_clearance: a 12 m bus leaving the ring swings its front over the give-way line of its exit
+    arm, so a vehicle waiting there must hang back; at that setback (and not at the line) its box is
+    clear of every box the bus sweeps along the connector. A standard car needs no setback anywhere."""
+    from generator.layout.roundabouts import ring_path
+    from generator.traffic.ring_clearance import setbacks
+
+    graph = LaneGraph(make_grid(spec_with(blocks=2)))
+    bus, wait = (12.0, 2.55), (12.0, 2.55)
+    for x in range(4):
+        for y in range(4):
+            if x == y:
+                continue
+            assert setbacks(graph, (x, y, 0), (4.8, 2.1), 2.55) == {}
+            sb = setbacks(graph, (x, y, 0), bus, wait[1])
+            assert set(sb) == {(y, 0)} and sb[(y, 0)] > 1.0, sb
+            p = ring_path(graph.grid.ring, np.zeros(2), x, y, 0)
+            swept = np.stack([OrientedBox((*q[:2], 1.5), (*bus, 3.0), float(h)).corners_xy()
+                              for q, h in zip(p.points, p.headings)])
+            a = -np.asarray(ARM_DIRS[y])
+            right = np.array([a[1], -a[0]])
+            for back, clear in ((sb[(y, 0)], True), (0.0, False)):
+                centre = -a * (graph.stop_m + back + wait[0] / 2) + right * graph.grid.lane_w / 2
+                box = OrientedBox((*centre, 1.5), (*wait, 3.0), float(np.arctan2(a[1], a[0]))).corners_xy()
+                assert boxes_overlap(box[None], swept).any() != clear, (x, y, back)

@@ -19,10 +19,10 @@ import time
 import numpy as np
 
 from generator.errors import SpecError
-from generator.geometry.mesh import merge
 from generator.layout.appearance import fleet_paint
 from generator.layout.streets import make_grid
 from generator.rng import stream
+from generator.traffic.fleet import fleet_proto
 from generator.traffic.lanes import LaneGraph
 from generator.traffic.movers import DT_S, Mover
 from generator.traffic.signals import CLEAR_S, Signals
@@ -230,16 +230,15 @@ def _drive(spec, graph, signals, lib, blocked, crossing, duration_s, distance_m)
     taken: dict[int, list] = {route[0]: [(0.0, EGO_SIZE_M[0])]}
     for field_name, (kind, n_var, speed, a_max, _) in KINDS.items():
         for _ in range(round(getattr(tr, field_name) * km)):
-            proto = _proto(lib, kind, int(g.integers(n_var)))
+            proto = fleet_proto(lib, kind, int(g.integers(n_var)))
             length, width = float(proto.hi[0] - proto.lo[0]), float(proto.hi[1] - proto.lo[1])
             e, s = _free_spot(graph, free, taken, length, g, field_name, spec)
             i = len(vehicles)
             v = Vehicle(i, length, width, min(tr.speed_limit_mps * float(g.uniform(*speed)), tr.speed_limit_mps),
                         a_max, [e.index], s, stream(spec.seed, "traffic", "vehicle", i))
             vehicles.append(v)
-            # still take the values the old per-vehicle colour took, so a seed's traffic drives as before:
-            # other draw orders expose a slewed excavator (4.3 m wide) grazing parked cars and a turning
-            # bus meeting a car at t = 0 (tests/test_traffic.py), which the simulation does not prevent
+            # still take the values the old per-vehicle colour took, so a seed's traffic drives as before
+            # (other draw orders put a turning bus onto a car at t = 0, tests/test_traffic.py)
             g.integers(8), g.uniform(0.9, 1.1, 3)
             movers.append(Mover(kind, lib.main_class(kind), proto, None, {**fleet_paint(paint), "role": "driving"}))
     sim = VehicleSim(graph, signals, vehicles, crossing)
@@ -304,22 +303,6 @@ def _free_spot(graph, free, taken, length, g, field_name, spec):
             taken.setdefault(e.index, []).append((s, length))
             return e, s
     raise SpecError(spec.source, f"traffic.{field_name}", "more vehicles than the free lanes can hold; lower it")
-
-
-def _proto(lib, kind: str, i: int):
-    """The prototype of a vehicle kind; a rider and the two-wheeler ridden merged into one."""
-    if kind not in ("bicyclist", "motorcyclist"):
-        return lib.variant(kind, i)
-    from generator.layout.placement_core import Proto
-
-    key = f"{kind}_riding_v{i}"
-    if key not in lib.protos:
-        rider = lib.variant(kind, i, lambda g: {"with_vehicle": False})
-        vehicle = lib.variant("ridden_bicycle" if kind == "bicyclist" else "ridden_motorcycle", i, stream_kind=kind)
-        mesh = merge([vehicle.mesh, rider.mesh])
-        lo, hi = mesh.bounds()
-        lib.protos[key] = Proto(key, kind, mesh, lo, hi, np.zeros((0, 6)))
-    return lib.protos[key]
 
 
 def _assemble(scene, movers: list[Mover], ego: TrackTrajectory, duration_s: float) -> World:

@@ -13,7 +13,9 @@ planned edges of the :class:`~generator.traffic.lanes.LaneGraph`, with
   vehicle holds a conflicting connector (:func:`generator.traffic.lanes.conflicts`; a bus or
   truck longer than 6 m holds the whole node), the exit lane has room for it to clear the
   far crosswalk, and no pedestrian is on or about to step onto a crosswalk it crosses. It
-  holds the grant until its rear is past the far crosswalk;
+  holds the grant until its rear is past the far crosswalk. At a roundabout, vehicles wait clear
+  of where a long vehicle on the ring swings over their give-way line, and it is granted only
+  while nobody sits there (:mod:`generator.traffic.ring_clearance`);
 * **the ego** is one of them: it drives route 0's walk on the graph at ``paths.speed_mps``,
   and at an intersection comes to a full stop for 1-3 s with ``traffic.ego_stop_probability``.
 
@@ -29,6 +31,7 @@ import numpy as np
 
 from generator.traffic.lanes import ARM_DIRS, LaneGraph
 from generator.traffic.shared import speed_caps
+from generator.traffic.ring_clearance import held_setback, waiting_clear
 from generator.traffic.roundabout_lanes import GIVE_WAY_CLEAR_S, GIVE_WAY_REQUEST_M
 from generator.traffic.signals import CLEAR_S
 
@@ -88,6 +91,7 @@ class VehicleSim:
         self.g, self.signals, self.vehicles, self.crossing = graph, signals, vehicles, crossing
         self.holders: dict = {}   # node -> {vehicle index: connector edge}
         self.caps = speed_caps(graph)   # edge -> speed limit (shared streets), m/s
+        self.occ: dict = {}             # this step's occupancy (edge -> [(s, vehicle)]), for ring_clearance
 
     # -- plans ---------------------------------------------------------------------------------
     def _extend(self, veh: Vehicle) -> None:
@@ -109,7 +113,7 @@ class VehicleSim:
 
     # -- one step -------------------------------------------------------------------------------
     def step(self, t: float, dt: float) -> None:
-        occ = self._occupancy()
+        occ = self.occ = self._occupancy()
         for veh in self.vehicles:
             self._maybe_grant(veh, t, occ)
         acc = [self._accel(veh, t, occ) for veh in self.vehicles]
@@ -153,7 +157,8 @@ class VehicleSim:
             return edge.length - (veh.s + veh.length / 2)
         if edge.kind != "lane" or veh.grant == veh.plan[1]:
             return np.inf
-        return edge.length - self.g.stop_s_from_end - (veh.s + veh.length / 2)
+        # at a roundabout, short of where a long vehicle on the ring swings over the line (ring_clearance)
+        return edge.length - self.g.stop_s_from_end - (veh.s + veh.length / 2) - held_setback(self, veh)
 
     def _accel(self, veh: Vehicle, t: float, occ: dict) -> float:
         v0 = self._desired(veh)
@@ -206,7 +211,7 @@ class VehicleSim:
                 continue
             if big or self.vehicles[vid].length > BIG_M or okey in self.g.conflicts_at(node)[key]:
                 return
-        if not self._room(veh, conn, occ):
+        if not self._room(veh, conn, occ) or (give_way and not waiting_clear(self, veh, conn, occ, B_COMF)):
             return
         # the signals keep vehicles from entering CLEAR_S before a walk phase: only people on (or
         # stepping onto) the crosswalks within that time can meet this vehicle
