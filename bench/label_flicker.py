@@ -12,13 +12,12 @@ Printed per factor, over consecutive frame pairs and pixels near markings:
   moved, the label did -- that is flicker;
 * wrong vs coverage: marked with coverage <= 0.3, or unmarked with coverage >= 0.7;
 * marking area: mean and relative spread of the marking pixel count over the frames;
-* seconds of the label passes (real + supersampled: Cycles, read back, vote) beside the dry RGB
-  pass of the same pose.
+* seconds of the label pass (Cycles + vote) beside the dry RGB pass of the same pose.
 
 A PNG strip (crop of distant markings, frames left to right; rows 1x, 3x, reference coverage)
 goes to ``--png``.
 
-    python bench/label_flicker.py [--frames 8] [--step-cm 3] [--png /work/figs/labelcost/label_flicker.png]
+    python bench/label_flicker.py [--frames 8] [--step-cm 3] [--png /work/figs/wetaa/label_flicker.png]
 """
 
 from __future__ import annotations
@@ -42,18 +41,16 @@ def _marking_ids():
 
 def _reference(r, marks) -> tuple[np.ndarray, np.ndarray]:
     """(H, W) float marking coverage and (H, W) bool centre-sample marking, from a 7x render."""
-    from generator.blender import geometry, label_shader, passes, session
-    from generator.blender.materials import label_world
-    from generator.labels import label_colour
+    from generator.blender import geometry, passes, session
+    from generator.blender.materials import label_material, label_world
     from generator.labels.supersample import _blocks
 
-    label_shader.mark_proxies(r.handles.proxy_objects)
-    session.label_state(r.bscene, label_shader.label_material(*passes._one_x_size(r.bscene)), label_world())
+    session.label_state(r.bscene, label_material(), label_world())
     geometry.set_proxies_visible(r.handles, True)
     with session.supersampled(r.bscene, REF):
         fine = passes._render(r.bscene, r.scratch / "ref.exr")
     geometry.set_proxies_visible(r.handles, False)
-    cls, _, _, _ = label_colour.decode(fine["Combined"], "reference pass")
+    cls, _ = passes._integers(fine["Combined"], "reference pass")
     b = np.isin(_blocks(cls, REF), marks)
     return b.mean(-1), b[..., (REF * REF) // 2]
 
@@ -100,7 +97,7 @@ def main() -> None:
     ap.add_argument("--frame", type=int, default=5)
     ap.add_argument("--frames", type=int, default=8)
     ap.add_argument("--step-cm", type=float, default=3.0)
-    ap.add_argument("--png", default="/work/figs/labelcost/label_flicker.png")
+    ap.add_argument("--png", default="/work/figs/wetaa/label_flicker.png")
     a = ap.parse_args()
 
     from generator.blender import passes
@@ -128,7 +125,7 @@ def main() -> None:
         r.place_camera(T)
         for k in FACTORS:
             lab = passes.render_labels(r.bscene, r.handles, r.k, r.scratch, k)
-            secs[k].append(lab.seconds["label_pass"] + lab.seconds["real_pass"])
+            secs[k].append(lab.seconds["label_pass"])
             labels[k].append(np.isin(lab.class_id, marks))
         c, centre = _reference(r, marks)
         cov.append(c)

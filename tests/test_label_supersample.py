@@ -130,38 +130,3 @@ def test_render_config_option_is_validated_and_1_keeps_the_old_hash(tmp_path):
         p.write_text(base + f"label_supersample: {bad}\n")
         with pytest.raises(SpecError, match=r"r.yaml: label_supersample: "):
             load_render_config(p)
-
-
-def _numpy_vote(values, eligible, centre):
-    """The vote as numpy expressions (the formulation before the compiled kernel): the reference."""
-    count = np.zeros(values.shape, np.int16)
-    for j in range(values.shape[-1]):
-        count += (values == values[..., j:j + 1]) & eligible[..., j:j + 1]
-    score = 2 * count
-    score[..., centre] += 1
-    score[~eligible] = -1
-    return np.argmax(score, axis=-1)
-
-
-def _numpy_majority(class_id, instance, k):
-    from generator.labels.supersample import _blocks
-
-    cls, inst = _blocks(class_id, k), _blocks(instance, k)
-    centre = (k * k) // 2
-    win = _numpy_vote(cls, np.ones(cls.shape, bool), centre)
-    out_cls = np.take_along_axis(cls, win[..., None], -1)[..., 0]
-    win_inst = _numpy_vote(inst, cls == out_cls[..., None], centre)
-    return out_cls, np.take_along_axis(inst, win_inst[..., None], -1)[..., 0]
-
-
-@pytest.mark.parametrize("k", [3, 5])
-def test_compiled_vote_equals_the_numpy_formulation_with_many_ties(k):
-    g = np.random.default_rng(k)
-    # few classes and instances on small blocks: ties (2-2-..., 3-3-3) are frequent
-    cls = g.integers(0, 3, (20 * k, 30 * k)).astype(np.uint8)
-    inst = g.integers(0, 3, cls.shape).astype(np.uint16)
-    got_c, got_i = majority_labels(cls, inst, k)
-    ref_c, ref_i = _numpy_majority(cls, inst, k)
-    assert np.array_equal(got_c, ref_c) and np.array_equal(got_i, ref_i)
-    # the tie rule mattered: in many pixels the winner is not the plain mode by first occurrence
-    assert (got_c != cls[k // 2::k, k // 2::k]).any() and (got_c == cls[k // 2::k, k // 2::k]).any()

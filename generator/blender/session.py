@@ -3,7 +3,7 @@
 Two render states share one scene: the RGB pass (the config's samples, bounces,
 filter, denoiser, motion blur) and the label pass (1 sample, no bounces, a box filter of
 minimal width, no denoising, no motion blur, the label material and world as view-layer
-overrides; pixel-centre rays may cross up to ``MAX_PROXY_CROSSINGS`` transparent label proxies).
+overrides).
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from __future__ import annotations
 import logging
 from contextlib import contextmanager
 
-from generator.blender import label_shader, motion
+from generator.blender import motion
 from generator.blender.bpy_guard import bpy
 from generator.spec.render import RenderConfig
 
@@ -109,21 +109,15 @@ def label_state(scene: "bpy.types.Scene", material, world) -> None:
     c.samples = 1
     c.use_adaptive_sampling = False
     c.max_bounces = 0
-    # pixel-centre rays pass through the label proxies (generator.blender.label_shader)
-    c.transparent_max_bounces = label_shader.MAX_PROXY_CROSSINGS
+    c.transparent_max_bounces = 0
     c.use_denoising = False
     c.pixel_filter_type = "BOX"
     c.filter_width = 0.01
     c.seed = 0
-    if scene.render.use_motion_blur:
-        scene.render.use_motion_blur = False  # labels at the image instant: never blended
+    scene.render.use_motion_blur = False  # labels at the image instant: never blended
     vl = scene.view_layers[0]
-    # Writing either override, even the value it holds, makes Cycles re-sync every object and
-    # rebuild its BVH (~0.4 s on the default town): write only a real change.
-    if vl.material_override != material:
-        vl.material_override = material
-    if vl.world_override != world:
-        vl.world_override = world
+    vl.material_override = material
+    vl.world_override = world
 
 
 @contextmanager
