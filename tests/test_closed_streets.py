@@ -20,8 +20,8 @@ from generator.layout.routes import make_routes
 from generator.layout.streets import make_grid
 from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
-from generator.traffic.lanes import LaneGraph, boxes_overlap
-from generator.world.scene import OrientedBox
+from generator.traffic.lanes import LaneGraph
+from traffic_contacts import assert_no_contact, static_quads
 
 TRAFFIC = {"cars_per_km": 25, "trucks_per_km": 2, "buses_per_km": 1, "cyclists_per_km": 3, "motorcyclists_per_km": 2,
            "other_vehicles_per_km": 1, "pedestrians_per_100m": 1.5, "standing_pedestrians_per_100m": 0.5}
@@ -149,19 +149,12 @@ def test_the_park_is_grass_and_a_path_with_trees_and_nothing_else(town):
 def test_a_minute_of_traffic_and_walkers_round_the_closed_streets(town):
     spec, scene, world = town
     grid = make_grid(spec)
-    parked = np.stack([o.box.corners_xy() for o in scene.objects if o.instance_id > 0])
+    parked = static_quads(scene)
     people = [a for a in world.actors if a.kind == "person"]
     vehicles = [a for a in world.actors if a.kind != "person"]
     assert len(people) > 10 and len(vehicles) > 10
     for t in np.arange(0.0, 60.0, 0.1):
-        q = np.stack([b.corners_xy() for b in world.boxes(t)])
-        ov = boxes_overlap(q, q)
-        np.fill_diagonal(ov, False)
-        assert not ov.any(), f"actors {np.argwhere(ov)[0]} overlap at t={t:.1f}"
-        E = world.ego.T_world_ego(t)[0]
-        ego = OrientedBox((E[0, 3], E[1, 3], 0.7), (4.6, 1.9, 1.5), float(np.arctan2(E[1, 0], E[0, 0])))
-        assert not boxes_overlap(ego.corners_xy()[None], q).any(), f"an actor touches the ego at t={t:.1f}"
-        assert not boxes_overlap(q, parked).any(), f"an actor touches a static object at t={t:.1f}"
+        assert_no_contact(world, t, parked)
         for seg in grid.closed:
             vc = np.array([a.box(t).center[:2] for a in vehicles])
             assert not _in_corridor(grid, seg, vc, grid.road_half).any(), f"a vehicle in a park at t={t:.1f}"

@@ -26,6 +26,7 @@ from generator.traffic.lanes import LaneGraph, boxes_overlap
 from generator.traffic.signals import Signals
 from generator.traffic.vehicles import Vehicle, VehicleSim
 from generator.world.scene import OrientedBox
+from traffic_contacts import assert_no_contact, assert_vehicles_miss_people, static_quads
 
 TRAFFIC = {"cars_per_km": 25, "trucks_per_km": 2, "buses_per_km": 1, "cyclists_per_km": 3, "motorcyclists_per_km": 2,
            "other_vehicles_per_km": 1, "pedestrians_per_100m": 1.0, "standing_pedestrians_per_100m": 0.5}
@@ -293,29 +294,18 @@ def test_no_vehicle_touches_a_pedestrian_at_an_unsignalled_roundabout(town):
     vehicles = [a for a in world.actors if a.kind != "person"]
     assert len(people) > 10 and len(vehicles) > 10
     for t in np.arange(0.0, MINUTE_S, 0.1):
-        p = np.stack([a.box(t).corners_xy() for a in people])
-        E = world.ego.T_world_ego(t)[0]
-        ego = OrientedBox((E[0, 3], E[1, 3], 0.7), (4.6, 1.9, 1.5), float(np.arctan2(E[1, 0], E[0, 0])))
-        hit = boxes_overlap(np.stack([a.box(t).corners_xy() for a in vehicles] + [ego.corners_xy()]), p)
-        assert not hit.any(), (t, np.argwhere(hit)[:3])
+        assert_vehicles_miss_people(world, t, vehicles, people)
 
 
 def test_a_minute_of_traffic_through_a_roundabout_never_touches(town):
     spec, scene, world = town
     grid = make_grid(spec)
     c, ring = grid.node_xy((1, 1)), grid.ring
-    parked = np.stack([o.box.corners_xy() for o in scene.objects if o.instance_id > 0])
+    parked = static_quads(scene)
     vehicles = [a for a in world.actors if a.kind != "person"]
     through = set()
     for t in np.arange(0.0, MINUTE_S, 0.1):
-        q = np.stack([b.corners_xy() for b in world.boxes(t)])
-        ov = boxes_overlap(q, q)
-        np.fill_diagonal(ov, False)
-        assert not ov.any(), f"actors {np.argwhere(ov)[0]} overlap at t={t:.1f}"
-        E = world.ego.T_world_ego(t)[0]
-        ego = OrientedBox((E[0, 3], E[1, 3], 0.7), (4.6, 1.9, 1.5), float(np.arctan2(E[1, 0], E[0, 0])))
-        assert not boxes_overlap(ego.corners_xy()[None], q).any(), f"an actor touches the ego at t={t:.1f}"
-        assert not boxes_overlap(q, parked).any(), f"an actor touches a static object at t={t:.1f}"
+        assert_no_contact(world, t, parked)
         for a in vehicles:
             box = a.box(t)
             corners = box.corners_xy() - c

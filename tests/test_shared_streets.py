@@ -23,6 +23,7 @@ from generator.spec import parse_spec
 from generator.traffic.build import build_world
 from test_one_way import ON_LANES
 from test_streets import GROUND_KINDS, _no_collisions, _rests_on_ground
+from traffic_contacts import assert_vehicles_miss_people
 
 
 def shared_spec(seed: int = 6, traffic: dict | None = None, **types):
@@ -143,9 +144,6 @@ def test_vehicles_keep_the_shared_speed_on_shared_streets(traffic_town):
 def test_people_stand_on_shared_carriageways_and_no_vehicle_touches_anyone(traffic_town):
     """With moving traffic, people stand on the shared streets' paving beside the lanes (road level,
     off the sidewalk); no vehicle box (ego included) meets a person's box, every 0.1 s."""
-    from generator.traffic.lanes import boxes_overlap
-    from generator.world.scene import OrientedBox
-
     spec, grid, world = traffic_town
     people = [a for a in world.actors if a.kind == "person"]
     vehicles = [a for a in world.actors if a.kind != "person"]
@@ -157,11 +155,7 @@ def test_people_stand_on_shared_carriageways_and_no_vehicle_touches_anyone(traff
         assert hit is not None and grid.lane_half < abs(hit[2]) < grid.road_half, a.name
         assert abs(a.track.pose(0.0)[0][2, 3]) < 1e-9       # on the road surface
     for t in np.arange(0.0, 20.0, 0.1):
-        p = np.stack([a.box(t).corners_xy() for a in people])
-        E = world.ego.T_world_ego(t)[0]
-        ego = OrientedBox((E[0, 3], E[1, 3], 0.7), (4.6, 1.9, 1.5), float(np.arctan2(E[1, 0], E[0, 0])))
-        hit = boxes_overlap(np.stack([a.box(t).corners_xy() for a in vehicles] + [ego.corners_xy()]), p)
-        assert not hit.any(), (t, np.argwhere(hit)[:3])
+        assert_vehicles_miss_people(world, t, vehicles, people)
 
 
 BAD = [

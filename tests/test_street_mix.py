@@ -20,12 +20,12 @@ from generator.layout.routes import MIN_RADIUS_M, make_routes
 from generator.layout.streets import STOP_U, make_grid
 from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
-from generator.traffic.lanes import LaneGraph, boxes_overlap
+from generator.traffic.lanes import LaneGraph
 from generator.traffic.vehicles import conflict_key
-from generator.world.scene import OrientedBox
 from test_one_way import _forward, _on_carriageway
 from test_roundabouts import _radii
 from test_streets import _no_collisions, _rests_on_ground
+from traffic_contacts import assert_no_contact
 
 SECONDS = 20.0
 TRAFFIC = {"cars_per_km": 25, "trucks_per_km": 2, "buses_per_km": 1, "cyclists_per_km": 3,
@@ -75,10 +75,7 @@ def test_traffic_in_a_mixed_town_never_touches():
     world = build_world(spec, scene, SECONDS)
     assert len(world.actors) > 5
     for t in np.arange(0.0, SECONDS, 0.2):
-        q = np.stack([b.corners_xy() for b in world.boxes(t)])
-        ov = boxes_overlap(q, q)
-        np.fill_diagonal(ov, False)
-        assert not ov.any(), f"actors {np.argwhere(ov)[0]} overlap at t={t:.1f}"
+        assert_no_contact(world, t, ego=False)
 
 
 # -- one-way streets with everything else ---------------------------------------------------------
@@ -212,14 +209,9 @@ def test_full_mix_traffic_obeys_one_way_never_touches_and_keeps_out_of_parks(ful
     assert len(vehicles) > 10
     n = 0
     for t in np.arange(0.0, SECONDS, 0.2):
-        q = np.stack([b.corners_xy() for b in world.boxes(t)])
-        ov = boxes_overlap(q, q)
-        np.fill_diagonal(ov, False)
-        assert not ov.any(), f"actors {np.argwhere(ov)[0]} overlap at t={t:.1f}"
+        assert_no_contact(world, t)
         E = world.ego.T_world_ego(t)[0]
         ego_yaw = float(np.arctan2(E[1, 0], E[0, 0]))
-        ego = OrientedBox((E[0, 3], E[1, 3], 0.7), (4.6, 1.9, 1.5), ego_yaw)
-        assert not boxes_overlap(ego.corners_xy()[None], q).any(), f"an actor touches the ego at t={t:.1f}"
         poses = [(a.box(t).center[:2], a.box(t).yaw) for a in vehicles] + [((E[0, 3], E[1, 3]), ego_yaw)]
         for xy, yaw in poses:
             xy = np.asarray(xy, float)
@@ -256,10 +248,7 @@ def test_a_bus_leaving_a_roundabout_keeps_off_a_bus_waiting_at_its_exit_arm():
     scene = build_scene(spec)
     world = build_world(spec, scene, 6.0)
     for t in np.arange(3.0, 6.0, 0.2):
-        q = np.stack([b.corners_xy() for b in world.boxes(t)])
-        ov = boxes_overlap(q, q)
-        np.fill_diagonal(ov, False)
-        assert not ov.any(), f"actors {np.argwhere(ov)[0]} overlap at t={t:.1f}"
+        assert_no_contact(world, t, ego=False)
 
 
 @pytest.mark.blender

@@ -14,7 +14,7 @@ from generator.traffic.build import build_world
 from generator.traffic.lanes import LaneGraph, boxes_overlap
 from generator.world.actors import MOVING_THRESHOLD_MPS, Track
 from generator.world.rig import SWEEP_PERIOD_S, Rig
-from generator.world.scene import OrientedBox
+from traffic_contacts import assert_no_contact, assert_vehicles_miss_people, static_quads
 
 TRAFFIC = {"cars_per_km": 25, "trucks_per_km": 2, "buses_per_km": 1, "cyclists_per_km": 3, "motorcyclists_per_km": 2,
            "other_vehicles_per_km": 1}
@@ -52,16 +52,9 @@ def test_vehicles_exist_move_and_the_ego_is_not_an_actor(town):
 
 def test_no_two_boxes_touch_at_any_time_ego_included(town):
     _, scene, world = town
-    parked = np.stack([o.box.corners_xy() for o in scene.objects if o.instance_id > 0])
+    parked = static_quads(scene)
     for t in _times():
-        q = np.stack([b.corners_xy() for b in world.boxes(t)])
-        ov = boxes_overlap(q, q)
-        np.fill_diagonal(ov, False)
-        assert not ov.any(), f"actors {np.argwhere(ov)[0]} overlap at t={t:.1f}"
-        E = world.ego.T_world_ego(t)[0]
-        ego = OrientedBox((E[0, 3], E[1, 3], 0.7), (4.6, 1.9, 1.5), float(np.arctan2(E[1, 0], E[0, 0])))
-        assert not boxes_overlap(ego.corners_xy()[None], q).any(), f"an actor touches the ego at t={t:.1f}"
-        assert not boxes_overlap(q, parked).any(), f"an actor touches a static object at t={t:.1f}"
+        assert_no_contact(world, t, parked)
 
 
 def test_no_vehicle_ever_touches_a_pedestrian():
@@ -72,11 +65,7 @@ def test_no_vehicle_ever_touches_a_pedestrian():
     vehicles = [a for a in world.actors if a.kind != "person"]
     assert len(people) > 30 and len(vehicles) > 20
     for t in _times():
-        p = np.stack([a.box(t).corners_xy() for a in people])
-        E = world.ego.T_world_ego(t)[0]
-        ego = OrientedBox((E[0, 3], E[1, 3], 0.7), (4.6, 1.9, 1.5), float(np.arctan2(E[1, 0], E[0, 0])))
-        hit = boxes_overlap(np.stack([a.box(t).corners_xy() for a in vehicles] + [ego.corners_xy()]), p)
-        assert not hit.any(), (t, np.argwhere(hit)[:3])
+        assert_vehicles_miss_people(world, t, vehicles, people)
 
 
 def test_vehicles_stay_on_the_driving_lanes(town):
@@ -283,7 +272,7 @@ def test_no_moving_actor_ever_touches_a_static_object(seed, roundabouts, dense):
     world = build_world(spec, scene, 20.0)
     assert "construction_vehicle" in {a.kind for a in world.actors}
     assert bool(make_grid(spec).roundabouts) == (roundabouts > 0)
-    static = np.stack([o.box.corners_xy() for o in scene.objects if o.instance_id > 0])
+    static = static_quads(scene)
     for t in np.arange(0.0, 20.0, 0.1):
         q = np.stack([b.corners_xy() for b in world.boxes(t)])
         hit = boxes_overlap(q, static)
