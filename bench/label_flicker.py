@@ -42,15 +42,15 @@ def _marking_ids():
 def _reference(r, marks) -> tuple[np.ndarray, np.ndarray]:
     """(H, W) float marking coverage and (H, W) bool centre-sample marking, from a 7x render."""
     from generator.blender import geometry, passes, session
-    from generator.blender.materials import label_material, label_world
+    from generator.blender.materials import label_material
     from generator.labels.supersample import _blocks
 
-    session.label_state(r.bscene, label_material(), label_world())
+    session.label_state(r.bscene, label_material())
     geometry.set_proxies_visible(r.handles, True)
     with session.supersampled(r.bscene, REF):
         fine = passes._render(r.bscene, r.scratch / "ref.exr")
     geometry.set_proxies_visible(r.handles, False)
-    cls, _ = passes._integers(fine["Combined"], "reference pass")
+    cls, _ = passes.label_samples(fine, "reference pass")
     b = np.isin(_blocks(cls, REF), marks)
     return b.mean(-1), b[..., (REF * REF) // 2]
 

@@ -240,6 +240,7 @@ class _Labels:
         self.instance = np.zeros((h, w), np.uint32)
         self.instance[h // 2 :, : w // 4] = 7
         self.depth = np.where(np.arange(h)[:, None] < h // 4, np.inf, 5.0 + np.arange(w)[None, :] / 4).astype(np.float32)
+        self.seconds = {"real_pass": 0.01, "label_pass": 0.02}
 
 
 def _class_names():

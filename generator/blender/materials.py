@@ -1,5 +1,5 @@
 """Blender materials: one procedural material per row of the material table, and the
-label-pass override.
+label-pass override (sky needs no label world: it is where the Z pass reports no hit).
 
 The label override is one emission material for every object: colour
 ``(class_id, instance_id, 0)`` from the per-face ``class_id`` attribute and the object
@@ -14,14 +14,12 @@ import logging
 from generator.blender import recipes, recipes_actors, recipes_look
 from generator.blender.bpy_guard import bpy
 from generator.blender.nodes import Nodes
-from generator.labels import class_table
 from generator.materials import material_table
 from generator.rng import stream
 
 log = logging.getLogger(__name__)
 
 LABEL_MATERIAL = "urbangen_label"
-LABEL_WORLD = "urbangen_label_world"
 
 
 def build_materials(seed: int) -> list["bpy.types.Material"]:
@@ -63,20 +61,3 @@ def label_material() -> "bpy.types.Material":
     g.output(g.emission(comb.outputs[0], 1.0))
     mat.cycles.emission_sampling = "NONE"
     return mat
-
-
-def label_world() -> "bpy.types.World":
-    """The label-pass world: the background emits the sky class id."""
-    world = bpy.data.worlds.get(LABEL_WORLD)
-    if world is not None:
-        return world
-    world = bpy.data.worlds.new(LABEL_WORLD)
-    g = Nodes(world.node_tree)
-    bg = g.node("ShaderNodeBackground")
-    g.set(bg.inputs["Color"], (float(class_table().id("sky")), 0.0, 0.0))
-    g.set(bg.inputs["Strength"], 1.0)
-    g.output(bg.outputs[0], "ShaderNodeOutputWorld")
-    # Never sampled as a light (the label pass has no bounces and no BSDFs): no importance map to
-    # build for it on every label render.
-    world.cycles.sampling_method = "NONE"
-    return world

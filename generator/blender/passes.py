@@ -10,6 +10,12 @@
   camera moves, and every pixel still holds one exact class id. The real pass (depth, the
   class a ray through the pixel centre hits) stays at 1x: depth is never voted or blended.
 
+The label state differs from the RGB state only in the view layer's material override,
+Cycles' sampling settings, the proxies' ray visibility and the resolution; the world stays
+(sky is where the Z pass reports no hit). Turning the override on and off makes Cycles
+recompile every shader, so :func:`render_label_batch` renders the label passes of several
+images behind one switch.
+
 Depth is converted from Cycles' planar Z to the distance along the pixel's ray
 (range, metres) so it compares directly with LiDAR range; sky pixels get +inf.
 Background mode has no pixels in "Render Result", so each render is saved with
@@ -21,6 +27,7 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Callable, Sequence
 
 import numpy as np
 import OpenEXR
@@ -28,10 +35,13 @@ import OpenEXR
 from generator.world import rig
 from generator.blender import geometry, session
 from generator.blender.bpy_guard import bpy
-from generator.blender.materials import label_material, label_world
+from generator.blender.materials import label_material
+from generator.labels import class_table
 from generator.labels.supersample import majority_labels
 
 SKY_Z = 1e9
+#: Native class of pixels whose ray hits nothing.
+SKY_CLASS = class_table().id("sky")
 
 
 @dataclass
@@ -88,45 +98,88 @@ def render_rgb(scene, bs: geometry.BlenderScene, cfg, seed: int, scratch: Path) 
     return np.ascontiguousarray(combined[..., :3], np.float32), time.perf_counter() - t
 
 
-def _integers(rgba: np.ndarray, what: str) -> tuple[np.ndarray, np.ndarray]:
+def _integers(rgba: np.ndarray, sky: np.ndarray, what: str) -> tuple[np.ndarray, np.ndarray]:
+    """Class and instance per pixel of a label-material render; ``sky`` pixels (nothing hit) get the
+    sky class and instance 0 (the background shows the RGB world's radiance, which is not a label)."""
     vals = rgba[..., :2]
     ints = np.rint(vals)
-    bad = np.abs(vals - ints) > 1e-3
+    bad = (np.abs(vals - ints) > 1e-3).any(axis=-1) & ~sky
     if bad.any():
         raise RuntimeError(f"{what}: {int(bad.sum())} pixel values are not integers: labels would be blended")
-    return ints[..., 0].astype(np.uint8), ints[..., 1].astype(np.uint16)
+    cls, inst = ints[..., 0].astype(np.uint8), ints[..., 1].astype(np.uint16)
+    cls[sky], inst[sky] = SKY_CLASS, 0
+    return cls, inst
+
+
+def label_samples(chans: dict[str, np.ndarray], what: str = "label pass") -> tuple[np.ndarray, np.ndarray]:
+    """(H, W) uint8 class and (H, W) uint16 instance of one label-material render's channels (as
+    read by :func:`_render`): exact integers, sky where the ray hit nothing."""
+    return _integers(chans["Combined"], _z(chans) >= SKY_Z, what)
+
+
+def _z(chans: dict[str, np.ndarray]) -> np.ndarray:
+    return chans["Depth.Z"] if "Depth.Z" in chans else chans["Z"]
 
 
 def render_labels(scene, bs: geometry.BlenderScene, k: np.ndarray, scratch: Path, supersample: int = 1) -> LabelPasses:
-    """Render the real and label passes for the current camera.
+    """Render the real and label passes for the current camera (:func:`render_label_batch` of one pose)."""
+    return render_label_batch(scene, bs, k, scratch, [lambda: None], supersample)[0]
+
+
+def render_label_batch(scene, bs: geometry.BlenderScene, k: np.ndarray, scratch: Path,
+                       poses: Sequence[Callable[[], object]], supersample: int = 1) -> list[LabelPasses]:
+    """Render the real and label passes of several camera poses with one switch into the label state.
+
+    Switching the scene between the RGB and the label state costs Cycles a re-sync of every
+    shader (the material override on, then off again before the next RGB render), which costs
+    more than the label renders themselves; a batch pays it once. The RGB world stays in
+    place: sky is where the Z pass reports no hit, so the sky model's precomputation is never
+    redone for labels.
 
     Parameters
     ----------
     k : (3, 3) float64
         Camera intrinsics, used to turn planar depth into range along each pixel ray.
+    poses : sequence of callables
+        Each puts the camera (and the actors) where one image is taken; called once before
+        that image's real pass and once before its label pass.
     supersample : int
         Odd factor: the label pass is rendered at ``supersample`` times the resolution and
         reduced by a per-pixel majority vote (1: one sample at each pixel centre).
+
+    Returns
+    -------
+    list of LabelPasses
+        One per pose, in order; ``seconds`` holds the pose's own render times plus an equal
+        share of the batch's state switches (``"switch"``).
     """
-    session.label_state(scene, label_material(), label_world())
-    secs = {}
+    t0 = time.perf_counter()
+    session.label_state(scene, label_material())
     geometry.set_proxies_visible(bs, False)
-    t = time.perf_counter()
-    real = _render(scene, scratch / "real.exr")
-    secs["real_pass"] = time.perf_counter() - t
+    reals, secs = [], [{} for _ in poses]
+    for place, sec in zip(poses, secs):
+        place()
+        t = time.perf_counter()
+        real = _render(scene, scratch / "real.exr")
+        real_class, real_instance = label_samples(real, "real pass")
+        z = _z(real)
+        h, w = real_class.shape
+        depth = (z / rig.pixel_rays(k, w, h)[..., 2]).astype(np.float32)
+        depth[z >= SKY_Z] = np.inf
+        reals.append((real_class, real_instance, depth))
+        sec["real_pass"] = time.perf_counter() - t
     geometry.set_proxies_visible(bs, True)
-    t = time.perf_counter()
+    out = []
     with session.supersampled(scene, supersample):
-        lab = _render(scene, scratch / "label.exr")
-    fine_class, fine_instance = _integers(lab["Combined"], "label pass")
-    del lab
-    class_id, instance = majority_labels(fine_class, fine_instance, supersample)
-    secs["label_pass"] = time.perf_counter() - t
+        for place, sec, (real_class, real_instance, depth) in zip(poses, secs, reals):
+            place()
+            t = time.perf_counter()
+            fine_class, fine_instance = label_samples(_render(scene, scratch / "label.exr"))
+            class_id, instance = majority_labels(fine_class, fine_instance, supersample)
+            sec["label_pass"] = time.perf_counter() - t
+            out.append(LabelPasses(class_id, instance, real_class, real_instance, depth, sec))
     geometry.set_proxies_visible(bs, False)
-    real_class, real_instance = _integers(real["Combined"], "real pass")
-    h, w = real_class.shape
-    z = real["Depth.Z"] if "Depth.Z" in real else real["Z"]
-    cos = rig.pixel_rays(k, w, h)[..., 2]
-    depth = (z / cos).astype(np.float32)
-    depth[z >= SKY_Z] = np.inf
-    return LabelPasses(class_id, instance, real_class, real_instance, depth, secs)
+    switch = (time.perf_counter() - t0 - sum(s["real_pass"] + s["label_pass"] for s in secs)) / max(len(poses), 1)
+    for sec in secs:
+        sec["switch"] = switch
+    return out

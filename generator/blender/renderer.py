@@ -163,6 +163,18 @@ class Renderer:
         """The real and label passes from the current camera (independent of lighting and weather)."""
         return passes.render_labels(self.bscene, self.handles, self.k, self.scratch, self.cfg.label_supersample)
 
+    def render_labels_batch(self, poses) -> list[passes.LabelPasses]:
+        """The real and label passes of several images behind one switch of the render state.
+
+        Parameters
+        ----------
+        poses : sequence of callables
+            Each poses the camera and actors for one image (e.g. :func:`generator.jobs.exposure.expose`
+            bound to its time); see :func:`generator.blender.passes.render_label_batch`.
+        """
+        return passes.render_label_batch(self.bscene, self.handles, self.k, self.scratch, poses,
+                                         self.cfg.label_supersample)
+
     def render(self, T_world_camera: np.ndarray, seed: int, light_info: dict,
                shutter: np.ndarray | None = None) -> RenderedFrame:
         """Render the RGB and label passes from one camera pose (optical frame, world; ``shutter`` as

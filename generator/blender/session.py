@@ -2,8 +2,9 @@
 
 Two render states share one scene: the RGB pass (the config's samples, bounces,
 filter, denoiser, motion blur) and the label pass (1 sample, no bounces, a box filter of
-minimal width, no denoising, no motion blur, the label material and world as view-layer
-overrides).
+minimal width, no denoising, no motion blur, the label material as the view layer's
+material override). A state only writes the override when it changes: Cycles re-syncs every
+shader on each write, even of the same value.
 """
 
 from __future__ import annotations
@@ -99,12 +100,15 @@ def rgb_state(scene: "bpy.types.Scene", cfg: RenderConfig, seed: int) -> None:
         scene.render.motion_blur_shutter = motion.SHUTTER_FRAMES
         scene.render.motion_blur_position = "CENTER"
     vl = scene.view_layers[0]
-    vl.material_override = None
-    vl.world_override = None
+    if vl.material_override is not None:
+        vl.material_override = None
 
 
-def label_state(scene: "bpy.types.Scene", material, world) -> None:
-    """Settings of the label pass: exact integers per pixel."""
+def label_state(scene: "bpy.types.Scene", material) -> None:
+    """Settings of the label pass: exact integers per pixel (``material`` emits them).
+
+    The world is left as it is: what the camera sees of it is sky, told apart by the Z pass.
+    """
     c = scene.cycles
     c.samples = 1
     c.use_adaptive_sampling = False
@@ -116,8 +120,8 @@ def label_state(scene: "bpy.types.Scene", material, world) -> None:
     c.seed = 0
     scene.render.use_motion_blur = False  # labels at the image instant: never blended
     vl = scene.view_layers[0]
-    vl.material_override = material
-    vl.world_override = world
+    if vl.material_override != material:
+        vl.material_override = material
 
 
 @contextmanager
@@ -125,18 +129,16 @@ def supersampled(scene: "bpy.types.Scene", k: int):
     """Render at ``k`` times the configured resolution inside the block (label pass).
 
     The image plane and field of view are unchanged, so with ``k`` odd the middle sample of
-    every ``k x k`` block is the centre of the pixel it belongs to. The depth pass is switched
-    off meanwhile: only the real pass (at 1x) provides depth, and a ``k``-times larger Z
-    buffer would only cost memory.
+    every ``k x k`` block is the centre of the pixel it belongs to. The depth pass stays on: it
+    tells the sky samples apart.
     """
     if k == 1:
         yield
         return
-    r, vl = scene.render, scene.view_layers[0]
-    percentage, z = r.resolution_percentage, vl.use_pass_z
+    r = scene.render
+    percentage = r.resolution_percentage
     r.resolution_percentage = percentage * k
-    vl.use_pass_z = False
     try:
         yield
     finally:
-        r.resolution_percentage, vl.use_pass_z = percentage, z
+        r.resolution_percentage = percentage

@@ -30,6 +30,7 @@ own (:func:`generator.weather.lidar_combination`): the images show what the scan
 
 from __future__ import annotations
 
+import functools
 import time
 from pathlib import Path
 
@@ -107,9 +108,11 @@ def render_pair(renderer, spec, cfg, rig, sensor, index: int, seq_dir: Path) -> 
     to_cs = class_table().to_cityscapes
     stem = f"{index:06d}"
     images, exposure = {}, None
-    for cam in CAMERAS:
-        T_world_camera = expose(renderer, rig, t_exp, rig.T_ego_stereo(cam))
-        labels = renderer.render_labels()
+    # both cameras' label passes behind one switch of the render state (see render_label_batch)
+    poses = [functools.partial(expose, renderer, rig, t_exp, rig.T_ego_stereo(cam)) for cam in CAMERAS]
+    pair_labels = renderer.render_labels_batch(poses)
+    for cam, pose, labels in zip(CAMERAS, poses, pair_labels):
+        T_world_camera = pose()
         rgb, _ = renderer.render_rgb(seed=child_seed(spec.seed, "frame", index, "stereo", cam))
         img, weather = weather_post(spec, index, tod, kind, rgb, labels.depth, renderer.k, ("stereo", cam),
                                     light_level(light))

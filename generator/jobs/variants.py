@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import time
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
@@ -24,6 +25,11 @@ from generator.jobs.images import write_image
 from generator.rng import child_seed, stream
 from generator.weather import (DEFAULT_TIMES, TIMES, combinations, draw_lighting, draw_weather, frame_wetness, has_fog,
                                has_rain, light_level, render_key)
+
+#: Memory a worker may hold in finished label arrays of a batch (see :func:`label_batch_size`).
+LABEL_BATCH_BYTES = 256 * 2**20
+#: Most frames in one label batch: a worker's first RGB image waits for its batch's labels.
+LABEL_BATCH_MAX = 16
 
 
 def parse_combos(text: str, times=DEFAULT_TIMES) -> list[tuple[str, str]]:
@@ -136,26 +142,62 @@ def camera_post(spec, cfg, frame_index: int, time_of_day: str, kind: str, rgb: n
     return apply_camera(rgb, params, g, exposure)
 
 
-def render_frame(renderer, spec, cfg, frame, out: Path, combos: list[tuple[str, str]], rig=None) -> dict[str, dict]:
+def pose_for(renderer, frame, rig=None) -> Callable[[], None]:
+    """A callable that poses ``renderer`` for ``frame``: exposed at ``frame.t`` on the drive's
+    timeline with ``rig`` (:func:`generator.jobs.exposure.expose`), else the camera at
+    ``frame.T_world_camera`` as is."""
+    if rig is None:
+        return lambda: renderer.place_camera(frame.T_world_camera)
+    return lambda: expose(renderer, rig, frame.t, frame.T_ego_camera)
+
+
+def label_batch_size(cfg) -> int:
+    """How many frames' label passes a worker renders behind one switch of the render state: as
+    many as fit :data:`LABEL_BATCH_BYTES` of finished label arrays, 1..:data:`LABEL_BATCH_MAX`."""
+    per_frame = cfg.width * cfg.height * (1 + 2 + 1 + 2 + 4)   # class, instance, real class, real instance, depth
+    return int(max(1, min(LABEL_BATCH_MAX, LABEL_BATCH_BYTES // per_frame)))
+
+
+def render_frames(renderer, spec, cfg, frames, out: Path, combos: list[tuple[str, str]], rig=None):
+    """Render and write every variant of each of ``frames``, the label passes of
+    :func:`label_batch_size` frames at a time (Cycles recompiles every shader when it switches
+    between the RGB and the label state, so switching once per batch instead of twice per frame
+    saves most of the labels' cost; the images are the same either way).
+
+    Yields
+    ------
+    (frame, dict)
+        Each frame, in order, with what :func:`render_frame` returns for it.
+    """
+    frames = list(frames)
+    n = label_batch_size(cfg)
+    for i in range(0, len(frames), n):
+        batch = frames[i:i + n]
+        labels = renderer.render_labels_batch([pose_for(renderer, f, rig) for f in batch])
+        for frame, lab in zip(batch, labels):
+            yield frame, render_frame(renderer, spec, cfg, frame, out, combos, rig, lab)
+
+
+def render_frame(renderer, spec, cfg, frame, out: Path, combos: list[tuple[str, str]], rig=None,
+                 labels=None) -> dict[str, dict]:
     """Render and write every variant in ``combos`` of ``frame``.
 
     With ``rig`` (a :class:`generator.world.rig.Rig`), the image is exposed at ``frame.t`` on the
     drive's timeline (:func:`generator.jobs.exposure.expose`: the world's actors where their tracks
     are then, the camera moving over the shutter when motion blur is on) and its metadata gets the
-    ``motion`` record; without, the camera is put at ``frame.T_world_camera`` as is.
+    ``motion`` record; without, the camera is put at ``frame.T_world_camera`` as is. ``labels``
+    (:class:`generator.blender.passes.LabelPasses`) are this frame's label passes if already
+    rendered (:func:`render_frames`); None renders them here.
 
     Returns
     -------
     dict
         Image name -> seconds per stage.
     """
-    t = time.perf_counter()
-    if rig is None:
-        renderer.place_camera(frame.T_world_camera)
-    else:
-        expose(renderer, rig, frame.t, frame.T_ego_camera)
-    labels = renderer.render_labels()
-    label_s = time.perf_counter() - t
+    pose_for(renderer, frame, rig)()
+    if labels is None:
+        labels = renderer.render_labels()
+    label_s = sum(labels.seconds.values())
     motion = None if rig is None else motion_record(renderer, frame.t, labels.instance)
     timings = {}
     for tod, wet, overcast in renders_needed(combos):

@@ -74,7 +74,7 @@ def run(job, queue) -> None:
 def _run(job, queue, scratch: Path) -> None:
     from generator.blender.renderer import Renderer  # imports bpy (after the sys.path clean-up)
     from generator.jobs.towns import local_frame
-    from generator.jobs.variants import render_frame
+    from generator.jobs.variants import render_frames
     from generator.layout import build_scene
     from generator.world.rig import Rig
 
@@ -88,8 +88,9 @@ def _run(job, queue, scratch: Path) -> None:
     queue.put(("ready", {"layout_s": layout_s, "blender_build_s": renderer.build_seconds, "pid": os.getpid()}))
 
     t_start = time.perf_counter()
-    for n, index in enumerate(job.frames, 1):
-        images = render_frame(renderer, spec, cfg, local_frame(rig, index, job.first), Path(job.out), job.combos, rig)
+    frames = [local_frame(rig, index, job.first) for index in job.frames]
+    for n, (index, (_, images)) in enumerate(zip(job.frames, render_frames(renderer, spec, cfg, frames, Path(job.out),
+                                                                            job.combos, rig)), 1):
         queue.put(("frame", index, {"images": images, "rss_mb": _rss_mb(), "frames_done": n}))
     if job.stereo:
         from generator.jobs.stereo import render_pair
