@@ -71,7 +71,8 @@ def test_signal_heads_face_exactly_the_approaches_traffic_takes(town):
         entering = _entering_arms(graph, node)
         got = heads.get(node, [])
         assert sorted(got) == sorted(set(got)), f"two heads for one approach at {node}"
-        assert set(got) == entering, f"node {node}: heads face arms {sorted(got)}, traffic enters from {sorted(entering)}"
+        assert set(got) == entering, \
+            f"node {node}: heads face arms {sorted(got)}, traffic enters from {sorted(entering)}"
         leaving_only += len(set(grid.arms(node)) - entering)
     assert leaving_only > 0, "no one-way street leaves a signalised node: the test would check nothing new"
 
@@ -120,7 +121,8 @@ def test_one_way_streets_carry_one_way_signs_at_entry_and_no_entry_at_exit(town)
         seg, u, v = where
         d = grid.section(seg).one_way
         assert d, f"{o.name}: a {kind} sign on a two-way street"
-        assert abs(o.transform[2, 3] - grid.curb_h) < 1e-9 and grid.ground_height(o.transform[:2, 3][None])[0] == grid.curb_h
+        assert abs(o.transform[2, 3] - grid.curb_h) < 1e-9             # at curb height, on raised ground
+        assert grid.ground_height(o.transform[:2, 3][None])[0] == grid.curb_h
         face = np.array([o.transform[0, 0], o.transform[1, 0]])       # local +x: the face's normal
         flow = d * np.array([np.cos(seg.yaw), np.sin(seg.yaw)])
         from_entry = u if d > 0 else seg.length - u

@@ -58,5 +58,6 @@ def block_paving(g: Nodes, rng: np.random.Generator):
     wear = g.noise(co, scale=0.3, detail=2)
     base = g.mix(g.mul(g.smooth(wear, 0.5, 0.75), 0.35), blocks, (0.24, 0.22, 0.2))
     base = g.mix(g.mul(grain, 0.2), base, (0.1, 0.09, 0.085))
-    color, rough, normal = wet_surface(g, base, 0.85, g.bump(g.add(g.mul(joints, -1.0), g.mul(grain, 0.1)), 0.35, 0.004))
+    relief = g.add(g.mul(joints, -1.0), g.mul(grain, 0.1))          # joints sunk, faces slightly rough
+    color, rough, normal = wet_surface(g, base, 0.85, g.bump(relief, 0.35, 0.004))
     return g.principled(base_color=color, roughness=rough, normal=normal)
