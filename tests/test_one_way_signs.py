@@ -181,3 +181,20 @@ def test_regulatory_sign_faces_look_plus_x_with_the_symbol_on_them():
         assert (sv[:, 1:].min(0) > fv[:, 1:].min(0)).all() and (sv[:, 1:].max(0) < fv[:, 1:].max(0)).all()
         plate = np.isin(m.face_material, [mats.id(face), mats.id("sign_symbol"), mats.id("sign_back")])
         assert (m.face_class[plate] == class_table().id("traffic_sign")).all()
+
+
+def test_no_moving_actor_touches_a_one_way_sign():
+    """With traffic and pedestrians (20 s, every 0.2 s), no vehicle, rider or pedestrian box
+    overlaps the footprint of a one-way or no-entry sign (pedestrians walk round them)."""
+    from generator.traffic.build import build_world
+    from generator.traffic.lanes import boxes_overlap
+    from test_street_mix import TRAFFIC
+
+    spec = full_spec(3, traffic={**TRAFFIC, "pedestrians_per_100m": 3.0})
+    scene = build_scene(spec)
+    world = build_world(spec, scene, 20.0)
+    signs = np.stack([o.box.corners_xy() for o in scene.objects if _face_kind(scene, o)])
+    assert len(signs) >= 10 and sum(a.kind == "person" for a in world.actors) >= 20
+    for t in np.arange(0.0, 20.0, 0.2):
+        q = np.stack([a.box(t).corners_xy() for a in world.actors])
+        assert not boxes_overlap(q, signs).any(), f"an actor touches a sign at t = {t:.1f} s"
