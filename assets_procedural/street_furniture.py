@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from assets_procedural.regulatory_signs import REGULATORY, SYMBOL_DEPTH_M, SYMBOL_MATERIAL, face_of
 from generator.geometry import Mesh, box, cylinder, disc, merge, pose, prism, tube
 
 X = np.array([1.0, 0.0, 0.0])
@@ -139,27 +140,35 @@ def traffic_sign(rng: np.random.Generator, shape: str = "circle") -> Mesh:
 
     Parameters
     ----------
-    shape : {"circle", "triangle", "square", "octagon", "diamond"}
-        Plate outline; its size (0.6-0.9 m across) is drawn from the rng.
+    shape : {"circle", "triangle", "square", "octagon", "diamond", "one_way", "no_entry"}
+        Plate outline; its size (0.5-0.9 m across) is drawn from the rng. ``one_way`` and
+        ``no_entry`` are the regulatory signs of one-way streets
+        (:mod:`assets_procedural.regulatory_signs`): a blue or red face with a white symbol on it.
 
     Returns
     -------
     Mesh
         Pole class ``pole``; plate class ``traffic_sign`` with the +x face ``sign_face``
-        (retroreflective) and back and rim ``sign_back``.
+        (retroreflective; ``sign_blue`` / ``sign_red`` under a ``sign_symbol`` plate for the
+        regulatory shapes) and back and rim ``sign_back``.
     """
-    outline = _sign_shape(shape, 1.0)
-    size = float(rng.uniform(*SIGN_SIZES[shape]))
-    outline = outline * size
+    symbols: list[np.ndarray] = []
+    if shape in REGULATORY:
+        outline, face, symbols = face_of(shape, rng)
+    else:
+        outline = _sign_shape(shape, 1.0) * float(rng.uniform(*SIGN_SIZES[shape]))
+        face = "sign_face"
     pole_h = float(rng.uniform(2.2, 2.8))
     r = 0.03
     zc = pole_h - 0.1 - outline[:, 1].max()
     # prism extrudes along z with its top cap facing +z; the rotation maps +z -> +x and
     # prism coordinates (px, py) -> (y, z) = (py, -px), so feed (px, py) = (-z, y)
+    to_plate = pose(r + 0.03, 0.0, zc, pitch=np.pi / 2)
     plate = prism(np.stack([-outline[:, 1], outline[:, 0]], 1), 0.0, 0.02, "traffic_sign", "sign_back",
-                  top_material="sign_face", bottom=True)
-    plate = plate.transformed(pose(r + 0.03, 0.0, zc, pitch=np.pi / 2))
-    parts = [cylinder(r, pole_h, "pole", "pole_metal", 8), plate,
+                  top_material=face, bottom=True).transformed(to_plate)
+    marks = [prism(np.stack([-o[:, 1], o[:, 0]], 1), 0.02, 0.02 + SYMBOL_DEPTH_M, "traffic_sign",
+                   SYMBOL_MATERIAL).transformed(to_plate) for o in symbols]
+    parts = [cylinder(r, pole_h, "pole", "pole_metal", 8), plate, *marks,
              box((0.04, 0.06, 0.04), "pole", "pole_metal", (r + 0.015, 0.0, zc + 0.6 * outline[:, 1].max())),
              box((0.04, 0.06, 0.04), "pole", "pole_metal", (r + 0.015, 0.0, zc + 0.6 * outline[:, 1].min()))]
     return merge(parts)

@@ -78,6 +78,27 @@ def test_shared_surface_is_paved_road_without_lane_markings(town):
         assert np.isclose(span[:, 0].min(), 0.0) and np.isclose(span[:, 0].max(), seg.length)
 
 
+def test_shared_paving_is_its_own_surface_not_the_sidewalks(town):
+    """The shared carriageway's paving is a material no sidewalk, curb or other road surface of the
+    town uses, with a colour of its own (so the camera and the LiDAR tell it from the pavement)."""
+    spec, grid, scene = town
+    table, mats = class_table(), material_table()
+    shared = {f"street_{s.index:04d}" for s in grid.segments if grid.section(s).kind == "shared"}
+    paving, elsewhere = set(), set()
+    for o in scene.objects:
+        if o.kind not in ("street", "sidewalk", "intersection", "corner"):
+            continue
+        m = scene.prototypes[o.prototype]
+        for cls in ("road", "sidewalk", "curb"):
+            ids = set(np.unique(m.face_material[m.face_class == table.id(cls)]).tolist())
+            (paving if o.name in shared and cls == "road" else elsewhere).update(ids)
+    assert paving == {mats.id(SURFACE)}
+    assert not paving & elsewhere, [mats.rows[i].name for i in paving & elsewhere]
+    colour = mats.colors[mats.id(SURFACE)].astype(int)
+    for other in ("sidewalk_concrete", "curb_concrete", "asphalt"):
+        assert np.abs(colour - mats.colors[mats.id(other)]).max() >= 40, other
+
+
 def test_bollards_line_the_strips_and_nothing_parks_there(town):
     spec, grid, scene = town
     per_strip: dict = {}

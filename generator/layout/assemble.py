@@ -2,7 +2,7 @@
 
 Order of work (each feature draws from its own named stream, so adding one does not
 shift the others): grid -> routes -> lots (blocks, then the band outside the ring road)
--> buildings -> hedges/fences -> traffic lights
+-> buildings -> hedges/fences -> traffic lights -> one-way signs
 -> lamps -> street trees -> verge hedges, bushes and trees -> signs -> lot greenery -> parked vehicles -> lane cars ->
 people -> ground objects. Objects accepted earlier win space; everything keeps clear of
 the routes (see :mod:`generator.layout.placement_core`). Finally the routes are verified
@@ -20,6 +20,7 @@ import numpy as np
 from generator.geometry import Mesh, pose
 from generator.labels import class_table
 from generator.layout import placement_lots as pl
+from generator.layout import placement_one_way as pw
 from generator.layout import placement_extras as px
 from generator.layout import placement_street as ps
 from generator.layout import placement_tracks as pt
@@ -44,6 +45,8 @@ STEPS = (
     ("buildings", lambda p, s, g, lots, st: pl.place_buildings(p, s, lots, g.curb_h)),
     ("hedges and fences", lambda p, s, g, lots, st: pl.place_fronts(p, s, lots, g.curb_h)),
     ("traffic lights", lambda p, s, g, lots, st: ps.place_traffic_lights(p, s, st)),
+    # one-way streets' "one way" and "no entry" signs (a no-op without one-way streets)
+    ("one-way signs", lambda p, s, g, lots, st: pw.place_one_way_signs(p, s, st)),
     ("lamp posts", lambda p, s, g, lots, st: ps.place_lamps(p, s, st)),
     ("street trees", lambda p, s, g, lots, st: ps.place_street_trees(p, s, st)),
     # verges exist only in towns with a streets spec (no-ops otherwise)

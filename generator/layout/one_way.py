@@ -155,6 +155,28 @@ def one_way_directions(seed: int, segments: Sequence, candidates: Sequence[int],
     return out
 
 
+def arriving_arms(grid, node: tuple[int, int]) -> list[int]:
+    """Arms of ``node`` (0 east, 1 north, 2 west, 3 south) along which traffic arrives at it.
+
+    Every open arm of a two-way street; the arm of a one-way street only at the node its traffic
+    runs to (at its other end vehicles only leave the node, so nothing approaches there).
+
+    Parameters
+    ----------
+    grid : Grid
+    node : tuple of int
+        Intersection ``(i, j)``.
+    """
+    from generator.layout.streets import ARM_STEP
+
+    out = []
+    for d in grid.arms(node):
+        seg, sense = grid.segment_between(node, (node[0] + ARM_STEP[d][0], node[1] + ARM_STEP[d][1]))
+        if grid.section(seg).one_way * sense <= 0:    # sense +1: leaving node along arm d is +u
+            out.append(d)
+    return out
+
+
 def one_way_marks(grid, direction: int, length: float, dashes) -> list[np.ndarray]:
     """Lane markings of a one-way segment (segment frame, ``(u0, v0, u1, v1)`` rectangles, metres).
 

@@ -13,6 +13,7 @@ import logging
 import numpy as np
 
 from generator.layout.appearance import fleet_paint, outfit
+from generator.layout.one_way import arriving_arms
 from generator.layout.placement_core import Placer, Proto
 from generator.layout.placement_lots import N_TREE_VARIANTS, tree_variant
 from generator.layout.placement_parks import plant_parks
@@ -60,7 +61,8 @@ class Street:
 
 def place_traffic_lights(placer: Placer, spec: SceneSpec, st: Street) -> None:
     """One signal per approach on its near-right corner, facing the approaching traffic (at a
-    roundabout a round sign instead, and bushes on its island)."""
+    roundabout a round sign instead, and bushes on its island). The arm of a one-way street that
+    runs away from the node is no approach and gets no head (:func:`arriving_arms`)."""
     grid = st.grid
     protos = [placer.lib.variant("traffic_light", i, lambda g: {"arm": 0.0}) for i in range(N_TL)]
     q = st.kerb_line
@@ -70,7 +72,7 @@ def place_traffic_lights(placer: Placer, spec: SceneSpec, st: Street) -> None:
             plant_island(placer, grid, node, spec.seed, st.h)
             continue
         c = grid.node_xy(node)
-        for d in grid.arms(node):
+        for d in arriving_arms(grid, node):
             yaw = d * np.pi / 2
             e = np.array([np.cos(yaw), np.sin(yaw)])
             left = np.array([-e[1], e[0]])

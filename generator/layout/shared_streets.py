@@ -4,8 +4,9 @@ A segment of cross-section type ``shared`` (:mod:`generator.layout.cross_section
 grid's kerb-to-kerb width and two-way lanes (so intersections, the lane graph and the routes
 are unchanged), but:
 
-* its whole carriageway is paved (material ``sidewalk_concrete``, the pavers' look and their
-  ~0.3 LiDAR reflectivity) instead of asphalt, and it stays class ``road``: vehicles drive on
+* its whole carriageway is paved (material ``block_paving``: small red-brown and grey concrete
+  blocks in stretcher bond, ~0.28 LiDAR reflectivity; not the sidewalks' square grey slabs, so a
+  camera tells the carriageway from the pavement) instead of asphalt, and it stays class ``road``: vehicles drive on
   it, which is what Cityscapes (7 road, "part of ground on which cars usually drive") and
   SemanticKITTI (40 road) call road; the strips behind the bollards would be *sidewalk* by
   Cityscapes' rule ("delimited from the road by some obstacle, such as curbs or poles"), but
@@ -30,7 +31,7 @@ import numpy as np
 from generator.layout.streets import BAY_M, PARKING_START_U, STOP_U
 from generator.rng import stream
 
-SURFACE = "sidewalk_concrete"    #: material of the paved carriageway (class road)
+SURFACE = "block_paving"         #: material of the paved carriageway (class road)
 SHARED_SPEED_MPS = 20.0 / 3.6   #: vehicles' speed limit on a shared street (20 km/h)
 BOLLARD_SPACING_M = 4.0         #: bollards along each furnished strip
 PEOPLE_PER_100M = 6.0           #: frozen town: people on a shared carriageway per 100 m

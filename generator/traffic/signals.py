@@ -8,6 +8,11 @@ enters the node; a vehicle may only enter while the next walk phase is at least
 A pedestrian steps onto a crosswalk only while the walk phase has time left for the whole
 crossing. Both rules are pure functions of (node, time), so vehicles and pedestrians never
 need to see each other to stay apart on a crosswalk.
+
+The phases belong to the node, not to its approaches: there is no green per arm, so a one-way
+street that only leaves a node (no approach, no signal head there:
+:func:`generator.layout.one_way.arriving_arms`) has no phase to remove either; vehicles only ever
+wait at the stop lines of the arms the lane graph enters the node from.
 """
 
 from __future__ import annotations
