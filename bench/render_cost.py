@@ -1,16 +1,15 @@
-"""Cost of wet renders and of the label passes, before and after issue 14 (items 5 and 6), side by side.
+"""Cost of wet renders before and after issue 14 (item 5), side by side. (The label passes' cost is measured in the
+worker's order, batched, by ``bench/label_cost.py``.)
 
 One process, one town, the same camera poses, two Blender scenes built one after the other:
 
 * before: the wet shader as it was (4D puddle noise, two 4D Voronoi ripple fields, the puddle
-  mask inside the bump height -- :func:`legacy_wet_surface` below is a verbatim copy) and the
-  label pass at 1 sample per pixel;
-* after: the shipped wet shader (:mod:`generator.blender.wet`) and the label pass of the
-  config (``label_supersample``, also timed at 1x).
+  mask inside the bump height -- :func:`legacy_wet_surface` below is a verbatim copy);
+* after: the shipped wet shader (:mod:`generator.blender.wet`).
 
 Per pose the RGB pass is rendered dry, wet, dry, wet (the production order switches shaders
 between them, so each render pays its shader recompile) and the medians are printed, with
-wet / dry and (real + label passes) / dry RGB. ``--diagnose`` adds both scenes at 0 bounces:
+wet / dry. ``--diagnose`` adds both scenes at 0 bounces:
 if the wet/dry ratio stays there, the cost is shading, not light paths.
 
     python bench/render_cost.py [--config preview] [--poses 2] [--diagnose] [--time-of-day night]
@@ -46,7 +45,7 @@ def legacy_wet_surface(g, color, roughness, normal=None, puddles: bool = True):
     return color, roughness, normal
 
 
-def _phase(name, wet_fn, scene, spec, cfg, poses, factors, keep: dict | None, diagnose: bool, tod: str) -> dict:
+def _phase(name, wet_fn, scene, spec, cfg, poses, keep: dict | None, diagnose: bool, tod: str) -> dict:
     from generator.blender import passes, recipes, session
     from generator.blender.renderer import Renderer
     from generator.weather import draw_lighting, frame_wetness
@@ -57,7 +56,7 @@ def _phase(name, wet_fn, scene, spec, cfg, poses, factors, keep: dict | None, di
         r = Renderer(scene, spec, cfg, Path(tempfile.mkdtemp(prefix="ug_cost_")))
     finally:
         recipes.wet_surface = shipped
-    out = {"dry": [], "wet": [], **{f"labels_{k}x": [] for k in factors}}
+    out = {"dry": [], "wet": []}
     for f in poses:
         light = draw_lighting(spec, f.index, tod)
         wetness, puddles = frame_wetness(spec, f.index)
@@ -71,9 +70,6 @@ def _phase(name, wet_fn, scene, spec, cfg, poses, factors, keep: dict | None, di
                 out[kind].append(s)
                 if keep is not None and f is poses[0]:
                     keep[f"{name}_{kind}"] = rgb
-        for k in factors:
-            lab = passes.render_labels(r.bscene, r.handles, r.k, r.scratch, k)
-            out[f"labels_{k}x"].append(lab.seconds["real_pass"] + lab.seconds["label_pass"])
         if diagnose:
             flat = dataclasses.replace(cfg, max_bounces=0)
             for kind, w in (("dry", 0.0), ("wet", wetness)):
@@ -123,22 +119,18 @@ def main() -> None:
     scene = build_scene(spec)
     rig = Rig.from_spec(spec, scene)
     poses = [rig.frame(a.first + 7 * i) for i in range(a.poses)]
-    factors = sorted({1, cfg.label_supersample})
     images: dict = {}
-    res = {"before": _phase("before", legacy_wet_surface, scene, spec, cfg, poses, [1], images, a.diagnose, a.time_of_day),
-           "after": _phase("after", wet_surface, scene, spec, cfg, poses, factors, images, a.diagnose, a.time_of_day)}
+    res = {"before": _phase("before", legacy_wet_surface, scene, spec, cfg, poses, images, a.diagnose, a.time_of_day),
+           "after": _phase("after", wet_surface, scene, spec, cfg, poses, images, a.diagnose, a.time_of_day)}
     print(f"{cfg.name} {cfg.width}x{cfg.height}, {cfg.samples} spp, {a.time_of_day}, {a.poses} poses x 2 renders each, medians (s)")
-    print(f"{'':<8}{'dry RGB':>9}{'wet RGB':>9}{'wet/dry':>9}" + "".join(f"{'labels ' + str(k) + 'x':>12}{'/dry':>7}" for k in factors)
+    print(f"{'':<8}{'dry RGB':>9}{'wet RGB':>9}{'wet/dry':>9}"
           + (f"{'dry 0b':>9}{'wet 0b':>9}{'ratio':>7}" if a.diagnose else ""))
     for name, m in res.items():
         line = f"{name:<8}{m['dry']:>9.2f}{m['wet']:>9.2f}{m['wet'] / m['dry']:>9.2f}"
-        for k in factors:
-            lk = m.get(f"labels_{k}x")
-            line += f"{lk:>12.2f}{lk / m['dry']:>7.1%}" if lk is not None else f"{'-':>12}{'-':>7}"
         if a.diagnose:
             line += f"{m['dry_0_bounces']:>9.2f}{m['wet_0_bounces']:>9.2f}{m['wet_0_bounces'] / m['dry_0_bounces']:>7.2f}"
         print(line)
-    print("labels = real pass + label pass (incl. the majority vote); the machine's load is shared, compare within a run.")
+    print("the machine's load is shared: compare within a run.")
     _look(Path(a.png), images)
     print(f"wrote {a.png}")
 
