@@ -89,7 +89,8 @@ def build_world(spec, scene, duration_s: float, distance_m: float = 0.0) -> Worl
             break
         horizon_s = 2.0 * crossing.asked_s  # same answers up to the old horizon (causal): a longer run, same world
         graph = LaneGraph(grid)
-    peds = [_lead_in(_extend_track(p, len(ego_dist))) for p in peds]
+    peds = [_lead_in(_extend_track(p, len(ego_dist)), grid.ground_height if p.attrs.get("role") == "walking" else None)
+            for p in peds]
     world = _assemble(scene, movers + peds, TrackTrajectory(ego_track, ego_dist), ego_track.t1)
     log.info("traffic %s: %d vehicles, %d pedestrians over %.1f s, simulated in %.2f s", spec.name, len(movers),
              len(peds), ego_track.t1, time.perf_counter() - t_start)
@@ -104,14 +105,18 @@ def _pedestrians(spec, grid, scene, signals, lib, n_steps: int) -> list[Mover]:
     return simulate_pedestrians(spec, grid, scene, signals, lib, n_steps, DT_S)
 
 
-def _lead_in(m: Mover) -> Mover:
-    """Prepend :data:`LEAD_IN` samples before t = 0 at the first step's velocity, so central
-    differences at t = 0 see the motion (a walker already walking) instead of a clamped track."""
+def _lead_in(m: Mover, ground=None) -> Mover:
+    """Prepend :data:`LEAD_IN` samples before t = 0 at the first step's horizontal velocity, so
+    central differences at t = 0 see the motion (a walker already walking) instead of a clamped
+    track. Their height is ``ground(xy)`` ((n, 2) -> (n,) metres: a walker's feet on the ground
+    there, :func:`generator.traffic.pedestrians.feet_height`), or the first sample's without it;
+    extrapolating a step up the kerb would sink the feet below the road."""
     tr = m.track
     if tr.t0 <= -LEAD_IN * DT_S + 1e-12 or len(tr.yaw) < 2:
         return m
     step = tr.xyz[1] - tr.xyz[0]
     back = tr.xyz[0] - step * np.arange(LEAD_IN, 0, -1)[:, None]
+    back[:, 2] = tr.xyz[0, 2] if ground is None else ground(back[:, :2])
     m.track = Track(tr.t0 - LEAD_IN * DT_S, tr.dt, np.vstack([back, tr.xyz]), np.r_[np.repeat(tr.yaw[:1], LEAD_IN), tr.yaw])
     return m
 
