@@ -14,7 +14,7 @@ from generator.traffic.build import build_world
 from generator.traffic.lanes import LaneGraph, boxes_overlap
 from generator.world.actors import MOVING_THRESHOLD_MPS, Track
 from generator.world.rig import SWEEP_PERIOD_S, Rig
-from traffic_contacts import assert_no_contact, assert_vehicles_miss_people, static_quads
+from traffic_contacts import assert_no_contact, assert_vehicles_miss_people, ego_box, static_quads
 
 TRAFFIC = {"cars_per_km": 25, "trucks_per_km": 2, "buses_per_km": 1, "cyclists_per_km": 3, "motorcyclists_per_km": 2,
            "other_vehicles_per_km": 1}
@@ -277,3 +277,22 @@ def test_no_moving_actor_ever_touches_a_static_object(seed, roundabouts, dense):
         q = np.stack([b.corners_xy() for b in world.boxes(t)])
         hit = boxes_overlap(q, static)
         assert not hit.any(), f"{world.actors[np.argwhere(hit)[0][0]].name} touches a static object at t={t:.1f}"
+
+
+@pytest.mark.parametrize("seed", [0, 1, 4])
+def test_no_vehicle_touches_a_person_in_roundabout_towns_with_excavators(seed):
+    """Over 30 s of 3 x 3 towns with half the interior nodes roundabouts and excavators driving, no
+    vehicle's box (nor the ego's) touches a walking or standing person, nor a person of the static
+    town (an excavator once touched a person at seed 0 with ``roundabouts: 0.5``, slewed 3-6 m wide)."""
+    spec = _sweep_town(seed, 0.5)
+    scene = build_scene(spec)
+    world = build_world(spec, scene, 30.0)
+    assert make_grid(spec).roundabouts
+    people = [a for a in world.actors if a.kind == "person"]
+    vehicles = [a for a in world.actors if a.kind != "person"]
+    assert "construction_vehicle" in {a.kind for a in vehicles} and len(people) > 20
+    static_people = np.stack([o.box.corners_xy() for o in scene.objects if o.instance_id > 0 and o.cls == "person"])
+    for t in np.arange(0.0, 30.0, 0.1):
+        assert_vehicles_miss_people(world, t, vehicles, people)
+        q = np.stack([a.box(t).corners_xy() for a in vehicles] + [ego_box(world, t).corners_xy()])
+        assert not boxes_overlap(q, static_people).any(), f"a vehicle touches a person of the static town at t={t:.1f}"

@@ -210,7 +210,9 @@ def test_motion_is_continuous_with_bounded_speed_acceleration_and_turn_rate(town
     v = np.diff(xyz[walking, :, :2], axis=1) / DT_S
     speed = np.linalg.norm(v, axis=2)
     assert speed.max() <= max_speed(town[0]) + 1e-6                        # no teleports
-    assert np.abs(np.diff(xyz[..., 2], axis=1)).max() < 0.03               # feet follow the curb smoothly
+    ground = town[1].ground_height(xyz[..., :2].reshape(-1, 2)).reshape(xyz.shape[:2])
+    assert np.array_equal(xyz[..., 2], ground)                             # feet on the ground: a kerb is a step
+    assert set(np.round(np.abs(np.diff(xyz[..., 2], axis=1)), 9).ravel()) <= {0.0, round(town[1].curb_h, 9)}
     tangential = np.diff(speed, axis=1) / DT_S
     assert tangential.max() <= walk_net.A_MAX + 0.05 and tangential.min() >= -walk_net.B_MAX - 0.05
     total = np.linalg.norm(np.diff(v, axis=1), axis=2) / DT_S

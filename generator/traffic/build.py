@@ -23,6 +23,7 @@ from generator.layout.appearance import fleet_paint
 from generator.layout.streets import make_grid
 from generator.rng import stream
 from generator.traffic.fleet import fleet_proto
+from generator.traffic.lane_clearance import MARGIN_M, blocked_lanes, too_narrow, widest_half_width
 from generator.traffic.lanes import LaneGraph
 from generator.traffic.movers import DT_S, Mover
 from generator.traffic.signals import CLEAR_S, Signals
@@ -77,19 +78,22 @@ def build_world(spec, scene, duration_s: float, distance_m: float = 0.0) -> Worl
     graph = LaneGraph(grid)
     signals = Signals(spec.seed, grid.nodes, grid.roundabouts)
     lib = Library(spec.seed)
+    half_width, widest = widest_half_width(spec, lib, KINDS, EGO_SIZE_M[1])
+    log.debug("lanes kept clear of static objects to %.2f m from their centre lines (%s)", half_width + MARGIN_M, widest)
     horizon_s = duration_s + 1.0 + LOOKAHEAD_S
     if distance_m > 0:  # the drive may take longer than asked: cover a slow ego
         horizon_s = max(horizon_s, distance_m / (0.25 * spec.paths.speed_mps) + 5.0 + LOOKAHEAD_S)
     while True:  # vehicles look ahead at crosswalks: pedestrians must be simulated past the drive's end
         peds = _pedestrians(spec, grid, scene, signals, lib, int(np.ceil(horizon_s / DT_S)) + 1)
         crossing = _crosswalk_occupancy(grid, graph, peds)
-        blocked = _blocked_lanes(graph, scene)
-        movers, ego_track, ego_dist = _drive(spec, graph, signals, lib, blocked, crossing, duration_s, distance_m)
+        blocked = blocked_lanes(graph, scene, half_width)
+        movers, ego_track, ego_dist = _drive(spec, graph, scene, signals, lib, blocked, crossing, duration_s, distance_m)
         if crossing is None or crossing.asked_s <= horizon_s:
             break
         horizon_s = 2.0 * crossing.asked_s  # same answers up to the old horizon (causal): a longer run, same world
         graph = LaneGraph(grid)
-    peds = [_lead_in(_extend_track(p, len(ego_dist))) for p in peds]
+    peds = [_lead_in(_extend_track(p, len(ego_dist)), grid.ground_height if p.attrs.get("role") == "walking" else None)
+            for p in peds]
     world = _assemble(scene, movers + peds, TrackTrajectory(ego_track, ego_dist), ego_track.t1)
     log.info("traffic %s: %d vehicles, %d pedestrians over %.1f s, simulated in %.2f s", spec.name, len(movers),
              len(peds), ego_track.t1, time.perf_counter() - t_start)
@@ -104,14 +108,18 @@ def _pedestrians(spec, grid, scene, signals, lib, n_steps: int) -> list[Mover]:
     return simulate_pedestrians(spec, grid, scene, signals, lib, n_steps, DT_S)
 
 
-def _lead_in(m: Mover) -> Mover:
-    """Prepend :data:`LEAD_IN` samples before t = 0 at the first step's velocity, so central
-    differences at t = 0 see the motion (a walker already walking) instead of a clamped track."""
+def _lead_in(m: Mover, ground=None) -> Mover:
+    """Prepend :data:`LEAD_IN` samples before t = 0 at the first step's horizontal velocity, so
+    central differences at t = 0 see the motion (a walker already walking) instead of a clamped
+    track. Their height is ``ground(xy)`` ((n, 2) -> (n,) metres: a walker's feet on the ground
+    there, :func:`generator.traffic.pedestrians.feet_height`), or the first sample's without it;
+    extrapolating a step up the kerb would sink the feet below the road."""
     tr = m.track
     if tr.t0 <= -LEAD_IN * DT_S + 1e-12 or len(tr.yaw) < 2:
         return m
     step = tr.xyz[1] - tr.xyz[0]
     back = tr.xyz[0] - step * np.arange(LEAD_IN, 0, -1)[:, None]
+    back[:, 2] = tr.xyz[0, 2] if ground is None else ground(back[:, :2])
     m.track = Track(tr.t0 - LEAD_IN * DT_S, tr.dt, np.vstack([back, tr.xyz]), np.r_[np.repeat(tr.yaw[:1], LEAD_IN), tr.yaw])
     return m
 
@@ -159,25 +167,6 @@ def _crosswalk_occupancy(grid, graph: LaneGraph, peds: list[Mover]):
     return crossing
 
 
-def _blocked_lanes(graph: LaneGraph, scene) -> set[int]:
-    """Lane edges a static object stands on (a double-parked truck, a car left in a lane)."""
-    from generator.traffic.lanes import boxes_overlap
-
-    boxes = [o.box for o in scene.objects if o.instance_id > 0]
-    if not boxes:
-        return set()
-    quads = np.stack([b.corners_xy() for b in boxes])
-    out = set()
-    for e in graph.lanes():
-        p0, p1 = e.path.points[0, :2], e.path.points[-1, :2]
-        d = (p1 - p0) / max(np.linalg.norm(p1 - p0), 1e-9)
-        n = np.array([-d[1], d[0]]) * (graph.grid.lane_w / 2 - 0.3)
-        lane = np.array([[p0 - n, p1 - n, p1 + n, p0 + n]])
-        if boxes_overlap(lane, quads).any():
-            out.add(e.index)
-    return out
-
-
 def _prune(graph: LaneGraph, blocked: set[int], keep: set[int]) -> set[int]:
     """Drop blocked lanes from the graph, and then every lane left without a way on (dead ends).
 
@@ -211,7 +200,7 @@ def _ego_route(graph: LaneGraph) -> list[int]:
     return out
 
 
-def _drive(spec, graph, signals, lib, blocked, crossing, duration_s, distance_m):
+def _drive(spec, graph, scene, signals, lib, blocked, crossing, duration_s, distance_m):
     tr = spec.traffic
     route = _ego_route(graph)
     blocked = _prune(graph, blocked, set(route))
@@ -232,10 +221,12 @@ def _drive(spec, graph, signals, lib, blocked, crossing, duration_s, distance_m)
         for _ in range(round(getattr(tr, field_name) * km)):
             proto = fleet_proto(lib, kind, int(g.integers(n_var)))
             length, width = float(proto.hi[0] - proto.lo[0]), float(proto.hi[1] - proto.lo[1])
-            e, s = _free_spot(graph, free, taken, length, g, field_name, spec)
+            avoid = frozenset(too_narrow(graph, scene, width / 2, set(route)))
+            e, s = _free_spot(graph, [f for f in free if f.index not in avoid] if avoid else free, taken, length, g,
+                              field_name, spec)
             i = len(vehicles)
             v = Vehicle(i, length, width, min(tr.speed_limit_mps * float(g.uniform(*speed)), tr.speed_limit_mps),
-                        a_max, [e.index], s, stream(spec.seed, "traffic", "vehicle", i))
+                        a_max, [e.index], s, stream(spec.seed, "traffic", "vehicle", i), avoid=avoid)
             vehicles.append(v)
             # still take the values the old per-vehicle colour took, so a seed's traffic drives as before
             # (other draw orders put a turning bus onto a car at t = 0, tests/test_traffic.py)

@@ -10,7 +10,7 @@ Vehicles of the moving traffic come from the scene's asset :class:`~generator.la
   wide; on a 3.5 m lane such a box reaches over the lane line into the parking strip and the
   opposite lane (the cause of moving excavators grazing parked cars). Travelling straight, the box
   is as wide as the tracks or the house (2.6-2.9 m), inside the band
-  :func:`generator.traffic.build._blocked_lanes` keeps free of static objects. These variants are a
+  :func:`generator.traffic.lane_clearance.blocked_lanes` keeps free of static objects. These variants are a
   separate family (tag ``"travel"``, stream ``("assets", "construction_vehicle", "travel", i)``), so
   the static town's excavators do not change.
 """

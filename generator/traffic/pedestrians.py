@@ -105,7 +105,7 @@ def simulate_pedestrians(spec: SceneSpec, grid: Grid, scene, signals, lib: Libra
     ww = build_walkways(grid, obstacles, body)
     t1 = time.perf_counter()
     cls = lib.main_class("person")
-    movers = _walkers(spec, ww, body, signals, walking, n_walk, n_steps, dt, cls) if n_walk and ww.paths else []
+    movers = _walkers(spec, grid, ww, body, signals, walking, n_walk, n_steps, dt, cls) if n_walk and ww.paths else []
     t2 = time.perf_counter()
     movers += _standers(spec, grid, ww, body, obstacles, standing, n_stand, n_steps, dt, cls)
     movers += shared_standers(spec, grid, obstacles, standing, n_steps, dt, cls, _proto_box)   # shared streets
@@ -115,7 +115,8 @@ def simulate_pedestrians(spec: SceneSpec, grid: Grid, scene, signals, lib: Libra
     return movers
 
 
-def _walkers(spec, ww: Walkways, body: wc.Body, signals, protos, n: int, n_steps: int, dt: float, cls: str):
+def _walkers(spec, grid: Grid, ww: Walkways, body: wc.Body, signals, protos, n: int, n_steps: int, dt: float,
+             cls: str):
     length = np.array([p.s[-1] for p in ww.paths])
     gap = wz.follow_gap(body, R_TURN)
     zones = wz.conflict_zones(ww.paths, ww.succ, wz.reach(ww.succ, length, wn.FOLLOW_M), body, gap)
@@ -144,9 +145,31 @@ def _walkers(spec, ww: Walkways, body: wc.Body, signals, protos, n: int, n_steps
     t0 = time.perf_counter()
     pos, yaw = ws.simulate(net, signals, np.array(edges), np.array(ss), np.array(pace), np.array(decide),
                            n_warm, n_steps, dt)
+    pos[..., 2] = feet_height(grid, pos[..., :2])
     log.debug("%d walkers, %d + %d steps: %.2f s", len(edges), n_warm, n_steps, time.perf_counter() - t0)
     return [Mover("person", cls, proto, Track(0.0, dt, pos[k], yaw[k]), {**look, "role": "walking"})
             for k, (proto, look) in enumerate(drawn)]
+
+
+def feet_height(grid: Grid, xy: np.ndarray) -> np.ndarray:
+    """Height of a walker's feet at centres ``xy``: the ground under the centre, exactly.
+
+    Parameters
+    ----------
+    grid : Grid
+    xy : (..., 2) float64
+        Walker centres, world frame, metres.
+
+    Returns
+    -------
+    (...) float64
+        :meth:`Grid.ground_height` there, metres: kerb height on the pavement (a closed street's
+        park, caps and corners included), 0 on the road (where walkers only cross). A walker
+        steps up or down the kerb between two samples; interpolating the positions of the walk
+        network instead would leave it half-way, inside the kerb, for a sample.
+    """
+    xy = np.asarray(xy, np.float64)
+    return grid.ground_height(xy.reshape(-1, 2)).reshape(xy.shape[:-1])
 
 
 def _spawn_mask(ww: Walkways, zones: wz.Zones, body: wc.Body, gap: float) -> list[np.ndarray]:

@@ -7,7 +7,9 @@ are the crosswalks, tagged with their node. Where a static object stands on a li
 ends, on the sidewalk or inside the crosswalk band, preferably inside its own half of the
 sidewalk); where no shift clears it, the edge is cut, and so is everything that no longer
 leads anywhere. Edges are :class:`~generator.world.scene.Path` polylines sampled every
-:data:`SAMPLE_M`. Frames: world, metres, z up (on the pavement or, across a street, the road).
+:data:`SAMPLE_M`. Frames: world, metres, z up: the height of the ground under the point
+(:meth:`~generator.layout.streets.Grid.ground_height`: kerb height on the pavement, closed
+streets' parks and corners included, 0 across a street; a walker steps up and down the kerb).
 """
 
 from __future__ import annotations
@@ -40,7 +42,6 @@ SAMPLE_M = 0.05     #: sample spacing of every edge (fine: finite differences se
 FIX_M = 0.3         #: no sideways shift this close to the ends of an edge (where it joins others)
 SIGMA_M = 0.4       #: smoothing of a sideways shift, metres
 OTHER_COST = 10.0   #: cost of a lateral step into the other direction's half of the sidewalk (own half: 1)
-RAMP_M = 0.4        #: the feet follow the curb down to the road over this distance either side of it
 
 
 @dataclass
@@ -195,7 +196,7 @@ def _assemble(grid: Grid, geoms: list, succ: list[list[int]], offs, body: wc.Bod
     ids[alive] = np.arange(alive.sum())
     log.info("walk network: %d edges (%d cut round obstacles or dead ends)", alive.sum(), len(geoms) - alive.sum())
     paths, out_succ, nodes, road, stop = [], [], [], [], []
-    rh, wi, h = grid.road_half, grid.walk_inner, grid.curb_h
+    rh, wi = grid.road_half, grid.walk_inner
     for e in np.flatnonzero(alive):
         xy = geoms[e]
         s = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(xy, axis=0), axis=1))]
@@ -203,8 +204,7 @@ def _assemble(grid: Grid, geoms: list, succ: list[list[int]], offs, body: wc.Bod
         su = np.linspace(0.0, s[-1], n)
         xy = np.stack([np.interp(su, s, xy[:, 0]), np.interp(su, s, xy[:, 1])], -1)
         d = street_distance(grid, xy)
-        x = np.clip((d - (rh - RAMP_M)) / (wi - rh + 2 * RAMP_M), 0.0, 1.0)
-        z = h * x * x * (3 - 2 * x)
+        z = grid.ground_height(xy)
         g = np.gradient(xy, axis=0)
         paths.append(Path(f"walk_{len(paths):04d}", np.column_stack([xy, z]), np.arctan2(g[:, 1], g[:, 0]), su))
         out_succ.append(tuple(int(ids[k]) for k in succ[e] if alive[k]))

@@ -1,0 +1,95 @@
+"""Which driving lanes static objects block, for the widest vehicle that drives them.
+
+A static object (a double-parked truck, a car left in a lane, a parked tram) blocks a lane edge
+when its footprint reaches into the band a moving vehicle's box sweeps along the lane: half the
+width of the widest vehicle that may drive there, mirrors included, either side of the lane
+centre line, plus :data:`MARGIN_M`. The half width is measured on the prototypes the moving
+traffic is drawn from (:func:`generator.traffic.fleet.fleet_proto`: every variant of every kind
+the spec asks for, and the ego), so a bus with its mirrors on arms (up to 1.5 m), a travelling
+excavator (1.3-1.45 m) or a truck sets it, not a constant. Blocked lanes leave the lane graph
+(:func:`generator.traffic.build._prune`). Frames: world, metres.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from generator.traffic.fleet import fleet_proto
+from generator.traffic.lanes import boxes_overlap
+
+MARGIN_M = 0.05      #: clearance beyond the widest box's side, metres
+
+
+def widest_half_width(spec, lib, kinds: dict, ego_width: float) -> tuple[float, str]:
+    """Half width (metres, mirrors included) of the widest vehicle the traffic of ``spec`` may
+    drive, and its prototype key.
+
+    Parameters
+    ----------
+    spec : generator.spec.SceneSpec
+        ``spec.traffic`` densities: kinds at 0 drive nowhere.
+    lib : generator.layout.placement_core.Library
+        The asset library the traffic draws its prototypes from.
+    kinds : dict
+        :data:`generator.traffic.build.KINDS` (spec field -> (kind, variants, ...)).
+    ego_width : float
+        Width of the ego's box, metres.
+    """
+    best, key = ego_width / 2, "ego"
+    for field_name, (kind, n_var, *_rest) in kinds.items():
+        if getattr(spec.traffic, field_name) <= 0:
+            continue
+        for i in range(n_var):
+            proto = fleet_proto(lib, kind, i)
+            half = float(proto.hi[1] - proto.lo[1]) / 2     # the box is centred on the lane centre line
+            if half > best:
+                best, key = half, proto.key
+    return best, key
+
+
+def too_narrow(graph, scene, half_width: float, lanes: set[int]) -> set[int]:
+    """The lane edges a vehicle of ``half_width`` (metres) must keep out of: those of ``lanes``
+    (kept open for the ego's route whatever stands beside them) :func:`blocked_lanes` blocks for
+    that width, and then every lane from which each way on leads only into them (it would be
+    stuck there). Every other lane of the (pruned) ``graph`` keeps a way on outside the set."""
+    out = blocked_lanes(graph, scene, half_width) & set(lanes)
+    while out:
+        stuck = {e.index for e in graph.lanes() if e.index not in out and e.succ
+                 and all(graph.edges[c].succ[0] in out for c in e.succ)}
+        if not stuck:
+            break
+        out |= stuck
+    return out
+
+
+def blocked_lanes(graph, scene, half_width: float) -> set[int]:
+    """Lane edges of ``graph`` (straight, one per lane and segment) a static object of ``scene``
+    reaches into: its footprint overlaps the band ``half_width + MARGIN_M`` either side of the
+    lane's centre line, over the lane's length.
+
+    Parameters
+    ----------
+    graph : generator.traffic.lanes.LaneGraph
+    scene : generator.world.scene.SceneModel
+        Placed objects (instance id > 0) are the obstacles.
+    half_width : float
+        Half width of the widest vehicle (:func:`widest_half_width`), metres.
+
+    Returns
+    -------
+    set of int
+        Indices of the blocked lane edges.
+    """
+    quads = [o.box.corners_xy() for o in scene.objects if o.instance_id > 0]
+    if not quads:
+        return set()
+    quads = np.stack(quads)
+    out = set()
+    for e in graph.lanes():
+        p0, p1 = e.path.points[0, :2], e.path.points[-1, :2]
+        d = (p1 - p0) / max(np.linalg.norm(p1 - p0), 1e-9)
+        n = np.array([-d[1], d[0]]) * (half_width + MARGIN_M)
+        lane = np.array([[p0 - n, p1 - n, p1 + n, p0 + n]])
+        if boxes_overlap(lane, quads).any():
+            out.add(e.index)
+    return out
