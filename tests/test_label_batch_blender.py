@@ -89,8 +89,14 @@ def test_sky_is_labelled_sky_with_the_rgb_world_in_place(renders):
     from generator.labels import class_table
 
     batched, _, _ = renders
-    lab = batched["labels"][0]
     sky = class_table().id("sky")
-    assert (lab.class_id == sky).any() and (lab.real_class == sky).any()
-    np.testing.assert_array_equal(lab.real_class == sky, np.isinf(lab.depth))
-    assert (lab.instance[lab.class_id == sky] == 0).all()
+    for lab in batched["labels"]:
+        label_sky, real_sky = lab.class_id == sky, lab.real_class == sky
+        h = label_sky.shape[0]
+        # the camera looks about level (pitch jitter of a few degrees) over ground reaching 2 km: no sky low down
+        low = slice(2 * h // 3, None)
+        assert label_sky[: h // 2].mean() > 0.05 and not label_sky[low].any() and not real_sky[low].any()
+        # the 3x vote and the 1x pixel-centre pass are separate renders: they agree but at sky borders
+        assert (label_sky == real_sky).mean() > 0.98
+        np.testing.assert_array_equal(real_sky, np.isinf(lab.depth))
+        assert (lab.instance[label_sky] == 0).all() and (lab.real_instance[real_sky] == 0).all()

@@ -10,9 +10,9 @@
   camera moves, and every pixel still holds one exact class id. The real pass (depth, the
   class a ray through the pixel centre hits) stays at 1x: depth is never voted or blended.
 
-The label state differs from the RGB state only in the view layer's material override,
-Cycles' sampling settings, the proxies' ray visibility and the resolution; the world stays
-(sky is where the Z pass reports no hit). Turning the override on and off makes Cycles
+The label state differs from the RGB state in the view layer's material override, Cycles'
+sampling, filter, bounce and seed settings, motion blur (off), the proxies' ray visibility and
+the resolution; the world stays (sky is where the Z pass reports no hit). Turning the override on and off makes Cycles
 recompile every shader, so :func:`render_label_batch` renders the label passes of several
 images behind one switch.
 
@@ -150,8 +150,11 @@ def render_label_batch(scene, bs: geometry.BlenderScene, k: np.ndarray, scratch:
     Returns
     -------
     list of LabelPasses
-        One per pose, in order; ``seconds`` holds the pose's own render times plus an equal
-        share of the batch's state switches (``"switch"``).
+        One per pose, in order; ``seconds`` holds the pose's own render times (``"real_pass"``,
+        ``"label_pass"``: Cycles, EXR read-back, vote) and an equal share of the batch's time
+        outside the renders (``"posing"``: posing camera and actors, the proxies' visibility).
+        Cycles pays the switch into the label state inside the first real pass, and the switch
+        back inside the next RGB render.
     """
     t0 = time.perf_counter()
     session.label_state(scene, label_material())
@@ -179,7 +182,7 @@ def render_label_batch(scene, bs: geometry.BlenderScene, k: np.ndarray, scratch:
             sec["label_pass"] = time.perf_counter() - t
             out.append(LabelPasses(class_id, instance, real_class, real_instance, depth, sec))
     geometry.set_proxies_visible(bs, False)
-    switch = (time.perf_counter() - t0 - sum(s["real_pass"] + s["label_pass"] for s in secs)) / max(len(poses), 1)
+    posing = (time.perf_counter() - t0 - sum(s["real_pass"] + s["label_pass"] for s in secs)) / max(len(poses), 1)
     for sec in secs:
-        sec["switch"] = switch
+        sec["posing"] = posing
     return out
