@@ -22,6 +22,7 @@ from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
 from generator.traffic.lanes import LaneGraph
 from traffic_contacts import assert_no_contact, static_quads
+from test_streets import _blender_matches_scene
 
 TRAFFIC = {"cars_per_km": 25, "trucks_per_km": 2, "buses_per_km": 1, "cyclists_per_km": 3, "motorcyclists_per_km": 2,
            "other_vehicles_per_km": 1, "pedestrians_per_100m": 1.5, "standing_pedestrians_per_100m": 0.5}
@@ -214,16 +215,10 @@ def test_feet_on_the_ground_under_them(seed):
 @pytest.mark.blender
 def test_blender_builds_the_pocket_parks_as_the_scene_model(tmp_path):
     """The parks (grass, footpath, kept sidewalks) and the T-junction caps reach Blender triangle for triangle."""
-    from generator.blender.renderer import Renderer
-    from generator.spec.render import load_render_config
-
     spec = parse_spec({"name": "closed_tiny", "seed": 2,
                        "town": {"blocks_x": 2, "blocks_y": 2, "block_size_m": 30, "block_size_jitter_m": 0,
                                 "margin_m": 8},
                        "streets": {"closed_streets": 1}}, "closed_tiny.json")
     scene = build_scene(spec)
     assert make_grid(spec).closed
-    n, bounds = Renderer(scene, spec, load_render_config("test"), tmp_path).evaluated_geometry()
-    assert n == len(scene.faces)
-    v = scene.vertices.astype(np.float64)
-    assert np.allclose(bounds, [v.min(0), v.max(0)], atol=1e-3)
+    _blender_matches_scene(spec, scene, tmp_path)

@@ -57,6 +57,42 @@ def _on_carriageway(grid, xy: np.ndarray):
     return None
 
 
+def check_lane_graph(grid, graph) -> None:
+    """The lane graph of ``grid`` obeys its one-way streets (also with closures and roundabouts, see
+    test_street_mix): every lane runs its direction on its slot and ends at the node it names,
+    one-way segments carry ``2 x lanes`` lanes their way and none against it, no dead end, edges
+    join end to start with the same heading, every lane is fed by a connector, and every street
+    reaches every other without a U-turn."""
+    lanes = grid.lanes
+    ow = {s.index: grid.section(s).one_way for s in grid.segments if grid.section(s).one_way}
+    segs = {s.index: s for s in grid.segments}
+    assert set(k[0] for k in graph.lane_edge) == set(segs), "lanes on a closed street, or an open one without"
+    for (si, d, k), ei in graph.lane_edge.items():
+        e, seg = graph.edges[ei], segs[si]
+        h = np.stack([np.cos(e.path.headings), np.sin(e.path.headings)], 1)
+        assert np.allclose(h @ np.array([np.cos(seg.yaw), np.sin(seg.yaw)]), d)     # it runs direction d
+        assert e.node == (seg.b if d > 0 else seg.a)                                  # it arrives where it says
+        ahead = d * np.array([np.cos(seg.yaw), np.sin(seg.yaw)])
+        assert np.dot(grid.node_xy(e.node) - e.path.points[-1, :2], ahead) == pytest.approx(graph.entry_m)
+        uv = segment_frame_points(seg, e.path.points[:, :2])
+        assert np.allclose(uv[:, 1], -d * (k + 0.5) * grid.lane_w)                    # on slot k's centre
+        if si in ow:
+            assert d == ow[si] and -lanes <= k < lanes
+        else:
+            assert 0 <= k < lanes
+    for si in ow:
+        assert sum(1 for key in graph.lane_edge if key[0] == si) == 2 * lanes
+    for e in graph.edges:
+        assert e.succ, f"{e.path.name} is a dead end"
+        for n in e.succ:
+            nxt = graph.edges[n]
+            assert np.linalg.norm(nxt.path.points[0, :2] - e.path.points[-1, :2]) < 1e-6
+            assert abs(np.angle(np.exp(1j * (nxt.path.headings[0] - e.path.headings[-1])))) < 1e-3
+    fed = {n for e in graph.edges if e.kind == "connector" for n in e.succ}
+    assert fed == {e.index for e in graph.lanes()}, "a lane no connector leads into (its traffic dies out)"
+    assert strongly_connected(grid.segments, ow)
+
+
 GRAPH_CASES = [(seed, 1, (3, 3)) for seed in range(16)] + [(seed, 2, (4, 3)) for seed in range(4)] \
     + [(seed, 1, (2, 2)) for seed in range(4)]
 
@@ -73,26 +109,7 @@ def test_lane_graph_runs_one_way_with_no_dead_end(seed, lanes, blocks):
     ow = {s.index: grid.section(s).one_way for s in grid.segments if grid.section(s).one_way}
     if blocks == (3, 3):
         assert ow, "a 3 x 3 town with one_way weight 3 of 4 draws one-way streets"
-    for (si, d, k), ei in graph.lane_edge.items():
-        e = graph.edges[ei]
-        seg = grid.segments[si]
-        h = np.stack([np.cos(e.path.headings), np.sin(e.path.headings)], 1)
-        assert np.allclose(h @ np.array([np.cos(seg.yaw), np.sin(seg.yaw)]), d)      # it runs direction d
-        if si in ow:
-            assert d == ow[si] and -lanes <= k < lanes
-            uv = segment_frame_points(seg, e.path.points[:, :2])
-            assert np.allclose(uv[:, 1], -d * (k + 0.5) * grid.lane_w)                # on slot k's centre
-    for si, d in ow.items():
-        assert sum(1 for key in graph.lane_edge if key[0] == si) == 2 * lanes
-    for e in graph.edges:
-        assert e.succ, f"{e.path.name} is a dead end"
-        for n in e.succ:
-            nxt = graph.edges[n]
-            assert np.linalg.norm(nxt.path.points[0, :2] - e.path.points[-1, :2]) < 1e-6
-            assert abs(np.angle(np.exp(1j * (nxt.path.headings[0] - e.path.headings[-1])))) < 1e-3
-    fed = {n for e in graph.edges if e.kind == "connector" for n in e.succ}
-    assert fed == {e.index for e in graph.lanes()}, "a lane no connector leads into (its traffic dies out)"
-    assert strongly_connected(grid.segments, ow)
+    check_lane_graph(grid, graph)
 
 
 def test_no_u_turn_trap_is_accepted():

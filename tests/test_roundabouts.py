@@ -27,6 +27,7 @@ from generator.traffic.signals import Signals
 from generator.traffic.vehicles import Vehicle, VehicleSim
 from generator.world.scene import OrientedBox
 from traffic_contacts import assert_no_contact, assert_vehicles_miss_people, static_quads
+from test_streets import _blender_matches_scene
 
 TRAFFIC = {"cars_per_km": 25, "trucks_per_km": 2, "buses_per_km": 1, "cyclists_per_km": 3, "motorcyclists_per_km": 2,
            "other_vehicles_per_km": 1, "pedestrians_per_100m": 1.0, "standing_pedestrians_per_100m": 0.5}
@@ -358,19 +359,13 @@ def test_lidar_rays_see_the_apron_and_the_raised_grass_at_their_heights(town):
 def test_blender_builds_the_roundabout_as_the_scene_model(tmp_path):
     """The island (apron, raised centre, grass), give-way lines and approach signs reach Blender
     triangle for triangle."""
-    from generator.blender.renderer import Renderer
-    from generator.spec.render import load_render_config
-
     spec = parse_spec({"name": "roundabout_tiny", "seed": 2,
                        "town": {"blocks_x": 2, "blocks_y": 2, "block_size_m": 30, "block_size_jitter_m": 0,
                                 "margin_m": 8},
                        "streets": {"roundabouts": 1}}, "roundabout_tiny.json")
     scene = build_scene(spec)
     assert make_grid(spec).roundabouts == {(1, 1)}
-    n, bounds = Renderer(scene, spec, load_render_config("test"), tmp_path).evaluated_geometry()
-    assert n == len(scene.faces)
-    v = scene.vertices.astype(np.float64)
-    assert np.allclose(bounds, [v.min(0), v.max(0)], atol=1e-3)
+    _blender_matches_scene(spec, scene, tmp_path)
 
 
 def test_a_vehicle_at_its_setback_keeps_clear_of_a_bus_swinging_out_over_its_give_way_line():

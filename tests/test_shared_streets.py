@@ -22,7 +22,7 @@ from generator.materials import material_table
 from generator.spec import parse_spec
 from generator.traffic.build import build_world
 from test_one_way import ON_LANES
-from test_streets import GROUND_KINDS, _no_collisions, _rests_on_ground
+from test_streets import _blender_matches_scene, GROUND_KINDS, _no_collisions, _rests_on_ground
 from traffic_contacts import assert_vehicles_miss_people
 
 
@@ -198,9 +198,6 @@ def test_bad_shared_weight_is_one_line(streets, expected):
 @pytest.mark.blender
 def test_blender_builds_one_way_and_shared_streets_as_the_scene_model(tmp_path):
     """Paved shared carriageways, bollards, one-way arrows and dividers reach Blender triangle for triangle."""
-    from generator.blender.renderer import Renderer
-    from generator.spec.render import load_render_config
-
     spec = parse_spec({"name": "oneway_shared_tiny", "seed": 5,
                        "town": {"blocks_x": 2, "blocks_y": 2, "block_size_m": 30, "block_size_jitter_m": 0,
                                 "margin_m": 8},
@@ -211,7 +208,4 @@ def test_blender_builds_one_way_and_shared_streets_as_the_scene_model(tmp_path):
     assert {"one_way", "shared"} <= kinds
     scene = build_scene(spec)
     assert any(o.kind == "bollard" for o in scene.objects)
-    n, bounds = Renderer(scene, spec, load_render_config("test"), tmp_path).evaluated_geometry()
-    assert n == len(scene.faces)
-    v = scene.vertices.astype(np.float64)
-    assert np.allclose(bounds, [v.min(0), v.max(0)], atol=1e-3)
+    _blender_matches_scene(spec, scene, tmp_path)

@@ -22,9 +22,9 @@ from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
 from generator.traffic.lanes import LaneGraph
 from generator.traffic.vehicles import conflict_key
-from test_one_way import _forward, _on_carriageway
+from test_one_way import _forward, _on_carriageway, check_lane_graph
 from test_roundabouts import _radii
-from test_streets import _no_collisions, _rests_on_ground
+from test_streets import _blender_matches_scene, _no_collisions, _rests_on_ground
 from traffic_contacts import assert_no_contact
 
 SECONDS = 20.0
@@ -83,42 +83,6 @@ def _one_way(grid) -> dict[int, int]:
     return {s.index: grid.section(s).one_way for s in grid.segments if grid.section(s).one_way}
 
 
-def _check_lane_graph(grid, graph) -> None:
-    """The checks of test_one_way's lane graph test, on a grid with closures and roundabouts: every
-    lane runs its direction on its slot and ends at the node it names, one-way segments carry
-    ``2 x lanes`` lanes their way and none against it, no dead end, edges join end to start with
-    the same heading, every lane is fed by a connector."""
-    lanes, ow = grid.lanes, _one_way(grid)
-    segs = {s.index: s for s in grid.segments}
-    assert set(k[0] for k in graph.lane_edge) == set(segs), "lanes on a closed street, or an open one without"
-    from generator.layout.street_meshes import segment_frame_points
-
-    for (si, d, k), ei in graph.lane_edge.items():
-        e, seg = graph.edges[ei], segs[si]
-        h = np.stack([np.cos(e.path.headings), np.sin(e.path.headings)], 1)
-        assert np.allclose(h @ np.array([np.cos(seg.yaw), np.sin(seg.yaw)]), d)     # it runs direction d
-        assert e.node == (seg.b if d > 0 else seg.a)                                  # it arrives where it says
-        ahead = d * np.array([np.cos(seg.yaw), np.sin(seg.yaw)])
-        assert np.dot(grid.node_xy(e.node) - e.path.points[-1, :2], ahead) == pytest.approx(graph.entry_m)
-        uv = segment_frame_points(seg, e.path.points[:, :2])
-        assert np.allclose(uv[:, 1], -d * (k + 0.5) * grid.lane_w)                    # on slot k's centre
-        if si in ow:
-            assert d == ow[si] and -lanes <= k < lanes
-        else:
-            assert 0 <= k < lanes
-    for si in ow:
-        assert sum(1 for key in graph.lane_edge if key[0] == si) == 2 * lanes
-    for e in graph.edges:
-        assert e.succ, f"{e.path.name} is a dead end"
-        for n in e.succ:
-            nxt = graph.edges[n]
-            assert np.linalg.norm(nxt.path.points[0, :2] - e.path.points[-1, :2]) < 1e-6
-            assert abs(np.angle(np.exp(1j * (nxt.path.headings[0] - e.path.headings[-1])))) < 1e-3
-    fed = {n for e in graph.edges if e.kind == "connector" for n in e.succ}
-    assert fed == {e.index for e in graph.lanes()}, "a lane no connector leads into (its traffic dies out)"
-    assert strongly_connected(grid.segments, ow)
-
-
 @pytest.mark.parametrize("seed", FULL_SEEDS)
 def test_one_way_with_shared_roundabouts_and_closures_builds_a_lane_graph_that_obeys_all(seed):
     """Every kind is drawn; no one-way segment ends at a roundabout (closed ones are parks, not
@@ -136,7 +100,7 @@ def test_one_way_with_shared_roundabouts_and_closures_builds_a_lane_graph_that_o
             assert not (grid.is_roundabout(s.a) or grid.is_roundabout(s.b)), s
             assert driven_directions(grid.segments, 4, 4).get(s.index, {ow[s.index]}) == {ow[s.index]}
     graph = LaneGraph(grid)
-    _check_lane_graph(grid, graph)
+    check_lane_graph(grid, graph)
     for node in grid.roundabouts:
         conns = {key: ci for key, ci in graph.connector.items() if key[0] == node}
         assert len(conns) == 12 * grid.lanes
@@ -255,9 +219,6 @@ def test_a_bus_leaving_a_roundabout_keeps_off_a_bus_waiting_at_its_exit_arm():
 def test_blender_builds_a_town_with_every_street_kind_as_the_scene_model(tmp_path):
     """One-way arrows, shared paving, roundabout islands and pocket parks in one town reach Blender
     triangle for triangle."""
-    from generator.blender.renderer import Renderer
-    from generator.spec.render import load_render_config
-
     spec = parse_spec({"name": "full_mix_tiny", "seed": 11,
                        "town": {"blocks_x": 3, "blocks_y": 3, "block_size_m": 30, "block_size_jitter_m": 0,
                                 "margin_m": 8},
@@ -267,10 +228,7 @@ def test_blender_builds_a_town_with_every_street_kind_as_the_scene_model(tmp_pat
     grid = make_grid(spec)
     assert _one_way(grid) and grid.roundabouts and grid.closed
     scene = build_scene(spec)
-    n, bounds = Renderer(scene, spec, load_render_config("test"), tmp_path).evaluated_geometry()
-    assert n == len(scene.faces)
-    v = scene.vertices.astype(np.float64)
-    assert np.allclose(bounds, [v.min(0), v.max(0)], atol=1e-3)
+    _blender_matches_scene(spec, scene, tmp_path)
 
 
 @pytest.mark.parametrize("kind", ["residential", "boulevard", "arterial", "one_way", "shared"])

@@ -258,9 +258,6 @@ def test_street_geometry_faces_up_and_curbs_face_the_lane(kitti):
 @pytest.mark.blender
 def test_blender_builds_the_street_types_as_the_scene_model(tmp_path):
     """Verges, median islands, verge hedges and district lots reach Blender triangle for triangle."""
-    from generator.blender.renderer import Renderer
-    from generator.spec.render import load_render_config
-
     spec = parse_spec({"name": "streets_tiny", "seed": 2,
                        "town": {"blocks_x": 1, "blocks_y": 1, "block_size_m": 40, "block_size_jitter_m": 0,
                                 "margin_m": 12},
@@ -269,6 +266,15 @@ def test_blender_builds_the_street_types_as_the_scene_model(tmp_path):
     scene = build_scene(spec)
     grid = make_grid(spec)
     assert {k for _, k, _ in grid.raised_rects()} == {"verge", "median"}
+    _blender_matches_scene(spec, scene, tmp_path)
+
+
+def _blender_matches_scene(spec, scene, tmp_path) -> None:
+    """Blender's evaluated geometry of ``scene`` has its triangle count and bounds (the street tests'
+    "reaches Blender triangle for triangle")."""
+    from generator.blender.renderer import Renderer
+    from generator.spec.render import load_render_config
+
     n, bounds = Renderer(scene, spec, load_render_config("test"), tmp_path).evaluated_geometry()
     assert n == len(scene.faces)
     v = scene.vertices.astype(np.float64)
