@@ -319,6 +319,14 @@ def test_sensor_file_in_a_spec(capsys, data, where):
     ('{"name": "x", "seed": 1, "paths": {"speed_mps": 1e999}}', "paths.speed_mps: must be a finite number, got inf"),
     ('{"name": "x", "seed": 1, "town\\n\\u0000": 1}', "town\\n\\x00: unknown key (allowed here:"),
     ('{"name": "x", "seed": 1, "\\ud800": 1}', "\\ud800: unknown key"),
+    ('{"name": "x", "seed": 1, "streets": {"intersection_angle_deg": [50, 80]}}',
+     "streets.intersection_angle_deg: must lie within [60, 90] degrees, got [50, 80]"),
+    ('{"name": "x", "seed": 1, "streets": {"intersection_angle_deg": [80, 70]}}',
+     "streets.intersection_angle_deg: must be a range [low, high] with low <= high"),
+    ('{"name": "x", "seed": 1, "streets": {"intersection_angle_deg": [70, 1e999]}}',
+     "streets.intersection_angle_deg[1]: must be a finite number, got inf"),
+    ('{"name": "x", "seed": 1, "streets": {"intersection_angle_deg": "70"}}',
+     "streets.intersection_angle_deg: must be a list of 2 items, each a number"),
 ])
 def test_layout_fixed_hostile_specs(tmp_path, capsys, text, reason):
     spec = tmp_path / "spec.json"

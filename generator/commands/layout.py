@@ -98,6 +98,9 @@ def summary(scene, spec, build_s: float) -> dict:
         "build_seconds": round(build_s, 3),
         **_streets(spec),
     }
+    if scene.town_map is not None:   # streets crossing at an angle (the towns with right angles read as before)
+        info["intersection_angle"] = {"angle_deg": round(scene.town_map.angle_deg, 4), "lean": scene.town_map.lean,
+                                      "grid_to_world_xy": [[round(float(v), 9) for v in row] for row in scene.town_map.A]}
     from generator.layout.closures import closed_record
     from generator.layout.roundabouts import roundabout_record
     from generator.layout.streets import make_grid

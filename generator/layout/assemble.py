@@ -26,12 +26,14 @@ from generator.layout import placement_street as ps
 from generator.layout import placement_tracks as pt
 from generator.layout import placement_verges as pv
 from generator.layout.lots import Lot, lot_ground_mesh, make_lots
+from generator.layout.mapped_scene import map_scene, verify_world_routes
 from generator.layout.outskirts import horizon_mesh
 from generator.layout.placement_core import EGO_HALF_WIDTH_M, Keepout, Library, Placed, Placer
 from generator.layout.routes import densify, make_routes
 from generator.layout.street_meshes import (intersection_road_mesh, intersection_walk_mesh, margin_mesh,
                                             segment_frame_points, segment_road_mesh, segment_walk_mesh)
 from generator.layout.streets import Grid, make_grid
+from generator.layout.town_map import draw_town_map
 from generator.world.scene import OrientedBox, Path, SceneModel, SceneObject
 from generator.spec.model import SceneSpec
 from generator.progress import progress
@@ -196,9 +198,14 @@ def build_scene(spec: SceneSpec) -> SceneModel:
     routes = make_routes(grid)
     lots = make_lots(spec, grid)
     limit = spec.paths.clearance_m + EGO_HALF_WIDTH_M
-    keepout = Keepout(np.concatenate([densify(r) for r in routes]), limit)
+    samples = np.concatenate([densify(r) for r in routes])
+    keepout = Keepout(samples, limit)
     lib = Library(spec.seed if spec.asset_seed is None else spec.asset_seed)  # re-drawn towns share the assets
-    placer = Placer(lib, keepout)
+    tmap = draw_town_map(spec, grid)
+    if tmap is None:
+        placer = Placer(lib, keepout)
+    else:   # streets crossing at an angle: laid out on the grid, checked in the world
+        placer = Placer(lib, keepout, town_map=tmap, world_keepout=Keepout(tmap.xy(samples), limit))
     street = ps.Street(grid)
     log.info("layout %s: %d x %d blocks, %d segments, %d lots", spec.name, len(grid.xs) - 1, len(grid.ys) - 1,
              len(grid.segments), len(lots))
@@ -207,10 +214,18 @@ def build_scene(spec: SceneSpec) -> SceneModel:
         step(placer, spec, grid, lots, street)
         log.info("placed %d %s (%.2f s)", len(placer.placed) - n0, label, time.perf_counter() - t1)
     prototypes, proxies, objects = _objects(grid, lots, placer.placed, lib)
-    verify_routes(routes, grid, objects[len(objects) - len(placer.placed):], limit - 1e-6)
+    first = len(objects) - len(placer.placed)
     scene = SceneModel(spec.seed, spec.spec_hash, grid.bounds, prototypes, proxies, objects, routes)
+    if tmap is None:
+        verify_routes(routes, grid, objects[first:], limit - 1e-6)
+    else:
+        verify_routes(routes, grid, [], limit)      # on the lanes (the grid's); distances in the world:
+        shaped = set(range(first)) | {first + i for i, p in enumerate(placer.placed) if lib.protos[p.proto].shaped}
+        scene = map_scene(scene, tmap, shaped)
+        verify_world_routes(scene, first, shaped, limit - 1e-6)
+        log.info("streets cross at %.1f degrees (lean %+d): the town is mapped from its grid", tmap.angle_deg, tmap.lean)
     log.info("scene %s: %d objects, %d prototypes, %d proxies, built in %.2f s", spec.name, len(objects),
-             len(prototypes), len(proxies), time.perf_counter() - t0)
+             len(scene.prototypes), len(scene.proxies), time.perf_counter() - t0)
     return scene
 
 

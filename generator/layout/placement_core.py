@@ -16,9 +16,9 @@ from collections import defaultdict
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from generator.geometry import Mesh, pose
+from generator.layout.keepout import Keepout, point_box_distance, point_polygon_distance  # noqa: F401 (re-exported)
 from generator.layout.overlap_kernel import any_overlap
 from generator.rng import stream
 from generator.world.scene import OrientedBox
@@ -72,6 +72,9 @@ class Proto:
     hi: np.ndarray           #: (3,) local AABB max
     bands: np.ndarray        #: (b, 6) collision boxes (local)
     params: dict = field(default_factory=dict)
+    #: made for one object from the layout (:meth:`Library.unique`): a skewed town maps it point by
+    #: point, not rigidly (:mod:`generator.layout.town_map`)
+    shaped: bool = False
 
 
 class Library:
@@ -96,12 +99,12 @@ class Library:
     def main_class(self, kind: str) -> str:
         return self._catalog.MAIN_CLASS[kind]
 
-    def _make(self, key: str, kind: str, g: np.random.Generator, params: dict) -> Proto:
+    def _make(self, key: str, kind: str, g: np.random.Generator, params: dict, shaped: bool = False) -> Proto:
         mesh = self._catalog.build(kind, g, **params)
         lo, hi = bounds = mesh.bounds()
         whole = kind in WHOLE_BOX_KINDS
         bands = self._cache.derive(mesh, f"bands/{whole}", lambda m: collision_boxes(m, whole=whole, bounds=bounds))
-        p = Proto(key, kind, mesh, lo, hi, bands, dict(params))
+        p = Proto(key, kind, mesh, lo, hi, bands, dict(params), shaped)
         self.protos[key] = p
         return p
 
@@ -124,7 +127,7 @@ class Library:
         """A new prototype of ``kind`` used by one object only."""
         n = self._unique[kind]
         self._unique[kind] += 1
-        return self._make(f"{kind}_{n:04d}", kind, stream(self.seed, "assets", kind, n), params)
+        return self._make(f"{kind}_{n:04d}", kind, stream(self.seed, "assets", kind, n), params, shaped=True)
 
     def label_proxy(self, key: str):
         """The label hull of prototype ``key`` (:func:`generator.geometry.proxy.label_proxy`), computed
@@ -224,38 +227,6 @@ class Occupancy:
                 self._cells[key].append(start + k)
 
 
-class Keepout:
-    """Route samples every 25 cm; objects must keep ``limit`` metres (2D) away from all of them."""
-
-    def __init__(self, samples_xy: np.ndarray, limit: float):
-        self.points = np.asarray(samples_xy, np.float64).reshape(-1, 2)
-        self.limit = float(limit)
-        self.tree = cKDTree(self.points) if len(self.points) else None
-
-    def distance(self, box: OrientedBox) -> float:
-        """2D distance from the box footprint to the nearest route sample within reach (inf if none)."""
-        if self.tree is None:
-            return np.inf
-        r = float(np.hypot(box.size[0], box.size[1]) / 2 + self.limit + 0.5)
-        idx = self.tree.query_ball_point(box.center[:2], r)
-        if not idx:
-            return np.inf
-        return float(point_box_distance(self.points[idx], box).min())
-
-    def violated(self, box: OrientedBox) -> bool:
-        return self.distance(box) < self.limit
-
-
-def point_box_distance(points: np.ndarray, box: OrientedBox) -> np.ndarray:
-    """(n,) float64 2D distance from (n, 2) world points to the footprint of ``box`` (0 inside)."""
-    p = np.asarray(points, np.float64).reshape(-1, 2) - np.asarray(box.center[:2])
-    c, s = np.cos(box.yaw), np.sin(box.yaw)
-    lx, ly = np.abs(p[:, 0] * c + p[:, 1] * s), np.abs(-p[:, 0] * s + p[:, 1] * c)
-    dx = np.maximum(lx - box.size[0] / 2, 0)
-    dy = np.maximum(ly - box.size[1] / 2, 0)
-    return np.hypot(dx, dy)
-
-
 @dataclass
 class Placed:
     """An accepted object, before instance ids and names are assigned."""
@@ -269,25 +240,59 @@ class Placed:
 
 
 class Placer:
-    """Accepts objects that clear the route keep-out and the occupancy."""
+    """Accepts objects that clear the route keep-out and the occupancy.
 
-    def __init__(self, library: Library, keepout: Keepout, occupancy: Occupancy | None = None):
+    Placement runs in the grid (layout) frame. In a skewed town (``town_map`` given) the checks
+    are made so that they hold in the world: the keep-out is measured in the world
+    (``world_keepout``, route samples mapped) against each object's world footprint, and a rigid
+    object enters the occupancy with grid boxes round the preimage of its world boxes
+    (:meth:`generator.layout.town_map.TownMap.preimage_boxes`); a shaped prototype's grid boxes
+    are exact preimages already.
+    """
+
+    def __init__(self, library: Library, keepout: Keepout, occupancy: Occupancy | None = None,
+                 town_map=None, world_keepout: Keepout | None = None):
         self.lib = library
         self.keepout = keepout
         self.occ = occupancy or Occupancy()
         self.placed: list[Placed] = []
+        self.town_map = town_map
+        self.world_keepout = world_keepout
+
+    def _boxes(self, proto: Proto, T: np.ndarray, pad: float, route_check: bool):
+        """``(box, collision boxes)`` in the grid frame, or None if the keep-out is violated."""
+        tm = self.town_map
+        if tm is None:
+            box = oriented_box(proto, T)
+            if route_check and self.keepout.violated(box):
+                return None
+            return box, world_boxes(proto.bands, T, pad)
+        box = oriented_box(proto, T)
+        if proto.shaped:
+            if route_check and self.world_keepout.polygon_distance(tm.xy(box.corners_xy())) < self.world_keepout.limit:
+                return None
+            return box, world_boxes(proto.bands, T, pad)
+        Tw = tm.rigid(T)
+        if route_check and self.world_keepout.violated(oriented_box(proto, Tw)):
+            return None
+        psi = float(np.arctan2(T[1, 0], T[0, 0]))
+        (cx, cy, hx, hy, *_), = tm.preimage_boxes(_box_row(oriented_box(proto, Tw)), psi)
+        grid_box = OrientedBox((float(cx), float(cy), box.center[2]), (2 * float(hx), 2 * float(hy), box.size[2]), psi)
+        return grid_box, tm.preimage_boxes(world_boxes(proto.bands, Tw, pad), psi)
+
+    def fits(self, proto: Proto, T: np.ndarray, pad: float = 0.0) -> bool:
+        """Whether ``proto`` under grid transform ``T`` would be accepted (nothing is placed)."""
+        checked = self._boxes(proto, T, pad, True)
+        return checked is not None and not self.occ.hits(checked[1])
 
     def try_place(self, proto: Proto, x: float, y: float, z: float, yaw: float, attrs: dict | None = None,
                   pad: float = 0.0) -> bool:
         """Place ``proto`` at (x, y, z) turned by ``yaw`` if it fits; return whether it was placed."""
         T = pose(x, y, z, yaw)
-        box = oriented_box(proto, T)
-        if self.keepout.violated(box):
+        checked = self._boxes(proto, T, pad, True)
+        if checked is None or self.occ.hits(checked[1]):
             return False
-        boxes = world_boxes(proto.bands, T, pad)
-        if self.occ.hits(boxes):
-            return False
-        self._accept(proto, T, box, boxes, attrs)
+        self._accept(proto, T, *checked, attrs)
         return True
 
     def place_on(self, proto: Proto, x: float, y: float, z: float, yaw: float, attrs: dict | None = None) -> None:
@@ -295,8 +300,14 @@ class Placer:
         placed (and tested) just before, under the same transform (a rider on its bicycle, rails
         under their tram). Its boxes still enter the occupancy."""
         T = pose(x, y, z, yaw)
-        self._accept(proto, T, oriented_box(proto, T), world_boxes(proto.bands, T), attrs)
+        self._accept(proto, T, *self._boxes(proto, T, 0.0, False), attrs)
 
     def _accept(self, proto: Proto, T: np.ndarray, box: OrientedBox, boxes: np.ndarray, attrs: dict | None) -> None:
         self.occ.add(boxes)
         self.placed.append(Placed(proto.kind, self.lib.main_class(proto.kind), proto.key, T, box, dict(attrs or {})))
+
+
+def _box_row(box: OrientedBox) -> np.ndarray:
+    """(1, 7) ``(cx, cy, hx, hy, yaw, z0, z1)`` row of an :class:`OrientedBox` (z interval its height)."""
+    return np.array([[box.center[0], box.center[1], box.size[0] / 2, box.size[1] / 2, box.yaw,
+                      box.center[2] - box.size[2] / 2, box.center[2] + box.size[2] / 2]])

@@ -24,7 +24,7 @@ import numpy as np
 
 from generator.layout.lots import Lot
 from generator.geometry import pose
-from generator.layout.placement_core import Placer, Proto, oriented_box, world_boxes
+from generator.layout.placement_core import Placer, Proto
 from generator.layout.appearance import fleet_paint, outfit
 from generator.layout.placement_street import Street, free_lane
 from generator.layout.streets import PARKING_START_U
@@ -190,7 +190,7 @@ def _bus_spot(placer: Placer, grid, seg, s: int, u: float, bus: Proto, yaw: floa
         if free_lane(placer, seg, v_lane, u - 7.0, u + 7.0):
             x, y = _at(seg, u, v_lane, bus, yaw)
             T = pose(x, y, 0.0, yaw)
-            if not placer.keepout.violated(oriented_box(bus, T)) and not placer.occ.hits(world_boxes(bus.bands, T, BUS_PAD_M)):
+            if placer.fits(bus, T, BUS_PAD_M):
                 return x, y
     return None
 

@@ -45,6 +45,8 @@ def spec_hash(spec: SceneSpec) -> str:
     for key in ("roundabouts", "closed_streets"):    # likewise these streets fields while 0
         if d.get("streets") is not None and not d["streets"].get(key):
             d["streets"].pop(key, None)
+    if d.get("streets") is not None and list(d["streets"].get("intersection_angle_deg", (90, 90))) == [90, 90]:
+        d["streets"].pop("intersection_angle_deg", None)   # and the angle while right
     return canonical_hash(d)
 
 
@@ -63,6 +65,9 @@ def check_streets(full: dict, source: str) -> None:
     lo, hi = streets["parking_occupancy"]
     if lo < 0 or hi > 1:
         raise SpecError(source, "streets.parking_occupancy", f"must lie within [0, 1], got {[lo, hi]}")
+    lo, hi = streets["intersection_angle_deg"]
+    if lo < 60 or hi > 90:
+        raise SpecError(source, "streets.intersection_angle_deg", f"must lie within [60, 90] degrees, got {[lo, hi]}")
     varied = sorted(k for k, w in streets["types"].items() if k != "plain" and w > 0)
     if varied and full["town"]["parking_strip_width_m"] <= 0:
         # every type but plain fills or turns the strips between the lanes and the kerbs

@@ -191,6 +191,8 @@ class Streets:
     roundabouts: float = 0.0
     #: share of the eligible interior segments closed and made pocket parks (:mod:`generator.layout.closures`)
     closed_streets: float = 0.0
+    #: [low, high] degrees the two street directions cross at, one draw per town (:mod:`generator.layout.town_map`)
+    intersection_angle_deg: Range = (90.0, 90.0)
 
 
 @dataclass(frozen=True)

@@ -25,6 +25,7 @@ from generator.rng import stream
 from generator.traffic.fleet import fleet_proto
 from generator.traffic.lane_clearance import MARGIN_M, blocked_lanes, too_narrow, widest_half_width
 from generator.traffic.lanes import LaneGraph
+from generator.traffic.mapped_tracks import ego_distance, map_track
 from generator.traffic.movers import DT_S, Mover
 from generator.traffic.signals import CLEAR_S, Signals
 from generator.traffic.vehicles import Vehicle, VehicleSim
@@ -71,6 +72,9 @@ def build_world(spec, scene, duration_s: float, distance_m: float = 0.0) -> Worl
     """
     if not spec.traffic.enabled:
         return frozen_world(scene, EgoTrajectory(scene.paths[0], spec.paths.speed_mps))
+    world_scene, tmap = scene, scene.town_map
+    if tmap is not None:    # streets crossing at an angle: the traffic runs on the town's grid
+        scene = scene.layout
     t_start = time.perf_counter()
     from generator.layout.placement_core import Library
 
@@ -87,14 +91,20 @@ def build_world(spec, scene, duration_s: float, distance_m: float = 0.0) -> Worl
         peds = _pedestrians(spec, grid, scene, signals, lib, int(np.ceil(horizon_s / DT_S)) + 1)
         crossing = _crosswalk_occupancy(grid, graph, peds)
         blocked = blocked_lanes(graph, scene, half_width)
-        movers, ego_track, ego_dist = _drive(spec, graph, scene, signals, lib, blocked, crossing, duration_s, distance_m)
+        movers, ego_track, ego_dist = _drive(spec, graph, scene, signals, lib, blocked, crossing, duration_s, distance_m,
+                                             None if tmap is None else tmap.A)
         if crossing is None or crossing.asked_s <= horizon_s:
             break
         horizon_s = 2.0 * crossing.asked_s  # same answers up to the old horizon (causal): a longer run, same world
         graph = LaneGraph(grid)
     peds = [_lead_in(_extend_track(p, len(ego_dist)), grid.ground_height if p.attrs.get("role") == "walking" else None)
             for p in peds]
-    world = _assemble(scene, movers + peds, TrackTrajectory(ego_track, ego_dist), ego_track.t1)
+    if tmap is not None:
+        for m in movers + peds:
+            m.track = map_track(m.track, tmap, (m.proto.lo[:2] + m.proto.hi[:2]) / 2)
+        ego_track = map_track(ego_track, tmap)
+        ego_dist = ego_distance(ego_track)
+    world = _assemble(world_scene, movers + peds, TrackTrajectory(ego_track, ego_dist), ego_track.t1)
     log.info("traffic %s: %d vehicles, %d pedestrians over %.1f s, simulated in %.2f s", spec.name, len(movers),
              len(peds), ego_track.t1, time.perf_counter() - t_start)
     return world
@@ -200,7 +210,9 @@ def _ego_route(graph: LaneGraph) -> list[int]:
     return out
 
 
-def _drive(spec, graph, scene, signals, lib, blocked, crossing, duration_s, distance_m):
+def _drive(spec, graph, scene, signals, lib, blocked, crossing, duration_s, distance_m, to_world=None):
+    """Simulate the vehicles and the ego; the ego's driven distance is measured in the world
+    (``to_world``: the (2, 2) map of a skewed town, None for the grid itself)."""
     tr = spec.traffic
     route = _ego_route(graph)
     blocked = _prune(graph, blocked, set(route))
@@ -252,7 +264,8 @@ def _drive(spec, graph, scene, signals, lib, blocked, crossing, duration_s, dist
         rec_xy.append([p[0] for p in poses])
         rec_h.append([p[1] for p in poses])
         if k > 0:
-            dist.append(dist[-1] + float(np.linalg.norm(rec_xy[-1][0] - rec_xy[-2][0])))
+            step = rec_xy[-1][0] - rec_xy[-2][0]
+            dist.append(dist[-1] + float(np.linalg.norm(step if to_world is None else to_world @ step)))
         if t >= duration_s + 1.0 and dist[-1] >= distance_m + 1.0:
             break
         if t > MAX_DRIVE_S:

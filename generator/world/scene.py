@@ -162,6 +162,11 @@ class SceneModel:
     objects : list of SceneObject
     paths : list of Path
         Lane-following routes for cameras and the ego vehicle.
+    town_map : generator.layout.town_map.TownMap or None
+        The grid -> world map of a town whose streets cross at an angle other than 90 degrees;
+        None when they cross at right angles (grid and world are the same frame).
+    layout : SceneModel or None
+        With a ``town_map``: the same town in the grid frame, where the traffic is simulated.
     """
 
     seed: int
@@ -171,6 +176,8 @@ class SceneModel:
     proxies: dict[str, Mesh]
     objects: list[SceneObject]
     paths: list[Path]
+    town_map: object = field(default=None, repr=False, compare=False)
+    layout: "SceneModel | None" = field(default=None, repr=False, compare=False)
 
     # -- flat triangle soup (what Embree casts against) --------------------------------------
     @functools.cached_property

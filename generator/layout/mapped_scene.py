@@ -1,0 +1,124 @@
+"""Carry a town laid out on the grid into the world of its :class:`~generator.layout.town_map.TownMap`.
+
+:func:`map_scene` turns the grid-frame :class:`~generator.world.scene.SceneModel` into the one
+every sensor sees: shaped objects (ground pieces, buildings, hedges, fences, walls, rails) get
+their map baked into a prototype of their own (a Blender object transform cannot hold a shear)
+under a pure translation; rigid objects keep their prototype under
+:meth:`~generator.layout.town_map.TownMap.rigid`. Paths are mapped sample by sample and their
+arc lengths re-measured. The grid-frame scene stays reachable as ``scene.layout`` (the traffic
+is simulated there, :func:`generator.traffic.build.build_world`) and the map as
+``scene.town_map``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from generator.geometry import Mesh
+from generator.layout.placement_core import Keepout, point_polygon_distance
+from generator.layout.town_map import TownMap
+from generator.world.scene import OrientedBox, Path, SceneModel, SceneObject
+
+
+class MappedLayoutError(RuntimeError):
+    """A mapped object ends up too close to a route (a bug of the placement checks)."""
+
+
+def _bake(mesh: Mesh, transform: np.ndarray) -> tuple[Mesh, np.ndarray]:
+    """``mesh`` under the (4, 4) affine ``transform``, re-centred: (mesh, translation (4, 4))."""
+    world = mesh.transformed(transform)
+    T = np.eye(4)
+    T[:3, 3] = transform[:3, 3]
+    inv = np.eye(4)
+    inv[:3, 3] = -transform[:3, 3]
+    return world.transformed(inv), T
+
+
+def _shaped_box(mesh: Mesh, transform: np.ndarray, yaw: float) -> OrientedBox:
+    """The box at ``yaw`` round the baked ``mesh`` (local frame translated by ``transform``)."""
+    c, s = np.cos(yaw), np.sin(yaw)
+    v = mesh.vertices
+    if not len(v):
+        return OrientedBox(tuple(float(x) for x in transform[:3, 3]), (0.0, 0.0, 0.0), float(yaw))
+    lx, ly = v[:, 0] * c + v[:, 1] * s, -v[:, 0] * s + v[:, 1] * c
+    lo = np.array([lx.min(), ly.min(), v[:, 2].min()])
+    hi = np.array([lx.max(), ly.max(), v[:, 2].max()])
+    mid = (lo + hi) / 2
+    centre = transform[:3, 3] + np.array([mid[0] * c - mid[1] * s, mid[0] * s + mid[1] * c, mid[2]])
+    return OrientedBox(tuple(float(x) for x in centre), tuple(float(x) for x in hi - lo), float(yaw))
+
+
+def map_path(path: Path, tmap: TownMap) -> Path:
+    """``path`` in the world: samples mapped, headings turned, arc lengths re-measured."""
+    pts = tmap.xy(path.points)
+    s = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))]
+    return Path(path.name, pts, tmap.yaw(path.headings), s, path.closed)
+
+
+def map_scene(layout: SceneModel, tmap: TownMap, shaped: set[int]) -> SceneModel:
+    """The world scene of the grid-frame ``layout``.
+
+    Parameters
+    ----------
+    layout : SceneModel
+        Built in the grid frame (:func:`generator.layout.assemble.build_scene`).
+    tmap : TownMap
+    shaped : set of int
+        Indices of the objects mapped point by point; the others are rigid.
+
+    Returns
+    -------
+    SceneModel
+        Same objects (names, classes, instance ids, order), world transforms and boxes; a shaped
+        object's prototype (and label proxy) is baked and keyed ``<name>_mapped``.
+    """
+    from generator.layout.assemble import box_of   # assemble imports this module
+
+    prototypes, proxies, objects = {}, {}, []
+    for o in layout.objects:
+        if o.index in shaped:
+            Ta = tmap.affine(o.transform)
+            mesh, T = _bake(layout.prototypes[o.prototype], Ta)
+            key = f"{o.name}_mapped"     # object names are unique; no prototype key ends so
+            prototypes[key] = mesh
+            proxy = None
+            if o.proxy is not None:
+                proxies[key], _ = _bake(layout.proxies[o.proxy], Ta)
+                proxy = key
+            yaw = float(np.arctan2(Ta[1, 0], Ta[0, 0]))
+            objects.append(SceneObject(o.index, o.name, o.kind, o.cls, o.instance_id, key, T,
+                                       _shaped_box(mesh, T, yaw), proxy, dict(o.attrs)))
+            continue
+        T = tmap.rigid(o.transform)
+        mesh = layout.prototypes[o.prototype]
+        prototypes.setdefault(o.prototype, mesh)
+        if o.proxy is not None:
+            proxies.setdefault(o.proxy, layout.proxies[o.proxy])
+        lo, hi = mesh.bounds()
+        objects.append(SceneObject(o.index, o.name, o.kind, o.cls, o.instance_id, o.prototype, T, box_of(lo, hi, T),
+                                   o.proxy, dict(o.attrs)))
+    (x0, y0), (x1, y1) = layout.bounds
+    corners = tmap.xy(np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]]))
+    bounds = np.stack([corners.min(0), corners.max(0)])
+    scene = SceneModel(layout.seed, layout.spec_hash, bounds, prototypes, proxies, objects,
+                       [map_path(p, tmap) for p in layout.paths])
+    scene.layout = layout
+    scene.town_map = tmap
+    return scene
+
+
+def verify_world_routes(scene: SceneModel, first: int, shaped: set[int], limit: float) -> None:
+    """Raise :class:`MappedLayoutError` unless every route sample of the world ``scene`` keeps
+    ``limit`` metres (2D) from each placed object (index ``first`` on): a rigid one's box, a shaped
+    one's mapped footprint (the parallelogram its grid box becomes)."""
+    layout, tmap = scene.layout, scene.town_map
+    for path in scene.paths:
+        keep = Keepout(path.points[:, :2], limit)
+        for o in scene.objects[first:]:
+            if o.index in shaped:
+                poly = tmap.xy(layout.objects[o.index].box.corners_xy())
+                d = float(point_polygon_distance(keep.points, poly).min())
+            else:
+                d = keep.distance(o.box)
+            if d < limit:
+                raise MappedLayoutError(f"{path.name}: {o.name} is {d:.2f} m from the route (< {limit:.2f} m)")

@@ -1,0 +1,45 @@
+"""Carry tracks simulated on a skewed town's grid into its world (:mod:`generator.layout.town_map`).
+
+The traffic of a town whose streets cross at an angle runs on the grid lanes
+(:func:`generator.traffic.build.build_world`); every actor is rigid, so its track is mapped by its
+centre: the centre goes through the map, the heading turns to the mapped direction, and the
+origin is put back behind the centre at the actor's own (unmapped) offset.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from generator.world.actors import Track
+
+
+def map_track(track: Track, tmap, offset_xy=(0.0, 0.0)) -> Track:
+    """``track`` (grid frame) in the world.
+
+    Parameters
+    ----------
+    track : Track
+        Origin positions (T, 3) and unwrapped headings (T,), grid frame.
+    tmap : generator.layout.town_map.TownMap
+    offset_xy : (2,) float
+        The actor's footprint centre in its local frame, metres (the origin is not the centre).
+
+    Returns
+    -------
+    Track
+        Same times; positions in the world (z unchanged), headings still unwrapped.
+    """
+    ox, oy = float(offset_xy[0]), float(offset_xy[1])
+    yaw = np.asarray(track.yaw, np.float64)
+    c, s = np.cos(yaw), np.sin(yaw)
+    centre = track.xyz[:, :2] + np.stack([ox * c - oy * s, ox * s + oy * c], -1)
+    centre_w = centre @ tmap.A.T
+    yaw_w = tmap.yaw(yaw)
+    cw, sw = np.cos(yaw_w), np.sin(yaw_w)
+    origin = centre_w - np.stack([ox * cw - oy * sw, ox * sw + oy * cw], -1)
+    return Track(track.t0, track.dt, np.c_[origin, track.xyz[:, 2]], yaw_w)
+
+
+def ego_distance(track: Track) -> np.ndarray:
+    """(T,) float64 distance the ego has driven at each sample of its (world) track, metres."""
+    return np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(track.xyz[:, :2], axis=0), axis=1))]
