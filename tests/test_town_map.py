@@ -260,3 +260,12 @@ def test_blender_builds_the_skewed_town_triangle_for_triangle(tmp_path):
     scene = build_scene(spec)
     assert scene.town_map is not None
     _blender_matches_scene(spec, scene, tmp_path)
+
+
+def test_image_metadata_records_the_drawn_angle():
+    from generator.imaging.metadata import _angle_record
+
+    spec = spec_with((61, 79), seed=12)
+    tm = draw_town_map(spec)
+    assert _angle_record(spec) == {"intersection_angle": {"angle_deg": tm.angle_deg, "lean": tm.lean}}
+    assert _angle_record(spec_with((90, 90))) == {}

@@ -37,10 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from generator.rng import stream
-
-RIGHT_ANGLE_TOL_DEG = 1e-6   #: an angle this close to 90 degrees is a right angle: no map at all
-
+from generator.spec.towns import intersection_angle
 
 @dataclass(frozen=True)
 class TownMap:
@@ -169,20 +166,12 @@ class TownMap:
 
 def draw_town_map(spec, grid=None) -> TownMap | None:
     """The map of ``spec``'s town on ``grid`` (its street lines; without it every rigid heading
-    turns as :meth:`TownMap.yaw`): None for right-angle streets (every spec without
-    ``streets.intersection_angle_deg`` below 90), else an angle drawn uniformly from that range
-    and a lean of either side, from the stream ``("layout", "intersection_angle")``."""
-    streets = getattr(spec, "streets", None)
-    if streets is None:
+    turns as :meth:`TownMap.yaw`): None for right-angle streets, else the angle and lean of
+    :func:`generator.spec.towns.intersection_angle`."""
+    drawn = intersection_angle(spec)
+    if drawn is None:
         return None
-    lo, hi = streets.intersection_angle_deg
-    if lo >= 90.0 - RIGHT_ANGLE_TOL_DEG:
-        return None
-    g = stream(spec.seed, "layout", "intersection_angle")
-    angle = float(g.uniform(lo, hi))
-    lean = int(g.choice([-1, 1]))
-    if angle >= 90.0 - RIGHT_ANGLE_TOL_DEG:
-        return None
+    angle, lean = drawn
     if grid is None:
         return TownMap(angle, lean)
     return TownMap(angle, lean, tuple(float(v) for v in grid.xs), tuple(float(v) for v in grid.ys),

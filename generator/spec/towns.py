@@ -21,7 +21,7 @@ from __future__ import annotations
 import dataclasses
 
 from generator.errors import UserError
-from generator.rng import child_seed
+from generator.rng import child_seed, stream
 
 
 def redraw_every(spec) -> int | None:
@@ -112,3 +112,23 @@ def spec_for_record(spec, record: dict | None, source: str):
 
 def _bad(source: str, what: str, spec):
     raise UserError(f"{source}: made from {what} than {spec.source} draws (town seed differs)")
+
+
+RIGHT_ANGLE_TOL_DEG = 1e-6   #: an angle this close to 90 degrees is a right angle: no map at all
+
+
+def intersection_angle(spec) -> tuple[float, int] | None:
+    """The angle (degrees) ``spec``'s two street directions cross at and the lean (+1 or -1) of
+    the north-south streets, drawn from ``streets.intersection_angle_deg`` on the stream
+    ``("layout", "intersection_angle")``; None for right angles (no ``streets``, or a range at 90).
+    The layout maps the town with them (:mod:`generator.layout.town_map`); metadata records them."""
+    streets = getattr(spec, "streets", None)
+    if streets is None:
+        return None
+    lo, hi = streets.intersection_angle_deg
+    if lo >= 90.0 - RIGHT_ANGLE_TOL_DEG:
+        return None
+    g = stream(spec.seed, "layout", "intersection_angle")
+    angle = float(g.uniform(lo, hi))
+    lean = int(g.choice([-1, 1]))
+    return None if angle >= 90.0 - RIGHT_ANGLE_TOL_DEG else (angle, lean)
