@@ -179,6 +179,23 @@ def test_people_stand_on_shared_carriageways_and_no_vehicle_touches_anyone(traff
         assert_vehicles_miss_people(world, t, vehicles, people)
 
 
+def test_standers_keep_beyond_the_widest_vehicle_the_traffic_drives(traffic_town):
+    """A stander's box stays beyond the half width of the widest vehicle driving (mirrors included)
+    from the outer lane's centre; with cars only, they may stand nearer than a bus would allow."""
+    spec, grid, world = traffic_town
+    outer = grid.lane_half - grid.lane_w / 2
+    half = max(a.size[1] / 2 for a in world.actors if a.kind != "person")
+    for a in (a for a in world.actors if a.attrs.get("placement") == "shared_street"):
+        corners = a.box(0.0).corners_xy()
+        v = np.array([abs(_shared_hit(grid, c)[2]) if _shared_hit(grid, c) else np.inf for c in corners])
+        assert v.min() >= outer + half, a.name
+    cars = shared_spec(6, {"cars_per_km": 30, "standing_pedestrians_per_100m": 4.0})
+    w = build_world(cars, build_scene(cars), 1.0)
+    nearest = min(min(abs(_shared_hit(grid, c)[2]) for c in a.box(0.0).corners_xy())
+                  for a in w.actors if a.attrs.get("placement") == "shared_street")
+    assert nearest < outer + half
+
+
 BAD = [
     ({"types": {"shared": -1}}, "streets.types.shared: must be a number in [0, 100], got -1"),
     ({"types": {"shared": [1]}}, "streets.types.shared: must be a number in [0, 100], got [1]"),

@@ -6,9 +6,10 @@ signals, so a walker crossing a shared street mid-block could meet a car. What i
 paving beside the lanes: the *furnished* strips of a shared street
 (:mod:`generator.layout.shared_streets`) hold bollards, not parked cars, and no vehicle drives
 there. :func:`shared_standers` puts ``traffic.standing_pedestrians_per_100m`` people per 100 m of
-such strip on it, at road level, outside the reach of the widest vehicle on the outer lane's
-centre (:data:`WIDEST_VEHICLE_M` plus :data:`CLEAR_M`) and :data:`END_CLEAR_M` inside the strip's
-ends, clear of the bollards and of each other.
+such strip on it, at road level, outside the reach of the widest vehicle the spec's traffic drives
+(mirrors included, :func:`generator.traffic.lane_clearance.widest_half_width`) on the outer lane's
+centre, plus :data:`CLEAR_M`, and :data:`END_CLEAR_M` inside the strip's ends, clear of the bollards
+and of each other.
 
 Randomness: stander ``k`` draws from ``("traffic", "pedestrian", "shared", k)``.
 """
@@ -29,15 +30,14 @@ from generator.world.actors import Track
 
 log = logging.getLogger(__name__)
 
-WIDEST_VEHICLE_M = 4.3   #: a slewed excavator, the widest moving vehicle (on its lane centre)
-CLEAR_M = 0.2            #: and a margin beyond it
+CLEAR_M = 0.2            #: a margin beyond the widest vehicle's side
 KERB_CLEAR_M = 0.3       #: a stander's box keeps this far from the curb face
 END_CLEAR_M = 4.0        #: ... and this far past the strip's ends (a turning bus swings its rear)
 TRIES = 100
 
 
 def shared_standers(spec, grid, obstacles: wc.Obstacles, protos, n_steps: int, dt: float, cls: str,
-                    box_of) -> list[Mover]:
+                    box_of, vehicle_half_width: float) -> list[Mover]:
     """Standing people in the furnished strips of the shared streets (empty without any).
 
     Parameters
@@ -54,6 +54,8 @@ def shared_standers(spec, grid, obstacles: wc.Obstacles, protos, n_steps: int, d
         Native class of a person.
     box_of : callable
         ``box_of(proto, x, y, z, yaw, grow) -> (1, 7)`` footprint box (``pedestrians._proto_box``).
+    vehicle_half_width : float
+        Half width of the widest vehicle that may drive the lanes, mirrors included, metres.
 
     Returns
     -------
@@ -62,7 +64,7 @@ def shared_standers(spec, grid, obstacles: wc.Obstacles, protos, n_steps: int, d
     """
     e0 = PARKING_START_U + END_CLEAR_M
     segs = [s for s in shared_segments(grid) if s.length - 2 * e0 > 1.0]
-    v0 = grid.lane_half - grid.lane_w / 2 + WIDEST_VEHICLE_M / 2 + CLEAR_M
+    v0 = grid.lane_half - grid.lane_w / 2 + vehicle_half_width + CLEAR_M
     v1 = grid.road_half - KERB_CLEAR_M
     dens = spec.traffic.standing_pedestrians_per_100m
     if not segs or dens <= 0 or v1 - v0 < 0.2:
