@@ -279,3 +279,24 @@ def _blender_matches_scene(spec, scene, tmp_path) -> None:
     assert n == len(scene.faces)
     v = scene.vertices.astype(np.float64)
     assert np.allclose(bounds, [v.min(0), v.max(0)], atol=1e-3)
+
+
+@pytest.mark.parametrize("town", ["kitti", "centre"])
+def test_what_stands_on_the_pavement_stays_on_it(town, request):
+    """A thing standing at kerb height keeps its lower 0.9 m over kerb-height ground: no rack,
+    bench or column reaches over the kerb into the road (poles' arms and crowns above may)."""
+    spec, grid, scene = request.getfixturevalue(town)
+    bad = []
+    for o in scene.objects:
+        if o.instance_id == 0 and o.kind in GROUND_KINDS:
+            continue
+        m = scene.prototypes[o.prototype]
+        v = apply(o.transform, m.vertices)
+        z0 = v[:, 2].min()
+        if abs(z0 - grid.curb_h) > 0.01:
+            continue
+        tri = v[m.faces]
+        low = tri[tri[:, :, 2].min(1) < z0 + 0.9].reshape(-1, 3)
+        if (grid.ground_height(low[:, :2]) < grid.curb_h - 1e-6).any():
+            bad.append(o.name)
+    assert not bad

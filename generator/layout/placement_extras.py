@@ -76,7 +76,8 @@ def place_street_objects(placer: Placer, spec: SceneSpec, st: Street) -> None:
 
 
 def place_bike_racks(placer: Placer, spec: SceneSpec, st: Street) -> None:
-    """Racks on the kerb line with 1-5 bicycles parked beside them, front wheel to the road."""
+    """Racks on the kerb line, their row of stands along the kerb, with 1-5 bicycles parked past
+    the rack's end, front wheel to the road."""
     dens = spec.density.bike_racks_per_block
     if dens <= 0:
         return
@@ -89,11 +90,14 @@ def place_bike_racks(placer: Placer, spec: SceneSpec, st: Street) -> None:
         for _ in range(int(g.poisson(per_side))):
             u = g.uniform(st.walk_u0 + 3.0, seg.length - st.walk_u0 - 8.0)
             v = s * (st.kerb_line + 0.4)
-            if not placer.try_place(racks[int(g.integers(N_VAR))], *seg.to_world(u, v)[0], st.h, along, pad=0.05):
+            rack = racks[int(g.integers(N_VAR))]
+            # the stands run along the rack's y: turned so the row follows the kerb (across the
+            # pavement a long rack would reach over the kerb into the road)
+            if not placer.try_place(rack, *seg.to_world(u, v)[0], st.h, along + np.pi / 2, pad=0.05):
                 continue
             for k in range(int(g.integers(1, 6))):
                 bike = bikes[int(g.integers(len(bikes)))]
-                uu = u + 1.6 + 0.75 * k
+                uu = u + float(rack.hi[1]) + 0.5 + 0.75 * k
                 placer.try_place(bike, *_at(seg, uu, v, bike, to_road), st.h, to_road,
                                  {**fleet_paint(g), "placement": "rack"})
 
