@@ -12,6 +12,7 @@ import pytest
 from scipy.spatial import ConvexHull
 
 from generator.geometry import apply, pose
+from generator.labels import class_table
 from generator.layout import build_scene
 from generator.layout.placement_core import world_boxes
 from generator.layout.streets import make_grid
@@ -130,7 +131,41 @@ def test_ground_is_the_grid_ground_mapped(skewed):
         g = scene.layout.objects[o.index]
         want = tm.xy(apply(g.transform, scene.layout.prototypes[g.prototype].vertices))
         got = apply(o.transform, scene.prototypes[o.prototype].vertices)
-        assert np.allclose(got, want, atol=1e-9), o.name
+        keep = np.ones(len(got), bool)
+        if o.kind == "street":      # bay lines are turned square to the kerb (test_bay_lines_...)
+            m = scene.prototypes[o.prototype]
+            keep[m.faces[m.face_class == class_table().id("road_marking")].ravel()] = False
+        assert np.allclose(got[keep], want[keep], atol=1e-9), o.name
+
+
+def test_bay_lines_stand_square_to_the_kerb(skewed):
+    """Parking bay lines (markings wholly in a side strip) are rectangles square to their street in
+    the world."""
+    spec, scene = skewed
+    tm, lane_half = scene.town_map, make_grid(spec).lane_half
+    mark = class_table().id("road_marking")
+    checked = 0
+    for o in scene.objects:
+        if o.kind != "street":
+            continue
+        g = scene.layout.objects[o.index]
+        street = tm.A @ g.transform[:2, 0]
+        street /= np.linalg.norm(street)
+        local = scene.layout.prototypes[g.prototype].vertices
+        m = scene.prototypes[o.prototype]
+        world = apply(o.transform, m.vertices)
+        faces = m.faces[m.face_class == mark]
+        for first in np.unique(faces.min(1)):
+            idx = np.unique(faces[faces.min(1) == first])
+            if len(idx) != 4 or (np.abs(local[idx, 1]) <= lane_half).any():
+                continue
+            q = world[idx, :2]
+            pairs = sorted((q[j] - q[i] for i in range(4) for j in range(i + 1, 4)), key=np.linalg.norm)
+            short, across = pairs[0], pairs[2]             # two short sides, two long sides, two diagonals
+            assert abs(across @ street) < 1e-6 * np.linalg.norm(across), o.name
+            assert abs(short[0] * street[1] - short[1] * street[0]) < 1e-6 * np.linalg.norm(short), o.name
+            checked += 1
+    assert checked > 20
 
 
 def _footprints(scene):

@@ -48,6 +48,26 @@ def _shaped_box(mesh: Mesh, transform: np.ndarray, yaw: float) -> OrientedBox:
     return OrientedBox(tuple(float(x) for x in centre), tuple(float(x) for x in hi - lo), float(yaw))
 
 
+def square_bay_lines(mesh: Mesh, k: float, lane_half: float) -> Mesh:
+    """``mesh`` (a street's road, segment frame) with each marking rectangle that lies wholly in a
+    side strip (``|v| > lane_half``: parking bay lines) sheared about its centre by ``u += k (v - v_c)``,
+    so that after the map it is square to the kerb instead of parallel to the cross street."""
+    from generator.labels import class_table
+
+    faces = mesh.faces[mesh.face_class == class_table().id("road_marking")]
+    if not len(faces):
+        return mesh
+    v = mesh.vertices.copy()
+    quad = faces.min(1)                                  # a rectangle's two triangles share its first vertex
+    for first in np.unique(quad):
+        idx = np.unique(faces[quad == first])
+        if len(idx) != 4 or (np.abs(v[idx, 1]) <= lane_half).any():
+            continue
+        vc = v[idx, 1].mean()
+        v[idx, 0] += k * (v[idx, 1] - vc)
+    return Mesh(v, mesh.faces, mesh.face_class, mesh.face_material, dict(mesh.anchors))
+
+
 def map_path(path: Path, tmap: TownMap) -> Path:
     """``path`` in the world: samples mapped, headings turned, arc lengths re-measured."""
     pts = tmap.xy(path.points)
@@ -78,7 +98,10 @@ def map_scene(layout: SceneModel, tmap: TownMap, shaped: set[int]) -> SceneModel
     for o in layout.objects:
         if o.index in shaped:
             Ta = tmap.affine(o.transform)
-            mesh, T = _bake(layout.prototypes[o.prototype], Ta)
+            mesh = layout.prototypes[o.prototype]
+            if o.kind == "street":
+                mesh = square_bay_lines(mesh, tmap.square_shear(o.transform), tmap.lane_half)
+            mesh, T = _bake(mesh, Ta)
             key = f"{o.name}_mapped"     # object names are unique; no prototype key ends so
             prototypes[key] = mesh
             proxy = None

@@ -50,9 +50,10 @@ class TownMap:
     lean : int
         +1: the y-streets lean towards +x going north (the intersections' acute angles face
         north-east and south-west); -1: towards -x.
-    xs, ys, corridor_half
-        The grid's street lines and corridor half width (:class:`generator.layout.streets.Grid`):
-        which street a rigid thing stands by. Without them every heading turns as :meth:`yaw`.
+    xs, ys, corridor_half, lane_half
+        The grid's street lines, corridor and lane half widths (:class:`generator.layout.streets.Grid`):
+        which street a rigid thing stands by, where the parking strips start. Without them every
+        heading turns as :meth:`yaw`.
     """
 
     angle_deg: float
@@ -60,6 +61,7 @@ class TownMap:
     xs: tuple = ()               #: grid x of the north-south street centre lines, metres
     ys: tuple = ()               #: grid y of the east-west street centre lines, metres
     corridor_half: float = 0.0   #: half width of a street corridor (kerb to lot line both sides), metres
+    lane_half: float = 0.0       #: half width of the lanes (centre line to the parking strips), metres
 
     @property
     def A(self) -> np.ndarray:
@@ -135,6 +137,12 @@ class TownMap:
         """(4, 4) world-from-local of shaped geometry at grid ``transform`` (the map after it)."""
         return self.matrix @ transform
 
+    def square_shear(self, transform: np.ndarray) -> float:
+        """``k`` such that the grid direction ``v + k u`` of a street frame (``transform``'s local x =
+        u along the street, y = v across) maps square to the street in the world."""
+        eu, ev = self.A @ transform[:2, 0], self.A @ transform[:2, 1]
+        return float(-(eu @ ev) / (eu @ eu))
+
     def preimage_boxes(self, boxes: np.ndarray, grid_yaw: float) -> np.ndarray:
         """Grid boxes that contain the preimages of world boxes.
 
@@ -175,4 +183,4 @@ def draw_town_map(spec, grid=None) -> TownMap | None:
     if grid is None:
         return TownMap(angle, lean)
     return TownMap(angle, lean, tuple(float(v) for v in grid.xs), tuple(float(v) for v in grid.ys),
-                   float(grid.corridor_half))
+                   float(grid.corridor_half), float(grid.lane_half))
