@@ -3,7 +3,7 @@
 :func:`map_scene` turns the grid-frame :class:`~generator.world.scene.SceneModel` into the one
 every sensor sees: shaped objects (ground pieces, buildings, hedges, fences, walls, rails) get
 their map baked into a prototype of their own (a Blender object transform cannot hold a shear)
-under a pure translation; rigid objects keep their prototype under
+under a rigid frame that keeps their local x axis; rigid objects keep their prototype under
 :meth:`~generator.layout.town_map.TownMap.rigid`. Paths are mapped sample by sample and their
 arc lengths re-measured. The grid-frame scene stays reachable as ``scene.layout`` (the traffic
 is simulated there, :func:`generator.traffic.build.build_world`) and the map as
@@ -17,7 +17,7 @@ import numpy as np
 from generator.geometry import Mesh
 from generator.layout.placement_core import Keepout, point_polygon_distance
 from generator.layout.town_map import TownMap
-from generator.world.scene import OrientedBox, Path, SceneModel, SceneObject
+from generator.world.scene import Path, SceneModel, SceneObject
 
 
 class MappedLayoutError(RuntimeError):
@@ -25,27 +25,20 @@ class MappedLayoutError(RuntimeError):
 
 
 def _bake(mesh: Mesh, transform: np.ndarray) -> tuple[Mesh, np.ndarray]:
-    """``mesh`` under the (4, 4) affine ``transform``, re-centred: (mesh, translation (4, 4))."""
-    world = mesh.transformed(transform)
+    """``mesh`` under the (4, 4) affine ``transform``, in a rigid frame of its own: (mesh, frame).
+
+    The frame (origin and yaw of ``transform``'s mapped local x axis) keeps the object's own axes
+    for what Blender shades in object coordinates (bricks along a wall, pavers along a street);
+    only the shear and stretch are baked into the vertices."""
+    yaw = float(np.arctan2(transform[1, 0], transform[0, 0]))
+    c, s = np.cos(yaw), np.sin(yaw)
     T = np.eye(4)
+    T[:2, :2] = [[c, -s], [s, c]]
     T[:3, 3] = transform[:3, 3]
     inv = np.eye(4)
-    inv[:3, 3] = -transform[:3, 3]
-    return world.transformed(inv), T
-
-
-def _shaped_box(mesh: Mesh, transform: np.ndarray, yaw: float) -> OrientedBox:
-    """The box at ``yaw`` round the baked ``mesh`` (local frame translated by ``transform``)."""
-    c, s = np.cos(yaw), np.sin(yaw)
-    v = mesh.vertices
-    if not len(v):
-        return OrientedBox(tuple(float(x) for x in transform[:3, 3]), (0.0, 0.0, 0.0), float(yaw))
-    lx, ly = v[:, 0] * c + v[:, 1] * s, -v[:, 0] * s + v[:, 1] * c
-    lo = np.array([lx.min(), ly.min(), v[:, 2].min()])
-    hi = np.array([lx.max(), ly.max(), v[:, 2].max()])
-    mid = (lo + hi) / 2
-    centre = transform[:3, 3] + np.array([mid[0] * c - mid[1] * s, mid[0] * s + mid[1] * c, mid[2]])
-    return OrientedBox(tuple(float(x) for x in centre), tuple(float(x) for x in hi - lo), float(yaw))
+    inv[:3, :3] = T[:3, :3].T
+    inv[:3, 3] = -T[:3, :3].T @ T[:3, 3]
+    return mesh.transformed(inv @ transform), T
 
 
 def square_bay_lines(mesh: Mesh, k: float, lane_half: float) -> Mesh:
@@ -108,9 +101,8 @@ def map_scene(layout: SceneModel, tmap: TownMap, shaped: set[int]) -> SceneModel
             if o.proxy is not None:
                 proxies[key], _ = _bake(layout.proxies[o.proxy], Ta)
                 proxy = key
-            yaw = float(np.arctan2(Ta[1, 0], Ta[0, 0]))
             objects.append(SceneObject(o.index, o.name, o.kind, o.cls, o.instance_id, key, T,
-                                       _shaped_box(mesh, T, yaw), proxy, dict(o.attrs)))
+                                       box_of(*mesh.bounds(), T), proxy, dict(o.attrs)))
             continue
         T = tmap.rigid(o.transform)
         mesh = layout.prototypes[o.prototype]

@@ -82,6 +82,11 @@ class TownMap:
         return m
 
     @property
+    def stretch(self) -> float:
+        """How much longer a length along either street direction is in the world: 1 / sin(angle)."""
+        return 1.0 / math.sin(math.radians(self.angle_deg))
+
+    @property
     def shrink(self) -> float:
         """Smallest singular value of ``A``: the most a grid distance can shrink in the world."""
         return float(np.linalg.svd(self.A, compute_uv=False).min())
