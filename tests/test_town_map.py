@@ -292,7 +292,7 @@ def test_blender_builds_the_skewed_town_triangle_for_triangle(tmp_path):
 
 
 def test_metadata_records_the_angle_the_town_was_built_with(skewed):
-    from generator.imaging.metadata import _angle_record
+    from generator.spec.towns import angle_record as _angle_record
 
     spec, scene = skewed
     assert _angle_record(spec) == {"intersection_angle": {"angle_deg": scene.town_map.angle_deg,

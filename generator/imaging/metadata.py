@@ -16,7 +16,7 @@ from generator import __version__
 from generator.imaging.exr import DEPTH_DEFINITION
 from generator.imaging.meta_fields import schema_message
 from generator.labels import class_table
-from generator.spec.towns import intersection_angle, town_record
+from generator.spec.towns import angle_record, town_record
 from generator.spec.validate import load_schema
 
 METADATA_VERSION = 1
@@ -62,12 +62,6 @@ def class_pixels(class_id: np.ndarray) -> dict[str, int]:
     return {name: int(c) for name, c in zip(class_table().names, counts) if c > 0}
 
 
-def _angle_record(spec) -> dict:
-    """``{"intersection_angle": {"angle_deg", "lean"}}`` for a town whose streets cross at an angle, else {}."""
-    drawn = intersection_angle(spec)
-    return {} if drawn is None else {"intersection_angle": {"angle_deg": drawn[0], "lean": drawn[1]}}
-
-
 def image_metadata(*, image: str, files: dict, frame, k: np.ndarray, width: int, height: int, hfov_deg: float,
                    class_id: np.ndarray, time_of_day: str, weather: dict, lighting: dict, spec, render_cfg,
                    device: str, timings: dict, blender_version: str | None, camera_model: dict | None = None,
@@ -100,7 +94,7 @@ def image_metadata(*, image: str, files: dict, frame, k: np.ndarray, width: int,
         "seed": spec.seed,
         "spec_hash": spec.spec_hash,
         **({"town": town_record(spec)} if getattr(spec, "town_index", None) is not None else {}),
-        **_angle_record(spec),
+        **angle_record(spec),
         "camera": {
             "position_m": _list(T[:3, 3]),
             "rotation_deg": {key: v for key, v in camera_angles(T).items() if key != "tilt"},

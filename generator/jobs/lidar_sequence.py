@@ -37,7 +37,7 @@ from generator.labels import class_table
 from generator.labels.sets import semantickitti_labels
 from generator.formats.point_sidecars import write_point_sidecars
 from generator.scan_effects.pipeline import process_scan, processing_for_spec
-from generator.spec.towns import town_record
+from generator.spec.towns import angle_record, town_record
 from generator.remission.models import IntensityFn, intensity_fn_for_spec
 from generator.lidar.scan import Scanner
 from generator.lidar.sensors import Sensor, sensor_for_spec
@@ -271,7 +271,7 @@ def _metadata(scene, spec, sensor: Sensor, options: SequenceOptions, intensity_f
         "frames": options.frames,
         "scene": {"name": spec.name, "seed": spec.seed, "spec_hash": spec.spec_hash, "scene_digest": scene.digest(),
                   "route": options.route, "triangles": int(len(scene.faces)),
-                  **({"town": town_record(spec)} if spec.town_index is not None else {})},
+                  **({"town": town_record(spec)} if spec.town_index is not None else {}), **angle_record(spec)},
         "sensor": {"name": sensor.name, "model": sensor.model, "file": sensor.source, "lasers": sensor.n_lasers,
                    "azimuth_steps": sensor.azimuth_steps, "rotation_hz": sensor.rotation_hz,
                    "range_m": [sensor.min_range_m, sensor.max_range_m],

@@ -132,3 +132,11 @@ def intersection_angle(spec) -> tuple[float, int] | None:
     angle = float(g.uniform(lo, hi))
     lean = int(g.choice([-1, 1]))
     return None if angle >= 90.0 - RIGHT_ANGLE_TOL_DEG else (angle, lean)
+
+
+def angle_record(spec) -> dict:
+    """``{"intersection_angle": {"angle_deg", "lean"}}`` for metadata records (images, LiDAR
+    sequences) of a town whose streets cross at an angle; ``{}`` for right angles, so the records of
+    those towns read as before."""
+    drawn = intersection_angle(spec)
+    return {} if drawn is None else {"intersection_angle": {"angle_deg": drawn[0], "lean": drawn[1]}}
