@@ -34,6 +34,7 @@ from generator.spec.model import SceneSpec
 N_VAR = 4
 STREET_OBJECTS = (("bench", 0.25), ("bin", 0.3), ("bollard", 0.25), ("hydrant", 0.1), ("advertising_column", 0.1))
 HYDRANT_COLORS = ((0.75, 0.08, 0.06), (0.85, 0.7, 0.05))
+KERB_GAP_M = 0.05   #: street furniture keeps this far back from the kerb edge
 
 
 def _protos(placer: Placer, kind: str, params_fn=None, n: int = N_VAR) -> list[Proto]:
@@ -69,10 +70,12 @@ def place_street_objects(placer: Placer, spec: SceneSpec, st: Street) -> None:
         for _ in range(int(g.poisson(dens * length / 100))):
             kind = kinds[int(g.choice(len(kinds), p=p / p.sum()))]
             u = g.uniform(st.walk_u0 + 0.5, seg.length - st.walk_u0 - 0.5)
-            v = s * (st.walk[1] - 0.5 if kind == "bench" else st.kerb_line)
             attrs = {"color": list(HYDRANT_COLORS[int(g.integers(2))])} if kind == "hydrant" else {}
-            placer.try_place(protos[kind][int(g.integers(N_VAR))], *seg.to_world(u, v)[0], st.h, to_road, attrs,
-                             pad=0.1)
+            proto = protos[kind][int(g.integers(N_VAR))]
+            # on the kerb line, or further in when the object is wider than the pavement there
+            reach = max(float(proto.hi[0]), -float(proto.lo[0]))
+            v = s * (st.walk[1] - 0.5 if kind == "bench" else max(st.kerb_line, st.grid.road_half + KERB_GAP_M + reach))
+            placer.try_place(proto, *seg.to_world(u, v)[0], st.h, to_road, attrs, pad=0.1)
 
 
 def place_bike_racks(placer: Placer, spec: SceneSpec, st: Street) -> None:
