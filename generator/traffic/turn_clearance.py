@@ -115,7 +115,8 @@ def held_setback(sim, veh) -> float:
     for vid, c in cache[edge.node]:
         if vid != veh.index:
             h = sim.vehicles[vid]
-            best = max(best, node_setbacks(sim.g, sim.g.edges[c], (h.length, h.width), veh.width).get((arm, edge.lane), 0.0))
+            sb = node_setbacks(sim.g, sim.g.edges[c], (h.length, h.width), veh.width)
+            best = max(best, sb.get((arm, edge.lane), 0.0))
     return best
 
 

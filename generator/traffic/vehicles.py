@@ -67,7 +67,7 @@ class Vehicle:
     stop_p: float = 0.0
     dwell_until: float | None = None
     decided: dict = field(default_factory=dict)
-    avoid: frozenset = frozenset()    #: lane edges too narrow, connectors too tight for this vehicle (lane_clearance.too_narrow)
+    avoid: frozenset = frozenset()    #: lanes too narrow, turns too tight for it (lane_clearance.too_narrow)
 
     @property
     def edge(self) -> int:
@@ -104,7 +104,8 @@ class VehicleSim:
                 continue
             options = last.succ
             if veh.avoid and last.kind == "lane":    # keep out of lanes and turns too tight for it, where it can
-                options = [c for c in options if c not in veh.avoid and self.g.edges[c].succ[0] not in veh.avoid] or options
+                options = [c for c in options
+                           if c not in veh.avoid and self.g.edges[c].succ[0] not in veh.avoid] or options
             if last.kind == "lane" and len(options) > 1:  # straight on twice as often as each turn
                 w = np.array([0.5 if self.g.edges[c].arms[0] == (self.g.edges[c].arms[1] + 2) % 4 else 0.25
                               for c in options])
