@@ -61,6 +61,14 @@ def node_setbacks(graph, conn, size: tuple[float, float], wait_w: float) -> dict
         ``(arm, slot) -> metres`` (> 0) the front of a vehicle waiting on that approach lane must keep
         back from its stop or give-way line; lanes not listed need none.
     """
+    fast = graph.__dict__.setdefault("_edge_setback_memo", {})   # asked every step: skip the keys and rounding
+    got = fast.get((conn.index, size[0], size[1], wait_w))
+    if got is None:
+        got = fast[(conn.index, size[0], size[1], wait_w)] = _node_setbacks(graph, conn, size, wait_w)
+    return got
+
+
+def _node_setbacks(graph, conn, size: tuple[float, float], wait_w: float) -> dict:
     key = _key(graph, conn)
     if graph.grid.is_roundabout(conn.node):
         return setbacks(graph, key, size, wait_w)
@@ -84,6 +92,27 @@ def _approaches(graph, node) -> list:
     return table.get(node, [])
 
 
+def _large_users(sim, cache: dict) -> None:
+    """Fill ``cache["users"]``: ``node -> {vehicle index: connector edge}`` of the vehicles larger than
+    the standard car that hold a connector of the node or are about to ask for one (front within
+    :data:`ABOUT_TO_ENTER_M` of their own line). A standard car needs no setback anywhere."""
+    large = cache.get("large")
+    if large is None:
+        large = [v for v in sim.vehicles if is_large(v)]
+    cache.clear()
+    cache.update(occ=sim.occ, large=large, users={})
+    users = cache["users"]
+    for node, held in sim.holders.items():
+        for vid, c in held.items():
+            if is_large(sim.vehicles[vid]):
+                users.setdefault(node, {})[vid] = c
+    for other in large:
+        lane = sim.g.edges[other.edge]
+        if (lane.kind == "lane" and other.grant is None and len(other.plan) > 1
+                and lane.length - sim.g.stop_s_from_end - (other.s + other.length / 2) < ABOUT_TO_ENTER_M):
+            users.setdefault(lane.node, {}).setdefault(other.index, other.plan[1])
+
+
 def held_setback(sim, veh) -> float:
     """Metres ``veh`` must now stop short of its stop (or give-way) line: the largest setback of its
     approach lane among the large vehicles holding connectors of the node ahead, or about to ask for
@@ -98,21 +127,12 @@ def held_setback(sim, veh) -> float:
     edge = sim.g.edges[veh.edge]
     cache = sim.__dict__.setdefault("_node_users", {})
     if cache.get("occ") is not sim.occ:     # once per step (occupancy is rebuilt every step)
-        cache.clear()
-        cache["occ"] = sim.occ
-    if edge.node not in cache:
-        users = dict(sim.holders.get(edge.node, {}))
-        for lane, _ in _approaches(sim.g, edge.node):
-            for _, other in sim.occ.get(lane.index, ()):
-                if (other.edge == lane.index and other.grant is None and len(other.plan) > 1
-                        and lane.length - sim.g.stop_s_from_end - (other.s + other.length / 2) < ABOUT_TO_ENTER_M):
-                    users.setdefault(other.index, other.plan[1])
-        # a standard car needs no setback anywhere: keep only the vehicles larger than it
-        cache[edge.node] = [(vid, c) for vid, c in users.items() if is_large(sim.vehicles[vid])]
-    if not cache[edge.node]:
+        _large_users(sim, cache)
+    users = cache["users"].get(edge.node)
+    if not users:
         return 0.0
     arm, best = approach_arm(sim.g, edge), 0.0
-    for vid, c in cache[edge.node]:
+    for vid, c in users.items():
         if vid != veh.index:
             h = sim.vehicles[vid]
             sb = node_setbacks(sim.g, sim.g.edges[c], (h.length, h.width), veh.width)
