@@ -233,7 +233,7 @@ def _drive(spec, graph, scene, signals, lib, blocked, crossing, duration_s, dist
         for _ in range(round(getattr(tr, field_name) * km)):
             proto = fleet_proto(lib, kind, int(g.integers(n_var)))
             length, width = float(proto.hi[0] - proto.lo[0]), float(proto.hi[1] - proto.lo[1])
-            avoid = frozenset(too_narrow(graph, scene, width / 2, set(route)))
+            avoid = frozenset(too_narrow(graph, scene, width / 2, set(route), length))
             e, s = _free_spot(graph, [f for f in free if f.index not in avoid] if avoid else free, taken, length, g,
                               field_name, spec)
             i = len(vehicles)

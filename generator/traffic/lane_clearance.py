@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from generator.traffic.fleet import fleet_proto
-from generator.traffic.lanes import boxes_overlap
+from generator.traffic.lanes import CAR_BOX_M, boxes_overlap
 
 MARGIN_M = 0.05      #: clearance beyond the widest box's side, metres
 
@@ -47,18 +47,70 @@ def widest_half_width(spec, lib, kinds: dict, ego_width: float) -> tuple[float, 
     return best, key
 
 
-def too_narrow(graph, scene, half_width: float, lanes: set[int]) -> set[int]:
-    """The lane edges a vehicle of ``half_width`` (metres) must keep out of: those of ``lanes``
-    (kept open for the ego's route whatever stands beside them) :func:`blocked_lanes` blocks for
-    that width, and then every lane from which each way on leads only into them (it would be
-    stuck there). Every other lane of the (pruned) ``graph`` keeps a way on outside the set."""
+def too_narrow(graph, scene, half_width: float, lanes: set[int], length: float | None = None) -> set[int]:
+    """The lane edges and connectors a vehicle of ``half_width`` (metres) must keep out of: those of
+    ``lanes`` (kept open for the ego's route whatever stands beside them) :func:`blocked_lanes` blocks
+    for that width; with its ``length`` (metres) as well, for a vehicle larger than the standard car,
+    the connectors its turning box would sweep onto a static object (:func:`blocked_turns`); and then
+    every lane from which each way on leads only into them (it would be stuck there). Every other
+    lane of the (pruned) ``graph`` keeps a way on outside the set."""
     out = blocked_lanes(graph, scene, half_width) & set(lanes)
+    if length is not None and (length > CAR_BOX_M[0] or 2 * half_width > CAR_BOX_M[1]):
+        out |= blocked_turns(graph, scene, (length, 2 * half_width))
     while out:
         stuck = {e.index for e in graph.lanes() if e.index not in out and e.succ
-                 and all(graph.edges[c].succ[0] in out for c in e.succ)}
+                 and all(c in out or graph.edges[c].succ[0] in out for c in e.succ)}
         if not stuck:
             break
         out |= stuck
+    return out
+
+
+def blocked_turns(graph, scene, size: tuple[float, float]) -> set[int]:
+    """Connectors of ``graph`` along which a box of ``size`` (length, width in metres, mirrors
+    included), centred on the connector's path and :data:`MARGIN_M` larger all round, overlaps a
+    static object of ``scene`` -- a long vehicle's overhang swinging over a parking strip at a
+    corner (a car's box keeps inside the road there).
+
+    Parameters
+    ----------
+    graph : generator.traffic.lanes.LaneGraph
+    scene : generator.world.scene.SceneModel
+        Placed objects (instance id > 0) are the obstacles.
+    size : (float, float)
+        Length and width of the vehicle's box, metres.
+
+    Returns
+    -------
+    set of int
+        Indices of the connector edges it must not take.
+    """
+    memo = graph.__dict__.setdefault("_blocked_turn_memo", {})
+    key = (id(scene), round(float(size[0]), 2), round(float(size[1]), 2))
+    if key in memo:
+        return memo[key]
+    quads = [o.box.corners_xy() for o in scene.objects if o.instance_id > 0]
+    out: set[int] = set()
+    if quads:
+        quads = np.stack(quads)
+        centres = quads.mean(1)
+        hl, hw = size[0] / 2 + MARGIN_M, size[1] / 2 + MARGIN_M
+        local = np.array([[-hl, -hw], [hl, -hw], [hl, hw], [-hl, hw]])
+        reach = np.hypot(hl, hw) + float(np.max(np.linalg.norm(quads - centres[:, None], axis=-1)))
+        for e in graph.edges:
+            if e.kind != "connector":
+                continue
+            p, h = e.path.points[:, :2], e.path.headings
+            lo, hi = p.min(0) - reach, p.max(0) + reach
+            near = np.all((centres >= lo) & (centres <= hi), axis=1)
+            if not near.any():
+                continue
+            c, s = np.cos(h), np.sin(h)
+            rot = np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)        # (n, 2, 2)
+            boxes = p[:, None] + np.einsum("nij,kj->nki", rot, local)                # (n, 4, 2)
+            if boxes_overlap(boxes, quads[near]).any():
+                out.add(e.index)
+    memo[key] = out
     return out
 
 

@@ -13,9 +13,9 @@ planned edges of the :class:`~generator.traffic.lanes.LaneGraph`, with
   vehicle holds a conflicting connector (:func:`generator.traffic.lanes.conflicts`; a bus or
   truck longer than 6 m holds the whole node), the exit lane has room for it to clear the
   far crosswalk, and no pedestrian is on or about to step onto a crosswalk it crosses. It
-  holds the grant until its rear is past the far crosswalk. At a roundabout, vehicles wait clear
-  of where a long vehicle on the ring swings over their give-way line, and it is granted only
-  while nobody sits there (:mod:`generator.traffic.ring_clearance`);
+  holds the grant until its rear is past the far crosswalk. Vehicles wait clear of where a long
+  vehicle turning through the node (or on a roundabout's ring) swings over their stop or give-way
+  line, and it is granted only while nobody sits there (:mod:`generator.traffic.turn_clearance`);
 * **the ego** is one of them: it drives route 0's walk on the graph at ``paths.speed_mps``,
   and at an intersection comes to a full stop for 1-3 s with ``traffic.ego_stop_probability``.
 
@@ -31,9 +31,9 @@ import numpy as np
 
 from generator.traffic.lanes import ARM_DIRS, LaneGraph
 from generator.traffic.shared import speed_caps
-from generator.traffic.ring_clearance import held_setback, waiting_clear
 from generator.traffic.roundabout_lanes import GIVE_WAY_CLEAR_S, GIVE_WAY_REQUEST_M
 from generator.traffic.signals import CLEAR_S
+from generator.traffic.turn_clearance import held_setback, is_large, waiting_clear
 
 log = logging.getLogger(__name__)
 
@@ -67,7 +67,7 @@ class Vehicle:
     stop_p: float = 0.0
     dwell_until: float | None = None
     decided: dict = field(default_factory=dict)
-    avoid: frozenset = frozenset()    #: lane edges too narrow for this vehicle (kept for the ego's route)
+    avoid: frozenset = frozenset()    #: lanes too narrow, turns too tight for it (lane_clearance.too_narrow)
 
     @property
     def edge(self) -> int:
@@ -92,7 +92,7 @@ class VehicleSim:
         self.g, self.signals, self.vehicles, self.crossing = graph, signals, vehicles, crossing
         self.holders: dict = {}   # node -> {vehicle index: connector edge}
         self.caps = speed_caps(graph)   # edge -> speed limit (shared streets), m/s
-        self.occ: dict = {}             # this step's occupancy (edge -> [(s, vehicle)]), for ring_clearance
+        self.occ: dict = {}             # this step's occupancy (edge -> [(s, vehicle)]), for turn_clearance
 
     # -- plans ---------------------------------------------------------------------------------
     def _extend(self, veh: Vehicle) -> None:
@@ -103,8 +103,9 @@ class VehicleSim:
                 veh.plan.append(veh.ego_route[veh.route_pos])
                 continue
             options = last.succ
-            if veh.avoid and last.kind == "lane":    # keep out of lanes too narrow for it, where it can
-                options = [c for c in options if self.g.edges[c].succ[0] not in veh.avoid] or options
+            if veh.avoid and last.kind == "lane":    # keep out of lanes and turns too tight for it, where it can
+                options = [c for c in options
+                           if c not in veh.avoid and self.g.edges[c].succ[0] not in veh.avoid] or options
             if last.kind == "lane" and len(options) > 1:  # straight on twice as often as each turn
                 w = np.array([0.5 if self.g.edges[c].arms[0] == (self.g.edges[c].arms[1] + 2) % 4 else 0.25
                               for c in options])
@@ -160,7 +161,7 @@ class VehicleSim:
             return edge.length - (veh.s + veh.length / 2)
         if edge.kind != "lane" or veh.grant == veh.plan[1]:
             return np.inf
-        # at a roundabout, short of where a long vehicle on the ring swings over the line (ring_clearance)
+        # short of where a large vehicle turning through the node swings over the line (turn_clearance)
         return edge.length - self.g.stop_s_from_end - (veh.s + veh.length / 2) - held_setback(self, veh)
 
     def _accel(self, veh: Vehicle, t: float, occ: dict) -> float:
@@ -214,7 +215,8 @@ class VehicleSim:
                 continue
             if big or self.vehicles[vid].length > BIG_M or okey in self.g.conflicts_at(node)[key]:
                 return
-        if not self._room(veh, conn, occ) or (give_way and not waiting_clear(self, veh, conn, occ, B_COMF)):
+        if not self._room(veh, conn, occ) or ((give_way or is_large(veh))
+                                              and not waiting_clear(self, veh, conn, occ, B_COMF)):
             return
         # the signals keep vehicles from entering CLEAR_S before a walk phase: only people on (or
         # stepping onto) the crosswalks within that time can meet this vehicle
