@@ -28,7 +28,7 @@ from generator.layout import placement_verges as pv
 from generator.layout.lots import Lot, lot_ground_mesh, make_lots
 from generator.layout.mapped_scene import map_scene, verify_world_routes
 from generator.layout.outskirts import horizon_mesh
-from generator.layout.placement_core import EGO_HALF_WIDTH_M, Keepout, Library, Placed, Placer
+from generator.layout.placement_core import EGO_HALF_WIDTH_M, Keepout, Library, Placed, Placer, box_of
 from generator.layout.routes import densify, make_routes
 from generator.layout.street_meshes import (intersection_road_mesh, intersection_walk_mesh, margin_mesh,
                                             segment_frame_points, segment_road_mesh, segment_walk_mesh)
@@ -77,13 +77,6 @@ STEPS = (
 
 class LayoutError(RuntimeError):
     """An internal invariant of the layout is broken (a bug, not a user error)."""
-
-
-def box_of(lo: np.ndarray, hi: np.ndarray, transform: np.ndarray) -> OrientedBox:
-    """OrientedBox of the local AABB ``lo``..``hi`` ((3,) metres) under a yaw-only ``transform``."""
-    c = (np.asarray(lo) + hi) / 2 @ transform[:3, :3].T + transform[:3, 3]
-    yaw = float(np.arctan2(transform[1, 0], transform[0, 0]))
-    return OrientedBox(tuple(float(v) for v in c), tuple(float(v) for v in np.subtract(hi, lo)), yaw)
 
 
 def _pits(grid: Grid, seg, trees: np.ndarray) -> np.ndarray:
@@ -198,14 +191,10 @@ def build_scene(spec: SceneSpec) -> SceneModel:
     routes = make_routes(grid)
     lots = make_lots(spec, grid)
     limit = spec.paths.clearance_m + EGO_HALF_WIDTH_M
-    samples = np.concatenate([densify(r) for r in routes])
-    keepout = Keepout(samples, limit)
+    keepout = Keepout(np.concatenate([densify(r) for r in routes]), limit)
     lib = Library(spec.seed if spec.asset_seed is None else spec.asset_seed)  # re-drawn towns share the assets
     tmap = draw_town_map(spec, grid)
-    if tmap is None:
-        placer = Placer(lib, keepout)
-    else:   # streets crossing at an angle: laid out on the grid, checked in the world
-        placer = Placer(lib, keepout, town_map=tmap, world_keepout=Keepout(tmap.xy(samples), limit))
+    placer = Placer(lib, keepout, town_map=tmap)   # with a map: laid out on the grid, checked in the world
     street = ps.Street(grid)
     log.info("layout %s: %d x %d blocks, %d segments, %d lots", spec.name, len(grid.xs) - 1, len(grid.ys) - 1,
              len(grid.segments), len(lots))

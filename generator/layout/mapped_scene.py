@@ -15,7 +15,8 @@ from __future__ import annotations
 import numpy as np
 
 from generator.geometry import Mesh
-from generator.layout.placement_core import Keepout, point_polygon_distance
+from generator.labels import class_table
+from generator.layout.placement_core import Keepout, box_of
 from generator.layout.town_map import TownMap
 from generator.world.scene import Path, SceneModel, SceneObject
 
@@ -45,8 +46,6 @@ def square_bay_lines(mesh: Mesh, k: float, lane_half: float) -> Mesh:
     """``mesh`` (a street's road, segment frame) with each marking rectangle that lies wholly in a
     side strip (``|v| > lane_half``: parking bay lines) sheared about its centre by ``u += k (v - v_c)``,
     so that after the map it is square to the kerb instead of parallel to the cross street."""
-    from generator.labels import class_table
-
     faces = mesh.faces[mesh.face_class == class_table().id("road_marking")]
     if not len(faces):
         return mesh
@@ -85,9 +84,7 @@ def map_scene(layout: SceneModel, tmap: TownMap, shaped: set[int]) -> SceneModel
         Same objects (names, classes, instance ids, order), world transforms and boxes; a shaped
         object's prototype (and label proxy) is baked and keyed ``<name>_mapped``.
     """
-    from generator.layout.assemble import box_of   # assemble imports this module
-
-    prototypes, proxies, objects = {}, {}, []
+    prototypes, proxies, objects, bounds = {}, {}, [], {}
     for o in layout.objects:
         if o.index in shaped:
             Ta = tmap.affine(o.transform)
@@ -105,17 +102,16 @@ def map_scene(layout: SceneModel, tmap: TownMap, shaped: set[int]) -> SceneModel
                                        box_of(*mesh.bounds(), T), proxy, dict(o.attrs)))
             continue
         T = tmap.rigid(o.transform)
-        mesh = layout.prototypes[o.prototype]
-        prototypes.setdefault(o.prototype, mesh)
+        if o.prototype not in prototypes:       # instanced: shared, bounds taken once
+            prototypes[o.prototype] = layout.prototypes[o.prototype]
+            bounds[o.prototype] = layout.prototypes[o.prototype].bounds()
         if o.proxy is not None:
             proxies.setdefault(o.proxy, layout.proxies[o.proxy])
-        lo, hi = mesh.bounds()
-        objects.append(SceneObject(o.index, o.name, o.kind, o.cls, o.instance_id, o.prototype, T, box_of(lo, hi, T),
-                                   o.proxy, dict(o.attrs)))
+        objects.append(SceneObject(o.index, o.name, o.kind, o.cls, o.instance_id, o.prototype, T,
+                                   box_of(*bounds[o.prototype], T), o.proxy, dict(o.attrs)))
     (x0, y0), (x1, y1) = layout.bounds
     corners = tmap.xy(np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]]))
-    bounds = np.stack([corners.min(0), corners.max(0)])
-    scene = SceneModel(layout.seed, layout.spec_hash, bounds, prototypes, proxies, objects,
+    scene = SceneModel(layout.seed, layout.spec_hash, np.stack([corners.min(0), corners.max(0)]), prototypes, proxies, objects,
                        [map_path(p, tmap) for p in layout.paths])
     scene.layout = layout
     scene.town_map = tmap
@@ -131,8 +127,7 @@ def verify_world_routes(scene: SceneModel, first: int, shaped: set[int], limit: 
         keep = Keepout(path.points[:, :2], limit)
         for o in scene.objects[first:]:
             if o.index in shaped:
-                poly = tmap.xy(layout.objects[o.index].box.corners_xy())
-                d = float(point_polygon_distance(keep.points, poly).min())
+                d = keep.polygon_distance(tmap.xy(layout.objects[o.index].box.corners_xy()))
             else:
                 d = keep.distance(o.box)
             if d < limit:

@@ -152,12 +152,16 @@ def world_boxes(local: np.ndarray, transform: np.ndarray, pad: float = 0.0) -> n
                      local[:, 2] + z, local[:, 5] + z], 1)
 
 
+def box_of(lo: np.ndarray, hi: np.ndarray, transform: np.ndarray) -> OrientedBox:
+    """OrientedBox of the local AABB ``lo``..``hi`` ((3,) metres) under a yaw-only ``transform``."""
+    c = (np.asarray(lo) + hi) / 2 @ transform[:3, :3].T + transform[:3, 3]
+    yaw = float(np.arctan2(transform[1, 0], transform[0, 0]))
+    return OrientedBox(tuple(float(v) for v in c), tuple(float(v) for v in np.subtract(hi, lo)), yaw)
+
+
 def oriented_box(proto: Proto, transform: np.ndarray) -> OrientedBox:
     """The object's :class:`OrientedBox`: the prototype's local AABB under ``transform``."""
-    c = (proto.lo + proto.hi) / 2 @ transform[:3, :3].T + transform[:3, 3]
-    size = proto.hi - proto.lo
-    yaw = float(np.arctan2(transform[1, 0], transform[0, 0]))
-    return OrientedBox(tuple(float(v) for v in c), tuple(float(v) for v in size), yaw)
+    return box_of(proto.lo, proto.hi, transform)
 
 
 def _axes(b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -250,33 +254,29 @@ class Placer:
     are exact preimages already.
     """
 
-    def __init__(self, library: Library, keepout: Keepout, occupancy: Occupancy | None = None,
-                 town_map=None, world_keepout: Keepout | None = None):
+    def __init__(self, library: Library, keepout: Keepout, occupancy: Occupancy | None = None, town_map=None):
         self.lib = library
         self.keepout = keepout
         self.occ = occupancy or Occupancy()
         self.placed: list[Placed] = []
         self.town_map = town_map
-        self.world_keepout = world_keepout
+        #: the keep-out in the world: the same route samples, mapped (None without a map)
+        self.world_keepout = None if town_map is None else Keepout(town_map.xy(keepout.points), keepout.limit)
 
     def _boxes(self, proto: Proto, T: np.ndarray, pad: float, route_check: bool):
         """``(box, collision boxes)`` in the grid frame, or None if the keep-out is violated."""
-        tm = self.town_map
-        if tm is None:
-            box = oriented_box(proto, T)
-            if route_check and self.keepout.violated(box):
-                return None
-            return box, world_boxes(proto.bands, T, pad)
-        box = oriented_box(proto, T)
-        if proto.shaped:
-            if route_check and self.world_keepout.polygon_distance(tm.xy(box.corners_xy())) < self.world_keepout.limit:
+        tm, box = self.town_map, oriented_box(proto, T)
+        if tm is None or proto.shaped:      # grid boxes are the exact preimages of the world's
+            if route_check and (self.keepout.violated(box) if tm is None else
+                                self.world_keepout.polygon_distance(tm.xy(box.corners_xy())) < self.keepout.limit):
                 return None
             return box, world_boxes(proto.bands, T, pad)
         Tw = tm.rigid(T)
-        if route_check and self.world_keepout.violated(oriented_box(proto, Tw)):
+        world_box = oriented_box(proto, Tw)
+        if route_check and self.world_keepout.violated(world_box):
             return None
         psi = float(np.arctan2(T[1, 0], T[0, 0]))
-        (cx, cy, hx, hy, *_), = tm.preimage_boxes(_box_row(oriented_box(proto, Tw)), psi)
+        (cx, cy, hx, hy, *_), = tm.preimage_boxes(_box_row(world_box), psi)
         grid_box = OrientedBox((float(cx), float(cy), box.center[2]), (2 * float(hx), 2 * float(hy), box.size[2]), psi)
         return grid_box, tm.preimage_boxes(world_boxes(proto.bands, Tw, pad), psi)
 
