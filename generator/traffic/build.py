@@ -25,7 +25,7 @@ from generator.rng import stream
 from generator.traffic.fleet import fleet_proto
 from generator.traffic.lane_clearance import MARGIN_M, blocked_lanes, too_narrow, widest_half_width
 from generator.traffic.lanes import LaneGraph
-from generator.traffic.mapped_tracks import ego_distance, map_track
+from generator.traffic.mapped_tracks import map_track
 from generator.traffic.movers import DT_S, Mover
 from generator.traffic.signals import CLEAR_S, Signals
 from generator.traffic.vehicles import Vehicle, VehicleSim
@@ -102,8 +102,7 @@ def build_world(spec, scene, duration_s: float, distance_m: float = 0.0) -> Worl
     if tmap is not None:
         for m in movers + peds:
             m.track = map_track(m.track, tmap, (m.proto.lo[:2] + m.proto.hi[:2]) / 2)
-        ego_track = map_track(ego_track, tmap)
-        ego_dist = ego_distance(ego_track)
+        ego_track = map_track(ego_track, tmap)      # ego_dist is measured in the world already (_drive)
     world = _assemble(world_scene, movers + peds, TrackTrajectory(ego_track, ego_dist), ego_track.t1)
     log.info("traffic %s: %d vehicles, %d pedestrians over %.1f s, simulated in %.2f s", spec.name, len(movers),
              len(peds), ego_track.t1, time.perf_counter() - t_start)

@@ -45,8 +45,3 @@ def map_track(track: Track, tmap, offset_xy=(0.0, 0.0)) -> Track:
     origin = centre_w - np.stack([ox * cw - oy * sw, ox * sw + oy * cw], -1)
     k = tmap.stretch
     return Track(track.t0 * k, track.dt * k, np.c_[origin, track.xyz[:, 2]], yaw_w)
-
-
-def ego_distance(track: Track) -> np.ndarray:
-    """(T,) float64 distance the ego has driven at each sample of its (world) track, metres."""
-    return np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(track.xyz[:, :2], axis=0), axis=1))]
