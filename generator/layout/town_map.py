@@ -32,12 +32,15 @@ from +x.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
+from generator.geometry import pose
 from generator.spec.towns import intersection_angle
+
 
 @dataclass(frozen=True)
 class TownMap:
@@ -63,18 +66,18 @@ class TownMap:
     corridor_half: float = 0.0   #: half width of a street corridor (kerb to lot line both sides), metres
     lane_half: float = 0.0       #: half width of the lanes (centre line to the parking strips), metres
 
-    @property
+    @functools.cached_property
     def A(self) -> np.ndarray:
         """(2, 2) float64 linear map, grid xy -> world xy."""
         a = math.radians(self.angle_deg)
         return np.array([[1.0, self.lean * math.cos(a)], [0.0, math.sin(a)]]) / math.sin(a)
 
-    @property
+    @functools.cached_property
     def A_inv(self) -> np.ndarray:
         """(2, 2) float64 inverse map, world xy -> grid xy."""
         return np.linalg.inv(self.A)
 
-    @property
+    @functools.cached_property
     def matrix(self) -> np.ndarray:
         """(4, 4) float64 homogeneous form of the map (z unchanged)."""
         m = np.eye(4)
@@ -131,9 +134,8 @@ class TownMap:
         local frame turned about world z by :meth:`turn` (tilts kept), no shear or scale."""
         psi = math.atan2(transform[1, 0], transform[0, 0])
         d = self.turn(float(transform[0, 3]), float(transform[1, 3]), psi)
-        rz = np.array([[math.cos(d), -math.sin(d), 0.0], [math.sin(d), math.cos(d), 0.0], [0.0, 0.0, 1.0]])
         out = np.eye(4)
-        out[:3, :3] = rz @ transform[:3, :3]
+        out[:3, :3] = pose(yaw=d)[:3, :3] @ transform[:3, :3]
         out[:3, 3] = transform[:3, 3]
         out[:2, 3] = self.A @ transform[:2, 3]
         return out
