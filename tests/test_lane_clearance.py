@@ -12,7 +12,8 @@ import pytest
 from generator.layout.assemble import build_scene
 from generator.layout.placement_core import Library
 from generator.spec.load import parse_spec
-from generator.traffic.build import EGO_SIZE_M, KINDS, build_world
+from generator.traffic.build import build_world
+from generator.traffic.fleet import EGO_SIZE_M, KINDS
 from generator.traffic.lane_clearance import widest_half_width
 from generator.traffic.lanes import boxes_overlap
 from traffic_contacts import static_quads

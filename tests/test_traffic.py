@@ -251,7 +251,7 @@ def test_every_moving_vehicle_fits_inside_its_lane():
     parking strip (parked cars) or the opposite lane. Excavators drive with the house straight
     (generator/traffic/fleet.py): slewed, their boxes were 3-6 m wide."""
     from generator.layout.placement_core import Library
-    from generator.traffic.build import KINDS
+    from generator.traffic.fleet import KINDS
     from generator.traffic.fleet import fleet_proto
 
     for seed in (1, 2, 3, 11):

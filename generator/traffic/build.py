@@ -22,7 +22,7 @@ from generator.errors import SpecError
 from generator.layout.appearance import fleet_paint
 from generator.layout.streets import make_grid
 from generator.rng import stream
-from generator.traffic.fleet import fleet_proto
+from generator.traffic.fleet import EGO_SIZE_M, KINDS, fleet_proto
 from generator.traffic.lane_clearance import MARGIN_M, blocked_lanes, too_narrow, widest_half_width
 from generator.traffic.lanes import LaneGraph
 from generator.traffic.mapped_tracks import map_track
@@ -39,16 +39,6 @@ LEAD_IN = 2           #: track samples before t = 0 (central differences at t = 
 LOOKAHEAD_S = CLEAR_S + 1.0  #: vehicles ask about crosswalks up to CLEAR_S ahead (VehicleSim._maybe_grant)
 MAX_DRIVE_S = 900.0
 SPACING_M = 6.0       #: lanes hold at most one vehicle per (length + this), for the capacity check
-EGO_SIZE_M = (4.6, 1.9)
-# spec field -> (asset kind, variants, speed factor of the limit, max acceleration m/s^2, nominal length m)
-KINDS = {
-    "cars_per_km": ("car", 6, (0.8, 1.0), 2.0, 4.6),
-    "trucks_per_km": ("truck", 3, (0.7, 0.85), 1.2, 8.0),
-    "buses_per_km": ("bus", 4, (0.7, 0.85), 1.0, 12.0),
-    "other_vehicles_per_km": ("construction_vehicle", 4, (0.5, 0.7), 1.0, 7.0),
-    "cyclists_per_km": ("bicyclist", 4, (0.35, 0.55), 1.0, 1.8),
-    "motorcyclists_per_km": ("motorcyclist", 4, (0.8, 1.0), 2.5, 2.2),
-}
 
 
 def build_world(spec, scene, duration_s: float, distance_m: float = 0.0) -> World:

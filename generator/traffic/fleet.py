@@ -1,7 +1,7 @@
 """The prototypes of the moving fleet: the same asset families as the static town, posed to drive.
 
 Vehicles of the moving traffic come from the scene's asset :class:`~generator.layout.placement_core.Library`
-(kinds of :data:`generator.traffic.build.KINDS`), with two differences from parked ones:
+(kinds of :data:`KINDS`), with two differences from parked ones:
 
 * a ridden two-wheeler is the rider and the vehicle merged into one prototype (one instance, as
   SemanticKITTI labels a bicyclist with its bicycle);
@@ -23,6 +23,17 @@ from generator.geometry.mesh import merge
 
 #: kind -> (tag, parameters) of the variant family that drives (kinds not listed: the plain variants)
 TRAVEL_POSE = {"construction_vehicle": ("travel", {"slew_deg": 0.0})}
+
+EGO_SIZE_M = (4.6, 1.9)
+# spec field -> (asset kind, variants, speed factor of the limit, max acceleration m/s^2, nominal length m)
+KINDS = {
+    "cars_per_km": ("car", 6, (0.8, 1.0), 2.0, 4.6),
+    "trucks_per_km": ("truck", 3, (0.7, 0.85), 1.2, 8.0),
+    "buses_per_km": ("bus", 4, (0.7, 0.85), 1.0, 12.0),
+    "other_vehicles_per_km": ("construction_vehicle", 4, (0.5, 0.7), 1.0, 7.0),
+    "cyclists_per_km": ("bicyclist", 4, (0.35, 0.55), 1.0, 1.8),
+    "motorcyclists_per_km": ("motorcyclist", 4, (0.8, 1.0), 2.5, 2.2),
+}
 
 
 def fleet_proto(lib, kind: str, i: int):

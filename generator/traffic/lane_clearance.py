@@ -31,7 +31,7 @@ def widest_half_width(spec, lib, kinds: dict, ego_width: float) -> tuple[float, 
     lib : generator.layout.placement_core.Library
         The asset library the traffic draws its prototypes from.
     kinds : dict
-        :data:`generator.traffic.build.KINDS` (spec field -> (kind, variants, ...)).
+        :data:`generator.traffic.fleet.KINDS` (spec field -> (kind, variants, ...)).
     ego_width : float
         Width of the ego's box, metres.
     """

@@ -34,6 +34,7 @@ from generator.traffic import walk_sim as ws
 from generator.traffic import walk_zones as wz
 from generator.traffic.movers import DT_S, Mover
 from generator.traffic.walk_lines import R_TURN
+from generator.traffic.fleet import EGO_SIZE_M, KINDS
 from generator.traffic.lane_clearance import widest_half_width
 from generator.traffic.walk_shared import shared_standers
 from generator.traffic.walkways import Walkways, build_walkways, obstacles_of
@@ -109,8 +110,6 @@ def simulate_pedestrians(spec: SceneSpec, grid: Grid, scene, signals, lib: Libra
     movers = _walkers(spec, grid, ww, body, signals, walking, n_walk, n_steps, dt, cls) if n_walk and ww.paths else []
     t2 = time.perf_counter()
     movers += _standers(spec, grid, ww, body, obstacles, standing, n_stand, n_steps, dt, cls)
-    from generator.traffic.build import EGO_SIZE_M, KINDS   # the fleet the traffic draws (build calls this module)
-
     widest, _ = widest_half_width(spec, lib, KINDS, EGO_SIZE_M[1])
     movers += shared_standers(spec, grid, obstacles, standing, n_steps, dt, cls, _proto_box, widest)   # shared streets
     log.info("pedestrians: %d walking, %d standing, %d steps (network %.2f s, walking %.2f s, standing %.2f s)",
