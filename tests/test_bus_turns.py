@@ -24,7 +24,7 @@ from generator.traffic.lane_clearance import MARGIN_M, blocked_turns, too_narrow
 from generator.traffic.lanes import ARM_DIRS, LaneGraph, boxes_overlap
 from generator.traffic.turn_clearance import node_setbacks
 from generator.world.scene import OrientedBox
-from traffic_contacts import assert_no_contact, assert_vehicles_miss_people, static_quads
+from kits.traffic_contacts import assert_no_contact, assert_vehicles_miss_people, static_quads
 
 ROOT = Path(__file__).parents[1]
 BUS = (12.13, 3.0)        #: the longest bus variant's box, mirrors included, metres

@@ -21,7 +21,7 @@ from generator.layout.streets import CROSSWALK_U, make_grid
 from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
 from generator.traffic.lanes import LaneGraph
-from traffic_contacts import assert_no_contact, static_quads
+from kits.traffic_contacts import assert_no_contact, static_quads
 from test_streets import _blender_matches_scene
 
 TRAFFIC = {"cars_per_km": 25, "trucks_per_km": 2, "buses_per_km": 1, "cyclists_per_km": 3, "motorcyclists_per_km": 2,

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fusion_kit import write_raycast_images
+from kits.fusion_kit import write_raycast_images
 from generator.dataset import Dataset
 from generator.errors import UserError
 from generator.formats import semantickitti as sk

@@ -15,8 +15,8 @@ from generator.fusion.agreement import HEADLINE, Agreement, FusedFrame, variant_
 from generator.fusion.semantic_map import VoxelMap, top_down_image
 from generator.labels import class_table
 from generator.lidar.caster import EmbreeCaster
-from fusion_kit import raycast_image, write_raycast_images
-from scene_kit import fence_scene, make_scene
+from kits.fusion_kit import raycast_image, write_raycast_images
+from kits.scene_kit import fence_scene, make_scene
 
 T = class_table()
 CAR, BUILDING, ROAD, FENCE = T.id("car"), T.id("building"), T.id("road"), T.id("fence")

@@ -47,7 +47,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from generator import cli
-from json_kit import value_paths
+from kits.json_kit import value_paths
 
 ROOT = Path(__file__).resolve().parents[1]
 MARKER = "HOSTILE-MARKER-7f3a"
@@ -70,7 +70,7 @@ class Kit:
 
 
 def _write_images(root: Path, scene, spec, n: int, width: int = 96, height: int = 64) -> None:
-    from fusion_kit import raycast_image
+    from kits.fusion_kit import raycast_image
 
     from generator.imaging.exr import LabelledImage, write_exr
     from generator.imaging.metadata import image_metadata

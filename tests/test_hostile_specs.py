@@ -35,7 +35,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from generator import cli
-from json_kit import value_paths
+from kits.json_kit import value_paths
 from generator.spec import load_spec
 
 ROOT = Path(__file__).resolve().parents[1]

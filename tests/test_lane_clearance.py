@@ -16,7 +16,7 @@ from generator.traffic.build import build_world
 from generator.traffic.fleet import EGO_SIZE_M, KINDS
 from generator.traffic.lane_clearance import widest_half_width
 from generator.traffic.lanes import boxes_overlap
-from traffic_contacts import static_quads
+from kits.traffic_contacts import static_quads
 
 ROOT = Path(__file__).parents[1]
 BUSES = {"cars_per_km": 10, "trucks_per_km": 1, "buses_per_km": 4, "other_vehicles_per_km": 1, "cyclists_per_km": 1}

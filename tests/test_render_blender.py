@@ -10,7 +10,7 @@ import pytest
 from generator.world import rig
 from generator.labels import class_table
 from generator.weather import Lighting
-from scene_kit import fence_scene
+from kits.scene_kit import fence_scene
 
 pytestmark = pytest.mark.blender
 

@@ -26,7 +26,7 @@ from generator.traffic.lanes import LaneGraph, boxes_overlap
 from generator.traffic.signals import Signals
 from generator.traffic.vehicles import Vehicle, VehicleSim
 from generator.world.scene import OrientedBox
-from traffic_contacts import assert_no_contact, assert_vehicles_miss_people, static_quads
+from kits.traffic_contacts import assert_no_contact, assert_vehicles_miss_people, static_quads
 from test_streets import _blender_matches_scene
 
 TRAFFIC = {"cars_per_km": 25, "trucks_per_km": 2, "buses_per_km": 1, "cyclists_per_km": 3, "motorcyclists_per_km": 2,

@@ -23,7 +23,7 @@ from generator.spec import parse_spec
 from generator.traffic.build import build_world
 from test_one_way import ON_LANES
 from test_streets import _blender_matches_scene, GROUND_KINDS, _no_collisions, _rests_on_ground
-from traffic_contacts import assert_vehicles_miss_people
+from kits.traffic_contacts import assert_vehicles_miss_people
 
 
 def shared_spec(seed: int = 6, traffic: dict | None = None, **types):

@@ -25,7 +25,7 @@ from generator.traffic.vehicles import conflict_key
 from test_one_way import _forward, _on_carriageway, check_lane_graph
 from test_roundabouts import _radii
 from test_streets import _blender_matches_scene, _no_collisions, _rests_on_ground
-from traffic_contacts import assert_no_contact
+from kits.traffic_contacts import assert_no_contact
 
 SECONDS = 20.0
 TRAFFIC = {"cars_per_km": 25, "trucks_per_km": 2, "buses_per_km": 1, "cyclists_per_km": 3,

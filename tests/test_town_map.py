@@ -19,7 +19,7 @@ from generator.layout.streets import make_grid
 from generator.layout.town_map import TownMap, draw_town_map
 from generator.spec import parse_spec
 from generator.traffic.build import build_world
-from traffic_contacts import assert_no_contact, assert_vehicles_miss_people, static_quads
+from kits.traffic_contacts import assert_no_contact, assert_vehicles_miss_people, static_quads
 
 GROUND_KINDS = ("street", "sidewalk", "intersection", "corner", "lot_ground", "terrain", "horizon")
 RIDERS = ("bicyclist", "motorcyclist")

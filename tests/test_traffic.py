@@ -14,7 +14,7 @@ from generator.traffic.build import build_world
 from generator.traffic.lanes import LaneGraph, boxes_overlap
 from generator.world.actors import MOVING_THRESHOLD_MPS, Track
 from generator.world.rig import SWEEP_PERIOD_S, Rig
-from traffic_contacts import assert_no_contact, assert_vehicles_miss_people, ego_box, static_quads
+from kits.traffic_contacts import assert_no_contact, assert_vehicles_miss_people, ego_box, static_quads
 
 TRAFFIC = {"cars_per_km": 25, "trucks_per_km": 2, "buses_per_km": 1, "cyclists_per_km": 3, "motorcyclists_per_km": 2,
            "other_vehicles_per_km": 1}
