@@ -8,7 +8,8 @@ re-drawn run of each (``town.redraw_every_frames``: a town seed, the spec's seed
 built one after the other, so the prototype cache is warm as in a real run), a 2x2 and a 4x4
 default town, and the test town and city centre. Every build goes through
 :func:`generator.layout.assemble.build_scene` and :meth:`SceneModel.digest` (every triangle,
-class, material, instance, label hull, object record and route).
+class, material, instance, label hull, object record and route). The digests were recorded with
+the arithmetic of tests/kits/reference_arithmetic.py; the script re-runs itself with it.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
+import os
 import sys
 import time
 from pathlib import Path
@@ -23,6 +25,15 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "tests"))
+
+from kits.reference_arithmetic import reference_env, why_not  # noqa: E402
+
+if __name__ == "__main__" and "OPENBLAS_CORETYPE" not in os.environ:   # before numpy loads
+    _env = reference_env()
+    if _env is None:
+        sys.exit(f"cannot check the pinned digests here: {why_not()}")
+    os.execve(sys.executable, [sys.executable, *sys.argv], _env)
 
 from generator.layout.assemble import build_scene  # noqa: E402
 from generator.spec import load_spec  # noqa: E402
