@@ -14,7 +14,7 @@ from scipy.spatial import ConvexHull
 from generator.geometry import apply, pose
 from generator.labels import class_table
 from generator.layout import build_scene
-from generator.layout.placement_core import world_boxes
+from generator.geometry.boxes import world_boxes
 from generator.layout.streets import make_grid
 from generator.layout.town_map import TownMap, draw_town_map
 from generator.spec import parse_spec
@@ -231,7 +231,8 @@ def test_vehicles_stand_in_the_mapped_lanes_and_strips(skewed):
 
 def test_routes_keep_clear_in_the_world(skewed):
     _, scene = skewed
-    from generator.layout.placement_core import EGO_HALF_WIDTH_M, point_box_distance
+    from generator.layout.placement_core import EGO_HALF_WIDTH_M
+    from generator.geometry.boxes import point_box_distance
 
     spec = skewed[0]
     limit = spec.paths.clearance_m + EGO_HALF_WIDTH_M

@@ -28,7 +28,8 @@ from generator.layout import placement_verges as pv
 from generator.layout.lots import Lot, lot_ground_mesh, make_lots
 from generator.layout.mapped_scene import map_scene, verify_world_routes
 from generator.layout.outskirts import horizon_mesh
-from generator.layout.placement_core import EGO_HALF_WIDTH_M, Keepout, Library, Placed, Placer, box_of
+from generator.geometry.boxes import box_of
+from generator.layout.placement_core import EGO_HALF_WIDTH_M, Keepout, Library, Placed, Placer
 from generator.layout.routes import densify, make_routes
 from generator.layout.street_meshes import (intersection_road_mesh, intersection_walk_mesh, margin_mesh,
                                             segment_frame_points, segment_road_mesh, segment_walk_mesh)

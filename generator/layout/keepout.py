@@ -1,8 +1,8 @@
 """The route keep-out: objects keep ``limit`` metres (2D) from every route sample.
 
 Distances from route samples to an object's footprint: an oriented box
-(:func:`point_box_distance`) or, for the parallelogram a skewed town makes of a shaped object's
-box, a convex polygon (:func:`point_polygon_distance`). Frames: whichever frame the samples are in
+(:func:`generator.geometry.boxes.point_box_distance`) or, for the parallelogram a skewed town makes
+of a shaped object's box, a convex polygon (:func:`generator.geometry.boxes.point_polygon_distance`). Frames: whichever frame the samples are in
 (grid or world), metres.
 """
 
@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-from generator.world.scene import OrientedBox
+from generator.geometry.boxes import OrientedBox, point_box_distance, point_polygon_distance
 
 
 class Keepout:
@@ -46,24 +46,3 @@ class Keepout:
         if not idx:
             return np.inf
         return float(point_polygon_distance(self.points[idx], poly).min())
-
-
-def point_box_distance(points: np.ndarray, box: OrientedBox) -> np.ndarray:
-    """(n,) float64 2D distance from (n, 2) world points to the footprint of ``box`` (0 inside)."""
-    p = np.asarray(points, np.float64).reshape(-1, 2) - np.asarray(box.center[:2])
-    c, s = np.cos(box.yaw), np.sin(box.yaw)
-    lx, ly = np.abs(p[:, 0] * c + p[:, 1] * s), np.abs(-p[:, 0] * s + p[:, 1] * c)
-    dx = np.maximum(lx - box.size[0] / 2, 0)
-    dy = np.maximum(ly - box.size[1] / 2, 0)
-    return np.hypot(dx, dy)
-
-
-def point_polygon_distance(points: np.ndarray, polygon: np.ndarray) -> np.ndarray:
-    """(n,) float64 2D distance from (n, 2) points to a convex (k, 2) counter-clockwise polygon (0 inside)."""
-    p = np.asarray(points, np.float64).reshape(-1, 1, 2)
-    a = np.asarray(polygon, np.float64).reshape(1, -1, 2)
-    e = np.roll(a, -1, axis=1) - a
-    t = np.clip(((p - a) * e).sum(-1) / np.maximum((e * e).sum(-1), 1e-18), 0.0, 1.0)
-    d = np.linalg.norm(p - a - t[..., None] * e, axis=-1).min(1)
-    inside = ((e[..., 0] * (p[..., 1] - a[..., 1]) - e[..., 1] * (p[..., 0] - a[..., 0])) >= 0).all(1)
-    return np.where(inside, 0.0, d)

@@ -16,7 +16,8 @@ import numpy as np
 
 from generator.geometry import Mesh
 from generator.labels import class_table
-from generator.layout.placement_core import Keepout, box_of
+from generator.geometry.boxes import box_of
+from generator.layout.placement_core import Keepout
 from generator.layout.town_map import TownMap
 from generator.world.scene import Path, SceneModel, SceneObject
 

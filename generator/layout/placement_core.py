@@ -18,10 +18,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from generator.geometry import Mesh, pose
-from generator.layout.keepout import Keepout, point_box_distance, point_polygon_distance  # noqa: F401 (re-exported)
-from generator.layout.overlap_kernel import any_overlap
+from generator.geometry.boxes import OrientedBox, box_of, world_boxes
+from generator.geometry.overlap_kernel import any_overlap
+from generator.layout.keepout import Keepout
 from generator.rng import stream
-from generator.world.scene import OrientedBox
 
 EGO_HALF_WIDTH_M = 1.2   #: half the width of the ego vehicle that drives the routes
 BAND_M = 0.5             #: height of a collision band
@@ -141,46 +141,9 @@ class Library:
         self.protos.pop(proto.key, None)
 
 
-def world_boxes(local: np.ndarray, transform: np.ndarray, pad: float = 0.0) -> np.ndarray:
-    """Local (b, 6) AABBs under a yaw-only ``transform`` -> (b, 7) ``(cx, cy, hx, hy, yaw, z0, z1)``."""
-    yaw = float(np.arctan2(transform[1, 0], transform[0, 0]))
-    c = (local[:, :3] + local[:, 3:]) / 2
-    cw = c @ transform[:3, :3].T + transform[:3, 3]
-    h = (local[:, 3:] - local[:, :3]) / 2
-    z = transform[2, 3]
-    return np.stack([cw[:, 0], cw[:, 1], h[:, 0] + pad, h[:, 1] + pad, np.full(len(c), yaw),
-                     local[:, 2] + z, local[:, 5] + z], 1)
-
-
-def box_of(lo: np.ndarray, hi: np.ndarray, transform: np.ndarray) -> OrientedBox:
-    """OrientedBox of the local AABB ``lo``..``hi`` ((3,) metres) under a yaw-only ``transform``."""
-    c = (np.asarray(lo) + hi) / 2 @ transform[:3, :3].T + transform[:3, 3]
-    yaw = float(np.arctan2(transform[1, 0], transform[0, 0]))
-    return OrientedBox(tuple(float(v) for v in c), tuple(float(v) for v in np.subtract(hi, lo)), yaw)
-
-
 def oriented_box(proto: Proto, transform: np.ndarray) -> OrientedBox:
     """The object's :class:`OrientedBox`: the prototype's local AABB under ``transform``."""
     return box_of(proto.lo, proto.hi, transform)
-
-
-def _axes(b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    c, s = np.cos(b[..., 4]), np.sin(b[..., 4])
-    return np.stack([c, s], -1), np.stack([-s, c], -1)
-
-
-def overlaps(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """(k, m) bool: do boxes ``a`` (k, 7) and ``b`` (m, 7) overlap (2D separating axes + z interval)?"""
-    A, B = a[:, None, :], b[None, :, :]
-    ax, ay = _axes(A)
-    bx, by = _axes(B)
-    d = B[..., :2] - A[..., :2]
-    ok = (A[..., 5] < B[..., 6]) & (B[..., 5] < A[..., 6])
-    for n in (ax, ay, bx, by):
-        ra = A[..., 2] * np.abs((n * ax).sum(-1)) + A[..., 3] * np.abs((n * ay).sum(-1))
-        rb = B[..., 2] * np.abs((n * bx).sum(-1)) + B[..., 3] * np.abs((n * by).sum(-1))
-        ok &= np.abs((n * d).sum(-1)) < ra + rb
-    return ok
 
 
 class Occupancy:
@@ -210,7 +173,7 @@ class Occupancy:
         idx = sorted({i for key in self._keys(boxes) for i in self._cells.get(key, ())})
         if not idx:
             return False
-        # overlaps(boxes, self.boxes[idx]).any(), compiled (the same float operations)
+        # boxes_overlap(boxes, self.boxes[idx]).any(), compiled (the same float operations)
         yaw = np.ascontiguousarray(boxes, np.float64)[:, 4]
         return bool(any_overlap(np.ascontiguousarray(boxes, np.float64), np.cos(yaw), np.sin(yaw),
                                 self._buf[idx], self._cos[idx], self._sin[idx]))
@@ -276,7 +239,7 @@ class Placer:
         if route_check and self.world_keepout.violated(world_box):
             return None
         psi = float(np.arctan2(T[1, 0], T[0, 0]))
-        (cx, cy, hx, hy, *_), = tm.preimage_boxes(_box_row(world_box), psi)
+        (cx, cy, hx, hy, *_), = tm.preimage_boxes(world_box.row(), psi)
         grid_box = OrientedBox((float(cx), float(cy), box.center[2]), (2 * float(hx), 2 * float(hy), box.size[2]), psi)
         return grid_box, tm.preimage_boxes(world_boxes(proto.bands, Tw, pad), psi)
 
@@ -305,9 +268,3 @@ class Placer:
     def _accept(self, proto: Proto, T: np.ndarray, box: OrientedBox, boxes: np.ndarray, attrs: dict | None) -> None:
         self.occ.add(boxes)
         self.placed.append(Placed(proto.kind, self.lib.main_class(proto.kind), proto.key, T, box, dict(attrs or {})))
-
-
-def _box_row(box: OrientedBox) -> np.ndarray:
-    """(1, 7) ``(cx, cy, hx, hy, yaw, z0, z1)`` row of an :class:`OrientedBox` (z interval its height)."""
-    return np.array([[box.center[0], box.center[1], box.size[0] / 2, box.size[1] / 2, box.yaw,
-                      box.center[2] - box.size[2] / 2, box.center[2] + box.size[2] / 2]])

@@ -42,6 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from generator.errors import SpecError
+from generator.geometry.boxes import corners
 from generator.layout.routes import MIN_RADIUS_M, RIGHT_RADIUS_M
 from generator.rng import stream
 from generator.world.scene import Path
@@ -154,11 +155,10 @@ def grid_ring(grid) -> Ring | None:
 
 
 def _corners(path: Path, size: tuple[float, float]) -> np.ndarray:
-    """(n, 4, 2) corners of a box of ``size`` (length, width) metres centred on every sample of ``path``."""
-    hl, hw = size[0] / 2, size[1] / 2
-    c, s = np.cos(path.headings)[:, None], np.sin(path.headings)[:, None]
-    dl, dw = np.array([hl, hl, -hl, -hl]), np.array([hw, -hw, hw, -hw])
-    return path.points[:, None, :2] + np.stack([c * dl - s * dw, s * dl + c * dw], -1)
+    """(n, 4, 2) corners of a box of ``size`` (length, width) metres centred on every sample of ``path``,
+    in the order front left, front right, rear left, rear right (so :func:`_closest`, which samples the
+    edges between consecutive corners, samples the front, the rear and the two diagonals)."""
+    return corners(path.points[:, :2], path.headings, size)[:, [2, 1, 3, 0]]
 
 
 def _inside_kerbs(path: Path, road_half: float) -> bool:

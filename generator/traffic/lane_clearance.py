@@ -15,7 +15,8 @@ from __future__ import annotations
 import numpy as np
 
 from generator.traffic.fleet import fleet_proto
-from generator.traffic.lanes import CAR_BOX_M, boxes_overlap
+from generator.geometry.boxes import corners, quads_overlap
+from generator.traffic.lanes import CAR_BOX_M
 
 MARGIN_M = 0.05      #: clearance beyond the widest box's side, metres
 
@@ -95,7 +96,6 @@ def blocked_turns(graph, scene, size: tuple[float, float]) -> set[int]:
         quads = np.stack(quads)
         centres = quads.mean(1)
         hl, hw = size[0] / 2 + MARGIN_M, size[1] / 2 + MARGIN_M
-        local = np.array([[-hl, -hw], [hl, -hw], [hl, hw], [-hl, hw]])
         reach = np.hypot(hl, hw) + float(np.max(np.linalg.norm(quads - centres[:, None], axis=-1)))
         for e in graph.edges:
             if e.kind != "connector":
@@ -105,10 +105,7 @@ def blocked_turns(graph, scene, size: tuple[float, float]) -> set[int]:
             near = np.all((centres >= lo) & (centres <= hi), axis=1)
             if not near.any():
                 continue
-            c, s = np.cos(h), np.sin(h)
-            rot = np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)        # (n, 2, 2)
-            boxes = p[:, None] + np.einsum("nij,kj->nki", rot, local)                # (n, 4, 2)
-            if boxes_overlap(boxes, quads[near]).any():
+            if quads_overlap(corners(p, h, size, MARGIN_M), quads[near]).any():
                 out.add(e.index)
     memo[key] = out
     return out
@@ -142,6 +139,6 @@ def blocked_lanes(graph, scene, half_width: float) -> set[int]:
         d = (p1 - p0) / max(np.linalg.norm(p1 - p0), 1e-9)
         n = np.array([-d[1], d[0]]) * (half_width + MARGIN_M)
         lane = np.array([[p0 - n, p1 - n, p1 + n, p0 + n]])
-        if boxes_overlap(lane, quads).any():
+        if quads_overlap(lane, quads).any():
             out.add(e.index)
     return out

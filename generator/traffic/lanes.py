@@ -206,32 +206,6 @@ def connector_path(c0: np.ndarray, entry_m: float, lane_w: float, x: int, y: int
     return _arc(centre, r, float(np.arctan2(a[1], a[0])), sign, name)
 
 
-def _corners(samples: np.ndarray, size) -> np.ndarray:
-    """(n, 4, 2) corners of boxes of ``size`` centred on the (n, 3) x, y, heading samples."""
-    hl, hw = size[0] / 2 + CONFLICT_PAD_M, size[1] / 2 + CONFLICT_PAD_M
-    local = np.array([[-hl, -hw], [hl, -hw], [hl, hw], [-hl, hw]])
-    c, s = np.cos(samples[:, 2]), np.sin(samples[:, 2])
-    rot = np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)   # (n, 2, 2)
-    return samples[:, None, :2] + np.einsum("nij,kj->nki", rot, local)
-
-
-def boxes_overlap(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """(n, m) bool: which convex quads ``a`` (n, 4, 2) and ``b`` (m, 4, 2) overlap (separating axes)."""
-    def axes(q):
-        e = np.roll(q, -1, axis=1) - q
-        return np.stack([-e[..., 1], e[..., 0]], -1)[:, :2]   # two edge normals suffice for rectangles
-
-    sep = np.zeros((len(a), len(b)), bool)
-    for own, ax_all in ((True, axes(a)), (False, axes(b))):
-        for j in range(2):
-            ax = ax_all[:, None, j, :] if own else ax_all[None, :, j, :]   # (n, 1, 2) or (1, m, 2)
-            ax = np.broadcast_to(ax, (len(a), len(b), 2))
-            pa = np.einsum("nkd,nmd->nmk", a, ax)
-            pb = np.einsum("mkd,nmd->nmk", b, ax)
-            sep |= (pa.max(-1) < pb.min(-1)) | (pb.max(-1) < pa.min(-1))
-    return ~sep
-
-
 def conflicts(graph: LaneGraph, size) -> dict:
     """Which connector kinds ``(arm_in, arm_out, lane)`` conflict, measured at a four-arm node.
 

@@ -37,7 +37,8 @@ from functools import lru_cache
 
 import numpy as np
 
-from generator.traffic.lanes import ARM_DIRS, CAR_BOX_M, STEP_M, Edge, _corners, boxes_overlap, connector_path
+from generator.geometry.boxes import corners, quad_pairs_overlap
+from generator.traffic.lanes import ARM_DIRS, CAR_BOX_M, CONFLICT_PAD_M, STEP_M, Edge, connector_path
 from generator.world.scene import Path
 
 KAPPA = 0.5523   #: cubic Bezier handle of a quarter circle, as a share of the radius
@@ -198,16 +199,9 @@ def _extended(entry_m: float, lane_w: float, key: tuple, ext: float) -> np.ndarr
     return np.vstack([np.c_[before, hb], mid, np.c_[after, ha]])
 
 
-def _pairs_overlap(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """(p,) bool: do the convex quads ``a[i]`` and ``b[i]`` ((p, 4, 2) each) overlap (separating axes)."""
-    sep = np.zeros(len(a), bool)
-    for q in (a, b):
-        e = np.roll(q, -1, axis=1) - q
-        for j in range(2):
-            ax = np.stack([-e[:, j, 1], e[:, j, 0]], -1)[:, None, :]      # (p, 1, 2)
-            pa, pb = (a * ax).sum(-1), (b * ax).sum(-1)
-            sep |= (pa.max(1) < pb.min(1)) | (pb.max(1) < pa.min(1))
-    return ~sep
+def _padded(samples: np.ndarray, size) -> np.ndarray:
+    """(n, 4, 2) corners of boxes of ``size`` grown by ``CONFLICT_PAD_M`` on the (n, 3) x, y, heading samples."""
+    return corners(samples[:, :2], samples[:, 2], size, CONFLICT_PAD_M)
 
 
 @lru_cache(maxsize=16)
@@ -218,7 +212,7 @@ def conflict_table(entry_m: float, stop_m: float, lane_w: float, keys: frozenset
     apart than the boxes' diameter are skipped, those closer than their width overlap without a test."""
     order = sorted(keys, key=repr)
     ext = stop_m - entry_m + size[0] / 2
-    geo = [_corners(_extended(entry_m, lane_w, k, ext), size) for k in order]
+    geo = [_padded(_extended(entry_m, lane_w, k, ext), size) for k in order]
     owner = np.concatenate([np.full(len(g), i) for i, g in enumerate(geo)])
     quads = np.concatenate(geo)
     centre = quads.mean(1)
@@ -230,7 +224,7 @@ def conflict_table(entry_m: float, stop_m: float, lane_w: float, keys: frozenset
         d = np.linalg.norm(centre[rows][:, None] - centre[cols][None], axis=-1)
         hit[i, owner[cols[np.nonzero(d < near)[1]]]] = True
         r, c = np.nonzero((d >= near) & (d <= far) & ~hit[i, owner[cols]][None])   # key pairs not yet decided
-        over = _pairs_overlap(quads[rows[r]], quads[cols[c]])
+        over = quad_pairs_overlap(quads[rows[r]], quads[cols[c]])
         hit[i, owner[cols[c[over]]]] = True
     hit |= hit.T
     np.fill_diagonal(hit, True)

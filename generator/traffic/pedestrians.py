@@ -22,6 +22,7 @@ import time
 import numpy as np
 from scipy.spatial import cKDTree
 
+from generator.geometry.boxes import box_pairs_overlap
 from generator.layout.placement_core import Library, Proto
 from generator.layout.appearance import outfit
 from generator.layout.placement_street import N_PEOPLE
@@ -230,11 +231,11 @@ def _standers(spec, grid: Grid, ww: Walkways, body: wc.Body, obstacles: wc.Obsta
             box = _proto_box(proto, x, y, grid.curb_h, yaw, MARGIN_M)
             if obstacles.hit(box).any():
                 continue
-            if len(placed) and wc.pair_overlap(np.repeat(box, len(placed), 0), placed).any():
+            if len(placed) and box_pairs_overlap(np.repeat(box, len(placed), 0), placed).any():
                 continue
             if lane_tree is not None:
                 near = lane_tree.query_ball_point(box[0, :2], body.radius + np.hypot(*box[0, 2:4]))
-                if near and wc.pair_overlap(np.repeat(box, len(near), 0), lane_boxes[near]).any():
+                if near and box_pairs_overlap(np.repeat(box, len(near), 0), lane_boxes[near]).any():
                     continue
             placed = np.vstack([placed, box])
             xyz = np.repeat([[x, y, grid.curb_h]], n_steps, 0)

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from generator.geometry.boxes import corners, quads_overlap
 from generator.layout.roundabouts import ARM_DIRS, ring_path
 
 GIVE_WAY_REQUEST_M = 8.0   #: at a roundabout a vehicle asks for its connector this close to the give-way line
@@ -48,16 +49,16 @@ def _extended(graph, x: int, y: int, k: int, ext: float) -> np.ndarray:
 def ring_conflicts(graph, size) -> dict:
     """Which ring connectors ``(arm_in, arm_out, lane)`` conflict (every pair whose padded boxes of
     ``size`` (length, width) metres can touch), measured at a roundabout centred on the origin."""
-    from generator.traffic.lanes import _corners, boxes_overlap
+    from generator.traffic.lanes import CONFLICT_PAD_M
 
     lanes = graph.grid.lanes
     keys = [(x, y, k) for x in range(4) for y in range(4) if x != y for k in range(lanes)]
     ext = graph.stop_m - graph.entry_m + size[0] / 2
-    geo = {key: _corners(_extended(graph, *key, ext), size) for key in keys}
+    geo = {key: corners(s[:, :2], s[:, 2], size, CONFLICT_PAD_M) for key in keys for s in [_extended(graph, *key, ext)]}
     out = {k: set() for k in keys}
     for i, ka in enumerate(keys):
         for kb in keys[i:]:
-            if ka == kb or boxes_overlap(geo[ka], geo[kb]).any():
+            if ka == kb or quads_overlap(geo[ka], geo[kb]).any():
                 out[ka].add(kb)
                 out[kb].add(ka)
     return out

@@ -17,11 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from generator.layout.placement_core import (
-    WHOLE_BOX_KINDS,
-    collision_boxes,
-    world_boxes,
-)
+from generator.geometry.boxes import box_pairs_overlap, world_boxes
+from generator.layout.placement_core import WHOLE_BOX_KINDS, collision_boxes
 
 #: Classes of flat ground (roads, pavements, terrain...): nothing a walker can bump into.
 GROUND_CLASSES = frozenset({"road", "road_marking", "crosswalk", "curb", "sidewalk", "parking", "terrain",
@@ -64,18 +61,6 @@ def body_of(protos, margin: float) -> Body:
     lo = np.min([p.lo for p in protos], 0)
     hi = np.max([p.hi for p in protos], 0)
     return Body(float(max(-lo[0], hi[0]) + margin), float(max(-lo[1], hi[1]) + margin), float(hi[2]))
-
-
-def pair_overlap(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """(k,) bool: does box ``a[i]`` overlap box ``b[i]`` ((k, 7) each; 2D separating axes + z interval)?"""
-    ok = (a[:, 5] < b[:, 6]) & (b[:, 5] < a[:, 6])
-    ca, sa, cb, sb = np.cos(a[:, 4]), np.sin(a[:, 4]), np.cos(b[:, 4]), np.sin(b[:, 4])
-    dx, dy = b[:, 0] - a[:, 0], b[:, 1] - a[:, 1]
-    for nx, ny in ((ca, sa), (-sa, ca), (cb, sb), (-sb, cb)):
-        ra = a[:, 2] * np.abs(nx * ca + ny * sa) + a[:, 3] * np.abs(-nx * sa + ny * ca)
-        rb = b[:, 2] * np.abs(nx * cb + ny * sb) + b[:, 3] * np.abs(-nx * sb + ny * cb)
-        ok &= np.abs(nx * dx + ny * dy) < ra + rb
-    return ok
 
 
 def _tiles(boxes: np.ndarray) -> np.ndarray:
@@ -136,7 +121,7 @@ class Obstacles:
         pairs = cKDTree(boxes[:, :2]).sparse_distance_matrix(self._tree, r, output_type="ndarray")
         if len(pairs):
             qi, oi = pairs["i"].astype(np.int64), pairs["j"].astype(np.int64)
-            np.logical_or.at(out, qi, pair_overlap(boxes[qi], self.boxes[oi]))
+            np.logical_or.at(out, qi, box_pairs_overlap(boxes[qi], self.boxes[oi]))
         return out
 
 

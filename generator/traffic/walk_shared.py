@@ -20,6 +20,7 @@ import logging
 
 import numpy as np
 
+from generator.geometry.boxes import box_pairs_overlap
 from generator.layout.appearance import outfit
 from generator.layout.shared_streets import shared_segments
 from generator.layout.streets import PARKING_START_U
@@ -83,7 +84,7 @@ def shared_standers(spec, grid, obstacles: wc.Obstacles, protos, n_steps: int, d
             box = box_of(proto, x, y, 0.0, yaw, 0.05)
             if not _inside_strip(grid, seg, box, v0, v1) or obstacles.hit(box).any():
                 continue
-            if len(placed) and wc.pair_overlap(np.repeat(box, len(placed), 0), placed).any():
+            if len(placed) and box_pairs_overlap(np.repeat(box, len(placed), 0), placed).any():
                 continue
             placed = np.vstack([placed, box])
             out.append(Mover("person", cls, proto, Track(0.0, dt, np.repeat([[x, y, 0.0]], n_steps, 0),

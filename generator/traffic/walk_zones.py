@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
+from generator.geometry.boxes import box_pairs_overlap
 from generator.traffic import walk_clear as wc
 
 STRIDE_M = 0.2       #: conflicts are looked for between samples this far apart
@@ -76,7 +77,7 @@ def follow_gap(body: wc.Body, radius: float) -> float:
     box = body.boxes(np.c_[x, y], th, 0.0)
     for gap in np.arange(2 * body.hx, 4 * body.radius, 0.05):
         k = round(gap / 0.02)
-        if not wc.pair_overlap(box[:-k], box[k:]).any():
+        if not box_pairs_overlap(box[:-k], box[k:]).any():
             return float(gap)
     return float(4 * body.radius)
 
@@ -105,7 +106,7 @@ def conflict_zones(paths, succ: list[tuple[int, ...]], near: list[dict[int, floa
     lateral = np.abs(-sn * (xy[j, 0] - xy[i, 0]) + c * (xy[j, 1] - xy[i, 1]))
     apart = (np.abs(np.sin(yaw[j] - yaw[i])) < 1e-3) & (lateral >= 2 * (body.hy + 0.05))
     i, j = i[~apart], j[~apart]
-    keep = wc.pair_overlap(boxes[i], boxes[j])
+    keep = box_pairs_overlap(boxes[i], boxes[j])
     i, j = i[keep], j[keep]
     keys = np.array([e * len(paths) + f for e, r in enumerate(near) for f in r], np.int64)
     vals = np.array([d for r in near for d in r.values()], np.float64)

@@ -1,11 +1,11 @@
 """The occupancy's separating-axis test, compiled (numba, GIL released).
 
-:meth:`generator.layout.placement_core.Occupancy.hits` asks ~1500 times per town whether a
-few collision boxes overlap any of the accepted boxes near them. As numpy expressions
-(:func:`generator.layout.placement_core.overlaps`) each question is ~60 short array passes
+The placer's occupancy (``Occupancy.hits`` in :mod:`generator.layout.placement`) asks ~1500 times
+per town whether a few collision boxes overlap any of the accepted boxes near them. As numpy
+expressions (:func:`generator.geometry.boxes.boxes_overlap`) each question is ~60 short array passes
 on arrays of a few dozen pairs; here it is one loop that stops at the first overlap.
 
-The arithmetic is the float64 arithmetic of ``overlaps``, in the same order and without fused
+The arithmetic is the float64 arithmetic of ``boxes_overlap``, in the same order and without fused
 multiply-adds (numba's default, no ``fastmath``), so every answer is the same: per axis ``n``
 of the four box axes, ``|n . d| < hx_a |n . ax_a| + hy_a |n . ay_a| + hx_b |n . ax_b| +
 hy_b |n . ay_b|`` with ``n . v = n0 v0 + n1 v1``, and the z intervals overlap strictly. The
@@ -40,7 +40,7 @@ def any_overlap(a, a_cos, a_sin, b, b_cos, b_sin):  # pragma: no cover - compile
     Returns
     -------
     bool
-        ``overlaps(a, b).any()``.
+        ``boxes_overlap(a, b).any()``.
     """
     for i in range(a.shape[0]):
         ca, sa = a_cos[i], a_sin[i]
@@ -51,7 +51,7 @@ def any_overlap(a, a_cos, a_sin, b, b_cos, b_sin):  # pragma: no cover - compile
             cb, sb = b_cos[j], b_sin[j]
             bhx, bhy = b[j, 2], b[j, 3]
             dx, dy = b[j, 0] - a[i, 0], b[j, 1] - a[i, 1]
-            # box axes: x = (c, s), y = (-s, c); the four candidate separating axes in overlaps' order
+            # box axes: x = (c, s), y = (-s, c); the four candidate separating axes in boxes_overlap's order
             if _separated(ca, sa, ca, sa, -sa, ca, cb, sb, -sb, cb, ahx, ahy, bhx, bhy, dx, dy):
                 continue
             if _separated(-sa, ca, ca, sa, -sa, ca, cb, sb, -sb, cb, ahx, ahy, bhx, bhy, dx, dy):
