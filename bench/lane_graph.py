@@ -18,7 +18,7 @@ import time
 
 import numpy as np
 
-from generator.layout.streets import make_grid
+from generator.layout.network.draw import make_grid
 from generator.spec import parse_spec
 from generator.traffic.lanes import LaneGraph
 from generator.traffic.one_way import conflict_table

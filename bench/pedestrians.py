@@ -29,8 +29,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from generator.layout import build_scene
-from generator.layout.placement_core import Library
-from generator.layout.streets import make_grid
+from generator.layout.placement.prototypes import Library
+from generator.layout.network.draw import make_grid
 from generator.spec import load_spec
 from generator.traffic import pedestrians as peds
 from generator.traffic import walk_sim

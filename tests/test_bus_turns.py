@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from generator.layout.assemble import build_scene
-from generator.layout.streets import make_grid
+from generator.layout.network.draw import make_grid
 from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
 from generator.traffic.lane_clearance import MARGIN_M, blocked_turns, too_narrow

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from generator.layout.assemble import build_scene
-from generator.layout.placement_core import Library
+from generator.layout.placement.prototypes import Library
 from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
 from generator.traffic.fleet import EGO_SIZE_M, KINDS

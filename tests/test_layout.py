@@ -12,13 +12,14 @@ from generator.geometry import apply
 from generator.labels import class_table
 from generator.layout import build_scene
 from generator.world.rig import Rig
-from generator.layout.placement_core import EGO_HALF_WIDTH_M
+from generator.layout.network.design_vehicle import EGO_HALF_WIDTH_M
 from generator.geometry.boxes import boxes_overlap, point_box_distance
 from generator.previews.layout_map import rasterize
-from generator.layout.lots import make_lots
-from generator.layout.outskirts import HORIZON_M
-from generator.layout.street_meshes import segment_frame_points
-from generator.layout.streets import MARK_Z_M, make_grid
+from generator.layout.lots.lot import make_lots
+from generator.layout.ground.terrain import HORIZON_M
+from generator.layout.network.grid import segment_frame_points
+from generator.layout.network.measures import MARK_Z_M
+from generator.layout.network.draw import make_grid
 from generator.materials import material_table
 from generator.world.scene import OrientedBox
 from generator.spec import parse_spec
@@ -118,7 +119,7 @@ def test_only_vehicles_stand_in_the_lanes_and_none_on_a_route(city_centre, root)
     """On the driving lanes stand only vehicles, riders, tram rails and people on crosswalks; every
     placed object keeps the route clearance (the same check build_scene makes)."""
     from generator.layout.assemble import verify_routes
-    from generator.layout.streets import make_grid
+    from generator.layout.network.draw import make_grid
     from generator.spec import load_spec
 
     grid = make_grid(load_spec(root / "scenes" / "city_centre.json"))

@@ -18,10 +18,11 @@ from generator.cli import main
 from generator.errors import SpecError
 from generator.labels import class_table
 from generator.layout import build_scene
-from generator.layout.one_way import driven_directions, strongly_connected
-from generator.layout.routes import make_routes
-from generator.layout.street_meshes import segment_frame_points
-from generator.layout.streets import STOP_U, make_grid
+from generator.layout.network.one_way import driven_directions, strongly_connected
+from generator.layout.network.routes import make_routes
+from generator.layout.network.grid import segment_frame_points
+from generator.layout.network.measures import STOP_U
+from generator.layout.network.draw import make_grid
 from generator.spec import load_spec, parse_spec
 from generator.traffic.build import build_world
 from generator.traffic.lanes import LaneGraph

@@ -16,11 +16,11 @@ from assets_procedural.catalog import build
 from generator.geometry import face_normals
 from generator.labels import class_table
 from generator.layout import build_scene
-from generator.layout.placement_core import EGO_HALF_WIDTH_M
+from generator.layout.network.design_vehicle import EGO_HALF_WIDTH_M
 from generator.geometry.boxes import point_box_distance
-from generator.layout.placement_street import Street
-from generator.layout.street_meshes import segment_frame_points
-from generator.layout.streets import make_grid
+from generator.layout.placement.street_frame import Street
+from generator.layout.network.grid import segment_frame_points
+from generator.layout.network.draw import make_grid
 from generator.materials import material_table
 from generator.traffic.lanes import LaneGraph
 from test_one_way import one_way_spec

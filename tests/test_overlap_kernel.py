@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from generator.geometry.overlap_kernel import any_overlap
-from generator.layout.placement_core import Occupancy
+from generator.layout.placement.placer import Occupancy
 from generator.geometry.boxes import boxes_overlap
 
 

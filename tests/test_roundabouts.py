@@ -15,11 +15,14 @@ import pytest
 from generator.errors import SpecError
 from generator.labels import class_table
 from generator.layout.assemble import build_scene
-from generator.layout.placement_core import EGO_HALF_WIDTH_M
-from generator.layout.roundabouts import (ARM_DIRS, DESIGN_VEHICLES_M, STANDARD_CAR_M, _closest, ring_geometry,
-                                          ring_path)
-from generator.layout.routes import MIN_RADIUS_M, make_routes
-from generator.layout.streets import APRON_H_M, make_grid
+from generator.layout.network.design_vehicle import EGO_HALF_WIDTH_M
+from generator.layout.network.measures import ARM_DIRS
+from generator.layout.network.design_vehicle import DESIGN_VEHICLES_M, STANDARD_CAR_M
+from generator.layout.network.rings import _closest, ring_geometry, ring_path
+from generator.layout.network.design_vehicle import MIN_RADIUS_M
+from generator.layout.network.routes import make_routes
+from generator.layout.network.measures import APRON_H_M
+from generator.layout.network.draw import make_grid
 from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
 from generator.traffic.lanes import LaneGraph
@@ -373,7 +376,7 @@ def test_a_vehicle_at_its_setback_keeps_clear_of_a_bus_swinging_out_over_its_giv
     """ring_clearance: a 12 m bus leaving the ring swings its front over the give-way line of its exit
     arm, so a vehicle waiting there must hang back; at that setback (and not at the line) its box is
     clear of every box the bus sweeps along the connector. A standard car needs no setback anywhere."""
-    from generator.layout.roundabouts import ring_path
+    from generator.layout.network.rings import ring_path
     from generator.traffic.ring_clearance import setbacks
 
     graph = LaneGraph(make_grid(spec_with(blocks=2)))

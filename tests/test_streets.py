@@ -18,13 +18,13 @@ from generator.errors import SpecError
 from generator.geometry import apply
 from generator.labels import class_table
 from generator.layout import build_scene
-from generator.layout.cross_sections import MEDIAN_W_M
-from generator.layout.districts import DISTRICTS
-from generator.layout.lots import make_lots
-from generator.layout.placement_core import EGO_HALF_WIDTH_M
+from generator.layout.network.cross_sections import MEDIAN_W_M
+from generator.layout.lots.districts import DISTRICTS
+from generator.layout.lots.lot import make_lots
+from generator.layout.network.design_vehicle import EGO_HALF_WIDTH_M
 from generator.geometry.boxes import boxes_overlap, point_box_distance
-from generator.layout.street_meshes import segment_frame_points
-from generator.layout.streets import make_grid
+from generator.layout.network.grid import segment_frame_points
+from generator.layout.network.draw import make_grid
 from generator.spec import load_spec, parse_spec
 from test_layout import _check_vehicles
 

@@ -8,7 +8,7 @@ import pytest
 from generator.errors import SpecError
 from generator.labels import class_table
 from generator.layout.assemble import build_scene
-from generator.layout.streets import make_grid
+from generator.layout.network.draw import make_grid
 from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
 from generator.traffic.lanes import LaneGraph
@@ -251,7 +251,7 @@ def test_every_moving_vehicle_fits_inside_its_lane():
     """A moving vehicle's box is no wider than a lane, so it never reaches over the lane line into the
     parking strip (parked cars) or the opposite lane. Excavators drive with the house straight
     (generator/traffic/fleet.py): slewed, their boxes were 3-6 m wide."""
-    from generator.layout.placement_core import Library
+    from generator.layout.placement.prototypes import Library
     from generator.traffic.fleet import KINDS
     from generator.traffic.fleet import fleet_proto
 

@@ -16,9 +16,10 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-from generator.layout.placement_core import Library, WHOLE_BOX_KINDS, collision_boxes
+from generator.layout.placement.prototypes import Library, WHOLE_BOX_KINDS, collision_boxes
 from generator.geometry.boxes import world_boxes
-from generator.layout.streets import CROSSWALK_U, make_grid
+from generator.layout.network.measures import CROSSWALK_U
+from generator.layout.network.draw import make_grid
 from generator.traffic import walk_clear, walk_net
 from generator.traffic.movers import DT_S
 from generator.traffic.pedestrians import (

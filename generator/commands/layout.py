@@ -101,9 +101,9 @@ def summary(scene, spec, build_s: float) -> dict:
     if scene.town_map is not None:   # streets crossing at an angle (the towns with right angles read as before)
         info["intersection_angle"] = {"angle_deg": round(scene.town_map.angle_deg, 4), "lean": scene.town_map.lean,
                                       "grid_to_world_xy": [[round(float(v), 9) for v in row] for row in scene.town_map.A]}
-    from generator.layout.closures import closed_record
-    from generator.layout.roundabouts import roundabout_record
-    from generator.layout.streets import make_grid
+    from generator.layout.network.closures import closed_record
+    from generator.layout.network.roundabouts import roundabout_record
+    from generator.layout.network.draw import make_grid
 
     grid = make_grid(spec)
     ring, closed = roundabout_record(grid), closed_record(grid)
@@ -116,8 +116,8 @@ def summary(scene, spec, build_s: float) -> dict:
 
 def _streets(spec) -> dict:
     """``{"streets": [...]}``: each segment's drawn cross-section, when the spec has ``streets``."""
-    from generator.layout.cross_sections import sections_record
-    from generator.layout.streets import make_grid
+    from generator.layout.network.cross_sections import sections_record
+    from generator.layout.network.draw import make_grid
 
     rows = sections_record(make_grid(spec)) if spec.streets is not None else []
     return {"streets": rows} if rows else {}

@@ -19,8 +19,8 @@ import time
 import numpy as np
 
 from generator.errors import SpecError
-from generator.layout.appearance import fleet_paint
-from generator.layout.streets import make_grid
+from generator.layout.placement.appearance import fleet_paint
+from generator.layout.network.draw import make_grid
 from generator.rng import stream
 from generator.traffic.fleet import EGO_SIZE_M, KINDS, fleet_proto
 from generator.traffic.lane_clearance import MARGIN_M, blocked_lanes, too_narrow, widest_half_width
@@ -66,7 +66,7 @@ def build_world(spec, scene, duration_s: float, distance_m: float = 0.0) -> Worl
     if tmap is not None:    # streets crossing at an angle: the traffic runs on the town's grid
         scene = scene.layout
     t_start = time.perf_counter()
-    from generator.layout.placement_core import Library
+    from generator.layout.placement.prototypes import Library
 
     grid = make_grid(spec)
     graph = LaneGraph(grid)
@@ -135,7 +135,7 @@ def _extend_track(m: Mover, n: int) -> Mover:
 
 def _crosswalk_occupancy(grid, graph: LaneGraph, peds: list[Mover]):
     """``crossing(node, arm, t0, t1)``: is a pedestrian within 1 m of that crosswalk band then."""
-    from generator.layout.streets import CROSSWALK_U
+    from generator.layout.network.measures import CROSSWALK_U
     from generator.traffic.lanes import ARM_DIRS
 
     walkers = [p for p in peds if p.attrs.get("role") != "standing"]
@@ -185,7 +185,7 @@ def _prune(graph: LaneGraph, blocked: set[int], keep: set[int]) -> set[int]:
 
 def _ego_route(graph: LaneGraph) -> list[int]:
     """Route 0 (the comb loop of :mod:`generator.layout.routes`) as a cycle of edges of ``graph``."""
-    from generator.layout.one_way import route_node_cycles
+    from generator.layout.network.cycles import route_node_cycles
     from generator.traffic.vehicles import arm_towards
 
     grid = graph.grid

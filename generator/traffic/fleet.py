@@ -57,7 +57,7 @@ def fleet_proto(lib, kind: str, i: int):
         return lib.variant(kind, i, lambda g: dict(params), tag=tag)
     if kind not in ("bicyclist", "motorcyclist"):
         return lib.variant(kind, i)
-    from generator.layout.placement_core import Proto
+    from generator.layout.placement.prototypes import Proto
 
     key = f"{kind}_riding_v{i}"
     if key not in lib.protos:

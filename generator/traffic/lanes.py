@@ -23,9 +23,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from generator.layout.roundabouts import ring_path
-from generator.layout.routes import MIN_RADIUS_M, RIGHT_RADIUS_M
-from generator.layout.streets import STOP_U, Grid
+from generator.layout.network.rings import ring_path
+from generator.layout.network.design_vehicle import MIN_RADIUS_M, RIGHT_RADIUS_M
+from generator.layout.network.measures import STOP_U
+from generator.layout.network.grid import Grid
 from generator.world.scene import Path
 
 ARM_DIRS = np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0], [0.0, -1.0]])  #: east, north, west, south

@@ -23,10 +23,10 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from generator.geometry.boxes import box_pairs_overlap
-from generator.layout.placement_core import Library, Proto
-from generator.layout.appearance import outfit
-from generator.layout.placement_street import N_PEOPLE
-from generator.layout.streets import Grid
+from generator.layout.placement.prototypes import Library, Proto
+from generator.layout.placement.appearance import outfit
+from generator.layout.placement.street import N_PEOPLE
+from generator.layout.network.grid import Grid
 from generator.rng import stream
 from generator.spec.model import SceneSpec
 from generator.traffic import walk_clear as wc

@@ -28,7 +28,8 @@ import functools
 
 import numpy as np
 
-from generator.layout.roundabouts import ARM_DIRS, ring_path
+from generator.layout.network.measures import ARM_DIRS
+from generator.layout.network.rings import ring_path
 
 SETBACK_PAD_M = 0.3   #: clearance kept between a waiting box and a box on the ring, metres
 STOP_TOL_M = 0.2   #: a vehicle stopped this little past its setback still counts as clear (inside the pad)

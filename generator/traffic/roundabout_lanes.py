@@ -26,7 +26,8 @@ from __future__ import annotations
 import numpy as np
 
 from generator.geometry.boxes import corners, quads_overlap
-from generator.layout.roundabouts import ARM_DIRS, ring_path
+from generator.layout.network.measures import ARM_DIRS
+from generator.layout.network.rings import ring_path
 
 GIVE_WAY_REQUEST_M = 8.0   #: at a roundabout a vehicle asks for its connector this close to the give-way line
 GIVE_WAY_CLEAR_S = 14.0    #: ... and only when nobody is on or steps onto its crosswalks this long

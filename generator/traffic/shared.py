@@ -6,7 +6,7 @@ Vehicles (:mod:`generator.traffic.vehicles`) cap their desired speed on an edge 
 
 from __future__ import annotations
 
-from generator.layout.shared_streets import SHARED_SPEED_MPS
+from generator.layout.network.cross_sections import SHARED_SPEED_MPS
 
 
 def speed_caps(graph) -> dict[int, float]:

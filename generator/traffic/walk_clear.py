@@ -18,7 +18,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from generator.geometry.boxes import box_pairs_overlap, world_boxes
-from generator.layout.placement_core import WHOLE_BOX_KINDS, collision_boxes
+from generator.layout.placement.prototypes import WHOLE_BOX_KINDS, collision_boxes
 
 #: Classes of flat ground (roads, pavements, terrain...): nothing a walker can bump into.
 GROUND_CLASSES = frozenset({"road", "road_marking", "crosswalk", "curb", "sidewalk", "parking", "terrain",

@@ -20,7 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from generator.layout.streets import CROSSWALK_U, Grid
+from generator.layout.network.measures import CROSSWALK_U
+from generator.layout.network.grid import Grid
 from generator.traffic.walk_clear import Body
 
 R_TURN = 1.0        #: radius of every turn, metres

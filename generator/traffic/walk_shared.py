@@ -21,9 +21,9 @@ import logging
 import numpy as np
 
 from generator.geometry.boxes import box_pairs_overlap
-from generator.layout.appearance import outfit
-from generator.layout.shared_streets import shared_segments
-from generator.layout.streets import PARKING_START_U
+from generator.layout.placement.appearance import outfit
+from generator.layout.network.cross_sections import shared_segments
+from generator.layout.network.measures import PARKING_START_U
 from generator.rng import stream
 from generator.traffic import walk_clear as wc
 from generator.traffic.movers import Mover

@@ -20,7 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from generator.layout.streets import CROSSWALK_U, Grid
+from generator.layout.network.measures import CROSSWALK_U
+from generator.layout.network.grid import Grid
 from generator.traffic import walk_clear as wc
 from generator.traffic.walk_lines import (
     KERB,
