@@ -32,11 +32,11 @@ from generator.layout import build_scene
 from generator.layout.placement.prototypes import Library
 from generator.layout.network.draw import make_grid
 from generator.spec import load_spec
-from generator.traffic import pedestrians as peds
-from generator.traffic import walk_sim
+from generator.traffic.pedestrians import simulate as peds
+from generator.traffic.pedestrians import sim as walk_sim
 from generator.traffic.movers import DT_S
-from generator.traffic.signals import Signals
-from generator.traffic.walk_lines import street_distance
+from generator.traffic.lanes.signals import Signals
+from generator.traffic.pedestrians.lines import street_distance
 
 
 class Clock:

@@ -20,10 +20,11 @@ from generator.layout.assemble import build_scene
 from generator.layout.network.draw import make_grid
 from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
-from generator.traffic.lane_clearance import MARGIN_M, blocked_turns, too_narrow
-from generator.traffic.lanes import ARM_DIRS, LaneGraph
+from generator.traffic.lanes.clearance import MARGIN_M, blocked_turns, too_narrow
+from generator.layout.network.measures import ARM_DIRS
+from generator.traffic.lanes.graph import LaneGraph
 from generator.geometry.boxes import quads_overlap
-from generator.traffic.turn_clearance import node_setbacks
+from generator.traffic.lanes.turn_clearance import node_setbacks
 from generator.world.scene import OrientedBox
 from kits.traffic_contacts import assert_no_contact, assert_vehicles_miss_people, static_quads
 

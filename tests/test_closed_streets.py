@@ -21,7 +21,7 @@ from generator.layout.network.measures import CROSSWALK_U
 from generator.layout.network.draw import make_grid
 from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
-from generator.traffic.lanes import LaneGraph
+from generator.traffic.lanes.graph import LaneGraph
 from kits.traffic_contacts import assert_no_contact, static_quads
 from test_streets import _blender_matches_scene
 

@@ -13,8 +13,9 @@ from generator.layout.assemble import build_scene
 from generator.layout.placement.prototypes import Library
 from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
-from generator.traffic.fleet import EGO_SIZE_M, KINDS
-from generator.traffic.lane_clearance import widest_half_width
+from generator.layout.network.design_vehicle import EGO_SIZE_M
+from generator.traffic.vehicles.fleet import KINDS
+from generator.traffic.vehicles.fleet import widest_half_width
 from generator.geometry.boxes import quads_overlap
 from kits.traffic_contacts import static_quads
 

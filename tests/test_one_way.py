@@ -25,7 +25,7 @@ from generator.layout.network.measures import STOP_U
 from generator.layout.network.draw import make_grid
 from generator.spec import load_spec, parse_spec
 from generator.traffic.build import build_world
-from generator.traffic.lanes import LaneGraph
+from generator.traffic.lanes.graph import LaneGraph
 from test_streets import _no_collisions, _rests_on_ground
 
 ON_LANES = ("car", "truck", "bus", "on_rails", "other_vehicle", "ridden_bicycle", "ridden_motorcycle",

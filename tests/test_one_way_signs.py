@@ -22,7 +22,7 @@ from generator.layout.placement.street_frame import Street
 from generator.layout.network.grid import segment_frame_points
 from generator.layout.network.draw import make_grid
 from generator.materials import material_table
-from generator.traffic.lanes import LaneGraph
+from generator.traffic.lanes.graph import LaneGraph
 from test_one_way import one_way_spec
 from test_street_mix import full_spec
 from test_streets import _no_collisions

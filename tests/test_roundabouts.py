@@ -25,10 +25,10 @@ from generator.layout.network.measures import APRON_H_M
 from generator.layout.network.draw import make_grid
 from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
-from generator.traffic.lanes import LaneGraph
+from generator.traffic.lanes.graph import LaneGraph
 from generator.geometry.boxes import quads_overlap
-from generator.traffic.signals import Signals
-from generator.traffic.vehicles import Vehicle, VehicleSim
+from generator.traffic.lanes.signals import Signals
+from generator.traffic.vehicles.sim import Vehicle, VehicleSim
 from generator.world.scene import OrientedBox
 from kits.traffic_contacts import assert_no_contact, assert_vehicles_miss_people, static_quads
 from test_streets import _blender_matches_scene
@@ -377,7 +377,7 @@ def test_a_vehicle_at_its_setback_keeps_clear_of_a_bus_swinging_out_over_its_giv
     arm, so a vehicle waiting there must hang back; at that setback (and not at the line) its box is
     clear of every box the bus sweeps along the connector. A standard car needs no setback anywhere."""
     from generator.layout.network.rings import ring_path
-    from generator.traffic.ring_clearance import setbacks
+    from generator.traffic.lanes.ring_clearance import setbacks
 
     graph = LaneGraph(make_grid(spec_with(blocks=2)))
     bus, wait = (12.0, 2.55), (12.0, 2.55)

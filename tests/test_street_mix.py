@@ -22,8 +22,8 @@ from generator.layout.network.measures import STOP_U
 from generator.layout.network.draw import make_grid
 from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
-from generator.traffic.lanes import LaneGraph
-from generator.traffic.vehicles import conflict_key
+from generator.traffic.lanes.graph import LaneGraph
+from generator.traffic.vehicles.sim import conflict_key
 from test_one_way import _forward, _on_carriageway, check_lane_graph
 from test_roundabouts import _radii
 from test_streets import _blender_matches_scene, _no_collisions, _rests_on_ground

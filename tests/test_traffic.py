@@ -11,7 +11,7 @@ from generator.layout.assemble import build_scene
 from generator.layout.network.draw import make_grid
 from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
-from generator.traffic.lanes import LaneGraph
+from generator.traffic.lanes.graph import LaneGraph
 from generator.geometry.boxes import quads_overlap
 from generator.world.actors import MOVING_THRESHOLD_MPS, Track
 from generator.world.rig import SWEEP_PERIOD_S, Rig
@@ -252,8 +252,8 @@ def test_every_moving_vehicle_fits_inside_its_lane():
     parking strip (parked cars) or the opposite lane. Excavators drive with the house straight
     (generator/traffic/fleet.py): slewed, their boxes were 3-6 m wide."""
     from generator.layout.placement.prototypes import Library
-    from generator.traffic.fleet import KINDS
-    from generator.traffic.fleet import fleet_proto
+    from generator.traffic.vehicles.fleet import KINDS
+    from generator.traffic.vehicles.fleet import fleet_proto
 
     for seed in (1, 2, 3, 11):
         grid, lib = make_grid(_sweep_town(seed, 0.0)), Library(seed)

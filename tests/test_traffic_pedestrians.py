@@ -20,17 +20,12 @@ from generator.layout.placement.prototypes import Library, WHOLE_BOX_KINDS, coll
 from generator.geometry.boxes import world_boxes
 from generator.layout.network.measures import CROSSWALK_U
 from generator.layout.network.draw import make_grid
-from generator.traffic import walk_clear, walk_net
+from generator.traffic.pedestrians import clear as walk_clear, net as walk_net
 from generator.traffic.movers import DT_S
-from generator.traffic.pedestrians import (
-    MARGIN_M,
-    max_speed,
-    person_protos,
-    sidewalk_length,
-    simulate_pedestrians,
-)
-from generator.traffic.signals import CYCLE_S, WALK_S, Signals
-from generator.traffic.walkways import build_walkways, obstacles_of
+from generator.traffic.pedestrians.simulate import (MARGIN_M, max_speed, person_protos, sidewalk_length,
+                                                    simulate_pedestrians)
+from generator.traffic.lanes.signals import CYCLE_S, Signals, WALK_S
+from generator.traffic.pedestrians.walkways import build_walkways, obstacles_of
 
 N_STEPS = int(CYCLE_S / DT_S)          # one whole signal cycle: every node has a walk phase
 GROUND = {"road", "road_marking", "crosswalk", "curb", "sidewalk", "parking", "terrain", "other_ground", "rail_track"}

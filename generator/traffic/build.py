@@ -19,16 +19,22 @@ import time
 import numpy as np
 
 from generator.errors import SpecError
-from generator.layout.placement.appearance import fleet_paint
+from generator.geometry.proxy import label_proxy
+from generator.layout.network.cycles import route_node_cycles
+from generator.layout.network.design_vehicle import EGO_SIZE_M
 from generator.layout.network.draw import make_grid
+from generator.layout.network.measures import ARM_DIRS, CROSSWALK_U
+from generator.layout.placement.appearance import fleet_paint
+from generator.layout.placement.prototypes import Library
 from generator.rng import stream
-from generator.traffic.fleet import EGO_SIZE_M, KINDS, fleet_proto
-from generator.traffic.lane_clearance import MARGIN_M, blocked_lanes, too_narrow, widest_half_width
-from generator.traffic.lanes import LaneGraph
+from generator.traffic.lanes.clearance import MARGIN_M, blocked_lanes, too_narrow
+from generator.traffic.lanes.graph import LaneGraph
+from generator.traffic.lanes.signals import CLEAR_S, Signals
 from generator.traffic.mapped_tracks import map_track
 from generator.traffic.movers import DT_S, Mover
-from generator.traffic.signals import CLEAR_S, Signals
-from generator.traffic.vehicles import Vehicle, VehicleSim
+from generator.traffic.pedestrians.simulate import simulate_pedestrians
+from generator.traffic.vehicles.fleet import KINDS, fleet_proto, widest_half_width
+from generator.traffic.vehicles.sim import Vehicle, VehicleSim, arm_towards
 from generator.world.actors import Actor, Track, TrackTrajectory, World, frozen_world
 from generator.world.trajectory import EgoTrajectory
 
@@ -66,14 +72,13 @@ def build_world(spec, scene, duration_s: float, distance_m: float = 0.0) -> Worl
     if tmap is not None:    # streets crossing at an angle: the traffic runs on the town's grid
         scene = scene.layout
     t_start = time.perf_counter()
-    from generator.layout.placement.prototypes import Library
-
     grid = make_grid(spec)
     graph = LaneGraph(grid)
     signals = Signals(spec.seed, grid.nodes, grid.roundabouts)
     lib = Library(spec.seed)
     half_width, widest = widest_half_width(spec, lib, KINDS, EGO_SIZE_M[1])
-    log.debug("lanes kept clear of static objects to %.2f m from their centre lines (%s)", half_width + MARGIN_M, widest)
+    log.debug("lanes kept clear of static objects to %.2f m from their centre lines (%s)", half_width + MARGIN_M,
+              widest)
     horizon_s = duration_s + 1.0 + LOOKAHEAD_S
     if distance_m > 0:  # the drive may take longer than asked: cover a slow ego
         horizon_s = max(horizon_s, distance_m / (0.25 * spec.paths.speed_mps) + 5.0 + LOOKAHEAD_S)
@@ -81,8 +86,8 @@ def build_world(spec, scene, duration_s: float, distance_m: float = 0.0) -> Worl
         peds = _pedestrians(spec, grid, scene, signals, lib, int(np.ceil(horizon_s / DT_S)) + 1)
         crossing = _crosswalk_occupancy(grid, graph, peds)
         blocked = blocked_lanes(graph, scene, half_width)
-        movers, ego_track, ego_dist = _drive(spec, graph, scene, signals, lib, blocked, crossing, duration_s, distance_m,
-                                             None if tmap is None else tmap.A)
+        movers, ego_track, ego_dist = _drive(spec, graph, scene, signals, lib, blocked, crossing, duration_s,
+                                             distance_m, None if tmap is None else tmap.A)
         if crossing is None or crossing.asked_s <= horizon_s:
             break
         horizon_s = 2.0 * crossing.asked_s  # same answers up to the old horizon (causal): a longer run, same world
@@ -102,8 +107,6 @@ def build_world(spec, scene, duration_s: float, distance_m: float = 0.0) -> Worl
 def _pedestrians(spec, grid, scene, signals, lib, n_steps: int) -> list[Mover]:
     if spec.traffic.pedestrians_per_100m <= 0 and spec.traffic.standing_pedestrians_per_100m <= 0:
         return []
-    from generator.traffic.pedestrians import simulate_pedestrians
-
     return simulate_pedestrians(spec, grid, scene, signals, lib, n_steps, DT_S)
 
 
@@ -119,7 +122,8 @@ def _lead_in(m: Mover, ground=None) -> Mover:
     step = tr.xyz[1] - tr.xyz[0]
     back = tr.xyz[0] - step * np.arange(LEAD_IN, 0, -1)[:, None]
     back[:, 2] = tr.xyz[0, 2] if ground is None else ground(back[:, :2])
-    m.track = Track(tr.t0 - LEAD_IN * DT_S, tr.dt, np.vstack([back, tr.xyz]), np.r_[np.repeat(tr.yaw[:1], LEAD_IN), tr.yaw])
+    m.track = Track(tr.t0 - LEAD_IN * DT_S, tr.dt, np.vstack([back, tr.xyz]),
+                    np.r_[np.repeat(tr.yaw[:1], LEAD_IN), tr.yaw])
     return m
 
 
@@ -135,9 +139,6 @@ def _extend_track(m: Mover, n: int) -> Mover:
 
 def _crosswalk_occupancy(grid, graph: LaneGraph, peds: list[Mover]):
     """``crossing(node, arm, t0, t1)``: is a pedestrian within 1 m of that crosswalk band then."""
-    from generator.layout.network.measures import CROSSWALK_U
-    from generator.traffic.lanes import ARM_DIRS
-
     walkers = [p for p in peds if p.attrs.get("role") != "standing"]
     if not walkers:
         return None
@@ -185,9 +186,6 @@ def _prune(graph: LaneGraph, blocked: set[int], keep: set[int]) -> set[int]:
 
 def _ego_route(graph: LaneGraph) -> list[int]:
     """Route 0 (the comb loop of :mod:`generator.layout.routes`) as a cycle of edges of ``graph``."""
-    from generator.layout.network.cycles import route_node_cycles
-    from generator.traffic.vehicles import arm_towards
-
     grid = graph.grid
     nodes = route_node_cycles(len(grid.xs) - 1, len(grid.ys) - 1)[0]
     k = grid.lanes - 1
@@ -299,8 +297,6 @@ def _free_spot(graph, free, taken, length, g, field_name, spec):
 
 
 def _assemble(scene, movers: list[Mover], ego: TrackTrajectory, duration_s: float) -> World:
-    from generator.geometry.proxy import label_proxy
-
     base = max([o.instance_id for o in scene.objects] + [0]) + 1
     if base + len(movers) > 65535:
         raise SpecError("", "traffic", f"{len(movers)} actors exceed the instance ids left in a uint16 label")

@@ -13,9 +13,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from generator.traffic import walk_zones as wz
-from generator.traffic.signals import CYCLE_S, WALK_S
-from generator.traffic.walk_net import A_MAX, B_MAX, COMMIT_M, HURRY, MARGIN_S, PLAN
+from generator.traffic.lanes.signals import CYCLE_S, WALK_S
+from generator.traffic.pedestrians import zones as wz
+from generator.traffic.pedestrians.net import A_MAX, B_MAX, COMMIT_M, HURRY, MARGIN_S, PLAN
 
 
 class Rules:

@@ -20,10 +20,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from generator.layout.network.measures import CROSSWALK_U
 from generator.layout.network.grid import Grid
-from generator.traffic import walk_clear as wc
-from generator.traffic.walk_lines import (
+from generator.layout.network.measures import CROSSWALK_U
+from generator.traffic.pedestrians import clear as wc
+from generator.traffic.pedestrians.lines import (
     KERB,
     R_TURN,
     Line,

@@ -19,7 +19,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from generator.geometry.boxes import box_pairs_overlap
-from generator.traffic import walk_clear as wc
+from generator.traffic.pedestrians import clear as wc
 
 STRIDE_M = 0.2       #: conflicts are looked for between samples this far apart
 ADJACENT_M = 1.0     #: intervals closer than this along a route share a cluster

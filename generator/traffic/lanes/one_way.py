@@ -33,15 +33,13 @@ guarantees (:mod:`generator.layout.one_way` keeps the open network strongly conn
 
 from __future__ import annotations
 
-from functools import lru_cache
-
 import numpy as np
 
-from generator.geometry.boxes import corners, quad_pairs_overlap
-from generator.traffic.lanes import ARM_DIRS, CAR_BOX_M, CONFLICT_PAD_M, STEP_M, Edge, connector_path
-from generator.world.scene import Path
-
-KAPPA = 0.5523   #: cubic Bezier handle of a quarter circle, as a share of the radius
+from generator.layout.network.design_vehicle import STANDARD_CAR_M
+from generator.layout.network.measures import ARM_DIRS
+from generator.traffic.lanes.conflicts import conflict_table
+from generator.traffic.lanes.edges import Edge
+from generator.traffic.lanes.paths import connector_path, merge_path, reversed_path
 
 
 def one_way_of(grid) -> dict[int, int]:
@@ -69,7 +67,7 @@ def apply_one_way(graph) -> bool:
             key, path, node, arms = (si, d, k), e.path, e.node, e.arms
         else:   # the contra lane k turns round: slot -1 - k of direction D
             seg = segs[si]
-            key, path = (si, D, -1 - k), _reversed(e.path, f"lane_{si}_{D}_{-1 - k}")
+            key, path = (si, D, -1 - k), reversed_path(e.path, f"lane_{si}_{D}_{-1 - k}")
             node = seg.b if D > 0 else seg.a
             arms = (int(np.argmax(ARM_DIRS @ np.array([np.cos(path.headings[0]), np.sin(path.headings[0])]))), -1)
         lane_edge[key] = len(edges)
@@ -110,7 +108,7 @@ def apply_one_way(graph) -> bool:
                         edges[lane_edge[(seg_in.index, -d_in, k)]].succ.append(ci)
                         edges[ci].succ.append(lane_edge[(seg_out.index, d_out, ko)])
     graph.edges, graph.lane_edge, graph.connector, graph.conflict_keys = edges, lane_edge, connector, ckeys
-    graph.conflict = conflict_table(graph.entry_m, graph.stop_m, grid.lane_w, frozenset(ckeys.values()), CAR_BOX_M)
+    graph.conflict = conflict_table(graph.entry_m, graph.stop_m, grid.lane_w, frozenset(ckeys.values()), STANDARD_CAR_M)
     return True
 
 
@@ -152,80 +150,3 @@ def exit_slots(k: int, s_in: list[int], s_out: list[int], left: bool) -> list[in
     if left and -1 - k in s_out:
         return [-1 - k]
     return [int(min(max(k, s_out[0]), s_out[-1]))]
-
-
-def _reversed(p: Path, name: str) -> Path:
-    """``p`` driven the other way (same points, reversed; headings turned round)."""
-    return Path(name, p.points[::-1].copy(), np.angle(np.exp(1j * (p.headings[::-1] + np.pi))), p.s[-1] - p.s[::-1])
-
-
-def merge_path(c0: np.ndarray, entry_m: float, lane_w: float, x: int, y: int, k_in: int, k_out: int,
-               name: str = "") -> Path:
-    """A connector from slot ``k_in`` of arm ``x`` to slot ``k_out`` of arm ``y`` of a node centred on
-    ``c0`` ((2,) world xy, metres): a cubic Bezier tangent to both lanes (a quarter-circle-like turn,
-    or an S-bend across lanes when straight on)."""
-    a, b = -ARM_DIRS[x], ARM_DIRS[y]
-    right_a, right_b = np.array([a[1], -a[0]]), np.array([b[1], -b[0]])
-    p0 = c0 - entry_m * a + (k_in + 0.5) * lane_w * right_a
-    p3 = c0 + entry_m * b + (k_out + 0.5) * lane_w * right_b
-    if abs(a[0] * b[1] - a[1] * b[0]) < 1e-9:        # straight on: handles a third of the way
-        h = float(np.dot(p3 - p0, a)) / 3
-        p1, p2 = p0 + h * a, p3 - h * b
-    else:                                              # turn: handles towards the tangents' crossing
-        s, t = np.linalg.solve(np.stack([a, b], 1), p3 - p0)
-        p1, p2 = p0 + KAPPA * s * a, p3 - KAPPA * t * b
-    n = max(8, int(np.ceil(np.linalg.norm(p3 - p0) * 1.6 / STEP_M)))
-    u = np.linspace(0.0, 1.0, n + 1)[:, None]
-    pts = (1 - u) ** 3 * p0 + 3 * (1 - u) ** 2 * u * p1 + 3 * (1 - u) * u ** 2 * p2 + u ** 3 * p3
-    der = 3 * (1 - u) ** 2 * (p1 - p0) + 6 * (1 - u) * u * (p2 - p1) + 3 * u ** 2 * (p3 - p2)
-    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
-    return Path(name, np.c_[pts, np.zeros(n + 1)], np.arctan2(der[:, 1], der[:, 0]), s)
-
-
-def _extended(entry_m: float, lane_w: float, key: tuple, ext: float) -> np.ndarray:
-    """(n, 3) x, y, heading samples of the connector ``key`` at a node on the origin, with ``ext``
-    metres of its lanes on each side."""
-    x, y, k_in = key[:3]
-    k_out = key[3] if len(key) > 3 else k_in
-    p = (connector_path(np.zeros(2), entry_m, lane_w, x, y, k_in) if k_out == k_in
-         else merge_path(np.zeros(2), entry_m, lane_w, x, y, k_in, k_out))
-    a, b = -ARM_DIRS[x], ARM_DIRS[y]
-    n = int(np.ceil(ext / 0.5))
-    before = p.points[0, :2] - a * np.linspace(ext, 0.5, n)[:, None]
-    after = p.points[-1, :2] + b * np.linspace(0.5, ext, n)[:, None]
-    hb, ha = np.full(n, np.arctan2(a[1], a[0])), np.full(n, np.arctan2(b[1], b[0]))
-    keep = np.r_[0:len(p.s):2, len(p.s) - 1]
-    mid = np.c_[p.points[keep, :2], p.headings[keep]]
-    return np.vstack([np.c_[before, hb], mid, np.c_[after, ha]])
-
-
-def _padded(samples: np.ndarray, size) -> np.ndarray:
-    """(n, 4, 2) corners of boxes of ``size`` grown by ``CONFLICT_PAD_M`` on the (n, 3) x, y, heading samples."""
-    return corners(samples[:, :2], samples[:, 2], size, CONFLICT_PAD_M)
-
-
-@lru_cache(maxsize=16)
-def conflict_table(entry_m: float, stop_m: float, lane_w: float, keys: frozenset, size) -> dict:
-    """``key -> set of keys`` that conflict: a car of ``size`` (length, width, metres) on one connector,
-    from the stop line to past the far crosswalk, can touch one on the other; also the table of
-    two-way nodes (:func:`generator.traffic.lanes.conflicts`). Box pairs whose centres are farther
-    apart than the boxes' diameter are skipped, those closer than their width overlap without a test."""
-    order = sorted(keys, key=repr)
-    ext = stop_m - entry_m + size[0] / 2
-    geo = [_padded(_extended(entry_m, lane_w, k, ext), size) for k in order]
-    owner = np.concatenate([np.full(len(g), i) for i, g in enumerate(geo)])
-    quads = np.concatenate(geo)
-    centre = quads.mean(1)
-    far = np.linalg.norm(quads[0] - centre[0], axis=1).max() * 2
-    near = min(np.linalg.norm(quads[0, 1] - quads[0, 0]), np.linalg.norm(quads[0, 2] - quads[0, 1]))
-    hit = np.zeros((len(order), len(order)), bool)
-    for i in range(len(order)):
-        rows, cols = np.flatnonzero(owner == i), np.flatnonzero(owner > i)   # each pair of keys once
-        d = np.linalg.norm(centre[rows][:, None] - centre[cols][None], axis=-1)
-        hit[i, owner[cols[np.nonzero(d < near)[1]]]] = True
-        r, c = np.nonzero((d >= near) & (d <= far) & ~hit[i, owner[cols]][None])   # key pairs not yet decided
-        over = quad_pairs_overlap(quads[rows[r]], quads[cols[c]])
-        hit[i, owner[cols[c[over]]]] = True
-    hit |= hit.T
-    np.fill_diagonal(hit, True)
-    return {k: {order[j] for j in np.flatnonzero(hit[i])} for i, k in enumerate(order)}

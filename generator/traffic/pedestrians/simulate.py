@@ -23,22 +23,22 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from generator.geometry.boxes import box_pairs_overlap
-from generator.layout.placement.prototypes import Library, Proto
-from generator.layout.placement.appearance import outfit
-from generator.layout.placement.street import N_PEOPLE
+from generator.layout.network.design_vehicle import EGO_SIZE_M
 from generator.layout.network.grid import Grid
+from generator.layout.placement.appearance import outfit
+from generator.layout.placement.prototypes import Library, Proto
+from generator.layout.placement.street import N_PEOPLE
 from generator.rng import stream
 from generator.spec.model import SceneSpec
-from generator.traffic import walk_clear as wc
-from generator.traffic import walk_net as wn
-from generator.traffic import walk_sim as ws
-from generator.traffic import walk_zones as wz
 from generator.traffic.movers import DT_S, Mover
-from generator.traffic.walk_lines import R_TURN
-from generator.traffic.fleet import EGO_SIZE_M, KINDS
-from generator.traffic.lane_clearance import widest_half_width
-from generator.traffic.walk_shared import shared_standers
-from generator.traffic.walkways import Walkways, build_walkways, obstacles_of
+from generator.traffic.pedestrians import clear as wc
+from generator.traffic.pedestrians import net as wn
+from generator.traffic.pedestrians import sim as ws
+from generator.traffic.pedestrians import zones as wz
+from generator.traffic.pedestrians.lines import R_TURN
+from generator.traffic.pedestrians.shared import shared_standers
+from generator.traffic.pedestrians.walkways import Walkways, build_walkways, obstacles_of
+from generator.traffic.vehicles.fleet import KINDS, widest_half_width
 from generator.world.actors import Track
 
 log = logging.getLogger(__name__)

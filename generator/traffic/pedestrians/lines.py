@@ -20,9 +20,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from generator.layout.network.measures import CROSSWALK_U
 from generator.layout.network.grid import Grid
-from generator.traffic.walk_clear import Body
+from generator.layout.network.measures import CROSSWALK_U
+from generator.traffic.pedestrians.clear import Body
 
 R_TURN = 1.0        #: radius of every turn, metres
 FURNITURE_M = 0.2   #: half width of a pole or trunk on the kerb-side line of a sidewalk

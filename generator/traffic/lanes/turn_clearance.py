@@ -28,14 +28,13 @@ so towns without trucks or buses drive exactly as before. Frames: world, metres.
 
 from __future__ import annotations
 
-from generator.traffic.lanes import CAR_BOX_M
-from generator.traffic.ring_clearance import (ABOUT_TO_ENTER_M, STOP_TOL_M, approach_arm, setbacks,
-                                              sweep_setbacks)
+from generator.layout.network.design_vehicle import STANDARD_CAR_M
+from generator.traffic.lanes.ring_clearance import ABOUT_TO_ENTER_M, STOP_TOL_M, approach_arm, setbacks, sweep_setbacks
 
 
 def is_large(veh) -> bool:
-    """Whether vehicle ``veh`` is longer or wider than the standard car (:data:`CAR_BOX_M`)."""
-    return veh.length > CAR_BOX_M[0] or veh.width > CAR_BOX_M[1]
+    """Whether vehicle ``veh`` is longer or wider than the standard car (:data:`STANDARD_CAR_M`)."""
+    return veh.length > STANDARD_CAR_M[0] or veh.width > STANDARD_CAR_M[1]
 
 
 def _key(graph, conn) -> tuple:

@@ -6,7 +6,8 @@ width of the widest vehicle that may drive there, mirrors included, either side 
 centre line, plus :data:`MARGIN_M`. The half width is measured on the prototypes the moving
 traffic is drawn from (:func:`generator.traffic.fleet.fleet_proto`: every variant of every kind
 the spec asks for, and the ego), so a bus with its mirrors on arms (up to 1.5 m), a travelling
-excavator (1.3-1.45 m) or a truck sets it, not a constant. Blocked lanes leave the lane graph
+excavator (1.3-1.45 m) or a truck sets it, not a constant
+(:func:`generator.traffic.vehicles.fleet.widest_half_width`). Blocked lanes leave the lane graph
 (:func:`generator.traffic.build._prune`). Frames: world, metres.
 """
 
@@ -14,38 +15,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from generator.traffic.fleet import fleet_proto
 from generator.geometry.boxes import corners, quads_overlap
-from generator.traffic.lanes import CAR_BOX_M
+from generator.layout.network.design_vehicle import STANDARD_CAR_M
 
 MARGIN_M = 0.05      #: clearance beyond the widest box's side, metres
-
-
-def widest_half_width(spec, lib, kinds: dict, ego_width: float) -> tuple[float, str]:
-    """Half width (metres, mirrors included) of the widest vehicle the traffic of ``spec`` may
-    drive, and its prototype key.
-
-    Parameters
-    ----------
-    spec : generator.spec.SceneSpec
-        ``spec.traffic`` densities: kinds at 0 drive nowhere.
-    lib : generator.layout.placement_core.Library
-        The asset library the traffic draws its prototypes from.
-    kinds : dict
-        :data:`generator.traffic.fleet.KINDS` (spec field -> (kind, variants, ...)).
-    ego_width : float
-        Width of the ego's box, metres.
-    """
-    best, key = ego_width / 2, "ego"
-    for field_name, (kind, n_var, *_rest) in kinds.items():
-        if getattr(spec.traffic, field_name) <= 0:
-            continue
-        for i in range(n_var):
-            proto = fleet_proto(lib, kind, i)
-            half = float(proto.hi[1] - proto.lo[1]) / 2     # the box is centred on the lane centre line
-            if half > best:
-                best, key = half, proto.key
-    return best, key
 
 
 def too_narrow(graph, scene, half_width: float, lanes: set[int], length: float | None = None) -> set[int]:
@@ -56,7 +29,7 @@ def too_narrow(graph, scene, half_width: float, lanes: set[int], length: float |
     every lane from which each way on leads only into them (it would be stuck there). Every other
     lane of the (pruned) ``graph`` keeps a way on outside the set."""
     out = blocked_lanes(graph, scene, half_width) & set(lanes)
-    if length is not None and (length > CAR_BOX_M[0] or 2 * half_width > CAR_BOX_M[1]):
+    if length is not None and (length > STANDARD_CAR_M[0] or 2 * half_width > STANDARD_CAR_M[1]):
         out |= blocked_turns(graph, scene, (length, 2 * half_width))
     while out:
         stuck = {e.index for e in graph.lanes() if e.index not in out and e.succ

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from generator.traffic import walk_zones as wz
+from generator.traffic.pedestrians import zones as wz
 
 A_MAX = 1.0        #: speeding up, m/s^2
 B_MAX = 1.5        #: slowing down, m/s^2

@@ -21,12 +21,12 @@ import logging
 import numpy as np
 
 from generator.geometry.boxes import box_pairs_overlap
-from generator.layout.placement.appearance import outfit
 from generator.layout.network.cross_sections import shared_segments
 from generator.layout.network.measures import PARKING_START_U
+from generator.layout.placement.appearance import outfit
 from generator.rng import stream
-from generator.traffic import walk_clear as wc
 from generator.traffic.movers import Mover
+from generator.traffic.pedestrians import clear as wc
 from generator.world.actors import Track
 
 log = logging.getLogger(__name__)

@@ -19,19 +19,9 @@ import logging
 
 import numpy as np
 
-from generator.traffic.signals import WALK_S
-from generator.traffic.walk_net import (
-    A_MAX,
-    B_MAX,
-    FOLLOW_M,
-    HURRY,
-    MARGIN_S,
-    PLAN,
-    RED_WEIGHT,
-    YAW_RATE,
-    Net,
-)
-from generator.traffic.walk_rules import Rules
+from generator.traffic.lanes.signals import WALK_S
+from generator.traffic.pedestrians.net import A_MAX, B_MAX, FOLLOW_M, HURRY, MARGIN_S, PLAN, RED_WEIGHT, YAW_RATE, Net
+from generator.traffic.pedestrians.rules import Rules
 
 log = logging.getLogger(__name__)
 
@@ -106,7 +96,8 @@ class _Walk(Rules):
         ok = (succ >= 0) & (length / (0.9 * HURRY * self.vdes[who, None]) + MARGIN_S < WALK_S - 1.0)
         ok = np.where(ok.any(1, keepdims=True), ok, succ >= 0)
         weight = ok.astype(np.float64)
-        for r, c in zip(*np.nonzero(ok & (net.cw[np.maximum(succ, 0)] >= 0) & (net.nsucc[prev] > 1)[:, None])):
+        for r, c in zip(*np.nonzero(ok & (net.cw[np.maximum(succ, 0)] >= 0) & (net.nsucc[prev] > 1)[:, None]),
+                        strict=True):
             need = length[r, c] / (PLAN * self.vdes[who[r]]) + MARGIN_S
             if not self.sig.may_cross(net.nodes[net.cw[succ[r, c]]], t + eta[r], need):
                 weight[r, c] = RED_WEIGHT
@@ -191,7 +182,8 @@ class _Walk(Rules):
         d_stop = np.minimum.reduce([d_lead - net.gap, d_zone - 0.01, d_curb])
         v_safe = -B_MAX * dt + np.sqrt((B_MAX * dt) ** 2 + 2 * B_MAX * np.maximum(d_stop, 0.0))
         i, f = net.lookup(self.e, self.s)
-        turn2 = np.minimum(net.env[i], (net.env0[self.route] + 2 * B_MAX * np.maximum(dist - self.v[:, None] * dt, 0)).min(1))
+        reach = net.env0[self.route] + 2 * B_MAX * np.maximum(dist - self.v[:, None] * dt, 0)
+        turn2 = np.minimum(net.env[i], reach.min(1))
         target = np.minimum(self._pace(t, dist), np.sqrt(np.maximum(turn2, 0.0)))
         lo = np.maximum(self.v - B_MAX * dt, 0.0)
         v = np.minimum(np.clip(target, lo, self.v + A_MAX * dt), v_safe)

@@ -29,11 +29,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from generator.traffic.lanes import ARM_DIRS, LaneGraph
-from generator.traffic.shared import speed_caps
-from generator.traffic.roundabout_lanes import GIVE_WAY_CLEAR_S, GIVE_WAY_REQUEST_M
-from generator.traffic.signals import CLEAR_S
-from generator.traffic.turn_clearance import held_setback, is_large, waiting_clear
+from generator.layout.network.measures import ARM_DIRS
+from generator.traffic.lanes.graph import LaneGraph
+from generator.traffic.lanes.roundabouts import GIVE_WAY_CLEAR_S, GIVE_WAY_REQUEST_M
+from generator.traffic.lanes.signals import CLEAR_S
+from generator.traffic.lanes.speed_caps import speed_caps
+from generator.traffic.lanes.turn_clearance import held_setback, is_large, waiting_clear
 
 log = logging.getLogger(__name__)
 
@@ -121,7 +122,7 @@ class VehicleSim:
         for veh in self.vehicles:
             self._maybe_grant(veh, t, occ)
         acc = [self._accel(veh, t, occ) for veh in self.vehicles]
-        for veh, a in zip(self.vehicles, acc):
+        for veh, a in zip(self.vehicles, acc, strict=True):
             v1 = max(0.0, veh.v + a * dt)
             veh.s += 0.5 * (veh.v + v1) * dt
             veh.v = v1

@@ -1,6 +1,6 @@
 """The prototypes of the moving fleet: the same asset families as the static town, posed to drive.
 
-Vehicles of the moving traffic come from the scene's asset :class:`~generator.layout.placement_core.Library`
+Vehicles of the moving traffic come from the scene's asset :class:`~generator.layout.placement.prototypes.Library`
 (kinds of :data:`KINDS`), with two differences from parked ones:
 
 * a ridden two-wheeler is the rider and the vehicle merged into one prototype (one instance, as
@@ -10,7 +10,7 @@ Vehicles of the moving traffic come from the scene's asset :class:`~generator.la
   wide; on a 3.5 m lane such a box reaches over the lane line into the parking strip and the
   opposite lane (the cause of moving excavators grazing parked cars). Travelling straight, the box
   is as wide as the tracks or the house (2.6-2.9 m), inside the band
-  :func:`generator.traffic.lane_clearance.blocked_lanes` keeps free of static objects. These variants are a
+  :func:`generator.traffic.lanes.clearance.blocked_lanes` keeps free of static objects. These variants are a
   separate family (tag ``"travel"``, stream ``("assets", "construction_vehicle", "travel", i)``), so
   the static town's excavators do not change.
 """
@@ -20,11 +20,11 @@ from __future__ import annotations
 import numpy as np
 
 from generator.geometry.mesh import merge
+from generator.layout.placement.prototypes import Library, Proto
 
 #: kind -> (tag, parameters) of the variant family that drives (kinds not listed: the plain variants)
 TRAVEL_POSE = {"construction_vehicle": ("travel", {"slew_deg": 0.0})}
 
-EGO_SIZE_M = (4.6, 1.9)
 # spec field -> (asset kind, variants, speed factor of the limit, max acceleration m/s^2, nominal length m)
 KINDS = {
     "cars_per_km": ("car", 6, (0.8, 1.0), 2.0, 4.6),
@@ -36,12 +36,12 @@ KINDS = {
 }
 
 
-def fleet_proto(lib, kind: str, i: int):
+def fleet_proto(lib: Library, kind: str, i: int) -> Proto:
     """Prototype ``i`` of a moving vehicle kind (see the module docstring).
 
     Parameters
     ----------
-    lib : generator.layout.placement_core.Library
+    lib : Library
     kind : str
         Asset kind (``"car"``, ``"bicyclist"``, ``"construction_vehicle"`` ...).
     i : int
@@ -49,7 +49,7 @@ def fleet_proto(lib, kind: str, i: int):
 
     Returns
     -------
-    generator.layout.placement_core.Proto
+    Proto
         Mesh in the local frame (x forward, y left, z up, origin on the ground), with its bounds.
     """
     if kind in TRAVEL_POSE:
@@ -57,8 +57,6 @@ def fleet_proto(lib, kind: str, i: int):
         return lib.variant(kind, i, lambda g: dict(params), tag=tag)
     if kind not in ("bicyclist", "motorcyclist"):
         return lib.variant(kind, i)
-    from generator.layout.placement.prototypes import Proto
-
     key = f"{kind}_riding_v{i}"
     if key not in lib.protos:
         rider = lib.variant(kind, i, lambda g: {"with_vehicle": False})
@@ -67,3 +65,30 @@ def fleet_proto(lib, kind: str, i: int):
         lo, hi = mesh.bounds()
         lib.protos[key] = Proto(key, kind, mesh, lo, hi, np.zeros((0, 6)))
     return lib.protos[key]
+
+
+def widest_half_width(spec, lib: Library, kinds: dict, ego_width: float) -> tuple[float, str]:
+    """Half width (metres, mirrors included) of the widest vehicle the traffic of ``spec`` may
+    drive, and its prototype key.
+
+    Parameters
+    ----------
+    spec : generator.spec.SceneSpec
+        ``spec.traffic`` densities: kinds at 0 drive nowhere.
+    lib : Library
+        The asset library the traffic draws its prototypes from.
+    kinds : dict
+        :data:`KINDS` (spec field -> (kind, variants, ...)).
+    ego_width : float
+        Width of the ego's box, metres.
+    """
+    best, key = ego_width / 2, "ego"
+    for field_name, (kind, n_var, *_rest) in kinds.items():
+        if getattr(spec.traffic, field_name) <= 0:
+            continue
+        for i in range(n_var):
+            proto = fleet_proto(lib, kind, i)
+            half = float(proto.hi[1] - proto.lo[1]) / 2     # the box is centred on the lane centre line
+            if half > best:
+                best, key = half, proto.key
+    return best, key
