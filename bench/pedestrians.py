@@ -3,7 +3,7 @@
     python bench/pedestrians.py [--spec scenes/default_town.json] [--density 5 10 20] [--steps 600]
 
 For each walking density (standing density a quarter of it) the town is built once and
-:func:`generator.traffic.pedestrians.simulate_pedestrians` runs ``--steps`` samples of
+:func:`generator.traffic.pedestrians.simulate.simulate_pedestrians` runs ``--steps`` samples of
 ``DT_S``. Columns:
 
 * ``walk`` / ``stand`` -- pedestrians placed;

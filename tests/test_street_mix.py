@@ -4,7 +4,7 @@ Each kind has its own test module; this one checks that they live together: the 
 invariants, a lane graph without dead ends in which every lane is fed and the roundabouts keep
 their ring connectors, routes and vehicles that drive one-way streets only forwards and stay out
 of the parks, and a stretch of traffic without contact. A one-way street never ends at a
-roundabout and is never closed (:mod:`generator.layout.one_way`).
+roundabout and is never closed (:mod:`generator.layout.network.one_way`).
 """
 
 from __future__ import annotations

@@ -4,7 +4,7 @@ One small town (``scenes/test_town.json`` with walking and standing pedestrians 
 is simulated once for a whole signal cycle; every test reads those tracks. Geometry checks
 are written out here (footprint overlap, walkable surface), not borrowed from the code under
 test. Static obstacles are the objects' collision bands (the layout's own definition of what
-occupies space, :func:`generator.layout.placement_core.collision_boxes`): a person may walk
+occupies space, :func:`generator.layout.placement.prototypes.collision_boxes`): a person may walk
 under a tree crown or a lamp arm, not through a trunk or a pole.
 """
 

@@ -1,6 +1,6 @@
 """The layout-to-world map of a town whose streets do not cross at right angles.
 
-The layout (:mod:`generator.layout.streets` and everything placed on it, and the traffic
+The layout (:mod:`generator.layout.network.grid` and everything placed on it, and the traffic
 simulated on its lanes) is drawn on an axis-aligned grid. A town with
 ``streets.intersection_angle_deg`` below 90 is then carried into the world by one linear map
 ``A`` (2x2, on x and y; z unchanged) that sends the grid's x axis to world +x and its y axis to
@@ -54,7 +54,7 @@ class TownMap:
         +1: the y-streets lean towards +x going north (the intersections' acute angles face
         north-east and south-west); -1: towards -x.
     xs, ys, corridor_half, lane_half
-        The grid's street lines, corridor and lane half widths (:class:`generator.layout.streets.Grid`):
+        The grid's street lines, corridor and lane half widths (:class:`generator.layout.network.grid.Grid`):
         which street a rigid thing stands by, where the parking strips start. Without them every
         heading turns as :meth:`yaw`.
     """
@@ -156,7 +156,7 @@ class TownMap:
         Parameters
         ----------
         boxes : (k, 7) float64
-            World boxes ``(cx, cy, hx, hy, yaw, z0, z1)`` (:func:`generator.layout.placement_core.world_boxes`).
+            World boxes ``(cx, cy, hx, hy, yaw, z0, z1)`` (:func:`generator.layout.placement.placer.world_boxes`).
         grid_yaw : float
             Yaw of the returned boxes in the grid, radians (the object's grid heading).
 

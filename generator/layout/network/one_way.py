@@ -19,7 +19,7 @@ The direction is not free:
   of two-way arms, and a one-way arm's left slots would have to merge on or off the ring.
 
 Both fallbacks are deterministic (they depend on the drawn closures and roundabouts only, which
-:func:`generator.layout.network.grid.make_grid` draws before the cross-sections).
+:func:`generator.layout.network.draw.make_grid` draws before the cross-sections).
 
 Draws: the free directions come from stream ``("layout", "one_way")``, one per candidate in
 segment order (none when no segment is drawn one-way, so other towns draw as before).

@@ -206,7 +206,7 @@ def ring_path(ring: Ring, c0: np.ndarray, x: int, y: int, k: int, name: str = ""
 
 
 def plain_path(entry_m: float, lane_w: float, c0: np.ndarray, x: int, y: int, k: int, name: str = "") -> Path:
-    """The connector of a plain node, as :func:`generator.traffic.lanes.connector_path` draws it: a
+    """The connector of a plain node, as :func:`generator.traffic.lanes.paths.connector_path` draws it: a
     straight line across, or a quarter circle of radius ``entry_m -+ o`` (right / left turn)."""
     a, b = -ARM_DIRS[x], ARM_DIRS[y]
     o = (k + 0.5) * lane_w

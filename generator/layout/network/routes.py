@@ -13,7 +13,7 @@ roundabout it passes (see below).
 
 In a town with roundabouts :func:`route_from_nodes` hands over to :func:`route_with_roundabouts` when
 the grid has roundabouts; towns without keep the original construction (and their bytes). Here a
-route is a walk on the lane graph of :class:`generator.traffic.lanes.LaneGraph` on the outermost
+route is a walk on the lane graph of :class:`generator.traffic.lanes.graph.LaneGraph` on the outermost
 lane ``lanes - 1``: straight lane pieces between nodes and, at each node, the connector from the arm
 it arrives by to the arm it leaves by -- a straight line or the quarter circle of a plain node
 (the same arcs the original routes draw), the entry fillet / ring arc / exit fillet of a

@@ -4,7 +4,7 @@ vehicles, walls, driveways and gravel.
 Each family has its own density in ``spec.density`` (0 = none, the default, so towns made before
 these families existed are unchanged) and its own named stream ``("layout", <family>)``; they are
 placed after everything else, so they only fill space the older families left free. Sides and
-yaws follow :mod:`generator.layout.placement_street`: side ``s`` of a segment is at ``v * s > 0``.
+yaws follow :mod:`generator.layout.placement.street`: side ``s`` of a segment is at ``v * s > 0``.
 
 * street objects (benches, bins, bollards, hydrants, advertising columns) on the kerb line;
 * bike racks on the kerb line, with bicycles parked side by side next to them;

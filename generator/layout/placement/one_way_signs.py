@@ -1,6 +1,6 @@
 """The regulatory signs of one-way streets: "one way" at the entry and along it, "no entry" at its exit.
 
-For a one-way segment (:attr:`generator.layout.cross_sections.CrossSection.one_way`) whose traffic
+For a one-way segment (:attr:`generator.layout.network.cross_sections.CrossSection.one_way`) whose traffic
 runs from its *entry* node to its *exit* node:
 
 * **entry**: a "one way" sign (:mod:`assets_procedural.regulatory_signs`) on each sidewalk just past

@@ -1,4 +1,4 @@
-"""Trees in the pocket parks of closed streets (:mod:`generator.layout.closures`).
+"""Trees in the pocket parks of closed streets (:mod:`generator.layout.network.closures`).
 
 Two rows of park trees, one on the grass either side of the footpath, about every
 ``PARK_TREE_SPACING_M`` metres with jitter; each stands only where the occupancy and the route

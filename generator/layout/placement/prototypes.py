@@ -66,7 +66,7 @@ class Proto:
     bands: np.ndarray        #: (b, 6) collision boxes (local)
     params: dict = field(default_factory=dict)
     #: made for one object from the layout (:meth:`Library.unique`): a skewed town maps it point by
-    #: point, not rigidly (:mod:`generator.layout.town_map`)
+    #: point, not rigidly (:mod:`generator.layout.mapping.town_map`)
     shaped: bool = False
 
 

@@ -1,6 +1,6 @@
 """Roundabout furniture: a round sign at every approach, bushes on the island.
 
-A roundabout has no signal heads (:func:`generator.layout.placement_street.place_traffic_lights`
+A roundabout has no signal heads (:func:`generator.layout.placement.street.place_traffic_lights`
 skips it): where a signal would stand, on the near-right corner of each approach, stands a round
 sign facing the approaching traffic (the town's circle sign prototype). Islands with a grass top
 (:attr:`generator.layout.network.rings.Ring.grass`) get bushes

@@ -18,7 +18,7 @@ are unchanged), but:
   parking (:func:`place_shared_bollards`);
 * moving vehicles keep to
   :data:`~generator.layout.network.cross_sections.SHARED_SPEED_MPS` on it
-  (:mod:`generator.traffic.vehicles.shared`);
+  (:mod:`generator.traffic.vehicles.sim.shared`);
 * in the frozen town people stand and walk on its carriageway (:func:`place_shared_people`).
 
 Curbs stay raised: a flush curb needs the sidewalk and the carriageway at one height, which the

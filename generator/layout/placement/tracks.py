@@ -1,6 +1,6 @@
 """Ballasted tram track beside the street: where a town has trams, the line also runs on its own bed.
 
-:func:`generator.layout.placement_extras.place_trams` stands each tram on grooved rails laid in a
+:func:`generator.layout.placement.extras.place_trams` stands each tram on grooved rails laid in a
 street lane (class ``road``: drivable, as Cityscapes counts street track). Tram lines also leave the
 street: along a park or a yard they run on a reserved track, a ballast bed with sleepers and rails
 (:func:`assets_procedural.tracks.rail_track`, class ``rail_track``: Cityscapes "rail track" 10,

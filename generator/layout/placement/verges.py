@@ -1,7 +1,7 @@
 """Greenery on the grass verges of residential streets and boulevards (towns with ``streets``).
 
 A verge is the raised grass strip between the lane edge and the curb
-(:mod:`generator.layout.cross_sections`). Boulevards get a row of trees down the middle of
+(:mod:`generator.layout.network.cross_sections`). Boulevards get a row of trees down the middle of
 each verge, evenly spaced at ``100 / (2 * verge_trees_per_100m)`` metres, with low hedges between
 them (each gap with probability ``verge_hedges``); residential verges
 get trees at ``verge_trees_per_100m`` (jittered), low hedge pieces over ``verge_hedges`` of their

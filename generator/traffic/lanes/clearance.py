@@ -4,7 +4,7 @@ A static object (a double-parked truck, a car left in a lane, a parked tram) blo
 when its footprint reaches into the band a moving vehicle's box sweeps along the lane: half the
 width of the widest vehicle that may drive there, mirrors included, either side of the lane
 centre line, plus :data:`MARGIN_M`. The half width is measured on the prototypes the moving
-traffic is drawn from (:func:`generator.traffic.fleet.fleet_proto`: every variant of every kind
+traffic is drawn from (:func:`generator.traffic.vehicles.fleet.fleet_proto`: every variant of every kind
 the spec asks for, and the ego), so a bus with its mirrors on arms (up to 1.5 m), a travelling
 excavator (1.3-1.45 m) or a truck sets it, not a constant
 (:func:`generator.traffic.vehicles.fleet.widest_half_width`). Blocked lanes leave the lane graph
@@ -48,7 +48,7 @@ def blocked_turns(graph, scene, size: tuple[float, float]) -> set[int]:
 
     Parameters
     ----------
-    graph : generator.traffic.lanes.LaneGraph
+    graph : generator.traffic.lanes.graph.LaneGraph
     scene : generator.world.scene.SceneModel
         Placed objects (instance id > 0) are the obstacles.
     size : (float, float)
@@ -91,7 +91,7 @@ def blocked_lanes(graph, scene, half_width: float) -> set[int]:
 
     Parameters
     ----------
-    graph : generator.traffic.lanes.LaneGraph
+    graph : generator.traffic.lanes.graph.LaneGraph
     scene : generator.world.scene.SceneModel
         Placed objects (instance id > 0) are the obstacles.
     half_width : float

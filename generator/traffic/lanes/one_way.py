@@ -1,8 +1,8 @@
 """One-way streets in the lane graph: every lane of a one-way segment runs its one direction.
 
-:class:`~generator.traffic.lanes.LaneGraph` builds ``lanes`` lanes per direction on every
+:class:`~generator.traffic.lanes.graph.LaneGraph` builds ``lanes`` lanes per direction on every
 segment; :func:`apply_one_way` then rewrites it for the segments whose cross-section is one-way
-(:attr:`generator.layout.cross_sections.CrossSection.one_way`):
+(:attr:`generator.layout.network.cross_sections.CrossSection.one_way`):
 
 * the lanes of the contra side turn round. Lane numbers are *signed slots*: slot ``k`` is
   centred ``(k + 0.5) * lane_w`` right of the centre line seen in the driving direction, so a
@@ -12,7 +12,7 @@ segment; :func:`apply_one_way` then rewrites it for the segments whose cross-sec
 * connectors are rebuilt at every plain node: from each lane arriving at a node to every other arm
   that has lanes *leaving* the node (so no connector enters a one-way street against it),
   into the same slot when the exit has it (the quarter circles of
-  :func:`~generator.traffic.lanes.connector_path`) or else into the nearest slot it has (a lane
+  :func:`~generator.traffic.lanes.paths.connector_path`) or else into the nearest slot it has (a lane
   of a one-way street left of the centre line merging into a two-way street: a cubic curve
   with the same end tangents);
 * the conflict table gains the keys ``(arm_in, arm_out, slot_in, slot_out)`` of the merging
@@ -20,15 +20,15 @@ segment; :func:`apply_one_way` then rewrites it for the segments whose cross-sec
   does (one table still serves every node); ``graph.conflict_keys`` maps a connector's edge
   index to its key.
 
-Roundabout nodes keep their ring connectors as :class:`~generator.traffic.lanes.LaneGraph` built
+Roundabout nodes keep their ring connectors as :class:`~generator.traffic.lanes.graph.LaneGraph` built
 them (same paths, keys ``(node, arm_in, arm_out, lane)``, linked to the rebuilt lane edges) and keep
 the roundabouts' own conflict table: the layout never makes a segment ending at a roundabout one-way
-(:mod:`generator.layout.one_way`), so every ring arm keeps its slots ``0 .. lanes - 1`` both ways.
-Segments are looked up by :attr:`~generator.layout.streets.Segment.index` (with closed streets
+(:mod:`generator.layout.network.one_way`), so every ring arm keeps its slots ``0 .. lanes - 1`` both ways.
+Segments are looked up by :attr:`~generator.layout.network.grid.Segment.index` (with closed streets
 ``grid.segments`` is not in index order of the full numbering).
 
 Every lane keeps a successor as long as every node has an arm leaving it, which the layout
-guarantees (:mod:`generator.layout.one_way` keeps the open network strongly connected).
+guarantees (:mod:`generator.layout.network.one_way` keeps the open network strongly connected).
 """
 
 from __future__ import annotations
@@ -119,7 +119,7 @@ def _keep_ring(graph, node, ring: list, edges: list, lane_edge: dict, connector:
     Raises
     ------
     ValueError
-        An arm of ``node`` is one-way (the layout never draws one: see :mod:`generator.layout.one_way`).
+        An arm of ``node`` is one-way (the layout never draws one: see :mod:`generator.layout.network.one_way`).
     """
     for (_, x, y, k), old in ring:
         seg_in, d_in = graph._segment_of(node, x)

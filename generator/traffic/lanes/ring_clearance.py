@@ -6,7 +6,7 @@ and crosses the give-way line of the arm it leaves by (and a wide box reaches ov
 arms it passes). Real drivers see this coming: whoever arrives at a give-way line while a bus is
 turning out over it holds back short of the line until the bus has gone, and a bus driver does
 not pull onto the ring while a vehicle sits at the give-way line it would swing over. The
-simulator does both (:mod:`generator.traffic.turn_clearance`, one rule for roundabouts and plain
+simulator does both (:mod:`generator.traffic.lanes.turn_clearance`, one rule for roundabouts and plain
 intersections) from the table computed here: the *setback* of every approach lane, the distance
 its vehicles must keep their front back from the give-way line so that a box waiting there stays
 clear of a vehicle of a given size on a given ring connector. This is chosen over moving the
@@ -106,7 +106,7 @@ def setbacks(graph, key: tuple, size: tuple[float, float], wait_w: float) -> dic
 
     Parameters
     ----------
-    graph : generator.traffic.lanes.LaneGraph
+    graph : generator.traffic.lanes.graph.LaneGraph
     key : (int, int, int)
         ``(arm_in, arm_out, lane)`` of the ring connector held.
     size : (float, float)

@@ -11,7 +11,7 @@ need to see each other to stay apart on a crosswalk.
 
 The phases belong to the node, not to its approaches: there is no green per arm, so a one-way
 street that only leaves a node (no approach, no signal head there:
-:func:`generator.layout.one_way.arriving_arms`) has no phase to remove either; vehicles only ever
+:func:`generator.layout.network.one_way.arriving_arms`) has no phase to remove either; vehicles only ever
 wait at the stop lines of the arms the lane graph enters the node from.
 """
 
@@ -37,7 +37,7 @@ class Signals:
         Intersections ``(i, j)``.
     unsignalled : set of (int, int)
         Nodes without signal heads (roundabouts): vehicles may always enter, giving way to people on
-        the crosswalks (:mod:`generator.traffic.roundabout_lanes`); people still cross in the walk
+        the crosswalks (:mod:`generator.traffic.lanes.roundabouts`); people still cross in the walk
         phase of the node's cycle, as at a pedestrian-called crossing.
     """
 

@@ -14,7 +14,7 @@ def speed_caps(graph) -> dict[int, float]:
 
     Parameters
     ----------
-    graph : generator.traffic.lanes.LaneGraph
+    graph : generator.traffic.lanes.graph.LaneGraph
 
     Returns
     -------

@@ -5,7 +5,7 @@ follow a car's path through a node the way a car does: its box centre keeps to t
 turn its front and rear overhangs swing to the outside of the arc. Turning right at a plain
 (signalised) intersection its front swings over the opposite half of the street it turns into,
 right onto a vehicle waiting at that arm's stop line; at a roundabout it swings over the give-way
-line of its exit arm (:mod:`generator.traffic.ring_clearance`). Real junctions handle this with
+line of its exit arm (:mod:`generator.traffic.lanes.ring_clearance`). Real junctions handle this with
 set-back stop lines or with drivers who hold back for a turning bus; urbangen does the latter, with
 one rule for both kinds of node, so only the rare long vehicle costs the others room:
 
@@ -20,8 +20,8 @@ one rule for both kinds of node, so only the rare long vehicle costs the others 
   that lane's setback.
 
 Setbacks are measured on the connector's own samples, relative to the node centre (every node of
-a kind has the same cross-section), with :data:`~generator.traffic.ring_clearance.SETBACK_PAD_M`
-all round (:func:`generator.traffic.ring_clearance.sweep_setbacks`). Vehicles no larger than the
+a kind has the same cross-section), with :data:`~generator.traffic.lanes.ring_clearance.SETBACK_PAD_M`
+all round (:func:`generator.traffic.lanes.ring_clearance.sweep_setbacks`). Vehicles no larger than the
 standard car never make anyone hang back, and at a plain node they are granted without the check,
 so towns without trucks or buses drive exactly as before. Frames: world, metres.
 """
@@ -46,8 +46,8 @@ def node_setbacks(graph, conn, size: tuple[float, float], wait_w: float) -> dict
 
     Parameters
     ----------
-    graph : generator.traffic.lanes.LaneGraph
-    conn : generator.traffic.lanes.Edge
+    graph : generator.traffic.lanes.graph.LaneGraph
+    conn : generator.traffic.lanes.edges.Edge
         A connector (plain node or ring).
     size : (float, float)
         Length and width of the holder's box, metres.
@@ -119,8 +119,8 @@ def held_setback(sim, veh) -> float:
 
     Parameters
     ----------
-    sim : generator.traffic.vehicles.VehicleSim
-    veh : generator.traffic.vehicles.Vehicle
+    sim : generator.traffic.vehicles.sim.VehicleSim
+    veh : generator.traffic.vehicles.sim.Vehicle
         On a lane edge.
     """
     edge = sim.g.edges[veh.edge]
@@ -146,9 +146,9 @@ def waiting_clear(sim, veh, conn, occ: dict, brake: float) -> bool:
 
     Parameters
     ----------
-    sim : generator.traffic.vehicles.VehicleSim
-    veh : generator.traffic.vehicles.Vehicle
-    conn : generator.traffic.lanes.Edge
+    sim : generator.traffic.vehicles.sim.VehicleSim
+    veh : generator.traffic.vehicles.sim.Vehicle
+    conn : generator.traffic.lanes.edges.Edge
         The connector asked for.
     occ : dict
         ``edge -> [(s, vehicle)]`` (:meth:`VehicleSim._occupancy`).

@@ -1,7 +1,7 @@
 """Keeping walkers clear of what stands on the pavement: obstacle boxes, box overlap, lane shifts.
 
 Obstacles are the collision bands of every non-ground object of the static town (the prototype
-cut into 0.5 m height bands, :func:`generator.layout.placement_core.collision_boxes`), so a tree
+cut into 0.5 m height bands, :func:`generator.layout.placement.prototypes.collision_boxes`), so a tree
 crown or a lamp arm above head height does not block the pavement under it while the trunk and
 the pole do. Large bands (fences, buildings) are cut into tiles of at most :data:`TILE_M`, so
 every obstacle is small and one k-d tree over tile centres finds the candidates of any query.

@@ -1,4 +1,4 @@
-"""Walking lines and the turns that join them (the geometry of :mod:`generator.traffic.walkways`).
+"""Walking lines and the turns that join them (the geometry of :mod:`generator.traffic.pedestrians.walkways`).
 
 Every street carries straight *lines* parallel to its centre line, two per sidewalk: the
 *kerb* line at lateral offset ``a`` and the *lot* line at ``b > a`` (metres from the street

@@ -1,6 +1,6 @@
 """The walk network as flat arrays for stepping walkers, and the numbers every walker lives by.
 
-Edges are sampled uniformly (:class:`~generator.traffic.walkways.Walkways`), so the sample
+Edges are sampled uniformly (:class:`~generator.traffic.pedestrians.walkways.Walkways`), so the sample
 under any arc length is found without a search. Per sample the network also carries the
 squared speed from which a walker can still slow down (at :data:`B_MAX`) for every turn ahead
 on the same edge without exceeding :data:`A_LAT` sideways.
@@ -25,7 +25,8 @@ RED_WEIGHT = 0.25  #: a crossing that will be red on arrival is chosen this many
 
 
 class Net:
-    """The walk network as flat arrays (edges sampled uniformly, see :class:`~generator.traffic.walkways.Walkways`)."""
+    """The walk network as flat arrays (edges sampled uniformly, see
+    :class:`~generator.traffic.pedestrians.walkways.Walkways`)."""
 
     def __init__(self, ww, zones: wz.Zones, gap: float):
         paths = ww.paths

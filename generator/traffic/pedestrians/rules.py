@@ -1,6 +1,7 @@
-"""The rules for crossing streets and passing conflict clusters (a mixin of :class:`~generator.traffic.walk_sim._Walk`).
+"""The rules for crossing streets and passing conflict clusters (a mixin of
+:class:`~generator.traffic.pedestrians.sim._Walk`).
 
-A walker enters a conflict cluster (:mod:`generator.traffic.walk_zones`) only with its whole
+A walker enters a conflict cluster (:mod:`generator.traffic.pedestrians.zones`) only with its whole
 pass through it granted, so no two walkers ever stand in conflicting intervals, and not if it
 would then stand inside behind someone standing or queueing. It commits to a crosswalk (and
 steps off the curb) only when ``signals.may_cross`` leaves time for the whole crossing at
@@ -19,7 +20,7 @@ from generator.traffic.pedestrians.net import A_MAX, B_MAX, COMMIT_M, HURRY, MAR
 
 
 class Rules:
-    """Commit and grant decisions on the state of :class:`~generator.traffic.walk_sim._Walk`."""
+    """Commit and grant decisions on the state of :class:`~generator.traffic.pedestrians.sim._Walk`."""
 
     def _crossing_time(self, k: int, d: float, pace: float) -> float:
         """Seconds for walker ``k`` to walk ``d`` metres at ``pace`` from its speed now (plus a margin)."""
@@ -80,7 +81,7 @@ class Rules:
     def _pass(self, k: int, iv: int) -> tuple[list[tuple[int, int]], np.ndarray, np.ndarray]:
         """Walker ``k``'s pass through ``iv``'s cluster starting at interval ``iv`` (its next
         occurrence on the route): ``(hop, interval)`` pairs in route order (contiguous: gaps under
-        :data:`~generator.traffic.walk_zones.ADJACENT_M`), the (m,) intervals and the (c,)
+        :data:`~generator.traffic.pedestrians.zones.ADJACENT_M`), the (m,) intervals and the (c,)
         intervals in conflict with them."""
         net = self.net
         z, hop = net.iv_cl[iv], int(self.hop[k])

@@ -1,13 +1,13 @@
 """People standing on the carriageway of shared streets, where moving traffic cannot reach them.
 
 With moving traffic on, walkers keep to the sidewalks and the signalled crosswalks
-(:mod:`generator.traffic.walk_sim`): the vehicles never see a person except through the
+(:mod:`generator.traffic.pedestrians.sim`): the vehicles never see a person except through the
 signals, so a walker crossing a shared street mid-block could meet a car. What is safe is the
 paving beside the lanes: the *furnished* strips of a shared street
-(:mod:`generator.layout.shared_streets`) hold bollards, not parked cars, and no vehicle drives
+(:mod:`generator.layout.placement.shared_streets`) hold bollards, not parked cars, and no vehicle drives
 there. :func:`shared_standers` puts ``traffic.standing_pedestrians_per_100m`` people per 100 m of
 such strip on it, at road level, outside the reach of the widest vehicle the spec's traffic drives
-(mirrors included, :func:`generator.traffic.lane_clearance.widest_half_width`) on the outer lane's
+(mirrors included, :func:`generator.traffic.vehicles.fleet.widest_half_width`) on the outer lane's
 centre, plus :data:`CLEAR_M`, and :data:`END_CLEAR_M` inside the strip's ends, clear of the bollards
 and of each other.
 
@@ -45,7 +45,7 @@ def shared_standers(spec, grid, obstacles: wc.Obstacles, protos, n_steps: int, d
     ----------
     spec : SceneSpec
     grid : Grid
-    obstacles : generator.traffic.walk_clear.Obstacles
+    obstacles : generator.traffic.pedestrians.clear.Obstacles
         The static town's obstacles (bollards included).
     protos : list of Proto
         Standing person prototypes.

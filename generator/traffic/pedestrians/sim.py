@@ -5,12 +5,12 @@ next :data:`K_ROUTE` edges of its route (drawn when a branch comes into view: at
 crossing that will be red on arrival less often). Every step each walker finds the nearest
 point it must be able to stop before -- a walker ahead on its route within ``FOLLOW_M``
 (minus the follow gap), the entry of a conflict interval it has not been granted, the curb
-before a crosswalk it has not committed to (:mod:`generator.traffic.walk_rules`) -- and takes
+before a crosswalk it has not committed to (:mod:`generator.traffic.pedestrians.rules`) -- and takes
 the largest speed from which it can still stop there braking at ``B_MAX``, slow enough for
 the turns ahead (sideways acceleration ``A_LAT``) and changing by at most ``A_MAX dt`` /
 ``B_MAX dt``; on a crossing it hurries (up to ``HURRY`` times its pace, with everyone behind
 it there) if the walk phase runs short. Its heading follows the path at up to ``YAW_RATE``
-(limits in :mod:`generator.traffic.walk_net`).
+(limits in :mod:`generator.traffic.pedestrians.net`).
 """
 
 from __future__ import annotations
@@ -34,7 +34,7 @@ def simulate(net: Net, signals, e, s, vdes, decide, n_warm: int, n_steps: int, d
     Parameters
     ----------
     net : Net
-    signals : generator.traffic.signals.Signals
+    signals : generator.traffic.lanes.signals.Signals
     e, s : (N,) int64, float64
         Start edges and arc lengths (clear of each other and of conflict intervals, off the road).
     vdes : (N,) float64

@@ -1,12 +1,12 @@
 """Pedestrians: people walking the sidewalks and crossing at crosswalks, and people standing.
 
 :func:`simulate_pedestrians` builds the walk network of the town
-(:mod:`generator.traffic.walkways`), puts ``traffic.pedestrians_per_100m`` walkers on it and
-walks them (:mod:`generator.traffic.walk_sim`), and places
+(:mod:`generator.traffic.pedestrians.walkways`), puts ``traffic.pedestrians_per_100m`` walkers on it and
+walks them (:mod:`generator.traffic.pedestrians.sim`), and places
 ``traffic.standing_pedestrians_per_100m`` people standing on the pavement clear of the
 walking lines and of every static object (and, on shared streets, beside the lanes on the
-carriageway: :mod:`generator.traffic.walk_shared`). Prototypes are the layout's own person variants
-(:func:`person_protos`, as :func:`generator.layout.placement_street.place_people` makes
+carriageway: :mod:`generator.traffic.pedestrians.shared`). Prototypes are the layout's own person variants
+(:func:`person_protos`, as :func:`generator.layout.placement.street.place_people` makes
 them): walking poses for walkers, standing poses for standers.
 
 Randomness: walker ``k`` draws its prototype, clothing, pace and start from
@@ -80,7 +80,7 @@ def simulate_pedestrians(spec: SceneSpec, grid: Grid, scene, signals, lib: Libra
         The street grid of ``scene``.
     scene : SceneModel
         The static town: walkers and standers keep clear of its non-ground objects.
-    signals : generator.traffic.signals.Signals
+    signals : generator.traffic.lanes.signals.Signals
         Walk phases: a walker steps onto a crosswalk only when ``signals.may_cross`` allows.
     lib : Library
         Prototype library (the layout's, so walkers share the static town's person meshes).

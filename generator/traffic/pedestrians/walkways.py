@@ -1,14 +1,14 @@
 """The walk network: directed walking edges along every sidewalk and across every crosswalk.
 
-The straight lines and the turns joining them come from :mod:`generator.traffic.walk_lines`.
+The straight lines and the turns joining them come from :mod:`generator.traffic.pedestrians.lines`.
 Lines are cut into *edges* at the ends of the turns; the pieces of a line crossing a street
 are the crosswalks, tagged with their node. Where a static object stands on a line
-(:class:`~generator.traffic.walk_clear.Obstacles`) the piece is shifted sideways (not at its
+(:class:`~generator.traffic.pedestrians.clear.Obstacles`) the piece is shifted sideways (not at its
 ends, on the sidewalk or inside the crosswalk band, preferably inside its own half of the
 sidewalk); where no shift clears it, the edge is cut, and so is everything that no longer
 leads anywhere. Edges are :class:`~generator.world.scene.Path` polylines sampled every
 :data:`SAMPLE_M`. Frames: world, metres, z up: the height of the ground under the point
-(:meth:`~generator.layout.streets.Grid.ground_height`: kerb height on the pavement, closed
+(:meth:`~generator.layout.network.grid.Grid.ground_height`: kerb height on the pavement, closed
 streets' parks and corners included, 0 across a street; a walker steps up and down the kerb).
 """
 

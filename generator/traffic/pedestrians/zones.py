@@ -8,7 +8,7 @@ only touch inside *conflict intervals*: stretches ``[s0, s1]`` of an edge
 another edge -- where lines cross, merge, split or (round an obstacle) share the pavement.
 Intervals closer than :data:`ADJACENT_M` along a route, or in conflict, form one *cluster*;
 a walker enters a cluster only with every interval it will pass there granted at once
-(:mod:`generator.traffic.walk_sim`), so no two walkers ever stand in conflicting intervals.
+(:mod:`generator.traffic.pedestrians.sim`), so no two walkers ever stand in conflicting intervals.
 """
 
 from __future__ import annotations

@@ -1,21 +1,21 @@
 """Vehicles on the lane graph: car-following, signalised intersections, turns; the ego among them.
 
 Kinematic, not physical. Every vehicle is a point ``s`` (its box centre) moving along its
-planned edges of the :class:`~generator.traffic.lanes.LaneGraph`, with
+planned edges of the :class:`~generator.traffic.lanes.graph.LaneGraph`, with
 
 * **car-following** by the Intelligent Driver Model (IDM: desired speed, safe time gap
   ``T``, minimum gap ``s0``, comfortable braking ``b``) against the nearest vehicle ahead on
   its plan (a vehicle whose rear still hangs over the previous edge counts there too);
 * **turn speeds**: at most ``sqrt(a_lat r)`` on an arc, approached at comfortable braking; the
-  same for an edge's speed limit (shared streets, :mod:`generator.traffic.shared`);
+  same for an edge's speed limit (shared streets, :mod:`generator.traffic.lanes.speed_caps`);
 * **intersections**: a vehicle stops with its front at the stop line until it is *granted*
-  its connector: the node's signal lets vehicles in (:mod:`generator.traffic.signals`), no
+  its connector: the node's signal lets vehicles in (:mod:`generator.traffic.lanes.signals`), no
   vehicle holds a conflicting connector (:func:`generator.traffic.lanes.conflicts`; a bus or
   truck longer than 6 m holds the whole node), the exit lane has room for it to clear the
   far crosswalk, and no pedestrian is on or about to step onto a crosswalk it crosses. It
   holds the grant until its rear is past the far crosswalk. Vehicles wait clear of where a long
   vehicle turning through the node (or on a roundabout's ring) swings over their stop or give-way
-  line, and it is granted only while nobody sits there (:mod:`generator.traffic.turn_clearance`);
+  line, and it is granted only while nobody sits there (:mod:`generator.traffic.lanes.turn_clearance`);
 * **the ego** is one of them: it drives route 0's walk on the graph at ``paths.speed_mps``,
   and at an intersection comes to a full stop for 1-3 s with ``traffic.ego_stop_probability``.
 
@@ -81,7 +81,7 @@ class VehicleSim:
     Parameters
     ----------
     graph : LaneGraph
-    signals : generator.traffic.signals.Signals
+    signals : generator.traffic.lanes.signals.Signals
     vehicles : list of Vehicle
         Their plans start with the edge they stand on.
     crossing : callable or None
@@ -280,7 +280,7 @@ class VehicleSim:
 
 def conflict_key(graph: LaneGraph, conn) -> tuple:
     """The conflict-table key of connector ``conn``: ``(arm_in, arm_out, lane)``, or the key
-    :mod:`generator.traffic.one_way` gave it (slots that differ in and out)."""
+    :mod:`generator.traffic.lanes.one_way` gave it (slots that differ in and out)."""
     return getattr(graph, "conflict_keys", {}).get(conn.index, (*conn.arms, conn.lane))
 
 
