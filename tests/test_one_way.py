@@ -268,12 +268,13 @@ def test_layout_summary_records_each_streets_draw():
     from generator.commands.layout import _streets
 
     spec = one_way_spec(0)
-    rows = _streets(spec)["streets"]
     grid = make_grid(spec)
+    rows = _streets(spec, grid)["streets"]
     assert [r["kind"] for r in rows] == [grid.section(s).kind for s in grid.segments]
     assert {(r["segment"], r["one_way"]) for r in rows if r["one_way"]} == \
         {(s.index, grid.section(s).one_way) for s in grid.segments if grid.section(s).one_way}
-    assert _streets(parse_spec({"name": "x", "seed": 1}, "x.json")) == {}
+    plain = parse_spec({"name": "x", "seed": 1}, "x.json")
+    assert _streets(plain, make_grid(plain)) == {}
 
 
 hypothesis = pytest.importorskip("hypothesis")

@@ -5,7 +5,7 @@ shift the others): grid -> routes -> lots (blocks, then the band outside the rin
 -> buildings -> hedges/fences -> traffic lights -> one-way signs
 -> lamps -> street trees -> verge hedges, bushes and trees -> signs -> lot greenery -> parked vehicles -> lane cars ->
 people -> ground objects. Objects accepted earlier win space; everything keeps clear of
-the routes (see :mod:`generator.layout.placement_core`). Finally the routes are verified
+the routes (see :mod:`generator.layout.placement`). Finally the routes are verified
 against every object box, and an internal error is raised if any sample is too close.
 """
 
@@ -40,6 +40,7 @@ from generator.layout.placement import verges as pv
 from generator.layout.placement.keepout import Keepout
 from generator.layout.placement.placer import Placed, Placer
 from generator.layout.placement.prototypes import Library
+from generator.layout.town import Town
 from generator.progress import progress
 from generator.spec.model import SceneSpec
 from generator.world.scene import Path, SceneModel, SceneObject
@@ -180,14 +181,16 @@ def verify_routes(paths: list[Path], grid: Grid, objects: list[SceneObject], lim
                 raise LayoutError(f"{path.name}: {o.name} is {d:.2f} m from the route (< {limit:.2f} m)")
 
 
-def build_scene(spec: SceneSpec) -> SceneModel:
+def build_scene(spec: SceneSpec) -> Town:
     """Build the town described by ``spec``.
 
     Returns
     -------
-    SceneModel
-        Ground pieces first, then placed objects in placement order; objects of thing classes
-        (``thing`` in ``classes.yaml``) get instance ids 1..N, stuff gets 0; route 0 is the comb loop
+    Town
+        The scene (a :class:`~generator.world.scene.SceneModel`) with the grid and asset library it
+        was built from (and the map of a town whose streets cross at an angle). Ground pieces
+        first, then placed objects in placement order; objects of thing classes (``thing`` in
+        ``classes.yaml``) get instance ids 1..N, stuff gets 0; route 0 is the comb loop
         :class:`generator.world.rig.Rig` follows.
 
     Raises
@@ -216,16 +219,18 @@ def build_scene(spec: SceneSpec) -> SceneModel:
     scene = SceneModel(spec.seed, spec.spec_hash, grid.bounds, prototypes, proxies, objects, routes)
     if tmap is None:
         verify_routes(routes, grid, objects[first:], limit - 1e-6)
+        town = Town.of(scene, grid, lib)
     else:
         verify_routes(routes, grid, [], limit)      # on the lanes (the grid's); distances in the world:
         shaped = set(range(first)) | {first + i for i, p in enumerate(placer.placed) if lib.protos[p.proto].shaped}
-        scene = map_scene(scene, tmap, shaped)
-        verify_world_routes(scene, first, shaped, limit - 1e-6)
+        world = map_scene(scene, tmap, shaped)
+        verify_world_routes(world, scene, tmap, first, shaped, limit - 1e-6)
         log.info("streets cross at %.1f degrees (lean %+d): the town is mapped from its grid", tmap.angle_deg,
                  tmap.lean)
+        town = Town.of(world, grid, lib, tmap, scene)
     log.info("scene %s: %d objects, %d prototypes, %d proxies, built in %.2f s", spec.name, len(objects),
-             len(scene.prototypes), len(scene.proxies), time.perf_counter() - t0)
-    return scene
+             len(town.prototypes), len(town.proxies), time.perf_counter() - t0)
+    return town
 
 
 def class_counts(scene: SceneModel) -> dict[str, dict[str, int]]:

@@ -8,7 +8,9 @@ a stream named ``("traffic", ...)`` of the spec seed, and the simulation is caus
 world at a time ``t`` does not depend on how long a run is.
 
 Vehicles start on free lane edges at rest and settle for :data:`WARMUP_S` seconds (the ego
-waiting at its start) before t = 0.
+waiting at its start) before t = 0. The traffic drives in the town it is given
+(:class:`~generator.layout.town.Town`): its grid, and its asset library, so moving vehicles and
+people are the static town's models -- in a re-drawn town the shared library of the spec's seed.
 """
 
 from __future__ import annotations
@@ -22,10 +24,9 @@ from generator.errors import SpecError
 from generator.geometry.proxy import label_proxy
 from generator.layout.network.cycles import route_node_cycles
 from generator.layout.network.design_vehicle import EGO_SIZE_M
-from generator.layout.network.draw import make_grid
 from generator.layout.network.measures import ARM_DIRS, CROSSWALK_U
 from generator.layout.placement.appearance import fleet_paint
-from generator.layout.placement.prototypes import Library
+from generator.layout.town import Town
 from generator.rng import stream
 from generator.traffic.lanes.clearance import MARGIN_M, blocked_lanes, too_narrow
 from generator.traffic.lanes.graph import LaneGraph
@@ -47,14 +48,16 @@ MAX_DRIVE_S = 900.0
 SPACING_M = 6.0       #: lanes hold at most one vehicle per (length + this), for the capacity check
 
 
-def build_world(spec, scene, duration_s: float, distance_m: float = 0.0) -> World:
+def build_world(spec, scene: Town, duration_s: float, distance_m: float = 0.0) -> World:
     """The world of ``spec`` over at least ``[0, duration_s]`` seconds.
 
     Parameters
     ----------
     spec : generator.spec.SceneSpec
-    scene : generator.world.scene.SceneModel
-        The static town built from ``spec``.
+    scene : Town
+        The static town built from ``spec`` (:func:`generator.layout.build_scene`): the traffic drives
+        on its grid and draws its vehicles and people from its asset library (a frozen town, with
+        every ``traffic`` density 0, may be any :class:`~generator.world.scene.SceneModel`).
     duration_s : float
         Simulated seconds from t = 0 (tracks run a little longer for central differences).
     distance_m : float
@@ -65,17 +68,19 @@ def build_world(spec, scene, duration_s: float, distance_m: float = 0.0) -> Worl
     SpecError
         More vehicles than the free lanes can hold, or the ego cannot drive ``distance_m``
         within :data:`MAX_DRIVE_S`.
+    TypeError
+        Traffic asked for in a scene that is not a :class:`Town`.
     """
     if not spec.traffic.enabled:
         return frozen_world(scene, EgoTrajectory(scene.paths[0], spec.paths.speed_mps))
-    world_scene, tmap = scene, scene.town_map
+    if not isinstance(scene, Town):
+        raise TypeError(f"build_world needs the Town build_scene returns, got {type(scene).__name__}")
+    world_scene, tmap, grid, lib = scene, scene.town_map, scene.grid, scene.library
     if tmap is not None:    # streets crossing at an angle: the traffic runs on the town's grid
         scene = scene.layout
     t_start = time.perf_counter()
-    grid = make_grid(spec)
     graph = LaneGraph(grid)
     signals = Signals(spec.seed, grid.nodes, grid.roundabouts)
-    lib = Library(spec.seed)
     half_width, widest = widest_half_width(spec, lib, KINDS, EGO_SIZE_M[1])
     log.debug("lanes kept clear of static objects to %.2f m from their centre lines (%s)", half_width + MARGIN_M,
               widest)
@@ -114,7 +119,7 @@ def _lead_in(m: Mover, ground=None) -> Mover:
     """Prepend :data:`LEAD_IN` samples before t = 0 at the first step's horizontal velocity, so
     central differences at t = 0 see the motion (a walker already walking) instead of a clamped
     track. Their height is ``ground(xy)`` ((n, 2) -> (n,) metres: a walker's feet on the ground
-    there, :func:`generator.traffic.pedestrians.feet_height`), or the first sample's without it;
+    there, :func:`generator.traffic.pedestrians.simulate.feet_height`), or the first sample's without it;
     extrapolating a step up the kerb would sink the feet below the road."""
     tr = m.track
     if tr.t0 <= -LEAD_IN * DT_S + 1e-12 or len(tr.yaw) < 2:
@@ -185,7 +190,7 @@ def _prune(graph: LaneGraph, blocked: set[int], keep: set[int]) -> set[int]:
 
 
 def _ego_route(graph: LaneGraph) -> list[int]:
-    """Route 0 (the comb loop of :mod:`generator.layout.routes`) as a cycle of edges of ``graph``."""
+    """Route 0 (the comb loop of :mod:`generator.layout.network.routes`) as a cycle of edges of ``graph``."""
     grid = graph.grid
     nodes = route_node_cycles(len(grid.xs) - 1, len(grid.ys) - 1)[0]
     k = grid.lanes - 1

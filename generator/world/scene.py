@@ -125,11 +125,10 @@ class SceneModel:
     objects : list of SceneObject
     paths : list of Path
         Lane-following routes for cameras and the ego vehicle.
-    town_map : generator.layout.town_map.TownMap or None
-        The grid -> world map of a town whose streets cross at an angle other than 90 degrees;
-        None when they cross at right angles (grid and world are the same frame).
-    layout : SceneModel or None
-        With a ``town_map``: the same town in the grid frame, where the traffic is simulated.
+
+    The town the layout builds (:class:`generator.layout.town.Town`) is a SceneModel that also
+    keeps the street grid, the asset library and, for streets crossing at an angle, the grid ->
+    world map and the grid-frame scene.
     """
 
     seed: int
@@ -139,8 +138,6 @@ class SceneModel:
     proxies: dict[str, Mesh]
     objects: list[SceneObject]
     paths: list[Path]
-    town_map: object = field(default=None, repr=False, compare=False)
-    layout: "SceneModel | None" = field(default=None, repr=False, compare=False)
 
     # -- flat triangle soup (what Embree casts against) --------------------------------------
     @functools.cached_property

@@ -1,13 +1,13 @@
-"""Carry a town laid out on the grid into the world of its :class:`~generator.layout.town_map.TownMap`.
+"""Carry a town laid out on the grid into the world of its :class:`~generator.layout.mapping.town_map.TownMap`.
 
 :func:`map_scene` turns the grid-frame :class:`~generator.world.scene.SceneModel` into the one
 every sensor sees: shaped objects (ground pieces, buildings, hedges, fences, walls, rails) get
 their map baked into a prototype of their own (a Blender object transform cannot hold a shear)
 under a rigid frame that keeps their local x axis; rigid objects keep their prototype under
-:meth:`~generator.layout.town_map.TownMap.rigid`. Paths are mapped sample by sample and their
+:meth:`~generator.layout.mapping.town_map.TownMap.rigid`. Paths are mapped sample by sample and their
 arc lengths re-measured. The grid-frame scene stays reachable as ``scene.layout`` (the traffic
 is simulated there, :func:`generator.traffic.build.build_world`) and the map as
-``scene.town_map``.
+``scene.town_map`` (:class:`generator.layout.town.Town`).
 """
 
 from __future__ import annotations
@@ -113,18 +113,16 @@ def map_scene(layout: SceneModel, tmap: TownMap, shaped: set[int]) -> SceneModel
     (x0, y0), (x1, y1) = layout.bounds
     corners = tmap.xy(np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]]))
     extent = np.stack([corners.min(0), corners.max(0)])
-    scene = SceneModel(layout.seed, layout.spec_hash, extent, prototypes, proxies, objects,
-                       [map_path(p, tmap) for p in layout.paths])
-    scene.layout = layout
-    scene.town_map = tmap
-    return scene
+    return SceneModel(layout.seed, layout.spec_hash, extent, prototypes, proxies, objects,
+                      [map_path(p, tmap) for p in layout.paths])
 
 
-def verify_world_routes(scene: SceneModel, first: int, shaped: set[int], limit: float) -> None:
-    """Raise :class:`MappedLayoutError` unless every route sample of the world ``scene`` keeps
-    ``limit`` metres (2D) from each placed object (index ``first`` on): a rigid one's box, a shaped
-    one's mapped footprint (the parallelogram its grid box becomes)."""
-    layout, tmap = scene.layout, scene.town_map
+def verify_world_routes(scene: SceneModel, layout: SceneModel, tmap: TownMap, first: int, shaped: set[int],
+                        limit: float) -> None:
+    """Raise :class:`MappedLayoutError` unless every route sample of the world ``scene`` (the map
+    ``tmap`` of the grid-frame ``layout``) keeps ``limit`` metres (2D) from each placed object (index
+    ``first`` on): a rigid one's box, a shaped one's mapped footprint (the parallelogram its grid box
+    becomes)."""
     for path in scene.paths:
         keep = Keepout(path.points[:, :2], limit)
         for o in scene.objects[first:]:
