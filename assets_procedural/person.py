@@ -2,7 +2,7 @@
 
 Proportions follow standard anthropometric ratios of body height (shoulders at 0.8 h,
 hips at 0.53 h, knees at 0.285 h). Every face is class ``person``. Each garment has its own
-material, so each can take its own colour per object (:mod:`generator.layout.appearance`):
+material, so each can take its own colour per object (:mod:`generator.layout.placement.appearance`):
 ``clothing`` (the top: torso, sleeves, a coat), ``clothing_bottom`` (trousers, shorts, a
 skirt), ``shoes`` (shoes and a carried bag), ``skin`` (face, hands, bare arms and legs) and
 ``hair``.

@@ -21,7 +21,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from generator.layout import build_scene  # noqa: E402
-from generator.layout.streets import make_grid  # noqa: E402
+from generator.layout.network.draw import make_grid  # noqa: E402
 from generator.previews.layout_map import render_map  # noqa: E402
 from generator.spec import parse_spec  # noqa: E402
 

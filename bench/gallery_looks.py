@@ -27,7 +27,7 @@ import numpy as np
 from PIL import Image, ImageDraw
 
 from assets_procedural import catalog
-from generator.layout.appearance import fleet_paint, outfit
+from generator.layout.placement.appearance import fleet_paint, outfit
 from assets_procedural.vehicle import CAR_VARIANTS
 from generator import geometry as M
 from generator.labels import class_table

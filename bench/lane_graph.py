@@ -18,10 +18,10 @@ import time
 
 import numpy as np
 
-from generator.layout.streets import make_grid
+from generator.layout.network.draw import make_grid
 from generator.spec import parse_spec
-from generator.traffic.lanes import LaneGraph
-from generator.traffic.one_way import conflict_table
+from generator.traffic.lanes.graph import LaneGraph
+from generator.traffic.lanes.conflicts import conflict_table
 
 
 def _spec(types: dict, blocks: int, lanes: int):

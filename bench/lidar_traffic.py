@@ -57,7 +57,7 @@ def lane_world(spec, scene, n: int, duration_s: float, ego_s: float) -> World:
     On the ego's route (0) nobody is within 10 m of the ego at t = 0 (arc length ``ego_s``), and the
     vehicles within 80 m drive at the ego's speed, so none runs into it during the sequence.
     """
-    from generator.layout.placement_core import Library
+    from generator.layout.placement.prototypes import Library
 
     g = np.random.default_rng(spec.seed)
     lib = Library(spec.seed)

@@ -3,7 +3,7 @@
     python bench/pedestrians.py [--spec scenes/default_town.json] [--density 5 10 20] [--steps 600]
 
 For each walking density (standing density a quarter of it) the town is built once and
-:func:`generator.traffic.pedestrians.simulate_pedestrians` runs ``--steps`` samples of
+:func:`generator.traffic.pedestrians.simulate.simulate_pedestrians` runs ``--steps`` samples of
 ``DT_S``. Columns:
 
 * ``walk`` / ``stand`` -- pedestrians placed;
@@ -29,14 +29,14 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from generator.layout import build_scene
-from generator.layout.placement_core import Library
-from generator.layout.streets import make_grid
+from generator.layout.placement.prototypes import Library
+from generator.layout.network.draw import make_grid
 from generator.spec import load_spec
-from generator.traffic import pedestrians as peds
-from generator.traffic import walk_sim
+from generator.traffic.pedestrians import simulate as peds
+from generator.traffic.pedestrians import sim as walk_sim
 from generator.traffic.movers import DT_S
-from generator.traffic.signals import Signals
-from generator.traffic.walk_lines import street_distance
+from generator.traffic.lanes.signals import Signals
+from generator.traffic.pedestrians.lines import street_distance
 
 
 class Clock:

@@ -2,7 +2,8 @@
 
 Walks every module's imports with ``ast`` (module-level and function-level alike, so a lazy
 import cannot hide a back edge) and checks them against :data:`ALLOWED`, the layer table
-README's "Tour of the code" shows.
+README's "Tour of the code" shows, and that no package has an import circle among its modules
+and sub-packages (:func:`test_no_import_circle_inside_a_package`).
 """
 
 from __future__ import annotations
@@ -154,7 +155,119 @@ def test_only_the_blender_edge_imports_bpy():
 def test_only_the_placement_step_imports_assets(graph):
     users = {m for m, targets in graph.items()
              if _package(m) != "assets_procedural" and any(_package(t) == "assets_procedural" for t in targets)}
-    assert users == {"generator.layout.placement_core"}
+    assert users == {"generator.layout.placement.prototypes"}
+
+
+def _module_edges() -> dict[str, set[str]]:
+    """Module -> the project modules it imports (module-level and lazy), each edge to the module itself:
+    ``from pkg import module`` is an edge to ``pkg.module``, ``from pkg import name`` one to ``pkg``
+    (its ``__init__``), ``from pkg.module import name`` one to ``pkg.module``."""
+    known = {m for m, _, _ in _modules()}
+    out: dict[str, set[str]] = {}
+    for module, is_init, path in _modules():
+        pkg = module if is_init else module.rsplit(".", 1)[0]
+        edges = set()
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Import):
+                for a in node.names:
+                    name = a.name
+                    while name and name not in known:
+                        name = name.rpartition(".")[0]
+                    if name:
+                        edges.add(name)
+            elif isinstance(node, ast.ImportFrom):
+                if node.level:
+                    base = pkg.split(".")[: len(pkg.split(".")) - (node.level - 1)]
+                    target = ".".join(base + ([node.module] if node.module else []))
+                else:
+                    target = node.module or ""
+                for a in node.names:
+                    if f"{target}.{a.name}" in known:
+                        edges.add(f"{target}.{a.name}")
+                    elif target in known:
+                        edges.add(target)
+        out[module] = edges - {module}
+    return out
+
+
+def _circles(edges: dict[str, set[str]]) -> list[list[str]]:
+    """One circle (a list of nodes, first repeated last) per strongly connected group of ``edges``."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    out = []
+
+    def connect(v: str) -> None:     # Tarjan's algorithm
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        for w in edges.get(v, ()):
+            if w not in index:
+                connect(w)
+                low[v] = min(low[v], low[w])
+            elif w in stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            group = set()
+            while True:
+                w = stack.pop()
+                group.add(w)
+                if w == v:
+                    break
+            if len(group) > 1:
+                out.append(_circle_in(edges, group))
+
+    for v in sorted(edges):
+        if v not in index:
+            connect(v)
+    return out
+
+
+def _circle_in(edges: dict[str, set[str]], group: set[str]) -> list[str]:
+    """A shortest circle through the first node of ``group`` (breadth first inside the group)."""
+    start = min(group)
+    paths = {start: [start]}
+    todo = [start]
+    while todo:
+        v = todo.pop(0)
+        for w in sorted(edges.get(v, ())):
+            if w == start:
+                return paths[v] + [start]
+            if w in group and w not in paths:
+                paths[w] = paths[v] + [w]
+                todo.append(w)
+    return sorted(group)
+
+
+def test_no_import_circle_inside_a_package():
+    """Inside every package the modules and sub-packages import one way: collapse every module below a
+    package to the package's child it lives in (a module or a sub-package), and the children's imports,
+    lazy ones included, form no circle. A package's ``__init__`` is the package itself."""
+    modules = _module_edges()
+    packages = sorted({m for m, is_init, _ in _modules() if is_init})
+    bad = []
+    for pkg in packages:
+        def child(m: str) -> str | None:
+            if m == pkg:
+                return pkg
+            return pkg + "." + m[len(pkg) + 1:].split(".")[0] if m.startswith(pkg + ".") else None
+
+        edges: dict[str, set[str]] = defaultdict(set)
+        for m, targets in modules.items():
+            a = child(m)
+            if a is None:
+                continue
+            for t in targets:
+                b = child(t)
+                if b is not None and b != a:
+                    edges[a].add(b)
+        bad += [f"{pkg}: " + " -> ".join(c) for c in _circles(edges)]
+    assert not bad, "import circles (lazy imports included):\n" + "\n".join(bad)
+
+
+def test_the_circle_finder_finds_circles():
+    edges = {"p.a": {"p.b"}, "p.b": {"p.c"}, "p.c": {"p.a", "p.d"}, "p.d": set()}
+    assert _circles(edges) == [["p.a", "p.b", "p.c", "p.a"]]
+    assert _circles({"p.a": {"p.b"}, "p.b": set()}) == []
 
 
 def test_modules_stay_small():

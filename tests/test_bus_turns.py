@@ -17,12 +17,14 @@ import numpy as np
 import pytest
 
 from generator.layout.assemble import build_scene
-from generator.layout.streets import make_grid
+from generator.layout.network.draw import make_grid
 from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
-from generator.traffic.lane_clearance import MARGIN_M, blocked_turns, too_narrow
-from generator.traffic.lanes import ARM_DIRS, LaneGraph, boxes_overlap
-from generator.traffic.turn_clearance import node_setbacks
+from generator.traffic.lanes.clearance import MARGIN_M, blocked_turns, too_narrow
+from generator.layout.network.measures import ARM_DIRS
+from generator.traffic.lanes.graph import LaneGraph
+from generator.geometry.boxes import quads_overlap
+from generator.traffic.lanes.turn_clearance import node_setbacks
 from generator.world.scene import OrientedBox
 from kits.traffic_contacts import assert_no_contact, assert_vehicles_miss_people, static_quads
 
@@ -103,7 +105,7 @@ def test_a_vehicle_at_its_setback_keeps_clear_of_a_bus_turning_right_into_its_st
                           for q, h in zip(rel, conn.path.headings)])
         for back, clear in ((sb[(y, 0)], True), (0.0, False)):
             box = _opposite_waiting_box(graph, y, back, wait)
-            assert boxes_overlap(box[None], swept).any() != clear, (x, y, back)
+            assert quads_overlap(box[None], swept).any() != clear, (x, y, back)
     assert right_turns == 4
 
 
@@ -121,6 +123,6 @@ def test_turns_whose_sweep_reaches_a_parked_object_are_avoided_by_buses_only():
         e = graph.edges[c]
         swept = np.stack([OrientedBox((*q[:2], 1.5), (*size, 3.0), float(h)).corners_xy()
                           for q, h in zip(e.path.points, e.path.headings)])
-        assert boxes_overlap(swept, parked).any()
+        assert quads_overlap(swept, parked).any()
     assert blocked <= too_narrow(graph, scene, BUS[1] / 2, set(), BUS[0])
     assert not too_narrow(graph, scene, 1.9 / 2, set(), 4.6) & blocked

@@ -15,7 +15,7 @@ from PIL import Image
 
 from generator.cli import main
 from generator.labels import class_table
-from generator.layout.streets import make_grid
+from generator.layout.network.draw import make_grid
 from generator.spec import load_spec
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -15,12 +15,13 @@ import pytest
 from generator.errors import SpecError
 from generator.labels import class_table
 from generator.layout.assemble import build_scene
-from generator.layout.closures import route_pairs
-from generator.layout.routes import make_routes
-from generator.layout.streets import CROSSWALK_U, make_grid
+from generator.layout.network.cycles import route_pairs
+from generator.layout.network.routes import make_routes
+from generator.layout.network.measures import CROSSWALK_U
+from generator.layout.network.draw import make_grid
 from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
-from generator.traffic.lanes import LaneGraph
+from generator.traffic.lanes.graph import LaneGraph
 from kits.traffic_contacts import assert_no_contact, static_quads
 from test_streets import _blender_matches_scene
 

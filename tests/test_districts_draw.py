@@ -14,7 +14,7 @@ from collections import Counter
 import numpy as np
 import pytest
 
-from generator.layout.districts import NAMES, draw_districts
+from generator.layout.lots.districts import NAMES, draw_districts
 from generator.spec import load_spec
 
 WEIGHTS = {"row_houses": 2.0, "detached": 3.0, "light_industry": 2.0, "park_edge": 0.5}

@@ -10,12 +10,13 @@ import numpy as np
 import pytest
 
 from generator.layout.assemble import build_scene
-from generator.layout.placement_core import Library
+from generator.layout.placement.prototypes import Library
 from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
-from generator.traffic.fleet import EGO_SIZE_M, KINDS
-from generator.traffic.lane_clearance import widest_half_width
-from generator.traffic.lanes import boxes_overlap
+from generator.layout.network.design_vehicle import EGO_SIZE_M
+from generator.traffic.vehicles.fleet import KINDS
+from generator.traffic.vehicles.fleet import widest_half_width
+from generator.geometry.boxes import quads_overlap
 from kits.traffic_contacts import static_quads
 
 ROOT = Path(__file__).parents[1]
@@ -56,5 +57,5 @@ def test_no_moving_vehicle_box_ever_overlaps_a_static_object(scene, seed):
     static = static_quads(town)
     for t in np.arange(0.0, 20.0, 0.1):
         q = np.stack([a.box(t).corners_xy() for a in vehicles])
-        hit = boxes_overlap(q, static)
+        hit = quads_overlap(q, static)
         assert not hit.any(), f"{vehicles[np.argwhere(hit)[0][0]].name} touches a static object at t={t:.1f}"

@@ -12,12 +12,14 @@ from generator.geometry import apply
 from generator.labels import class_table
 from generator.layout import build_scene
 from generator.world.rig import Rig
-from generator.layout.placement_core import EGO_HALF_WIDTH_M, overlaps, point_box_distance
+from generator.layout.network.design_vehicle import EGO_HALF_WIDTH_M
+from generator.geometry.boxes import boxes_overlap, point_box_distance
 from generator.previews.layout_map import rasterize
-from generator.layout.lots import make_lots
-from generator.layout.outskirts import HORIZON_M
-from generator.layout.street_meshes import segment_frame_points
-from generator.layout.streets import MARK_Z_M, make_grid
+from generator.layout.lots.lot import make_lots
+from generator.layout.ground.terrain import HORIZON_M
+from generator.layout.network.grid import segment_frame_points
+from generator.layout.network.measures import MARK_Z_M
+from generator.layout.network.draw import make_grid
 from generator.materials import material_table
 from generator.world.scene import OrientedBox
 from generator.spec import parse_spec
@@ -125,7 +127,7 @@ def test_only_vehicles_stand_in_the_lanes_and_none_on_a_route(city_centre, root)
     """On the driving lanes stand only vehicles, riders, tram rails and people on crosswalks; every
     placed object keeps the route clearance (the same check build_scene makes)."""
     from generator.layout.assemble import verify_routes
-    from generator.layout.streets import make_grid
+    from generator.layout.network.draw import make_grid
     from generator.spec import load_spec
 
     grid = make_grid(load_spec(root / "scenes" / "city_centre.json"))
@@ -176,7 +178,7 @@ def test_no_building_or_parked_car_overlaps_a_driving_lane(default_spec, default
     objs = [o for o in default_scene.objects
             if o.kind == "building" or (o.kind in ("car", "truck") and o.attrs.get("placement") == "parked")]
     assert any(o.kind == "car" for o in objs) and any(o.kind == "building" for o in objs)
-    assert not overlaps(_obj_boxes(objs, shrink=0.005), lanes).any()
+    assert not boxes_overlap(_obj_boxes(objs, shrink=0.005), lanes).any()
 
 
 def test_buildings_stay_off_streets_and_sidewalks(default_spec, default_scene):
@@ -185,7 +187,7 @@ def test_buildings_stay_off_streets_and_sidewalks(default_spec, default_scene):
     x0, y0, x1, y1 = grid.corridor_rect
     corridors = [(x0, y - c, x1, y + c) for y in grid.ys] + [(x - c, y0, x + c, y1) for x in grid.xs]
     objs = default_scene.objects_of("building")
-    assert not overlaps(_obj_boxes(objs, shrink=0.005), _rect_boxes(corridors)).any()
+    assert not boxes_overlap(_obj_boxes(objs, shrink=0.005), _rect_boxes(corridors)).any()
 
 
 def test_vehicles_only_in_parking_strips_or_lanes(default_spec, default_scene):
@@ -268,7 +270,7 @@ def test_nothing_collides_at_street_level(default_scene):
         boxes.append([c[0], c[1], (hi[0] - lo[0]) / 2, (hi[1] - lo[1]) / 2, o.box.yaw, 0.0, 1.0])
         names.append(o.name)
     b = np.array(boxes)
-    hit = overlaps(b, b)
+    hit = boxes_overlap(b, b)
     np.fill_diagonal(hit, False)
     pairs = [(names[i], names[j]) for i, j in zip(*np.nonzero(np.triu(hit)))]
     assert not pairs
@@ -368,7 +370,7 @@ def test_outer_lots_tile_the_band_round_the_ring_road(default_spec):
     assert (corners >= [bx0 - 1e-6, by0 - 1e-6]).all() and (corners <= [bx1 + 1e-6, by1 + 1e-6]).all()
     boxes = np.array([[*lot.to_world([(0.0, lot.depth / 2)])[0], lot.width / 2 - 0.01, lot.depth / 2 - 0.01,
                        lot.yaw, -1.0, 1.0] for lot in lots])
-    hit = overlaps(boxes, np.vstack([boxes, _rect_boxes([grid.corridor_rect])[0]]))
+    hit = boxes_overlap(boxes, np.vstack([boxes, _rect_boxes([grid.corridor_rect])[0]]))
     hit[np.arange(len(lots)), np.arange(len(lots))] = False
     assert not hit.any(), "outer lots overlap each other or the street grid"
     # the same lot logic as inside the blocks: widths, uses, fronts

@@ -159,7 +159,7 @@ def test_a_passing_car_is_smeared_exactly_as_each_column_saw_it(hdl64e, ground):
 
 
 def test_a_library_car_is_hit_on_its_own_surface(hdl64e, ground):
-    from generator.layout.placement_core import Library
+    from generator.layout.placement.prototypes import Library
 
     mesh = Library(0).variant("car", 0).mesh
     s, t0 = hdl64e, 0.0

@@ -15,7 +15,7 @@ from assets_procedural import catalog
 from assets_procedural.car_body import BODY_TYPES
 from assets_procedural.vehicle import CAR_VARIANTS
 from generator.geometry import face_normals
-from generator.layout.appearance import Palette, appearance, fleet_paint, outfit, srgb_to_linear
+from generator.layout.placement.appearance import Palette, appearance, fleet_paint, outfit, srgb_to_linear
 from generator.materials import material_table
 from generator.rng import stream
 

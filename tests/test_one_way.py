@@ -18,13 +18,14 @@ from generator.cli import main
 from generator.errors import SpecError
 from generator.labels import class_table
 from generator.layout import build_scene
-from generator.layout.one_way import driven_directions, strongly_connected
-from generator.layout.routes import make_routes
-from generator.layout.street_meshes import segment_frame_points
-from generator.layout.streets import STOP_U, make_grid
+from generator.layout.network.one_way import driven_directions, strongly_connected
+from generator.layout.network.routes import make_routes
+from generator.layout.network.grid import segment_frame_points
+from generator.layout.network.measures import STOP_U
+from generator.layout.network.draw import make_grid
 from generator.spec import load_spec, parse_spec
 from generator.traffic.build import build_world
-from generator.traffic.lanes import LaneGraph
+from generator.traffic.lanes.graph import LaneGraph
 from test_streets import _no_collisions, _rests_on_ground
 
 ON_LANES = ("car", "truck", "bus", "on_rails", "other_vehicle", "ridden_bicycle", "ridden_motorcycle",
@@ -267,12 +268,13 @@ def test_layout_summary_records_each_streets_draw():
     from generator.commands.layout import _streets
 
     spec = one_way_spec(0)
-    rows = _streets(spec)["streets"]
     grid = make_grid(spec)
+    rows = _streets(spec, grid)["streets"]
     assert [r["kind"] for r in rows] == [grid.section(s).kind for s in grid.segments]
     assert {(r["segment"], r["one_way"]) for r in rows if r["one_way"]} == \
         {(s.index, grid.section(s).one_way) for s in grid.segments if grid.section(s).one_way}
-    assert _streets(parse_spec({"name": "x", "seed": 1}, "x.json")) == {}
+    plain = parse_spec({"name": "x", "seed": 1}, "x.json")
+    assert _streets(plain, make_grid(plain)) == {}
 
 
 hypothesis = pytest.importorskip("hypothesis")

@@ -16,12 +16,13 @@ from assets_procedural.catalog import build
 from generator.geometry import face_normals
 from generator.labels import class_table
 from generator.layout import build_scene
-from generator.layout.placement_core import EGO_HALF_WIDTH_M, point_box_distance
-from generator.layout.placement_street import Street
-from generator.layout.street_meshes import segment_frame_points
-from generator.layout.streets import make_grid
+from generator.layout.network.design_vehicle import EGO_HALF_WIDTH_M
+from generator.geometry.boxes import point_box_distance
+from generator.layout.placement.street_frame import Street
+from generator.layout.network.grid import segment_frame_points
+from generator.layout.network.draw import make_grid
 from generator.materials import material_table
-from generator.traffic.lanes import LaneGraph
+from generator.traffic.lanes.graph import LaneGraph
 from test_one_way import one_way_spec
 from test_street_mix import full_spec
 from test_streets import _no_collisions
@@ -187,7 +188,7 @@ def test_no_moving_actor_touches_a_one_way_sign():
     """With traffic and pedestrians (20 s, every 0.2 s), no vehicle, rider or pedestrian box
     overlaps the footprint of a one-way or no-entry sign (pedestrians walk round them)."""
     from generator.traffic.build import build_world
-    from generator.traffic.lanes import boxes_overlap
+    from generator.geometry.boxes import quads_overlap
     from test_street_mix import TRAFFIC
 
     spec = full_spec(3, traffic={**TRAFFIC, "pedestrians_per_100m": 3.0})
@@ -197,4 +198,4 @@ def test_no_moving_actor_touches_a_one_way_sign():
     assert len(signs) >= 10 and sum(a.kind == "person" for a in world.actors) >= 20
     for t in np.arange(0.0, 20.0, 0.2):
         q = np.stack([a.box(t).corners_xy() for a in world.actors])
-        assert not boxes_overlap(q, signs).any(), f"an actor touches a sign at t = {t:.1f} s"
+        assert not quads_overlap(q, signs).any(), f"an actor touches a sign at t = {t:.1f} s"

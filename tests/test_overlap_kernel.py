@@ -10,8 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from generator.layout.overlap_kernel import any_overlap
-from generator.layout.placement_core import Occupancy, overlaps
+from generator.geometry.overlap_kernel import any_overlap
+from generator.layout.placement.placer import Occupancy
+from generator.geometry.boxes import boxes_overlap
 
 
 def _kernel(a, b):
@@ -34,7 +35,7 @@ def test_kernel_agrees_with_overlaps_on_random_and_touching_boxes():
     for t in range(6000):
         snap = t % 2 == 0
         a, b = _boxes(rng, int(rng.integers(1, 6)), 6.0, snap), _boxes(rng, int(rng.integers(1, 40)), 12.0, snap)
-        want = bool(overlaps(a, b).any())
+        want = bool(boxes_overlap(a, b).any())
         assert _kernel(a, b) == want, (a, b)
         answers[want] += 1
     assert min(answers.values()) > 1000  # both answers exercised
@@ -46,7 +47,7 @@ def test_kernel_agrees_pair_by_pair_at_the_boundary():
     for yaw in (0.0, np.pi / 2, np.pi / 4, 1e-9):
         for x in np.linspace(0.9, 1.1, 401):
             b = np.array([[x, 0.3, 0.5, 0.5, yaw, 0.0, 1.0]])
-            assert _kernel(a, b) == bool(overlaps(a, b).any()), (yaw, x)
+            assert _kernel(a, b) == bool(boxes_overlap(a, b).any()), (yaw, x)
 
 
 def test_occupancy_hits_is_overlaps_of_the_boxes_near():
@@ -54,7 +55,7 @@ def test_occupancy_hits_is_overlaps_of_the_boxes_near():
     occ = Occupancy()
     for _ in range(300):
         boxes = _boxes(rng, int(rng.integers(1, 4)), 40.0, bool(rng.integers(2)))
-        want = len(occ.boxes) > 0 and bool(overlaps(boxes, occ.boxes).any())
+        want = len(occ.boxes) > 0 and bool(boxes_overlap(boxes, occ.boxes).any())
         assert occ.hits(boxes) == want
         if not want:
             occ.add(boxes)

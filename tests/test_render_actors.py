@@ -27,7 +27,7 @@ LATER = 0.2
 def car_world(spec, scene, rig: Rig, t: float, cars=CARS) -> World:
     """``scene`` plus car actors on straight tracks, placed relative to the ego at time ``t``."""
     from generator.geometry.proxy import label_proxy
-    from generator.layout.placement_core import Library
+    from generator.layout.placement.prototypes import Library
 
     T = rig.T_world_ego(t)[0]
     axes = {"fwd": T[:3, 0], "left": T[:3, 1]}

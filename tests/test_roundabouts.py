@@ -15,16 +15,20 @@ import pytest
 from generator.errors import SpecError
 from generator.labels import class_table
 from generator.layout.assemble import build_scene
-from generator.layout.placement_core import EGO_HALF_WIDTH_M
-from generator.layout.roundabouts import (ARM_DIRS, DESIGN_VEHICLES_M, STANDARD_CAR_M, _closest, ring_geometry,
-                                          ring_path)
-from generator.layout.routes import MIN_RADIUS_M, make_routes
-from generator.layout.streets import APRON_H_M, make_grid
+from generator.layout.network.design_vehicle import EGO_HALF_WIDTH_M
+from generator.layout.network.measures import ARM_DIRS
+from generator.layout.network.design_vehicle import DESIGN_VEHICLES_M, STANDARD_CAR_M
+from generator.layout.network.rings import _closest, ring_geometry, ring_path
+from generator.layout.network.design_vehicle import MIN_RADIUS_M
+from generator.layout.network.routes import make_routes
+from generator.layout.network.measures import APRON_H_M
+from generator.layout.network.draw import make_grid
 from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
-from generator.traffic.lanes import LaneGraph, boxes_overlap
-from generator.traffic.signals import Signals
-from generator.traffic.vehicles import Vehicle, VehicleSim
+from generator.traffic.lanes.graph import LaneGraph
+from generator.geometry.boxes import quads_overlap
+from generator.traffic.lanes.signals import Signals
+from generator.traffic.vehicles.sim import Vehicle, VehicleSim
 from generator.world.scene import OrientedBox
 from kits.traffic_contacts import assert_no_contact, assert_vehicles_miss_people, static_quads
 from test_streets import _blender_matches_scene
@@ -199,7 +203,7 @@ def test_an_entering_vehicle_waits_while_a_vehicle_on_the_ring_holds_a_conflicti
         pb, hb = sim.pose(b)
         qa = OrientedBox((*pa, 0.7), (4.5, 1.9, 1.5), ha).corners_xy()[None]
         qb = OrientedBox((*pb, 0.7), (4.5, 1.9, 1.5), hb).corners_xy()[None]
-        assert not boxes_overlap(qa, qb).any(), t
+        assert not quads_overlap(qa, qb).any(), t
     assert released is not None and granted is not None and granted >= released
 
 
@@ -279,13 +283,13 @@ def test_the_island_is_raised_other_ground_with_grass_and_nothing_but_vehicles_o
     # the planting intersects nothing else, and no other object reaches over the island
     isl = [o for o in placed if np.hypot(*(o.transform[:2, 3] - c)) < ring.island_r]
     rest = [o for o in placed if np.hypot(*(o.transform[:2, 3] - c)) >= ring.island_r]
-    ov = boxes_overlap(np.stack([o.box.corners_xy() for o in isl]), np.stack([o.box.corners_xy() for o in rest]))
+    ov = quads_overlap(np.stack([o.box.corners_xy() for o in isl]), np.stack([o.box.corners_xy() for o in rest]))
     assert not ov.any()
-    ov = boxes_overlap(np.stack([o.box.corners_xy() for o in isl]), np.stack([o.box.corners_xy() for o in isl]))
+    ov = quads_overlap(np.stack([o.box.corners_xy() for o in isl]), np.stack([o.box.corners_xy() for o in isl]))
     np.fill_diagonal(ov, False)
     assert not ov.any()
     square = np.array([[c + ring.island_r * np.array(d) for d in ((-1, -1), (1, -1), (1, 1), (-1, 1))]])
-    assert not boxes_overlap(square, np.stack([o.box.corners_xy() for o in rest])).any()
+    assert not quads_overlap(square, np.stack([o.box.corners_xy() for o in rest])).any()
 
 
 def test_no_vehicle_touches_a_pedestrian_at_an_unsignalled_roundabout(town):
@@ -372,8 +376,8 @@ def test_a_vehicle_at_its_setback_keeps_clear_of_a_bus_swinging_out_over_its_giv
     """ring_clearance: a 12 m bus leaving the ring swings its front over the give-way line of its exit
     arm, so a vehicle waiting there must hang back; at that setback (and not at the line) its box is
     clear of every box the bus sweeps along the connector. A standard car needs no setback anywhere."""
-    from generator.layout.roundabouts import ring_path
-    from generator.traffic.ring_clearance import setbacks
+    from generator.layout.network.rings import ring_path
+    from generator.traffic.lanes.ring_clearance import setbacks
 
     graph = LaneGraph(make_grid(spec_with(blocks=2)))
     bus, wait = (12.0, 2.55), (12.0, 2.55)
@@ -392,4 +396,4 @@ def test_a_vehicle_at_its_setback_keeps_clear_of_a_bus_swinging_out_over_its_giv
             for back, clear in ((sb[(y, 0)], True), (0.0, False)):
                 centre = -a * (graph.stop_m + back + wait[0] / 2) + right * graph.grid.lane_w / 2
                 box = OrientedBox((*centre, 1.5), (*wait, 3.0), float(np.arctan2(a[1], a[0]))).corners_xy()
-                assert boxes_overlap(box[None], swept).any() != clear, (x, y, back)
+                assert quads_overlap(box[None], swept).any() != clear, (x, y, back)

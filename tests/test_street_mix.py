@@ -4,7 +4,7 @@ Each kind has its own test module; this one checks that they live together: the 
 invariants, a lane graph without dead ends in which every lane is fed and the roundabouts keep
 their ring connectors, routes and vehicles that drive one-way streets only forwards and stay out
 of the parks, and a stretch of traffic without contact. A one-way street never ends at a
-roundabout and is never closed (:mod:`generator.layout.one_way`).
+roundabout and is never closed (:mod:`generator.layout.network.one_way`).
 """
 
 from __future__ import annotations
@@ -15,13 +15,15 @@ import numpy as np
 import pytest
 
 from generator.layout.assemble import build_scene
-from generator.layout.one_way import driven_directions, strongly_connected
-from generator.layout.routes import MIN_RADIUS_M, make_routes
-from generator.layout.streets import STOP_U, make_grid
+from generator.layout.network.one_way import driven_directions, strongly_connected
+from generator.layout.network.design_vehicle import MIN_RADIUS_M
+from generator.layout.network.routes import make_routes
+from generator.layout.network.measures import STOP_U
+from generator.layout.network.draw import make_grid
 from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
-from generator.traffic.lanes import LaneGraph
-from generator.traffic.vehicles import conflict_key
+from generator.traffic.lanes.graph import LaneGraph
+from generator.traffic.vehicles.sim import conflict_key
 from test_one_way import _forward, _on_carriageway, check_lane_graph
 from test_roundabouts import _radii
 from test_streets import _blender_matches_scene, _no_collisions, _rests_on_ground
@@ -117,7 +119,7 @@ def test_one_way_with_shared_roundabouts_and_closures_builds_a_lane_graph_that_o
 def test_layout_summary_rows_name_each_open_segment_with_its_own_section():
     """``urbangen layout``'s street rows: one per open segment, with that segment's nodes and type
     (they were zipped against the full section list, so one row in the wrong place per closure)."""
-    from generator.layout.cross_sections import sections_record
+    from generator.layout.network.cross_sections import sections_record
 
     grid = make_grid(full_spec(5))
     rows = sections_record(grid)

@@ -18,12 +18,13 @@ from generator.errors import SpecError
 from generator.geometry import apply
 from generator.labels import class_table
 from generator.layout import build_scene
-from generator.layout.cross_sections import MEDIAN_W_M
-from generator.layout.districts import DISTRICTS
-from generator.layout.lots import make_lots
-from generator.layout.placement_core import EGO_HALF_WIDTH_M, overlaps, point_box_distance
-from generator.layout.street_meshes import segment_frame_points
-from generator.layout.streets import make_grid
+from generator.layout.network.cross_sections import MEDIAN_W_M
+from generator.layout.lots.districts import DISTRICTS
+from generator.layout.lots.lot import make_lots
+from generator.layout.network.design_vehicle import EGO_HALF_WIDTH_M
+from generator.geometry.boxes import boxes_overlap, point_box_distance
+from generator.layout.network.grid import segment_frame_points
+from generator.layout.network.draw import make_grid
 from generator.spec import load_spec, parse_spec
 from test_layout import _check_vehicles
 
@@ -49,7 +50,7 @@ def _no_collisions(scene) -> None:
         names.append(o.name)
         riding.append(scene.objects[o.index - 1].name if o.cls in RIDERS else "")
     b = np.array(boxes)
-    hit = overlaps(b, b)
+    hit = boxes_overlap(b, b)
     np.fill_diagonal(hit, False)
     pairs = [(names[i], names[j]) for i, j in zip(*np.nonzero(np.triu(hit)))
              if riding[i] != names[j] and riding[j] != names[i]]

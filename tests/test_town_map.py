@@ -14,9 +14,9 @@ from scipy.spatial import ConvexHull
 from generator.geometry import apply, pose
 from generator.labels import class_table
 from generator.layout import build_scene
-from generator.layout.placement_core import world_boxes
-from generator.layout.streets import make_grid
-from generator.layout.town_map import TownMap, draw_town_map
+from generator.geometry.boxes import world_boxes
+from generator.layout.network.draw import make_grid
+from generator.layout.mapping.town_map import TownMap, draw_town_map
 from generator.spec import parse_spec
 from generator.traffic.build import build_world
 from kits.traffic_contacts import assert_no_contact, assert_vehicles_miss_people, static_quads
@@ -231,7 +231,8 @@ def test_vehicles_stand_in_the_mapped_lanes_and_strips(skewed):
 
 def test_routes_keep_clear_in_the_world(skewed):
     _, scene = skewed
-    from generator.layout.placement_core import EGO_HALF_WIDTH_M, point_box_distance
+    from generator.layout.network.design_vehicle import EGO_HALF_WIDTH_M
+    from generator.geometry.boxes import point_box_distance
 
     spec = skewed[0]
     limit = spec.paths.clearance_m + EGO_HALF_WIDTH_M

@@ -8,10 +8,11 @@ import pytest
 from generator.errors import SpecError
 from generator.labels import class_table
 from generator.layout.assemble import build_scene
-from generator.layout.streets import make_grid
+from generator.layout.network.draw import make_grid
 from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
-from generator.traffic.lanes import LaneGraph, boxes_overlap
+from generator.traffic.lanes.graph import LaneGraph
+from generator.geometry.boxes import quads_overlap
 from generator.world.actors import MOVING_THRESHOLD_MPS, Track
 from generator.world.rig import SWEEP_PERIOD_S, Rig
 from kits.traffic_contacts import assert_no_contact, assert_vehicles_miss_people, ego_box, static_quads
@@ -250,9 +251,9 @@ def test_every_moving_vehicle_fits_inside_its_lane():
     """A moving vehicle's box is no wider than a lane, so it never reaches over the lane line into the
     parking strip (parked cars) or the opposite lane. Excavators drive with the house straight
     (generator/traffic/fleet.py): slewed, their boxes were 3-6 m wide."""
-    from generator.layout.placement_core import Library
-    from generator.traffic.fleet import KINDS
-    from generator.traffic.fleet import fleet_proto
+    from generator.layout.placement.prototypes import Library
+    from generator.traffic.vehicles.fleet import KINDS
+    from generator.traffic.vehicles.fleet import fleet_proto
 
     for seed in (1, 2, 3, 11):
         grid, lib = make_grid(_sweep_town(seed, 0.0)), Library(seed)
@@ -275,7 +276,7 @@ def test_no_moving_actor_ever_touches_a_static_object(seed, roundabouts, dense):
     static = static_quads(scene)
     for t in np.arange(0.0, 20.0, 0.1):
         q = np.stack([b.corners_xy() for b in world.boxes(t)])
-        hit = boxes_overlap(q, static)
+        hit = quads_overlap(q, static)
         assert not hit.any(), f"{world.actors[np.argwhere(hit)[0][0]].name} touches a static object at t={t:.1f}"
 
 
@@ -295,4 +296,4 @@ def test_no_vehicle_touches_a_person_in_roundabout_towns_with_excavators(seed):
     for t in np.arange(0.0, 30.0, 0.1):
         assert_vehicles_miss_people(world, t, vehicles, people)
         q = np.stack([a.box(t).corners_xy() for a in vehicles] + [ego_box(world, t).corners_xy()])
-        assert not boxes_overlap(q, static_people).any(), f"a vehicle touches a person of the static town at t={t:.1f}"
+        assert not quads_overlap(q, static_people).any(), f"a vehicle touches a person of the static town at t={t:.1f}"

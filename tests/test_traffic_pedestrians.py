@@ -4,7 +4,7 @@ One small town (``scenes/test_town.json`` with walking and standing pedestrians 
 is simulated once for a whole signal cycle; every test reads those tracks. Geometry checks
 are written out here (footprint overlap, walkable surface), not borrowed from the code under
 test. Static obstacles are the objects' collision bands (the layout's own definition of what
-occupies space, :func:`generator.layout.placement_core.collision_boxes`): a person may walk
+occupies space, :func:`generator.layout.placement.prototypes.collision_boxes`): a person may walk
 under a tree crown or a lamp arm, not through a trunk or a pole.
 """
 
@@ -16,24 +16,16 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-from generator.layout.placement_core import (
-    WHOLE_BOX_KINDS,
-    Library,
-    collision_boxes,
-    world_boxes,
-)
-from generator.layout.streets import CROSSWALK_U, make_grid
-from generator.traffic import walk_clear, walk_net
+from generator.layout.placement.prototypes import Library, WHOLE_BOX_KINDS, collision_boxes
+from generator.geometry.boxes import world_boxes
+from generator.layout.network.measures import CROSSWALK_U
+from generator.layout.network.draw import make_grid
+from generator.traffic.pedestrians import clear as walk_clear, net as walk_net
 from generator.traffic.movers import DT_S
-from generator.traffic.pedestrians import (
-    MARGIN_M,
-    max_speed,
-    person_protos,
-    sidewalk_length,
-    simulate_pedestrians,
-)
-from generator.traffic.signals import CYCLE_S, WALK_S, Signals
-from generator.traffic.walkways import build_walkways, obstacles_of
+from generator.traffic.pedestrians.simulate import (MARGIN_M, max_speed, person_protos, sidewalk_length,
+                                                    simulate_pedestrians)
+from generator.traffic.lanes.signals import CYCLE_S, Signals, WALK_S
+from generator.traffic.pedestrians.walkways import build_walkways, obstacles_of
 
 N_STEPS = int(CYCLE_S / DT_S)          # one whole signal cycle: every node has a walk phase
 GROUND = {"road", "road_marking", "crosswalk", "curb", "sidewalk", "parking", "terrain", "other_ground", "rail_track"}

@@ -16,8 +16,8 @@ import pytest
 from generator.labels import class_table
 from generator.labels.sets import label_sets, semantickitti_labels
 from generator.layout import build_scene
-from generator.layout.lots import make_lots
-from generator.layout.streets import make_grid
+from generator.layout.lots.lot import make_lots
+from generator.layout.network.draw import make_grid
 from generator.lidar.scan import Scanner
 from generator.lidar.sensors import sensor_for_spec
 from generator.spec import parse_spec

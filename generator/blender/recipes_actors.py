@@ -1,7 +1,7 @@
 """Material recipes of vehicles and people, whose colours come per object.
 
 Prototype meshes are shared by many objects, so a car's paint and a person's garments, skin and
-hair are object properties (:mod:`generator.layout.appearance` draws them; the layout stores them
+hair are object properties (:mod:`generator.layout.placement.appearance` draws them; the layout stores them
 in ``attrs``; :func:`generator.blender.geometry.new_object` writes them): ``Object.color`` holds
 the paint or the top, ``ug_<name>_color`` the others, ``ug_paint_metallic`` 0/1 and ``ug_outfit``
 1 where a person's colours were given (0: the earlier look, tones from the object's random

@@ -96,17 +96,15 @@ def summary(scene, spec, build_s: float) -> dict:
         "routes": [{"name": p.name, "length_m": round(p.length(), 2), "samples": int(len(p.points)),
                     "closed": p.closed} for p in scene.paths],
         "build_seconds": round(build_s, 3),
-        **_streets(spec),
+        **_streets(spec, scene.grid),
     }
     if scene.town_map is not None:   # streets crossing at an angle (the towns with right angles read as before)
         info["intersection_angle"] = {"angle_deg": round(scene.town_map.angle_deg, 4), "lean": scene.town_map.lean,
                                       "grid_to_world_xy": [[round(float(v), 9) for v in row] for row in scene.town_map.A]}
-    from generator.layout.closures import closed_record
-    from generator.layout.roundabouts import roundabout_record
-    from generator.layout.streets import make_grid
+    from generator.layout.network.closures import closed_record
+    from generator.layout.network.roundabouts import roundabout_record
 
-    grid = make_grid(spec)
-    ring, closed = roundabout_record(grid), closed_record(grid)
+    ring, closed = roundabout_record(scene.grid), closed_record(scene.grid)    # the grid the town was built on
     if ring is not None:     # only towns with roundabouts or closed streets: the others' summaries read as before
         info["roundabouts"] = ring
     if closed is not None:
@@ -114,12 +112,11 @@ def summary(scene, spec, build_s: float) -> dict:
     return info
 
 
-def _streets(spec) -> dict:
-    """``{"streets": [...]}``: each segment's drawn cross-section, when the spec has ``streets``."""
-    from generator.layout.cross_sections import sections_record
-    from generator.layout.streets import make_grid
+def _streets(spec, grid) -> dict:
+    """``{"streets": [...]}``: each segment's drawn cross-section of ``grid``, when the spec has ``streets``."""
+    from generator.layout.network.cross_sections import sections_record
 
-    rows = sections_record(make_grid(spec)) if spec.streets is not None else []
+    rows = sections_record(grid) if spec.streets is not None else []
     return {"streets": rows} if rows else {}
 
 

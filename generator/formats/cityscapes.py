@@ -41,6 +41,7 @@ from PIL import Image
 from generator.atomic import staging
 from generator.errors import UserError
 from generator.labels import class_table
+from generator.labels.cityscapes import cityscapes_labels
 
 log = logging.getLogger(__name__)
 
@@ -49,29 +50,12 @@ SPLITS = ("train", "val", "test")
 DEFAULT_SPLIT = "val"
 CITY_PREFIX = "urbangen"
 
-#: Cityscapes labels (cityscapesScripts ``helpers/labels.py``): id -> (name, train id, has instances, RGB colour).
-LABELS: dict[int, tuple[str, int, bool, tuple[int, int, int]]] = {
-    0: ("unlabeled", 255, False, (0, 0, 0)), 1: ("ego vehicle", 255, False, (0, 0, 0)),
-    2: ("rectification border", 255, False, (0, 0, 0)), 3: ("out of roi", 255, False, (0, 0, 0)),
-    4: ("static", 255, False, (0, 0, 0)), 5: ("dynamic", 255, False, (111, 74, 0)),
-    6: ("ground", 255, False, (81, 0, 81)), 7: ("road", 0, False, (128, 64, 128)),
-    8: ("sidewalk", 1, False, (244, 35, 232)), 9: ("parking", 255, False, (250, 170, 160)),
-    10: ("rail track", 255, False, (230, 150, 140)), 11: ("building", 2, False, (70, 70, 70)),
-    12: ("wall", 3, False, (102, 102, 156)), 13: ("fence", 4, False, (190, 153, 153)),
-    14: ("guard rail", 255, False, (180, 165, 180)), 15: ("bridge", 255, False, (150, 100, 100)),
-    16: ("tunnel", 255, False, (150, 120, 90)), 17: ("pole", 5, False, (153, 153, 153)),
-    18: ("polegroup", 255, False, (153, 153, 153)), 19: ("traffic light", 6, False, (250, 170, 30)),
-    20: ("traffic sign", 7, False, (220, 220, 0)), 21: ("vegetation", 8, False, (107, 142, 35)),
-    22: ("terrain", 9, False, (152, 251, 152)), 23: ("sky", 10, False, (70, 130, 180)),
-    24: ("person", 11, True, (220, 20, 60)), 25: ("rider", 12, True, (255, 0, 0)),
-    26: ("car", 13, True, (0, 0, 142)), 27: ("truck", 14, True, (0, 0, 70)),
-    28: ("bus", 15, True, (0, 60, 100)), 29: ("caravan", 255, True, (0, 0, 90)),
-    30: ("trailer", 255, True, (0, 0, 110)), 31: ("train", 16, True, (0, 80, 100)),
-    32: ("motorcycle", 17, True, (0, 0, 230)), 33: ("bicycle", 18, True, (119, 11, 32)),
-}
-INSTANCE_LABEL_IDS = tuple(i for i, row in LABELS.items() if row[2])
-_TRAIN = np.array([LABELS[i][1] for i in range(len(LABELS))], np.uint8)
-_COLOR = np.array([LABELS[i][3] for i in range(len(LABELS))], np.uint8)
+#: Cityscapes labels (cityscapesScripts ``helpers/labels.py``, as data in ``generator/labels/cityscapes.yaml``):
+#: id -> (name, train id, has instances, RGB colour).
+LABELS: dict[int, tuple[str, int, bool, tuple[int, int, int]]] = cityscapes_labels().table
+INSTANCE_LABEL_IDS = cityscapes_labels().instance_ids
+_TRAIN = cityscapes_labels().train_ids
+_COLOR = cityscapes_labels().colors
 SUFFIXES = ("leftImg8bit", "gtFine_labelIds", "gtFine_instanceIds", "gtFine_labelTrainIds", "gtFine_color")
 
 

@@ -5,7 +5,7 @@ shift the others): grid -> routes -> lots (blocks, then the band outside the rin
 -> buildings -> hedges/fences -> traffic lights -> one-way signs
 -> lamps -> street trees -> verge hedges, bushes and trees -> signs -> lot greenery -> parked vehicles -> lane cars ->
 people -> ground objects. Objects accepted earlier win space; everything keeps clear of
-the routes (see :mod:`generator.layout.placement_core`). Finally the routes are verified
+the routes (see :mod:`generator.layout.placement`). Finally the routes are verified
 against every object box, and an internal error is raised if any sample is too close.
 """
 
@@ -18,25 +18,32 @@ from collections import defaultdict
 import numpy as np
 
 from generator.geometry import Mesh, pose
+from generator.geometry.boxes import box_of
 from generator.labels import class_table
-from generator.layout import placement_lots as pl
-from generator.layout import placement_one_way as pw
-from generator.layout import placement_extras as px
-from generator.layout import placement_street as ps
-from generator.layout import placement_tracks as pt
-from generator.layout import placement_verges as pv
-from generator.layout.lots import Lot, lot_ground_mesh, make_lots
-from generator.layout.mapped_scene import map_scene, verify_world_routes
-from generator.layout.outskirts import horizon_mesh
-from generator.layout.placement_core import EGO_HALF_WIDTH_M, Keepout, Library, Placed, Placer, box_of
-from generator.layout.routes import densify, make_routes
-from generator.layout.street_meshes import (intersection_road_mesh, intersection_walk_mesh, margin_mesh,
-                                            segment_frame_points, segment_road_mesh, segment_walk_mesh)
-from generator.layout.streets import Grid, make_grid
-from generator.layout.town_map import draw_town_map
-from generator.world.scene import OrientedBox, Path, SceneModel, SceneObject
-from generator.spec.model import SceneSpec
+from generator.layout.ground.intersections import intersection_road_mesh, intersection_walk_mesh
+from generator.layout.ground.roads import segment_road_mesh
+from generator.layout.ground.sidewalks import segment_walk_mesh
+from generator.layout.ground.terrain import horizon_mesh, margin_mesh
+from generator.layout.lots.lot import Lot, lot_ground_mesh, make_lots
+from generator.layout.mapping.mapped_scene import map_scene, verify_world_routes
+from generator.layout.mapping.town_map import draw_town_map
+from generator.layout.network.design_vehicle import EGO_HALF_WIDTH_M
+from generator.layout.network.draw import make_grid
+from generator.layout.network.grid import Grid, segment_frame_points
+from generator.layout.network.routes import densify, make_routes
+from generator.layout.placement import extras as px
+from generator.layout.placement import on_lots as pl
+from generator.layout.placement import one_way_signs as pw
+from generator.layout.placement import street as ps
+from generator.layout.placement import tracks as pt
+from generator.layout.placement import verges as pv
+from generator.layout.placement.keepout import Keepout
+from generator.layout.placement.placer import Placed, Placer
+from generator.layout.placement.prototypes import Library
+from generator.layout.town import Town
 from generator.progress import progress
+from generator.spec.model import SceneSpec
+from generator.world.scene import Path, SceneModel, SceneObject
 
 log = logging.getLogger(__name__)
 
@@ -90,7 +97,8 @@ def _pits(grid: Grid, seg, trees: np.ndarray) -> np.ndarray:
     return uv[on]
 
 
-def ground_pieces(grid: Grid, lots: list[Lot], placed: list[Placed] = ()) -> list[tuple[str, str, str, Mesh, np.ndarray]]:
+def ground_pieces(grid: Grid, lots: list[Lot],
+                  placed: list[Placed] = ()) -> list[tuple[str, str, str, Mesh, np.ndarray]]:
     """Stuff objects: ``(kind, class, prototype key or "", mesh, transform)``.
 
     One road and one sidewalk object (with tree pits under the street trees of ``placed``)
@@ -164,7 +172,8 @@ def verify_routes(paths: list[Path], grid: Grid, objects: list[SceneObject], lim
         inside = ((xy[:, None, 0] >= drive[None, :, 0] - 1e-6) & (xy[:, None, 0] <= drive[None, :, 2] + 1e-6)
                   & (xy[:, None, 1] >= drive[None, :, 1] - 1e-6) & (xy[:, None, 1] <= drive[None, :, 3] + 1e-6)).any(1)
         if not inside.all():
-            raise LayoutError(f"{path.name}: {int((~inside).sum())} samples off the driving lanes, e.g. {xy[~inside][0]}")
+            raise LayoutError(f"{path.name}: {int((~inside).sum())} samples off the driving lanes, "
+                              f"e.g. {xy[~inside][0]}")
         keep = Keepout(xy, limit)
         for o in objects:
             d = keep.distance(o.box)
@@ -172,14 +181,17 @@ def verify_routes(paths: list[Path], grid: Grid, objects: list[SceneObject], lim
                 raise LayoutError(f"{path.name}: {o.name} is {d:.2f} m from the route (< {limit:.2f} m)")
 
 
-def build_scene(spec: SceneSpec) -> SceneModel:
+def build_scene(spec: SceneSpec) -> Town:
     """Build the town described by ``spec``.
 
     Returns
     -------
-    SceneModel
-        Ground pieces first, then placed objects in placement order; objects of thing classes
-        (``thing`` in ``classes.yaml``) get instance ids 1..N, stuff gets 0; route 0 is the comb loop :class:`generator.world.rig.Rig` follows.
+    Town
+        The scene (a :class:`~generator.world.scene.SceneModel`) with the grid and asset library it
+        was built from (and the map of a town whose streets cross at an angle). Ground pieces
+        first, then placed objects in placement order; objects of thing classes (``thing`` in
+        ``classes.yaml``) get instance ids 1..N, stuff gets 0; route 0 is the comb loop
+        :class:`generator.world.rig.Rig` follows.
 
     Raises
     ------
@@ -207,15 +219,18 @@ def build_scene(spec: SceneSpec) -> SceneModel:
     scene = SceneModel(spec.seed, spec.spec_hash, grid.bounds, prototypes, proxies, objects, routes)
     if tmap is None:
         verify_routes(routes, grid, objects[first:], limit - 1e-6)
+        town = Town.of(scene, grid, lib)
     else:
         verify_routes(routes, grid, [], limit)      # on the lanes (the grid's); distances in the world:
         shaped = set(range(first)) | {first + i for i, p in enumerate(placer.placed) if lib.protos[p.proto].shaped}
-        scene = map_scene(scene, tmap, shaped)
-        verify_world_routes(scene, first, shaped, limit - 1e-6)
-        log.info("streets cross at %.1f degrees (lean %+d): the town is mapped from its grid", tmap.angle_deg, tmap.lean)
+        world = map_scene(scene, tmap, shaped)
+        verify_world_routes(world, scene, tmap, first, shaped, limit - 1e-6)
+        log.info("streets cross at %.1f degrees (lean %+d): the town is mapped from its grid", tmap.angle_deg,
+                 tmap.lean)
+        town = Town.of(world, grid, lib, tmap, scene)
     log.info("scene %s: %d objects, %d prototypes, %d proxies, built in %.2f s", spec.name, len(objects),
-             len(scene.prototypes), len(scene.proxies), time.perf_counter() - t0)
-    return scene
+             len(town.prototypes), len(town.proxies), time.perf_counter() - t0)
+    return town
 
 
 def class_counts(scene: SceneModel) -> dict[str, dict[str, int]]:

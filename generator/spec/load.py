@@ -55,7 +55,7 @@ def check_streets(full: dict, source: str) -> None:
     street types other than plain only where the town has strips between the lanes and kerbs.
 
     One-way streets combine with roundabouts and closed streets: the layout keeps a closed street
-    and a roundabout's arms two-way (:mod:`generator.layout.one_way`)."""
+    and a roundabout's arms two-way (:mod:`generator.layout.network.one_way`)."""
     streets = full.get("streets")
     if streets is None:
         return
@@ -71,7 +71,7 @@ def check_streets(full: dict, source: str) -> None:
     varied = sorted(k for k, w in streets["types"].items() if k != "plain" and w > 0)
     if varied and full["town"]["parking_strip_width_m"] <= 0:
         # every type but plain fills or turns the strips between the lanes and the kerbs
-        # (generator.layout.cross_sections); without them the weights would be silently ignored
+        # (generator.layout.network.cross_sections); without them the weights would be silently ignored
         raise SpecError(source, "streets.types", f"{', '.join(varied)} need(s) the strips between lanes and kerbs, "
                         "but town.parking_strip_width_m is 0; give the strips a width or use plain only")
 

@@ -177,8 +177,8 @@ class Streets:
     """Street variety: weights of the cross-section types and districts, parking occupancy range.
 
     Weights are relative (``{"plain": 1, "boulevard": 3}``: a boulevard three times as often as a
-    plain street); the draws are made in :mod:`generator.layout.streets` and
-    :mod:`generator.layout.districts`.
+    plain street); the draws are made in :mod:`generator.layout.network.draw` and
+    :mod:`generator.layout.lots.districts`.
     """
 
     types: dict
@@ -187,11 +187,12 @@ class Streets:
     verge_bushes_per_100m: float
     verge_hedges: float
     districts: dict
-    #: share of the four-arm intersections that are roundabouts (:mod:`generator.layout.roundabouts`)
+    #: share of the four-arm intersections that are roundabouts (:mod:`generator.layout.network.roundabouts`)
     roundabouts: float = 0.0
-    #: share of the eligible interior segments closed and made pocket parks (:mod:`generator.layout.closures`)
+    #: share of the eligible interior segments closed and made pocket parks (:mod:`generator.layout.network.closures`)
     closed_streets: float = 0.0
-    #: [low, high] degrees the two street directions cross at, one draw per town (:mod:`generator.layout.town_map`)
+    #: [low, high] degrees the two street directions cross at, one draw per town
+    #: (:mod:`generator.layout.mapping.town_map`)
     intersection_angle_deg: Range = (90.0, 90.0)
 
 

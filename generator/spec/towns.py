@@ -121,7 +121,7 @@ def intersection_angle(spec) -> tuple[float, int] | None:
     """The angle (degrees) ``spec``'s two street directions cross at and the lean (+1 or -1) of
     the north-south streets, drawn from ``streets.intersection_angle_deg`` on the stream
     ``("layout", "intersection_angle")``; None for right angles (no ``streets``, or a range at 90).
-    The layout maps the town with them (:mod:`generator.layout.town_map`); metadata records them."""
+    The layout maps the town with them (:mod:`generator.layout.mapping.town_map`); metadata records them."""
     streets = getattr(spec, "streets", None)
     if streets is None:
         return None

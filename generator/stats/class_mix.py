@@ -20,15 +20,13 @@ import numpy as np
 
 from generator.formats import semantickitti as sk
 from generator.labels import class_table
+from generator.labels.cityscapes import cityscapes_labels
 from generator.labels.sets import label_sets
 from generator.stats import images as image_stats
 from generator.stats.report import Section, Table
 
-#: Cityscapes' 19 train classes: (label id, name), in train-id order.
-CITYSCAPES_TRAIN = ((7, "road"), (8, "sidewalk"), (11, "building"), (12, "wall"), (13, "fence"), (17, "pole"),
-                    (19, "traffic light"), (20, "traffic sign"), (21, "vegetation"), (22, "terrain"), (23, "sky"),
-                    (24, "person"), (25, "rider"), (26, "car"), (27, "truck"), (28, "bus"), (31, "train"),
-                    (32, "motorcycle"), (33, "bicycle"))
+#: Cityscapes' 19 train classes: (label id, name), in train-id order (``generator/labels/cityscapes.yaml``).
+CITYSCAPES_TRAIN = cityscapes_labels().train_classes
 
 
 @dataclass

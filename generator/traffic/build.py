@@ -8,7 +8,9 @@ a stream named ``("traffic", ...)`` of the spec seed, and the simulation is caus
 world at a time ``t`` does not depend on how long a run is.
 
 Vehicles start on free lane edges at rest and settle for :data:`WARMUP_S` seconds (the ego
-waiting at its start) before t = 0.
+waiting at its start) before t = 0. The traffic drives in the town it is given
+(:class:`~generator.layout.town.Town`): its grid, and its asset library, so moving vehicles and
+people are the static town's models -- in a re-drawn town the shared library of the spec's seed.
 """
 
 from __future__ import annotations
@@ -19,16 +21,21 @@ import time
 import numpy as np
 
 from generator.errors import SpecError
-from generator.layout.appearance import fleet_paint
-from generator.layout.streets import make_grid
+from generator.geometry.proxy import label_proxy
+from generator.layout.network.cycles import route_node_cycles
+from generator.layout.network.design_vehicle import EGO_SIZE_M
+from generator.layout.network.measures import ARM_DIRS, CROSSWALK_U
+from generator.layout.placement.appearance import fleet_paint
+from generator.layout.town import Town
 from generator.rng import stream
-from generator.traffic.fleet import EGO_SIZE_M, KINDS, fleet_proto
-from generator.traffic.lane_clearance import MARGIN_M, blocked_lanes, too_narrow, widest_half_width
-from generator.traffic.lanes import LaneGraph
+from generator.traffic.lanes.clearance import MARGIN_M, blocked_lanes, too_narrow
+from generator.traffic.lanes.graph import LaneGraph
+from generator.traffic.lanes.signals import CLEAR_S, Signals
 from generator.traffic.mapped_tracks import map_track
 from generator.traffic.movers import DT_S, Mover
-from generator.traffic.signals import CLEAR_S, Signals
-from generator.traffic.vehicles import Vehicle, VehicleSim
+from generator.traffic.pedestrians.simulate import simulate_pedestrians
+from generator.traffic.vehicles.fleet import KINDS, fleet_proto, widest_half_width
+from generator.traffic.vehicles.sim import Vehicle, VehicleSim, arm_towards
 from generator.world.actors import Actor, Track, TrackTrajectory, World, frozen_world
 from generator.world.trajectory import EgoTrajectory
 
@@ -41,14 +48,16 @@ MAX_DRIVE_S = 900.0
 SPACING_M = 6.0       #: lanes hold at most one vehicle per (length + this), for the capacity check
 
 
-def build_world(spec, scene, duration_s: float, distance_m: float = 0.0) -> World:
+def build_world(spec, scene: Town, duration_s: float, distance_m: float = 0.0) -> World:
     """The world of ``spec`` over at least ``[0, duration_s]`` seconds.
 
     Parameters
     ----------
     spec : generator.spec.SceneSpec
-    scene : generator.world.scene.SceneModel
-        The static town built from ``spec``.
+    scene : Town
+        The static town built from ``spec`` (:func:`generator.layout.build_scene`): the traffic drives
+        on its grid and draws its vehicles and people from its asset library (a frozen town, with
+        every ``traffic`` density 0, may be any :class:`~generator.world.scene.SceneModel`).
     duration_s : float
         Simulated seconds from t = 0 (tracks run a little longer for central differences).
     distance_m : float
@@ -59,21 +68,22 @@ def build_world(spec, scene, duration_s: float, distance_m: float = 0.0) -> Worl
     SpecError
         More vehicles than the free lanes can hold, or the ego cannot drive ``distance_m``
         within :data:`MAX_DRIVE_S`.
+    TypeError
+        Traffic asked for in a scene that is not a :class:`Town`.
     """
     if not spec.traffic.enabled:
         return frozen_world(scene, EgoTrajectory(scene.paths[0], spec.paths.speed_mps))
-    world_scene, tmap = scene, scene.town_map
+    if not isinstance(scene, Town):
+        raise TypeError(f"build_world needs the Town build_scene returns, got {type(scene).__name__}")
+    world_scene, tmap, grid, lib = scene, scene.town_map, scene.grid, scene.library
     if tmap is not None:    # streets crossing at an angle: the traffic runs on the town's grid
         scene = scene.layout
     t_start = time.perf_counter()
-    from generator.layout.placement_core import Library
-
-    grid = make_grid(spec)
     graph = LaneGraph(grid)
     signals = Signals(spec.seed, grid.nodes, grid.roundabouts)
-    lib = Library(spec.seed)
     half_width, widest = widest_half_width(spec, lib, KINDS, EGO_SIZE_M[1])
-    log.debug("lanes kept clear of static objects to %.2f m from their centre lines (%s)", half_width + MARGIN_M, widest)
+    log.debug("lanes kept clear of static objects to %.2f m from their centre lines (%s)", half_width + MARGIN_M,
+              widest)
     horizon_s = duration_s + 1.0 + LOOKAHEAD_S
     if distance_m > 0:  # the drive may take longer than asked: cover a slow ego
         horizon_s = max(horizon_s, distance_m / (0.25 * spec.paths.speed_mps) + 5.0 + LOOKAHEAD_S)
@@ -81,8 +91,8 @@ def build_world(spec, scene, duration_s: float, distance_m: float = 0.0) -> Worl
         peds = _pedestrians(spec, grid, scene, signals, lib, int(np.ceil(horizon_s / DT_S)) + 1)
         crossing = _crosswalk_occupancy(grid, graph, peds)
         blocked = blocked_lanes(graph, scene, half_width)
-        movers, ego_track, ego_dist = _drive(spec, graph, scene, signals, lib, blocked, crossing, duration_s, distance_m,
-                                             None if tmap is None else tmap.A)
+        movers, ego_track, ego_dist = _drive(spec, graph, scene, signals, lib, blocked, crossing, duration_s,
+                                             distance_m, None if tmap is None else tmap.A)
         if crossing is None or crossing.asked_s <= horizon_s:
             break
         horizon_s = 2.0 * crossing.asked_s  # same answers up to the old horizon (causal): a longer run, same world
@@ -102,8 +112,6 @@ def build_world(spec, scene, duration_s: float, distance_m: float = 0.0) -> Worl
 def _pedestrians(spec, grid, scene, signals, lib, n_steps: int) -> list[Mover]:
     if spec.traffic.pedestrians_per_100m <= 0 and spec.traffic.standing_pedestrians_per_100m <= 0:
         return []
-    from generator.traffic.pedestrians import simulate_pedestrians
-
     return simulate_pedestrians(spec, grid, scene, signals, lib, n_steps, DT_S)
 
 
@@ -111,7 +119,7 @@ def _lead_in(m: Mover, ground=None) -> Mover:
     """Prepend :data:`LEAD_IN` samples before t = 0 at the first step's horizontal velocity, so
     central differences at t = 0 see the motion (a walker already walking) instead of a clamped
     track. Their height is ``ground(xy)`` ((n, 2) -> (n,) metres: a walker's feet on the ground
-    there, :func:`generator.traffic.pedestrians.feet_height`), or the first sample's without it;
+    there, :func:`generator.traffic.pedestrians.simulate.feet_height`), or the first sample's without it;
     extrapolating a step up the kerb would sink the feet below the road."""
     tr = m.track
     if tr.t0 <= -LEAD_IN * DT_S + 1e-12 or len(tr.yaw) < 2:
@@ -119,7 +127,8 @@ def _lead_in(m: Mover, ground=None) -> Mover:
     step = tr.xyz[1] - tr.xyz[0]
     back = tr.xyz[0] - step * np.arange(LEAD_IN, 0, -1)[:, None]
     back[:, 2] = tr.xyz[0, 2] if ground is None else ground(back[:, :2])
-    m.track = Track(tr.t0 - LEAD_IN * DT_S, tr.dt, np.vstack([back, tr.xyz]), np.r_[np.repeat(tr.yaw[:1], LEAD_IN), tr.yaw])
+    m.track = Track(tr.t0 - LEAD_IN * DT_S, tr.dt, np.vstack([back, tr.xyz]),
+                    np.r_[np.repeat(tr.yaw[:1], LEAD_IN), tr.yaw])
     return m
 
 
@@ -135,9 +144,6 @@ def _extend_track(m: Mover, n: int) -> Mover:
 
 def _crosswalk_occupancy(grid, graph: LaneGraph, peds: list[Mover]):
     """``crossing(node, arm, t0, t1)``: is a pedestrian within 1 m of that crosswalk band then."""
-    from generator.layout.streets import CROSSWALK_U
-    from generator.traffic.lanes import ARM_DIRS
-
     walkers = [p for p in peds if p.attrs.get("role") != "standing"]
     if not walkers:
         return None
@@ -184,10 +190,7 @@ def _prune(graph: LaneGraph, blocked: set[int], keep: set[int]) -> set[int]:
 
 
 def _ego_route(graph: LaneGraph) -> list[int]:
-    """Route 0 (the comb loop of :mod:`generator.layout.routes`) as a cycle of edges of ``graph``."""
-    from generator.layout.one_way import route_node_cycles
-    from generator.traffic.vehicles import arm_towards
-
+    """Route 0 (the comb loop of :mod:`generator.layout.network.routes`) as a cycle of edges of ``graph``."""
     grid = graph.grid
     nodes = route_node_cycles(len(grid.xs) - 1, len(grid.ys) - 1)[0]
     k = grid.lanes - 1
@@ -299,8 +302,6 @@ def _free_spot(graph, free, taken, length, g, field_name, spec):
 
 
 def _assemble(scene, movers: list[Mover], ego: TrackTrajectory, duration_s: float) -> World:
-    from generator.geometry.proxy import label_proxy
-
     base = max([o.instance_id for o in scene.objects] + [0]) + 1
     if base + len(movers) > 65535:
         raise SpecError("", "traffic", f"{len(movers)} actors exceed the instance ids left in a uint16 label")

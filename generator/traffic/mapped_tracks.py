@@ -1,10 +1,10 @@
-"""Carry tracks simulated on a skewed town's grid into its world (:mod:`generator.layout.town_map`).
+"""Carry tracks simulated on a skewed town's grid into its world (:mod:`generator.layout.mapping.town_map`).
 
 The traffic of a town whose streets cross at an angle runs on the grid lanes
 (:func:`generator.traffic.build.build_world`); every actor is rigid, so its track is mapped by its
 centre: the centre goes through the map, the heading turns to the mapped direction, and the
 origin is put back behind the centre at the actor's own (unmapped) offset. The map stretches every
-length along a street by :attr:`~generator.layout.town_map.TownMap.stretch`, so the track is also
+length along a street by :attr:`~generator.layout.mapping.town_map.TownMap.stretch`, so the track is also
 slowed by that factor (its times stretched): along the streets every actor moves in the world at
 the speed, and waits as long as, it was simulated with (speed limits, the ego's ``speed_mps``,
 walking speeds hold in the world).
@@ -24,7 +24,7 @@ def map_track(track: Track, tmap, offset_xy=(0.0, 0.0)) -> Track:
     ----------
     track : Track
         Origin positions (T, 3) and unwrapped headings (T,), grid frame.
-    tmap : generator.layout.town_map.TownMap
+    tmap : generator.layout.mapping.town_map.TownMap
     offset_xy : (2,) float
         The actor's footprint centre in its local frame, metres (the origin is not the centre).
 

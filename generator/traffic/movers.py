@@ -1,6 +1,6 @@
 """What every traffic simulation hands to :func:`generator.traffic.build.build_world`.
 
-A :class:`Mover` is a prototype (from the layout's asset :class:`~generator.layout.placement_core.Library`,
+A :class:`Mover` is a prototype (from the layout's asset :class:`~generator.layout.placement.prototypes.Library`,
 so the same meshes the static town uses) plus its sampled :class:`~generator.world.actors.Track`.
 A ridden two-wheeler is one mover whose prototype is the rider and the vehicle merged (one
 instance, as SemanticKITTI labels a bicyclist with the bicycle).
@@ -26,7 +26,7 @@ class Mover:
         Asset kind (``"car"``, ``"person"``, ``"ridden_bicycle"`` ...).
     cls : str
         Main native class (``"car"``, ``"person"``, ``"bicyclist"`` ...).
-    proto : generator.layout.placement_core.Proto
+    proto : generator.layout.placement.prototypes.Proto
         Prototype (mesh in the local frame: x forward, y left, z up, origin on the ground).
     track : Track
         Pose of the local origin every :data:`DT_S` seconds from t = 0.

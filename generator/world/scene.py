@@ -17,44 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from generator.geometry import Mesh, apply
-
-
-@dataclass(frozen=True)
-class OrientedBox:
-    """An upright oriented 3D box.
-
-    Attributes
-    ----------
-    center : (3,) float64
-        Box centre, world frame, metres.
-    size : (3,) float64
-        Length (along heading), width, height in metres.
-    yaw : float
-        Heading of the length axis, radians, counter-clockwise from +x.
-    """
-
-    center: tuple[float, float, float]
-    size: tuple[float, float, float]
-    yaw: float
-
-    def corners_xy(self) -> np.ndarray:
-        """(4, 2) float64 footprint corners, counter-clockwise."""
-        c, s = np.cos(self.yaw), np.sin(self.yaw)
-        hl, hw = self.size[0] / 2, self.size[1] / 2
-        local = np.array([[-hl, -hw], [hl, -hw], [hl, hw], [-hl, hw]])
-        return local @ np.array([[c, s], [-s, c]]) + np.asarray(self.center[:2])
-
-    def contains(self, points: np.ndarray, margin: float = 0.0) -> np.ndarray:
-        """(n,) bool: which (n, 3) world points lie inside the box grown by ``margin`` metres."""
-        p = np.asarray(points, np.float64).reshape(-1, 3) - np.asarray(self.center)
-        c, s = np.cos(self.yaw), np.sin(self.yaw)
-        lx, ly = p[:, 0] * c + p[:, 1] * s, -p[:, 0] * s + p[:, 1] * c
-        h = np.asarray(self.size) / 2 + margin
-        return (np.abs(lx) <= h[0]) & (np.abs(ly) <= h[1]) & (np.abs(p[:, 2]) <= h[2])
-
-    def quaternion(self) -> tuple[float, float, float, float]:
-        """Rotation as a unit quaternion (x, y, z, w)."""
-        return (0.0, 0.0, float(np.sin(self.yaw / 2)), float(np.cos(self.yaw / 2)))
+from generator.geometry.boxes import OrientedBox
 
 
 @dataclass
@@ -162,11 +125,10 @@ class SceneModel:
     objects : list of SceneObject
     paths : list of Path
         Lane-following routes for cameras and the ego vehicle.
-    town_map : generator.layout.town_map.TownMap or None
-        The grid -> world map of a town whose streets cross at an angle other than 90 degrees;
-        None when they cross at right angles (grid and world are the same frame).
-    layout : SceneModel or None
-        With a ``town_map``: the same town in the grid frame, where the traffic is simulated.
+
+    The town the layout builds (:class:`generator.layout.town.Town`) is a SceneModel that also
+    keeps the street grid, the asset library and, for streets crossing at an angle, the grid ->
+    world map and the grid-frame scene.
     """
 
     seed: int
@@ -176,8 +138,6 @@ class SceneModel:
     proxies: dict[str, Mesh]
     objects: list[SceneObject]
     paths: list[Path]
-    town_map: object = field(default=None, repr=False, compare=False)
-    layout: "SceneModel | None" = field(default=None, repr=False, compare=False)
 
     # -- flat triangle soup (what Embree casts against) --------------------------------------
     @functools.cached_property

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from generator.traffic.lanes import boxes_overlap
+from generator.geometry.boxes import quads_overlap
 from generator.world.scene import OrientedBox
 
 EGO_SIZE_M = (4.6, 1.9, 1.5)
@@ -26,18 +26,18 @@ def assert_no_contact(world, t: float, parked: np.ndarray | None = None, ego: bo
     """No two actors overlap at ``t``, none touches the ego (unless ``ego`` is False), and none a
     ``parked`` footprint. Returns the (n, 4, 2) actor footprints at ``t``."""
     q = np.stack([b.corners_xy() for b in world.boxes(t)])
-    ov = boxes_overlap(q, q)
+    ov = quads_overlap(q, q)
     np.fill_diagonal(ov, False)
     assert not ov.any(), f"actors {np.argwhere(ov)[0]} overlap at t={t:.1f}"
     if ego:
-        assert not boxes_overlap(ego_box(world, t).corners_xy()[None], q).any(), f"an actor touches the ego at t={t:.1f}"
+        assert not quads_overlap(ego_box(world, t).corners_xy()[None], q).any(), f"an actor touches the ego at t={t:.1f}"
     if parked is not None:
-        assert not boxes_overlap(q, parked).any(), f"an actor touches a static object at t={t:.1f}"
+        assert not quads_overlap(q, parked).any(), f"an actor touches a static object at t={t:.1f}"
     return q
 
 
 def assert_vehicles_miss_people(world, t: float, vehicles: list, people: list) -> None:
     """No vehicle (nor the ego) touches a person at ``t``."""
     p = np.stack([a.box(t).corners_xy() for a in people])
-    hit = boxes_overlap(np.stack([a.box(t).corners_xy() for a in vehicles] + [ego_box(world, t).corners_xy()]), p)
+    hit = quads_overlap(np.stack([a.box(t).corners_xy() for a in vehicles] + [ego_box(world, t).corners_xy()]), p)
     assert not hit.any(), (t, np.argwhere(hit)[:3])

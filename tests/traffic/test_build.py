@@ -1,0 +1,57 @@
+"""The traffic drives in the town it is given: its grid, and its asset library.
+
+A re-drawn town (``town.redraw_every_frames``) shares the asset library of the spec's seed (README:
+"its asset prototypes stay those of ``seed``"), so a car driving past is one of the models parked in
+every town of the run. The moving fleet used to be drawn from a library of the town's own seed.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from generator.layout import build_scene
+from generator.spec.load import parse_spec
+from generator.spec.towns import town_spec
+from generator.traffic import build_world
+
+DOC = {"name": "redrawn_small_town", "seed": 7,
+       "town": {"blocks_x": 1, "blocks_y": 1, "block_size_m": 36, "block_size_jitter_m": 0, "margin_m": 12,
+                "redraw_every_frames": 5},
+       "density": {"parked_cars_per_100m": 14, "people_per_100m": 6},
+       "traffic": {"cars_per_km": 30, "pedestrians_per_100m": 2.0, "standing_pedestrians_per_100m": 1.0}}
+
+
+@pytest.fixture(scope="module")
+def towns():
+    """(base scene, town 1's scene, town 1's world): the spec's own town and a re-drawn one."""
+    spec = parse_spec(DOC, "redrawn_small_town.json")
+    town1 = town_spec(spec, 1)
+    scene1 = build_scene(town1)
+    return build_scene(spec), scene1, build_world(town1, scene1, 2.0)
+
+
+def _same_mesh(a, b) -> bool:
+    return (np.array_equal(a.vertices, b.vertices) and np.array_equal(a.faces, b.faces)
+            and np.array_equal(a.face_class, b.face_class))
+
+
+def test_a_redrawn_towns_moving_fleet_comes_from_the_shared_asset_library(towns):
+    base, scene1, world = towns
+    assert scene1.seed != base.seed                      # a town of its own ...
+    shared = [k for k in world.prototypes if k.removeprefix("actor_") in base.prototypes]
+    kinds = {k.removeprefix("actor_").split("_v")[0] for k in shared}
+    assert {"car", "person"} <= kinds, f"no moving car or person shares a model with the base town: {shared}"
+    for key in shared:                                   # ... whose cars and people are the run's models
+        model = key.removeprefix("actor_")
+        assert _same_mesh(world.prototypes[key], base.prototypes[model]), f"{key} is not the run's {model}"
+        if model in scene1.prototypes:                   # and the models parked in this very town
+            assert _same_mesh(world.prototypes[key], scene1.prototypes[model]), key
+
+
+def test_the_traffic_drives_on_the_grid_and_library_the_town_was_built_from(towns):
+    _, scene1, world = towns
+    assert world.scene is scene1
+    assert scene1.library.seed == DOC["seed"]            # the spec's seed, not the town's
+    for a in world.actors:                               # every moving model is the library's own mesh
+        assert world.prototypes[a.prototype] is scene1.library.protos[a.prototype.removeprefix("actor_")].mesh
