@@ -1,6 +1,6 @@
 """Layout maps of one town per district (and a mix of street types), to look at.
 
-    python bench/district_maps.py [--out /work/figs/streets] [--seed 2]
+    python bench/district_maps.py --out DIR [--seed 2]
 
 For each of ``detached``, ``row_houses``, ``dense_centre``, ``light_industry`` and ``park_edge``
 a 2 x 2-block town whose every block is that district, with residential streets, boulevards,
@@ -40,7 +40,7 @@ def spec_for(district: str, seed: int):
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--out", default="/work/figs/streets")
+    ap.add_argument("--out", required=True, help="folder for the PNGs")
     ap.add_argument("--seed", type=int, default=2)
     args = ap.parse_args()
     out = Path(args.out)

@@ -12,7 +12,7 @@ The paint / outfit names and triangle counts are printed, with the render time p
 
 Usage::
 
-    python bench/gallery_looks.py [/work/figs/looksv/gallery.png] [--seed 3] [--size 480x270] [--samples 16]
+    python bench/gallery_looks.py OUT.png [--seed 3] [--size 480x270] [--samples 16]
 """
 
 from __future__ import annotations
@@ -93,7 +93,7 @@ def _instances(inst: np.ndarray) -> np.ndarray:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("out", nargs="?", default="/work/figs/looksv/gallery.png")
+    ap.add_argument("out", help="the gallery PNG to write")
     ap.add_argument("--seed", type=int, default=3)
     ap.add_argument("--size", default="480x270")
     ap.add_argument("--samples", type=int, default=16)

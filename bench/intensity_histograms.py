@@ -1,6 +1,6 @@
 """Per-class intensity histograms of a generated default-town sequence under two intensity models.
 
-    python bench/intensity_histograms.py [--dataset /work/scratch/lidar_hist] [--frames 5]
+    python bench/intensity_histograms.py --dataset DIR [--frames 5]
                                          [--models class_normal,physical] [--out PNG]
 
 If the dataset lacks them, the sequences are generated first, one per model, with the CLI:
@@ -101,7 +101,7 @@ def draw(per_model: dict[str, dict[int, np.ndarray]], classes: list[int], out: P
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--dataset", type=Path, default=Path("/work/scratch/lidar_hist"))
+    ap.add_argument("--dataset", type=Path, required=True, help="scratch folder for the sequences it casts")
     ap.add_argument("--spec", type=Path, default=ROOT / "scenes" / "default_town.json")
     ap.add_argument("--frames", type=int, default=5)
     ap.add_argument("--models", default="class_normal,physical")

@@ -17,7 +17,7 @@ Printed per factor, over consecutive frame pairs and pixels near markings:
 A PNG strip (crop of distant markings, frames left to right; rows 1x, 3x, reference coverage)
 goes to ``--png``.
 
-    python bench/label_flicker.py [--frames 8] [--step-cm 3] [--png /work/figs/wetaa/label_flicker.png]
+    python bench/label_flicker.py [--frames 8] [--step-cm 3] --png OUT.png
 """
 
 from __future__ import annotations
@@ -97,7 +97,7 @@ def main() -> None:
     ap.add_argument("--frame", type=int, default=5)
     ap.add_argument("--frames", type=int, default=8)
     ap.add_argument("--step-cm", type=float, default=3.0)
-    ap.add_argument("--png", default="/work/figs/wetaa/label_flicker.png")
+    ap.add_argument("--png", required=True, help="the strip PNG to write")
     a = ap.parse_args()
 
     from generator.blender import passes

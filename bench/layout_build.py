@@ -23,7 +23,7 @@ the process: a render worker, ``generate``'s second pass; every prototype a hit)
 (towns 1.. of a re-drawn run, ``town.redraw_every_frames``, built one after the other after town 0:
 the shared asset library is warm, the town's own buildings, fences and hedges are not), wall and
 process-CPU seconds, with the prototype hit rate of the new towns. ``--baseline DIR`` (another
-checkout, e.g. ``git -C /work/main archive HEAD | tar -x -C DIR``) runs the very same measurement
+checkout, e.g. ``git archive HEAD~5 | tar -x -C DIR``) runs the very same measurement
 with that code, alternating with this checkout's, and prints the two rows side by side; the last
 column says whether this checkout built the baseline's bytes (cold town and every re-drawn town).
 Every warm build is checked to give the cold build's digest. On a loaded machine compare the CPU

@@ -1,6 +1,6 @@
 """Render the looks of issue 14 item 4 in Blender: RGB beside the label view, one row per shot.
 
-    python bench/look_gallery.py [/work/figs/lookst/gallery.png] [--spec scenes/default_town.json]
+    python bench/look_gallery.py OUT.png [--spec scenes/default_town.json]
                                  [--width 480] [--samples 16] [--only trees facades road]
 
 Shots, all in the town the spec builds (day, clear, the spec's seed):
@@ -148,7 +148,7 @@ def to_srgb(rgb: np.ndarray) -> np.ndarray:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("out", type=Path, nargs="?", default=Path("/work/figs/lookst/gallery.png"))
+    ap.add_argument("out", type=Path, help="the gallery PNG to write")
     ap.add_argument("--spec", type=Path, default=ROOT / "scenes" / "default_town.json")
     ap.add_argument("--width", type=int, default=480)
     ap.add_argument("--samples", type=int, default=16)

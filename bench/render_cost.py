@@ -106,7 +106,7 @@ def main() -> None:
     ap.add_argument("--first", type=int, default=5)
     ap.add_argument("--diagnose", action="store_true")
     ap.add_argument("--time-of-day", default="day", choices=["day", "night"])
-    ap.add_argument("--png", default="/work/figs/wetaa/wet_look.png")
+    ap.add_argument("--png", default=None, help="also write the dry/wet crops side by side to this PNG")
     a = ap.parse_args()
 
     from generator.blender.wet import wet_surface
@@ -131,8 +131,9 @@ def main() -> None:
             line += f"{m['dry_0_bounces']:>9.2f}{m['wet_0_bounces']:>9.2f}{m['wet_0_bounces'] / m['dry_0_bounces']:>7.2f}"
         print(line)
     print("the machine's load is shared: compare within a run.")
-    _look(Path(a.png), images)
-    print(f"wrote {a.png}")
+    if a.png:
+        _look(Path(a.png), images)
+        print(f"wrote {a.png}")
 
 
 if __name__ == "__main__":

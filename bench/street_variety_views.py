@@ -14,7 +14,7 @@ Each shot is one row of the PNG: RGB | class colours. Render time per shot is pr
 
 Usage::
 
-    python bench/street_variety_views.py [/work/figs/owsigns/views.png] [--seed 4] [--size 480x270] [--samples 16]
+    python bench/street_variety_views.py OUT.png [--seed 4] [--size 480x270] [--samples 16]
 """
 
 from __future__ import annotations
@@ -69,7 +69,7 @@ def shots(grid) -> dict:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("out", nargs="?", default="/work/figs/owsigns/views.png")
+    ap.add_argument("out", help="the views PNG to write")
     ap.add_argument("--seed", type=int, default=4)
     ap.add_argument("--size", default="480x270")
     ap.add_argument("--samples", type=int, default=16)

@@ -4,8 +4,9 @@ Render nodes run urbangen headless with stderr going to a log file; a tqdm bar i
 there (it only draws on a terminal), which leaves minutes without a word. :func:`progress`
 returns a tqdm bar when stderr is a terminal and otherwise a :class:`LogProgress` that logs
 ``desc: done/total unit (pct), rate, ETA`` on the ``urbangen.progress`` logger every
-:data:`PERIOD_S` seconds and once at the end. The command line shows that logger at INFO
-unless ``--quiet``.
+:data:`PERIOD_S` seconds and once at the end. A job shorter than that logs nothing (its result
+is the line to read), and a job that fails does not claim to be done: the error stays the last
+line. The command line shows that logger at INFO unless ``--quiet``.
 """
 
 from __future__ import annotations
@@ -40,19 +41,21 @@ class LogProgress:
     total : int, optional
     desc : str
     unit : str
-    period_s : float
-        Seconds between two lines.
+    period_s : float, optional
+        Seconds between two lines (default :data:`PERIOD_S`).
     """
 
     def __init__(self, iterable: Iterable | None = None, total: int | None = None, desc: str = "", unit: str = "it",
-                 period_s: float = PERIOD_S):
+                 period_s: float | None = None):
         self.iterable = iterable
         if total is None and iterable is not None and hasattr(iterable, "__len__"):
             total = len(iterable)
-        self.total, self.desc, self.unit, self.period_s = total, desc, unit, period_s
+        self.total, self.desc, self.unit = total, desc, unit
+        self.period_s = PERIOD_S if period_s is None else period_s
         self.n = 0
         self.start = self._last = time.monotonic()
         self._closed = False
+        self._spoke = False
 
     def line(self, now: float | None = None) -> str:
         """The progress line as it stands."""
@@ -72,12 +75,15 @@ class LogProgress:
         now = time.monotonic()
         if now - self._last >= self.period_s:
             self._last = now
+            self._spoke = True
             log.info("%s", self.line(now))
 
     def close(self) -> None:
+        """The closing line, if the job lasted long enough to have progress worth a line."""
         if not self._closed:
             self._closed = True
-            log.info("%s (done)", self.line())
+            if self._spoke or time.monotonic() - self.start >= self.period_s:
+                log.info("%s (done)", self.line())
 
     def __iter__(self) -> Iterator:
         for item in self.iterable:
@@ -88,8 +94,11 @@ class LogProgress:
     def __enter__(self) -> "LogProgress":
         return self
 
-    def __exit__(self, *exc) -> None:
-        self.close()
+    def __exit__(self, exc_type, *exc) -> None:
+        if exc_type is None:
+            self.close()
+        else:
+            self._closed = True   # failed: the error, not "(done)", is the last line
 
 
 def progress(iterable: Iterable | None = None, *, total: int | None = None, desc: str = "", unit: str = "it",

@@ -109,6 +109,7 @@ def test_convert_selected_sequences_only(tmp_path):
     ("same_dir", "output must differ from the input"),
     ("count_mismatch", "labels but"),
     ("bad_labels_option", "invalid choice"),
+    ("empty_seq", "no scans; nothing to convert"),
 ])
 def test_bad_input_one_line_exit_2_nothing_written(tmp_path, capsys, case, message):
     src, dst = tmp_path / "src", tmp_path / "dst"
@@ -126,6 +127,10 @@ def test_bad_input_one_line_exit_2_nothing_written(tmp_path, capsys, case, messa
         sk.write_scan(src / "sequences" / "00" / "velodyne" / "000001.bin", np.zeros((3, 3)), np.zeros(3))
     elif case == "bad_labels_option":
         args[-1] = "cityscapes"
+    elif case == "empty_seq":  # a sequence with its folders and calib but no scan (converted "0 scans" before)
+        d = src / "sequences" / "00"
+        for f in [*(d / "velodyne").iterdir(), *(d / "labels").iterdir(), d / "poses.txt", d / "times.txt"]:
+            f.unlink()
     try:
         rc = cli.main(args)
     except SystemExit as e:  # argparse's own errors

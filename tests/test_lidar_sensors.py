@@ -12,8 +12,9 @@ import yaml
 from generator.errors import SpecError
 from generator.lidar.sensors import load_preset, load_sensor, preset_names, sensor_for_spec
 from generator.spec import load_spec
+from kits.paths import SHARED
 
-REFERENCE = Path("/work/shared/reference/velodyne_hdl64e_s3_calibration.yaml")
+REFERENCE = SHARED / "reference" / "velodyne_hdl64e_s3_calibration.yaml"
 
 
 @pytest.fixture(scope="module")

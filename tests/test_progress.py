@@ -22,10 +22,27 @@ def test_without_a_terminal_progress_logs_instead_of_drawing(caplog, monkeypatch
     import io
     import sys
     monkeypatch.setattr(sys, "stderr", io.StringIO())  # not a TTY
+    monkeypatch.setattr("generator.progress.PERIOD_S", 0.0)
     items = list(progress(range(3), desc="scan", unit="scan"))
     assert items == [0, 1, 2]
     assert any("scan: 3/3 scan (100%)" in r.getMessage() for r in caplog.records)
     assert sys.stderr.getvalue() == ""  # no bar characters in a log file
+
+
+def test_a_short_job_logs_nothing_and_a_failed_one_does_not_say_done(caplog):
+    """The result (or the error) is the last line a user reads, not a progress line."""
+    caplog.set_level(logging.INFO, logger="urbangen.progress")
+    with LogProgress(total=3, desc="verify", unit="image") as bar:
+        bar.update(3)
+    assert not caplog.records
+    try:
+        with LogProgress(total=3, desc="verify", unit="image", period_s=0.0) as bar:
+            bar.update(1)
+            raise ValueError("bad EXR")
+    except ValueError:
+        pass
+    lines = [r.getMessage() for r in caplog.records]
+    assert lines and not any("(done)" in m for m in lines)
 
 
 def test_help_texts_have_no_rest_markup(capsys):

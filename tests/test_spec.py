@@ -118,6 +118,6 @@ def test_render_config_errors(tmp_path):
     p.write_text("name: r\nresolution: [640]\nsamples: 4\n")
     with pytest.raises(SpecError, match=r"r.yaml: resolution: must be a list of 2 items"):
         load_render_config(p)
-    p.write_text("name: r\nresolution: [64, 64]\nsamples: 4\ndenoiser: optix\n")
+    p.write_text("name: r\nresolution: [64, 64]\nsamples: 4\ndenoiser: optics\n")
     with pytest.raises(SpecError, match=r"denoiser: must be one of"):
         load_render_config(p)

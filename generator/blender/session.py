@@ -25,24 +25,55 @@ def reset() -> "bpy.types.Scene":
     return bpy.context.scene
 
 
-def _gpu_available() -> bool:
+#: GPU backends in order of preference (OptiX first: the paper's, and the only one with its denoiser)
+BACKENDS = ("OPTIX", "CUDA", "HIP", "ONEAPI", "METAL")
+#: Scene property holding the denoiser :func:`configure` chose (read by :func:`rgb_state`)
+DENOISER_KEY = "urbangen_denoiser"
+
+
+def _use_backend(backend: str) -> bool:
+    """Switch Cycles to ``backend`` and enable its GPUs; False if it has none here."""
     prefs = bpy.context.preferences.addons["cycles"].preferences
-    for backend in ("OPTIX", "CUDA", "HIP", "ONEAPI", "METAL"):
-        try:
-            prefs.compute_device_type = backend
-        except TypeError:
-            continue
-        prefs.get_devices()
-        gpus = [d for d in prefs.devices if d.type != "CPU"]
-        if gpus:
-            for d in prefs.devices:
-                d.use = d.type != "CPU"
-            return True
-    return False
+    try:
+        prefs.compute_device_type = backend
+    except TypeError:
+        return False
+    prefs.get_devices()
+    if not any(d.type == backend for d in prefs.devices):
+        return False
+    for d in prefs.devices:
+        d.use = d.type != "CPU"
+    return True
+
+
+def _gpu_available() -> bool:
+    return any(_use_backend(b) for b in BACKENDS)
+
+
+def _denoiser(scene: "bpy.types.Scene", cfg: RenderConfig) -> str:
+    """The Cycles denoiser for ``cfg`` ("" for none): OptiX where an OptiX device exists (it denoises
+    on that GPU even when the render runs on the CPU), else OpenImageDenoise with a warning."""
+    if cfg.denoiser == "none":
+        return ""
+    if cfg.denoiser == "optix":
+        if _use_backend("OPTIX"):
+            try:
+                scene.cycles.denoiser = "OPTIX"
+                scene.cycles.denoising_use_gpu = True
+                return "OPTIX"
+            except TypeError:
+                pass
+        log.warning("render config %s asks for the OptiX denoiser but no OptiX device (an NVIDIA RTX GPU with its "
+                    "driver) was found; denoising with OpenImageDenoise on the CPU instead", cfg.name)
+    return "OPENIMAGEDENOISE"
 
 
 def configure(scene: "bpy.types.Scene", cfg: RenderConfig) -> str:
-    """Apply ``cfg`` to ``scene``; return the device actually used ("CPU" or "GPU")."""
+    """Apply ``cfg`` to ``scene``; return the device actually used ("CPU" or "GPU").
+
+    A GPU or the OptiX denoiser asked for where none exists falls back to the CPU (OpenImageDenoise)
+    with a warning, so a config written for a GPU render node still runs anywhere.
+    """
     scene.render.engine = "CYCLES"
     device = "CPU"
     if cfg.device == "gpu":
@@ -52,6 +83,7 @@ def configure(scene: "bpy.types.Scene", cfg: RenderConfig) -> str:
             log.warning("render config %s asks for a GPU but none was found (no OptiX/CUDA/HIP/oneAPI/Metal "
                         "device); rendering on the CPU instead", cfg.name)
     scene.cycles.device = device
+    scene[DENOISER_KEY] = _denoiser(scene, cfg)
     r = scene.render
     r.resolution_x, r.resolution_y = cfg.width, cfg.height
     r.resolution_percentage = 100
@@ -89,9 +121,10 @@ def rgb_state(scene: "bpy.types.Scene", cfg: RenderConfig, seed: int) -> None:
     c.sample_clamp_indirect = 10.0
     c.pixel_filter_type = "BLACKMAN_HARRIS"
     c.filter_width = 1.5
-    c.use_denoising = cfg.denoiser != "none"
+    denoiser = scene.get(DENOISER_KEY) or ""
+    c.use_denoising = bool(denoiser)
     if c.use_denoising:
-        c.denoiser = "OPENIMAGEDENOISE"
+        c.denoiser = denoiser
         c.denoising_quality = cfg.denoiser_quality.upper()
     c.seed = seed % (2**31 - 1)
     blur = cfg.motion_blur.enabled

@@ -135,6 +135,9 @@ def convert_dataset(src: str | Path, dst: str | Path, labels: str = "unified11",
         raise UserError(f"{dst}: output must differ from the input dataset")
     names = pick_sequences(src, sequences)
     seqs = [sk.Sequence(src, n) for n in names]  # validates folders, poses/times lengths
+    for seq in seqs:
+        if len(seq) == 0:
+            raise UserError(f"{seq.dir / 'velodyne'}: no scans; nothing to convert")
     for n in names:
         if (dst / "sequences" / n).exists():
             raise UserError(f"{dst / 'sequences' / n}: exists; remove it or choose another output folder")
