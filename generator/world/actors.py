@@ -180,27 +180,38 @@ class World:
         """sha256 (hex) of every actor's identity and pose and the ego's pose at ``times`` (seconds).
 
         Recorded with a sequence (``lidar_meta.json`` ``traffic.digest``) so a world rebuilt
-        from the spec later (fusion, OpenLABEL) is known to be the one the sensors saw; poses
-        are rounded to 1e-6 so the digest does not hang on the last bit.
+        from the spec later (fusion, OpenLABEL) is known to be the one the sensors saw. Poses are
+        rounded to 1e-6 and negative zeros made positive, so the digest does not hang on the last
+        bit: machines whose vectorised maths differs there (AVX-512 and AVX2 ``exp``, ``arctan2``...)
+        agree on it.
         """
+        return self._digest(times, signed_zeros=False)
+
+    def _digest(self, times, signed_zeros: bool) -> str:
         t = np.round(np.asarray(times, np.float64).reshape(-1), 4)  # times.txt keeps 7 significant digits
-        h = hashlib.sha256(np.round(self.ego.T_world_ego(t), 6).tobytes())
+        zero = -0.0 if signed_zeros else 0.0  # x + 0.0 turns -0.0 into 0.0; x + -0.0 keeps every bit
+
+        def rounded(a: np.ndarray) -> bytes:
+            return (np.round(a, 6) + zero).tobytes()
+
+        h = hashlib.sha256(rounded(self.ego.T_world_ego(t)))
         for a in self.actors:
             h.update(f"{a.uid}/{a.instance_id}/{a.kind}/{a.cls}".encode())
-            h.update(np.round(a.track.pose(t), 6).tobytes())
+            h.update(rounded(a.track.pose(t)))
         return h.hexdigest()
 
     def check_digest(self, recorded, times, source: str) -> None:
         """Refuse (one line) a rebuilt world whose :meth:`digest` differs from the ``recorded`` one.
 
-        Nothing to check when nothing was recorded (a sequence from before digests).
+        Nothing to check when nothing was recorded (a sequence from before digests); a digest
+        recorded before negative zeros were folded is accepted too.
         """
         if recorded is None:
             return
-        if recorded != self.digest(times):
+        if recorded != self.digest(times) and recorded != self._digest(times, signed_zeros=True):
             raise UserError(f"{source}: traffic.digest: the traffic rebuilt from the spec is not the one this "
-                            "sequence was cast in (another spec in manifest.json, or another version of urbangen's traffic model); "
-                            "regenerate the sequence with this version")
+                            "sequence was cast in (another spec in manifest.json, or another version of urbangen's "
+                            "traffic model); regenerate the sequence with this version")
 
     def T_world_actor(self, t: float) -> np.ndarray:
         """(n, 4, 4) float64 pose of every actor at time ``t`` (seconds)."""
