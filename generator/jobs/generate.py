@@ -213,7 +213,9 @@ def run_generate(spec, cfg, opts: GenerateOptions) -> dict:
     manifest["finished"]["images"] = [n for k in plan.frames if k in done for n in plan.images_of(k)]
     manifest["finished"].setdefault("stereo", [])
     results, n_todo, n_stereo = [], 0, 0
+    from generator.dataset import Dataset
     from generator.jobs.finish import write_openlabel, write_stats
+    from generator.jobs.motion import motion_done, write_motion
 
     for town in pre.towns:
         tplan, tspec = town.plan, town.spec
@@ -243,6 +245,10 @@ def run_generate(spec, cfg, opts: GenerateOptions) -> dict:
             results.append(run_jobs(opts.executor, jobs, len(todo) + len(stereo_todo), on_frame, opts.ray_address))
             shutil.rmtree(out / ".scratch", ignore_errors=True)
             n_todo, n_stereo = n_todo + len(todo), n_stereo + len(stereo_todo)
+        if todo or stereo_todo or not motion_done(out, tplan, pairs):  # flow and disparity from the passes
+            t = time.perf_counter()
+            write_motion(Dataset(out, tplan.sequence), drive.world, tplan.frames, tplan.sequence, cfg.exr_codec)
+            run["motion_s"] = round(run.get("motion_s", 0.0) + time.perf_counter() - t, 2)
         write_openlabel(tspec, out, tplan, scene, drive.world)  # the world the sequence was cast in
         mf.save(out, manifest)
         del scene, drive
