@@ -19,6 +19,7 @@ moved point lands anywhere on the surface, between rings too), and the static po
 from __future__ import annotations
 
 import argparse
+import itertools
 import json
 import sys
 from pathlib import Path
@@ -69,7 +70,7 @@ def pair_stats(a, b, fw, fw_flags, bw, bw_flags) -> dict:
             ok &= ((bw_flags[r, c] & 2) > 0) & (b.instance[r, c] == a.instance) & (b.class_id[r, c] == a.class_id)
         fx, fy = x - x0, y - y0
         wts = [(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy]
-        back = sum(wt[..., None] * bw[r, c] for wt, (r, c) in zip(wts, corners))
+        back = sum(wt[..., None] * bw[r, c] for wt, (r, c) in zip(wts, corners, strict=True))
         err = np.linalg.norm(fw + back, axis=-1)[ok]
         if err.size:
             out.update(round_trip_pixels=int(err.size), round_trip_median_px=float(np.median(err)),
@@ -82,7 +83,7 @@ def images_stream(ds: Dataset) -> list[dict]:
     frames = sorted({int(n[:6]) for n in ds.image_names()})
     names = {int(n[:6]): n for n in ds.image_names() if n.endswith("day_clear")}
     out = []
-    for k0, k1 in zip(frames, frames[1:]):
+    for k0, k1 in itertools.pairwise(frames):
         if k0 not in names or k1 not in names:
             continue
         f0, f1 = ds.image_flow(names[k0]), ds.image_flow(names[k1])
@@ -98,7 +99,7 @@ def stereo_stream(ds: Dataset) -> list[dict]:
     seq = ds.root / "lidar" / "sequences" / ds.sequence
     sweeps = sorted(int(p.stem) for p in (seq / "passes_2").glob("*.exr"))
     out = []
-    for j0, j1 in zip(sweeps, sweeps[1:]):
+    for j0, j1 in itertools.pairwise(sweeps):
         f0, f1 = ds.stereo_flow(j0, 2), ds.stereo_flow(j1, 2)
         if f0 is None:
             continue

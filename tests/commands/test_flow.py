@@ -1,4 +1,6 @@
-"""``urbangen flow DIR``: the motion ground truth of an existing dataset; bad input is one line, exit 2, nothing written."""
+"""``urbangen flow DIR``: the motion ground truth of an existing dataset.
+
+Bad input is one line, exit 2, nothing written."""
 
 from __future__ import annotations
 

@@ -5,8 +5,7 @@ from __future__ import annotations
 import numpy as np
 import OpenImageIO as oiio
 
-from generator.formats.kitti_flow import (read_disparity_png, read_flow_png, write_disparity_png,
-                                          write_flow_png)
+from generator.formats.kitti_flow import read_disparity_png, read_flow_png, write_disparity_png, write_flow_png
 
 
 def _raw(path) -> np.ndarray:

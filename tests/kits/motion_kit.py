@@ -62,7 +62,7 @@ class Caster:
         cls = np.where(prim >= 0, sc.face_class[np.maximum(prim, 0)], SKY).astype(np.uint8)
         inst = np.where(prim >= 0, sc.face_instance[np.maximum(prim, 0)], 0).astype(np.uint32)
         depth = np.where(prim >= 0, dist, np.inf)
-        for a, T in zip(self.world.actors, self.world.T_world_actor(t)):
+        for a, T in zip(self.world.actors, self.world.T_world_actor(t), strict=True):
             mesh = self.world.prototypes[a.prototype]
             caster = EmbreeCaster(M.apply(T, mesh.vertices).astype(np.float32), mesh.faces.astype(np.uint32))
             da, pa = caster.intersect(o, d32, 1e4)

@@ -135,7 +135,7 @@ def test_forward_and_backward_flow_are_consistent(town):
         one_surface &= bw.visible[r, c] & (b.instance[r, c] == a.instance) & (cls_b[r, c] == cls_a)
     fx, fy = x - x0c, y - y0c
     wts = [(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy]
-    back = sum(wt[..., None] * bw.uv[r, c] for wt, (r, c) in zip(wts, corners))
+    back = sum(wt[..., None] * bw.uv[r, c] for wt, (r, c) in zip(wts, corners, strict=True))
     err = np.linalg.norm(fw.uv + back, axis=-1)[one_surface]
     assert one_surface.sum() > 1000
     assert err.max() <= 0.5, np.percentile(err, [50, 99, 100])
