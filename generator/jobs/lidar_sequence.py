@@ -173,7 +173,7 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
     sweeps = []  # LiDAR world poses during each sweep (fusion de-skews with them)
     actors = world.actors if world is not None else []
     flows = ScanFlowWriter(seq, rig, world, sensor, skew)  # scene_flow/ of each sweep, once the next is cast
-    with Scanner(scene, sensor, threads=options.threads, world=world) as scanner:
+    with Scanner(scene, sensor, threads=options.threads, world=world) as scanner, flows:
         for j in progress_bar(range(options.frames), desc=f"lidar {name}", unit="scan", enabled=progress):
             t_j = times[j]
             scan = scanner.sweep(rig, t_j, skew)

@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from generator.errors import UserError
+from generator.formats.point_sidecars import TIMES_DIR, read_sidecar
 from generator.formats.scene_flow import FOLDER, write_scene_flow
 from generator.motion.scene_flow import SceneFlow
 
@@ -39,6 +40,17 @@ class ScanFlowWriter:
         self.actors = list(world.actors) if world is not None else []
         self._flows: SceneFlow | None = None
         self._prev: tuple[int, float, np.ndarray] | None = None
+
+    def close(self) -> None:
+        """Stop the scene flow's helper thread."""
+        if self._flows is not None:
+            self._flows.close()
+
+    def __enter__(self) -> ScanFlowWriter:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
 
     def add(self, j: int, t_j: float, points: np.ndarray) -> None:
         """Sweep ``j`` (start ``t_j`` seconds; its processed point records, the ``.bin`` rows) is cast:
@@ -79,23 +91,24 @@ def write_sequence_flow(seq, out_dir: Path, rig, world, sensor, motion_skew: boo
     int
         Scans written.
     """
-    from generator.formats.point_sidecars import TIMES_DIR, read_sidecar
-
-    writer = ScanFlowWriter(out_dir, rig, world, sensor, motion_skew)
     frames = sorted(seq.frames)
-    times = seq.times
-    for j in frames:
-        rec = seq.read(j, True)
-        n = len(rec.points)
-        tau = read_sidecar(seq.dir, TIMES_DIR, j, n) if motion_skew else None
-        if motion_skew and tau is None:
-            raise UserError(f"{seq.dir / TIMES_DIR}: no firing times of scan {j:06d}: a sequence cast with motion "
-                            "skew needs them for its scene flow")
-        col = (np.zeros(n, np.int64) if tau is None else
-               np.rint(np.asarray(tau, np.float64) * sensor.azimuth_steps * sensor.rotation_hz).astype(np.int64))
-        col = np.clip(col, 0, sensor.azimuth_steps - 1)
-        inst = rec.instance if rec.instance is not None else np.zeros(n, np.uint16)
-        points = {"x": rec.points[:, 0], "y": rec.points[:, 1], "z": rec.points[:, 2], "instance": inst, "column": col}
-        t_j = float(times[j]) if times is not None and j < len(times) else rig.sweep_time(j)
-        writer.add(j, t_j, points)
+    with ScanFlowWriter(out_dir, rig, world, sensor, motion_skew) as writer:
+        for j in frames:
+            t_j = float(seq.times[j]) if seq.times is not None and j < len(seq.times) else rig.sweep_time(j)
+            writer.add(j, t_j, _points(seq, j, sensor, motion_skew))
     return max(0, len(frames) - 1)
+
+
+def _points(seq, j: int, sensor, motion_skew: bool) -> dict[str, np.ndarray]:
+    """The fields of scan ``j`` the scene flow reads, from its files (the column from the firing time)."""
+    rec = seq.read(j, True)
+    n = len(rec.points)
+    tau = read_sidecar(seq.dir, TIMES_DIR, j, n) if motion_skew else None
+    if motion_skew and tau is None:
+        raise UserError(f"{seq.dir / TIMES_DIR}: no firing times of scan {j:06d}: a sequence cast with motion "
+                        "skew needs them for its scene flow")
+    col = (np.zeros(n, np.int64) if tau is None else
+           np.rint(np.asarray(tau, np.float64) * sensor.azimuth_steps * sensor.rotation_hz).astype(np.int64))
+    inst = rec.instance if rec.instance is not None else np.zeros(n, np.uint16)
+    return {"x": rec.points[:, 0], "y": rec.points[:, 1], "z": rec.points[:, 2], "instance": inst,
+            "column": np.clip(col, 0, sensor.azimuth_steps - 1)}

@@ -1,14 +1,17 @@
-"""The scene flow's per-point loops, compiled (numba): two passes over a sweep's point records.
+"""The scene flow's per-point loops, compiled (numba).
 
 Written as numpy expressions (a (3, 4) matrix gathered per point, the points stacked out of their
 records, the panorama filled with ``np.minimum.at``) the scene flow of a 130k-point sweep took
-~30 ms of CPU, half a sweep's cast. Here a sweep is read twice, straight from its records' fields
-(strided views, no copies): :func:`prepare` once, when the sweep arrives (its range panorama for
-the sweep before it, stored (azimuth cell, beam) so one column's beams are adjacent, and which of
-its points lie on actors), and :func:`flow_flags` once, when
-its own flow is due (the flow, the point carried to the next sweep and that sweep's verdict on
-it, in one go). Azimuths use :func:`_atan2`, a polynomial (max error 1e-5 rad, ~1/300 of an
-azimuth cell) that LLVM vectorises; the panorama and the flags use the same one, so cells agree.
+~30 ms of CPU, half a sweep's cast. Here each step is one pass over the points, and the arithmetic
+that can run in SIMD lanes does: a sweep's coordinates are first gathered out of its 40-byte point
+records into three contiguous arrays (:func:`gather`, one pass over the records' memory), so
+:func:`directions` (azimuth cell, elevation bin and range of every point, branch-free) vectorises
+-- about 7x faster than on the strided fields. The passes that look things up by index
+(:func:`scatter_min` into the panorama, :func:`apply_flows` with its per-column transform,
+:func:`judge` against the panorama) stay scalar. Every kernel releases the GIL and the per-point
+ones work on whatever slice they are given, so :class:`generator.motion.scene_flow.SceneFlow` splits
+them over two threads. Azimuths use :func:`_atan2`, a polynomial (max error 1e-5 rad, ~1/300 of an azimuth
+cell); the panorama and the flags use the same one, so cells agree.
 """
 
 from __future__ import annotations
@@ -18,6 +21,8 @@ from numba import njit
 
 _PI = np.float32(np.pi)
 _HALF_PI = np.float32(np.pi / 2)
+#: Elevation bins beyond this many are clipped (an int32 conversion must not overflow).
+_BIG = np.float32(1e9)
 
 
 @njit(nogil=True, cache=True, boundscheck=False, inline="always")
@@ -35,17 +40,6 @@ def _atan2(y, x):  # pragma: no cover - compiled
     if x < 0:
         r = _PI - r
     return -r if y < 0 else r
-
-
-@njit(nogil=True, cache=True, boundscheck=False, inline="always")
-def _cell(dx, dy, dz, t_lo, t_scale, n_k, a_scale, steps):  # pragma: no cover - compiled
-    """(tangent-of-elevation bin, azimuth cell, horizontal distance) of a direction, float32."""
-    rho = np.sqrt(dx * dx + dy * dy)
-    k = np.int64((dz / rho - t_lo) * t_scale)
-    k = 0 if k < 0 else (n_k - 1 if k >= n_k else k)
-    c = np.int64((_atan2(dy, dx) + _PI) * a_scale)
-    c = steps - 1 if c >= steps else (0 if c < 0 else c)
-    return k, c, rho
 
 
 @njit(nogil=True, cache=True, boundscheck=False)
@@ -70,55 +64,59 @@ def relative_poses(P, Q, M, E):  # pragma: no cover - compiled
 
 
 @njit(nogil=True, cache=True, boundscheck=False)
-def prepare(x, y, z, instance, lookup, z0, lut_nearest, t_lo, t_scale, pan, on_actor):  # pragma: no cover
-    """One pass over a sweep: its range panorama and which of its points lie on actors.
-
-    Parameters
-    ----------
-    x, y, z : (m,) float32
-        Points, LiDAR frame at their firing instants (any strides).
-    instance : (m,) integer
-        Instance ids.
-    lookup : (I,) int64
-        Instance id -> actor index, -1 for none (ids past the table: none).
-    z0 : float
-        Height of the beams' mean emission point above the sensor origin, metres.
-    lut_nearest : (K,) int64
-        Beam row nearest to each tangent-of-elevation bin ``t_lo + k / t_scale``.
-    pan : (steps, rows) float32
-        Preset to inf; written: the nearest range in each direction cell; (0, 0): skipped.
-    on_actor : (m,) uint8
-        Written: 1 on an actor's point.
-    """
-    n_k, size = lut_nearest.shape[0], lookup.shape[0]
-    steps = pan.shape[0]
-    want = pan.shape[1] > 0
-    a_scale = np.float32(steps / (2.0 * np.pi)) if want else np.float32(0.0)
-    tl, ts, zf = np.float32(t_lo), np.float32(t_scale), np.float32(z0)
+def gather(x, y, z, instance, lookup, out, on_actor):  # pragma: no cover - compiled
+    """Coordinates into ``out`` (3, n) float32 and ``on_actor`` (n,) uint8 (1 where ``lookup[instance] >= 0``;
+    ids past the table have no actor), one pass over the records."""
+    size = lookup.shape[0]
     for i in range(x.shape[0]):
+        out[0, i], out[1, i], out[2, i] = x[i], y[i], z[i]
         inst = np.int64(instance[i])
         on_actor[i] = 1 if (inst < size and lookup[inst] >= 0) else 0
-        if not want:
-            continue
-        dx, dy, dz = x[i], y[i], z[i] - zf
-        if dx == 0 and dy == 0:
-            continue
-        k, c, rho = _cell(dx, dy, dz, tl, ts, n_k, a_scale, steps)
-        j = lut_nearest[k]
-        r = np.sqrt(rho * rho + dz * dz)
-        if r < pan[c, j]:
-            pan[c, j] = r
 
 
 @njit(nogil=True, cache=True, boundscheck=False)
-def flow_flags(x, y, z, col, which, E, L, pan, lut_below, z0, t_lo, t_scale, top, bottom, rmin, rmax,
-               obj, flag, moved):  # pragma: no cover - compiled
-    """One pass over a sweep: each point's object flow, where the next sweep sees it, and that sweep's verdict.
+def directions(xyz, z0, t_lo, t_scale, steps, k_out, c_out, r_out):  # pragma: no cover - compiled
+    """Points ``xyz`` (3, n) float32: elevation bin, azimuth cell and range from the beams' mean emission
+    point (``z0`` above the origin), branch-free so it vectorises (a loop over ``range(start, stop)``
+    would not: callers pass slices).
+
+    ``k_out`` (n,) int32: ``(dz / rho - t_lo) * t_scale`` (not clipped to the table: out of the view's
+    tangents when < 0 or beyond it); ``c_out`` (n,) int32 in ``0 .. steps - 1``; ``r_out`` (n,) float32 metres.
+    """
+    a_scale = np.float32(steps / (2.0 * np.pi))
+    tl, ts, zf = np.float32(t_lo), np.float32(t_scale), np.float32(z0)
+    tiny = np.float32(1e-20)
+    last = np.int32(steps - 1)
+    for i in range(xyz.shape[1]):
+        dx, dy, dz = xyz[0, i], xyz[1, i], xyz[2, i] - zf
+        rho2 = dx * dx + dy * dy
+        t = dz / max(np.sqrt(rho2), tiny)
+        k_out[i] = np.int32(max(min((t - tl) * ts, _BIG), -_BIG))
+        c = np.int32((_atan2(dy, dx) + _PI) * a_scale)
+        c_out[i] = min(max(c, np.int32(0)), last)
+        r_out[i] = np.sqrt(rho2 + dz * dz)
+
+
+@njit(nogil=True, cache=True, boundscheck=False)
+def scatter_min(k, c, r, lut_nearest, pan):  # pragma: no cover - compiled
+    """The range panorama ``pan`` (steps, rows) float32 (preset to inf): per direction cell the nearest range;
+    a point's row is the beam nearest its elevation bin (``lut_nearest``)."""
+    n_k = lut_nearest.shape[0]
+    for i in range(k.shape[0]):
+        kk = k[i]
+        j = lut_nearest[0 if kk < 0 else (n_k - 1 if kk >= n_k else kk)]
+        if r[i] < pan[c[i], j]:
+            pan[c[i], j] = r[i]
+
+
+@njit(nogil=True, cache=True, boundscheck=False)
+def apply_flows(xyz, col, which, E, L, obj, moved):  # pragma: no cover - compiled
+    """Each point's object flow and where the next sweep sees it.
 
     Parameters
     ----------
-    x, y, z : (n,) float32
-        Points, LiDAR frame at their firing instants (any strides).
+    xyz : (3, n) float32
+        Points, LiDAR frame at their firing instants (:func:`gather`).
     col : (n,) integer
         Firing column of each point.
     which : (n,) int64
@@ -128,32 +126,13 @@ def flow_flags(x, y, z, col, which, E, L, pan, lut_below, z0, t_lo, t_scale, top
     L : (R, 3, 4) float64
         Per (actor, column): the actor's displacement ``t_p -> t_p + dt`` in the LiDAR frame at
         ``t_p``; row 0 unused.
-    pan : (steps, rows) float32
-        The next sweep's panorama (:func:`prepare`); (0, 0): no flags.
-    lut_below : (K,) int64
-        Highest beam row at or below each tangent bin (-1: below the lowest beam).
-    z0, t_lo, t_scale
-        As for :func:`prepare`.
-    top, bottom : float
-        Tangents of the view's upper and lower edges.
-    rmin, rmax : float
-        Sensor range, metres.
     obj : (n, 3) float32
         Written: ``L x - x`` (0 on the static town).
-    flag : (n,) uint8
-        Written (with a panorama): 0 seen, 1 hidden, 2 gone
-        (:func:`generator.motion.scene_flow.next_sweep_flags`).
-    moved : (n, 3) or (0, 3) float32
-        Written if not empty: ``E (L x)``.
+    moved : (3, n) float32
+        Written: ``E (L x)``.
     """
-    steps, n_rows = pan.shape
-    want_flags, want_moved = n_rows > 0, moved.shape[0] > 0
-    n_k = lut_below.shape[0]
-    a_scale = np.float32(steps / (2.0 * np.pi)) if want_flags else np.float32(0.0)
-    tl, ts, zf = np.float32(t_lo), np.float32(t_scale), np.float32(z0)
-    top32, bottom32, rmin32, rmax32 = np.float32(top), np.float32(bottom), np.float32(rmin), np.float32(rmax)
-    for p in range(x.shape[0]):
-        a, b, c = np.float64(x[p]), np.float64(y[p]), np.float64(z[p])
+    for p in range(which.shape[0]):
+        a, b, c = np.float64(xyz[0, p]), np.float64(xyz[1, p]), np.float64(xyz[2, p])
         w = which[p]
         if w == 0:
             q0, q1, q2 = a, b, c
@@ -162,27 +141,32 @@ def flow_flags(x, y, z, col, which, E, L, pan, lut_below, z0, t_lo, t_scale, top
             q1 = L[w, 1, 0] * a + L[w, 1, 1] * b + L[w, 1, 2] * c + L[w, 1, 3]
             q2 = L[w, 2, 0] * a + L[w, 2, 1] * b + L[w, 2, 2] * c + L[w, 2, 3]
         k = np.int64(col[p])
-        m0 = np.float32(E[k, 0, 0] * q0 + E[k, 0, 1] * q1 + E[k, 0, 2] * q2 + E[k, 0, 3])
-        m1 = np.float32(E[k, 1, 0] * q0 + E[k, 1, 1] * q1 + E[k, 1, 2] * q2 + E[k, 1, 3])
-        m2 = np.float32(E[k, 2, 0] * q0 + E[k, 2, 1] * q1 + E[k, 2, 2] * q2 + E[k, 2, 3])
+        moved[0, p] = E[k, 0, 0] * q0 + E[k, 0, 1] * q1 + E[k, 0, 2] * q2 + E[k, 0, 3]
+        moved[1, p] = E[k, 1, 0] * q0 + E[k, 1, 1] * q1 + E[k, 1, 2] * q2 + E[k, 1, 3]
+        moved[2, p] = E[k, 2, 0] * q0 + E[k, 2, 1] * q1 + E[k, 2, 2] * q2 + E[k, 2, 3]
         obj[p, 0], obj[p, 1], obj[p, 2] = q0 - a, q1 - b, q2 - c
-        if want_moved:
-            moved[p, 0], moved[p, 1], moved[p, 2] = m0, m1, m2
-        if not want_flags:
-            continue
-        dz = m2 - zf
-        if m0 == 0 and m1 == 0:
-            flag[p] = 2
-            continue
-        kk, cc, rho = _cell(m0, m1, dz, tl, ts, n_k, a_scale, steps)
-        r = np.sqrt(rho * rho + dz * dz)
-        t = dz / rho
-        if r < rmin32 or r > rmax32 or t > top32 or t < bottom32:
-            flag[p] = 2
+
+
+@njit(nogil=True, cache=True, boundscheck=False)
+def judge(k, c, r, pan, lut_below, rmin, rmax, out):  # pragma: no cover - compiled
+    """Moved points (:func:`directions`): 0 seen, 1 hidden, 2 gone
+    (:func:`generator.motion.scene_flow.next_sweep_flags`) against the next sweep's panorama ``pan``.
+
+    ``lut_below`` (K,): the highest beam row at or below each elevation bin (-1: below the lowest
+    beam); a bin outside ``0 .. K - 1`` is out of the view.
+    """
+    n_rows = pan.shape[1]
+    n_k = lut_below.shape[0]
+    rmin32, rmax32 = np.float32(rmin), np.float32(rmax)
+    for p in range(k.shape[0]):
+        kk, rr = k[p], r[p]
+        if kk < 0 or kk >= n_k or rr < rmin32 or rr > rmax32:
+            out[p] = 2
             continue
         below = lut_below[kk]
         lo = below if below > 0 else 0
         hi = below + 1 if below + 1 < n_rows else n_rows - 1
-        tol = np.float32(0.03) * r
-        limit = r - (tol if tol > np.float32(0.25) else np.float32(0.25))
-        flag[p] = 1 if (pan[cc, lo] < limit and pan[cc, hi] < limit) else 0
+        tol = np.float32(0.03) * rr
+        limit = rr - (tol if tol > np.float32(0.25) else np.float32(0.25))
+        cc = c[p]
+        out[p] = 1 if (pan[cc, lo] < limit and pan[cc, hi] < limit) else 0

@@ -21,6 +21,7 @@ No ray is cast: the flag reads sweep ``j + 1``'s points.
 from __future__ import annotations
 
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -71,9 +72,8 @@ class View:
         self.z0 = float(np.mean(sensor.vert_offset * np.cos(sensor.elevation))) if origin_z is None else origin_z
         half_top = (el[-1] - el[-2]) / 2 if len(el) > 1 else np.radians(1.0)
         half_bottom = (el[1] - el[0]) / 2 if len(el) > 1 else np.radians(1.0)
-        self.top, self.bottom = float(np.tan(el[-1] + half_top)), float(np.tan(el[0] - half_bottom))
-        self.t_lo = self.bottom
-        self.t_scale = LUT_BINS / (self.top - self.bottom)
+        top, bottom = float(np.tan(el[-1] + half_top)), float(np.tan(el[0] - half_bottom))
+        self.t_lo, self.t_scale = bottom, LUT_BINS / (top - bottom)  # bins 0 .. LUT_BINS - 1 span the view
         t = self.t_lo + (np.arange(LUT_BINS) + 0.5) / self.t_scale
         tan_el = np.tan(el)
         self.lut_nearest = np.searchsorted((tan_el[1:] + tan_el[:-1]) / 2, t).astype(np.int64)
@@ -81,28 +81,49 @@ class View:
         self.rows, self.steps = len(el), int(sensor.azimuth_steps)
         self.rmin, self.rmax = float(sensor.min_range_m), float(sensor.max_range_m)
 
-    def panorama(self, x: np.ndarray, y: np.ndarray, z: np.ndarray, instance: np.ndarray | None = None,
-                 lookup: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """(steps, rows) float32 range panorama of a sweep's points (inf: no return in a cell), and the
-        rows of its points on actors (``lookup``: instance id -> actor index or -1; none without)."""
-        return _prepare(x, y, z, instance, lookup, self, np.full((self.steps, self.rows), np.inf, np.float32))
+    def cells(self, xyz: np.ndarray, pool=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(elevation bin, azimuth cell, range) of points ``xyz`` (3, n) float32 (:func:`kernels.directions`)."""
+        n = xyz.shape[1]
+        k, c, r = np.empty(n, np.int32), np.empty(n, np.int32), np.empty(n, np.float32)
+        _split(lambda a, b: kernels.directions(xyz[:, a:b], self.z0, self.t_lo, self.t_scale, self.steps, k[a:b],
+                                               c[a:b], r[a:b]), n, pool)
+        return k, c, r
+
+    def panorama(self, xyz: np.ndarray) -> np.ndarray:
+        """(steps, rows) float32 range panorama of a sweep's points ``xyz`` (3, n) (inf: no return in a cell)."""
+        pan = np.full((self.steps, self.rows), np.inf, np.float32)
+        kernels.scatter_min(*self.cells(xyz), self.lut_nearest, pan)
+        return pan
+
+    def judge(self, moved: np.ndarray, pan: np.ndarray, pool=None) -> np.ndarray:
+        """(n,) uint8 :data:`SEEN` / :data:`HIDDEN` / :data:`GONE` of moved points (3, n) against a panorama."""
+        k, c, r = self.cells(moved, pool)
+        out = np.empty(len(k), np.uint8)
+        _split(lambda a, b: kernels.judge(k[a:b], c[a:b], r[a:b], pan, self.lut_below, self.rmin, self.rmax, out[a:b]),
+               len(k), pool)
+        return out
 
 
-_NO_VIEW_LUT = np.zeros(1, np.int64)
 _NO_LOOKUP = np.full(1, -1, np.int64)
 
 
-def _prepare(x, y, z, instance, lookup, view: View | None, pan: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(panorama or an empty one, actor rows) of a sweep: :func:`generator.motion.kernels.prepare`."""
-    on = np.empty(len(x), np.uint8)
-    inst = np.zeros(len(x), np.uint8) if instance is None else instance
-    lut, z0, t_lo, t_scale = ((view.lut_nearest, view.z0, view.t_lo, view.t_scale) if view is not None
-                              else (_NO_VIEW_LUT, 0.0, 0.0, 1.0))
-    kernels.prepare(x, y, z, inst, _NO_LOOKUP if lookup is None else lookup, z0, lut, t_lo, t_scale, pan, on)
-    return pan, np.flatnonzero(on)
+def _gather(x, y, z, instance, lookup) -> tuple[np.ndarray, np.ndarray]:
+    """((3, n) float32 coordinates, rows on actors) of a sweep's fields: one pass over its records."""
+    n = len(x)
+    xyz, on = np.empty((3, n), np.float32), np.empty(n, np.uint8)
+    inst = np.zeros(n, np.uint8) if instance is None else instance
+    kernels.gather(x, y, z, inst, _NO_LOOKUP if lookup is None else lookup, xyz, on)
+    return xyz, np.flatnonzero(on)
 
 
-_NO_PAN = np.zeros((0, 0), np.float32)
+def _split(fn, n: int, pool) -> None:
+    """``fn(start, stop)`` over rows ``0 .. n``: the second half on the pool's thread when there is one."""
+    if pool is None or n < 4096:
+        fn(0, n)
+        return
+    half = pool.submit(fn, n // 2, n)
+    fn(0, n // 2)
+    half.result()
 
 
 def next_sweep_flags(moved: np.ndarray, next_xyz: np.ndarray, sensor) -> np.ndarray:
@@ -124,16 +145,8 @@ def next_sweep_flags(moved: np.ndarray, next_xyz: np.ndarray, sensor) -> np.ndar
     occlusion edges.
     """
     view = View(sensor)
-    nxt = np.asarray(next_xyz, np.float32)
-    m = np.asarray(moved, np.float32)
-    pan, _ = view.panorama(nxt[:, 0], nxt[:, 1], nxt[:, 2])
-    E = np.zeros((1, 3, 4))
-    E[0, :, :3] = np.eye(3)
-    obj, flag = np.empty((len(m), 3), np.float32), np.empty(len(m), np.uint8)
-    kernels.flow_flags(m[:, 0], m[:, 1], m[:, 2], np.zeros(len(m), np.int64), np.zeros(len(m), np.int64), E,
-                       np.zeros((1, 3, 4)), pan, view.lut_below, view.z0, view.t_lo, view.t_scale, view.top,
-                       view.bottom, view.rmin, view.rmax, obj, flag, np.zeros((0, 3), np.float32))
-    return flag
+    nxt = np.ascontiguousarray(np.asarray(next_xyz, np.float32).T)
+    return view.judge(np.ascontiguousarray(np.asarray(moved, np.float32).T), view.panorama(nxt))
 
 
 class SceneFlow:
@@ -142,7 +155,9 @@ class SceneFlow:
     Parameters
     ----------
     T_world_ego : callable
-        ``(k,) seconds -> (k, 4, 4)`` ego world poses (:meth:`generator.world.rig.Rig.T_world_ego`).
+        ``(k,) seconds -> (k, 4, 4)`` ego world poses (the drive's ``T_world_ego``; a sampled drive's,
+        :meth:`generator.world.actors.TrackTrajectory.T_world_ego`, is evaluated on its track's samples
+        in one vectorised pass).
     T_ego_lidar : (4, 4) float64
         The LiDAR mount.
     actors : list of generator.world.actors.Actor
@@ -153,19 +168,23 @@ class SceneFlow:
         Time from a sweep's start to the next one's, seconds.
     view : View, optional
         The sensor's view (needed by :meth:`sweep` only).
+    threads : int
+        1 or 2: with 2 a helper thread builds the next sweep's panorama while this sweep's points
+        move, and takes half of every per-point pass (the kernels release the GIL), as the scanner
+        casts on two threads.
 
     Notes
     -----
-    Each sweep is read twice (:mod:`generator.motion.kernels`): when it arrives as the *next*
-    sweep (its panorama; which points are on actors) and when its own flow is computed. The ego
-    poses at every column's instant ``dt`` later are the next sweep's own, so they are kept for
+    Each sweep's records are read twice (:mod:`generator.motion.kernels`): when it arrives as the
+    *next* sweep (its panorama; which points are on actors) and when its own flow is computed. The
+    ego poses at every column's instant ``dt`` later are the next sweep's own, so they are kept for
     it. Actor poses at the (actor, column) pairs hit come from one vectorised evaluation of all
     tracks (:class:`generator.lidar.tracks.TrackBank`, bit-identical to
     :meth:`generator.world.actors.Track.pose`).
     """
 
     def __init__(self, T_world_ego: PoseFn, T_ego_lidar: np.ndarray, actors: list, column_time: np.ndarray, dt: float,
-                 view: View | None = None):
+                 view: View | None = None, threads: int = 2):
         from generator.lidar.tracks import TrackBank
 
         self.T_world_ego, self.dt, self.view = T_world_ego, float(dt), view
@@ -176,30 +195,48 @@ class SceneFlow:
         self.lookup = np.full(int(ids.max()) + 1 if len(ids) else 1, -1, np.int64)
         self.lookup[ids] = np.arange(len(ids))
         self.bank = TrackBank([a.track for a in actors]) if len(actors) else None
+        track = getattr(getattr(T_world_ego, "__self__", None), "track", None)  # TrackTrajectory.T_world_ego
+        self._ego_bank = TrackBank([track]) if track is not None else None
         self._poses: tuple[float, np.ndarray] | None = None
-        self._next: tuple | None = None  # (records, actor rows) of the last sweep seen as the next one
+        self._next: tuple | None = None  # (records, coordinates, actor rows) of the last sweep seen as the next one
+        self._pool = ThreadPoolExecutor(1, thread_name_prefix="scene-flow") if threads > 1 else None
 
     @classmethod
-    def for_rig(cls, rig, actors: list, sensor, motion_skew: bool, dt: float) -> SceneFlow:
+    def for_rig(cls, rig, actors: list, sensor, motion_skew: bool, dt: float, threads: int = 2) -> SceneFlow:
         """The scene flow of ``sensor``'s sweeps on ``rig`` (:class:`generator.world.rig.Rig` with its drive;
         columns at their own instants when ``motion_skew``)."""
         ct = sensor.column_time() if motion_skew else np.zeros(sensor.azimuth_steps)
-        return cls(rig.T_world_ego, rig.T_ego_lidar, actors, ct, dt, View(sensor))
+        return cls(rig.trajectory.T_world_ego, rig.T_ego_lidar, actors, ct, dt, View(sensor), threads)
+
+    def close(self) -> None:
+        """Stop the helper thread."""
+        if self._pool is not None:
+            self._pool.shutdown()
+            self._pool = None
+
+    def __enter__(self) -> SceneFlow:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
 
     def _ego_poses(self, t: float) -> np.ndarray:
+        """(steps, 4, 4) ego poses at every column's instant of a sweep starting at ``t``."""
         if self._poses is not None and self._poses[0] == t:
             return self._poses[1]
-        return self.T_world_ego(t + self.column_time)
+        times = t + self.column_time
+        if self._ego_bank is not None:  # a sampled track: one vectorised evaluation, as Track.pose computes it
+            return _yaw_poses(*self._ego_bank.position_heading(np.zeros(len(times), np.int64), times))
+        return self.T_world_ego(times)
 
-    def _run(self, x, y, z, instance, column, t_sweep: float, rows: np.ndarray, pan: np.ndarray,
-             want_moved: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _moves(self, column, instance, t_sweep: float, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(E per column, L per (actor, column) pair, each point's row of L) of a sweep."""
         P = self._ego_poses(t_sweep)
-        Q = self.T_world_ego(t_sweep + self.dt + self.column_time)
+        Q = self._ego_poses(t_sweep + self.dt)
         self._poses = (t_sweep + self.dt, Q)
         E = np.empty((self.steps, 3, 4))
         kernels.relative_poses(P, Q, self.T_ego_lidar, E)
-        n = len(x)
-        which = np.zeros(n, np.int64)
+        which = np.zeros(len(column), np.int64)
         L = np.zeros((1, 3, 4))
         if len(rows) and self.bank is not None:
             col = np.asarray(column)[rows].astype(np.int64)
@@ -212,16 +249,15 @@ class SceneFlow:
             Tc = P[pcol] @ self.T_ego_lidar
             L = np.concatenate([L, (_inv(Tc) @ A1 @ _inv(A0) @ Tc)[:, :3, :]])
             which[rows] = 1 + back
-        v = self.view
-        obj = np.empty((n, 3), np.float32)
-        flag = np.zeros(n, np.uint8)
-        moved = np.empty((n if want_moved else 0, 3), np.float32)
-        lut, z0, t_lo, t_scale, top, bottom, rmin, rmax = (
-            (v.lut_below, v.z0, v.t_lo, v.t_scale, v.top, v.bottom, v.rmin, v.rmax) if v is not None
-            else (_NO_VIEW_LUT, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0))
-        kernels.flow_flags(x, y, z, column, which, E, np.ascontiguousarray(L), pan, lut, z0, t_lo, t_scale, top,
-                           bottom, rmin, rmax, obj, flag, moved)
-        return obj, flag, moved
+        return E, np.ascontiguousarray(L), which
+
+    def _apply(self, xyz, column, instance, t_sweep: float, rows) -> tuple[np.ndarray, np.ndarray]:
+        E, L, which = self._moves(column, instance, t_sweep, rows)
+        n = len(which)
+        obj, moved = np.empty((n, 3), np.float32), np.empty((3, n), np.float32)
+        _split(lambda a, b: kernels.apply_flows(xyz[:, a:b], column[a:b], which[a:b], E, L, obj[a:b], moved[:, a:b]), n,
+               self._pool)
+        return obj, moved
 
     def flow(self, x: np.ndarray, y: np.ndarray, z: np.ndarray, instance: np.ndarray, column: np.ndarray,
              t_sweep: float) -> tuple[np.ndarray, np.ndarray]:
@@ -242,9 +278,9 @@ class SceneFlow:
         -------
         object, moved : (n, 3) float32
         """
-        no_pan, rows = _prepare(x, y, z, instance, self.lookup, None, _NO_PAN)
-        obj, _, moved = self._run(x, y, z, instance, column, t_sweep, rows, no_pan, True)
-        return obj, moved
+        xyz, rows = _gather(x, y, z, instance, self.lookup)
+        obj, moved = self._apply(xyz, column, instance, t_sweep, rows)
+        return obj, np.ascontiguousarray(moved.T)
 
     def sweep(self, points: np.ndarray, next_points: np.ndarray, t_sweep: float) -> tuple[np.ndarray, np.ndarray]:
         """``object`` flow (n, 3) float32 and flag (n,) uint8 of a sweep's point records against the next sweep's.
@@ -252,18 +288,27 @@ class SceneFlow:
         ``points`` and ``next_points`` are point records with at least ``x, y, z, instance, column``
         (:data:`generator.lidar.points.POINT_DTYPE`), after the scan's processing (the rows the
         ``.bin`` holds). Called for consecutive sweeps, each sweep's records are read once as the
-        next sweep and once as the current one.
+        next sweep and once as the current one; the next sweep's panorama is made on the helper
+        thread while this one's points move.
         """
         fields = ("x", "y", "z", "instance")
         if self._next is not None and self._next[0] is points:
-            rows = self._next[1]
+            xyz, rows = self._next[1], self._next[2]
         else:
-            rows = _prepare(*(points[f] for f in fields), self.lookup, None, _NO_PAN)[1]
-        pan, next_rows = self.view.panorama(*(next_points[f] for f in fields), self.lookup)
-        self._next = (next_points, next_rows)
-        obj, flag, _ = self._run(points["x"], points["y"], points["z"], points["instance"], points["column"], t_sweep,
-                                 rows, pan, False)
-        return obj, flag
+            xyz, rows = _gather(*(points[f] for f in fields), self.lookup)
+
+        def prepare():
+            nxt, next_rows = _gather(*(next_points[f] for f in fields), self.lookup)
+            return nxt, next_rows, self.view.panorama(nxt)
+
+        pending = self._pool.submit(prepare) if self._pool is not None else None
+        E, L, which = self._moves(points["column"], points["instance"], t_sweep, rows)
+        n = len(which)
+        obj, moved = np.empty((n, 3), np.float32), np.empty((3, n), np.float32)
+        kernels.apply_flows(xyz, points["column"], which, E, L, obj, moved)
+        nxt, next_rows, pan = pending.result() if pending is not None else prepare()
+        self._next = (next_points, nxt, next_rows)
+        return obj, self.view.judge(moved, pan, self._pool)
 
 
 def scene_flow(xyz: np.ndarray, instance: np.ndarray, column: np.ndarray, column_time: np.ndarray, t_sweep: float,
@@ -285,6 +330,6 @@ def scene_flow(xyz: np.ndarray, instance: np.ndarray, column: np.ndarray, column
     actors : list of generator.world.actors.Actor
     """
     p = np.asarray(xyz, np.float32)
-    obj, moved = SceneFlow(rig.T_world_ego, rig.T_ego_lidar, actors, column_time, dt).flow(
-        p[:, 0], p[:, 1], p[:, 2], instance, column, t_sweep)
+    with SceneFlow(rig.trajectory.T_world_ego, rig.T_ego_lidar, actors, column_time, dt, threads=1) as sf:
+        obj, moved = sf.flow(p[:, 0], p[:, 1], p[:, 2], instance, column, t_sweep)
     return obj, (moved.astype(np.float64) - p).astype(np.float32)
