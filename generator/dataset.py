@@ -30,6 +30,16 @@ Arrays and frames
   ``pose`` (4, 4) float64 LiDAR pose in the first scan's LiDAR frame; ``time`` seconds.
 * ``Box``: an OpenLABEL cuboid in the ego (``vehicle-iso8855``) frame of its frame: ``center``
   (3,), ``quaternion`` (x, y, z, w), ``size`` (3,) metres, ``cls``, ``uid``, ``points``.
+
+Motion ground truth (:mod:`generator.jobs.motion`, :mod:`generator.formats.scene_flow`)
+--------------------------------------------------------------------------------------
+* :meth:`Dataset.image_flow` / :meth:`Dataset.stereo_flow`: ``FlowMaps`` with ``forward`` and
+  ``backward`` (H, W, 2) float32 pixels (u right, v down; None at a stream's end) and their flags
+  (bit 1 known = KITTI ``flow_occ``, 2 visible in the other image = ``flow_noc``, 4 on an actor);
+* :meth:`Dataset.disparity`: ``DisparityMap`` ``d`` (H, W) float32 pixels (``f b / Z``) and flags
+  (1 ``disp_occ``, 2 ``disp_noc``);
+* :meth:`Dataset.scene_flow`: (n, 3) float32 metres in the scan's LiDAR frame per point, with the
+  ego's motion (default) or without, and the flag (n,) uint8 (0 seen, 1 hidden, 2 gone at the next scan).
 """
 
 from __future__ import annotations

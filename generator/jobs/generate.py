@@ -37,7 +37,8 @@ from generator.atomic import clean_temporaries
 from generator.errors import SpecError, UserError
 from generator.jobs import manifest as mf
 from generator.jobs.executors import make_jobs, run_jobs
-from generator.jobs.plan import MAX_FRAME_INDEX, MAX_IMAGES, Plan, check_free_space, check_plan, image_bytes, scan_bytes
+from generator.jobs.plan import (MAX_FRAME_INDEX, MAX_IMAGES, Plan, check_free_space, check_plan, image_bytes, motion_bytes,
+                                 scan_bytes)
 from generator.jobs.stereo import pair_done, stereo_frames
 from generator.jobs.towns import town_runs
 from generator.safeload import MAX_METADATA_BYTES, load_json
@@ -188,6 +189,7 @@ def preflight(spec, cfg, opts: GenerateOptions) -> Preflight:
             built[run.index] = (scene, drive)
     per_image = image_bytes(cfg.width, cfg.height, cfg.exr_codec, len(class_table().names), cfg.preview)
     need = (len(todo) * len(plan.combos) + 2 * n_pairs) * per_image
+    need += (len(todo) + 3 * n_pairs) * motion_bytes(cfg.width, cfg.height)  # flows (a frame; both cameras) + disparity
     need += scans * scan_bytes(sensor.rays_per_sweep)
     check_free_space(out, need, f"{len(todo) * len(plan.combos)} images and {n_pairs} stereo pairs at "
                                 f"{cfg.width}x{cfg.height}, {scans} scans" + (f" of {len(towns)} towns" if len(towns) > 1
