@@ -64,7 +64,8 @@ def pair_stats(a, b, fw, fw_flags, bw, bw_flags) -> dict:
         x0, y0 = np.clip(x0, 0, w - 2), np.clip(y0, 0, h - 2)
         corners = [(y0 + dy, x0 + dx) for dy in (0, 1) for dx in (0, 1)]
         depths = np.stack([b.depth[r, c] for r, c in corners])
-        smooth = (depths.max(0) - depths.min(0)) <= 0.02 * depths.min(0) + 0.05  # no depth edge in the cell
+        with np.errstate(invalid="ignore"):  # sky: inf - inf
+            smooth = (depths.max(0) - depths.min(0)) <= 0.02 * depths.min(0) + 0.05  # no depth edge in the cell
         ok &= smooth
         for r, c in corners:
             ok &= ((bw_flags[r, c] & 2) > 0) & (b.instance[r, c] == a.instance) & (b.class_id[r, c] == a.class_id)
