@@ -40,6 +40,7 @@ COMMANDS = [
     "convert",
     "import_carla",
     "fuse",
+    "flow",
     "eval",
     "export",
     "openlabel",

@@ -30,6 +30,16 @@ Arrays and frames
   ``pose`` (4, 4) float64 LiDAR pose in the first scan's LiDAR frame; ``time`` seconds.
 * ``Box``: an OpenLABEL cuboid in the ego (``vehicle-iso8855``) frame of its frame: ``center``
   (3,), ``quaternion`` (x, y, z, w), ``size`` (3,) metres, ``cls``, ``uid``, ``points``.
+
+Motion ground truth (:mod:`generator.jobs.motion`, :mod:`generator.formats.scene_flow`)
+--------------------------------------------------------------------------------------
+* :meth:`Dataset.image_flow` / :meth:`Dataset.stereo_flow`: ``FlowMaps`` with ``forward`` and
+  ``backward`` (H, W, 2) float32 pixels (u right, v down; None at a stream's end) and their flags
+  (bit 1 known = KITTI ``flow_occ``, 2 visible in the other image = ``flow_noc``, 4 on an actor);
+* :meth:`Dataset.disparity`: ``DisparityMap`` ``d`` (H, W) float32 pixels (``f b / Z``) and flags
+  (1 ``disp_occ``, 2 ``disp_noc``);
+* :meth:`Dataset.scene_flow`: (n, 3) float32 metres in the scan's LiDAR frame per point, with the
+  ego's motion (default) or without, and the flag (n,) uint8 (0 seen, 1 hidden, 2 gone at the next scan).
 """
 
 from __future__ import annotations
@@ -42,9 +52,11 @@ import numpy as np
 
 from generator.errors import SpecError, UserError
 from generator.formats import semantickitti as sk
-from generator.formats.point_sidecars import NATIVE_DIR, read_sidecar
+from generator.formats.point_sidecars import NATIVE_DIR, TIMES_DIR, read_sidecar
+from generator.formats.scene_flow import ego_flow, read_scene_flow
 from generator.imaging import meta_fields as md
 from generator.imaging.exr import read_exr
+from generator.imaging.motion_exr import DisparityMap, FlowMaps, read_disparity_exr, read_flow_exr
 from generator.labels import class_table
 from generator.labels.sets import label_sets
 from generator.safeload import printable
@@ -145,9 +157,13 @@ class Dataset:
         names = sorted(p.stem for p in (self.root / "images").glob("[0-9][0-9][0-9][0-9][0-9][0-9]*.json"))
         return [n for n in names if frame is None or int(n[:6]) == frame]
 
+    def image_files(self, name: str) -> tuple[Path, Path]:
+        """(EXR, metadata JSON) of image ``name``: the one place that says where an image lives."""
+        return self.root / "images" / f"{name}.exr", self.root / "images" / f"{name}.json"
+
     def image(self, name: str) -> ImageSample:
         """The image ``name`` with its masks, instances, depth and metadata."""
-        exr, meta = self.root / "images" / f"{name}.exr", self.root / "images" / f"{name}.json"
+        exr, meta = self.image_files(name)
         if not os.path.lexists(exr) or not os.path.lexists(meta):
             raise UserError(f"{exr}: no such image (with its .json)")
         img = read_exr(exr)
@@ -180,6 +196,45 @@ class Dataset:
             out.scan = self.scan(j)
         out.boxes = self.boxes(j) if j is not None else []
         return out
+
+    # -- motion ground truth (generator.jobs.motion, generator.formats.scene_flow) ---------------
+    def image_flow(self, name: str) -> FlowMaps | None:
+        """Optical flow of image ``name`` of images/ to the next and previous frame of its stream
+        (every variant of a frame shares it); None when the dataset has none for that frame."""
+        return _maybe(self.root / "flow" / f"{name[:6]}.exr", read_flow_exr)
+
+    def stereo_flow(self, index: int, camera: int = 2) -> FlowMaps | None:
+        """Optical flow of ``image_2|3/NNNNNN`` (sweep ``index``) to the next and previous pair of the stream."""
+        return _maybe(self._seq_dir() / f"flow_{int(camera)}" / f"{index:06d}.exr", read_flow_exr)
+
+    def disparity(self, index: int) -> DisparityMap | None:
+        """Disparity of ``image_2/NNNNNN`` (sweep ``index``): ``d = f b / Z``, with the right view's occlusion."""
+        return _maybe(self._seq_dir() / "disp_2" / f"{index:06d}.exr", read_disparity_exr)
+
+    def scene_flow(self, index: int, ego_motion: bool = True) -> tuple[np.ndarray, np.ndarray] | None:
+        """Scene flow of scan ``index``: ((n, 3) float32 metres, (n,) uint8 flag 0 seen / 1 hidden / 2 gone).
+
+        ``ego_motion`` True: the flow as the sensor sees it (``xyz + flow`` is where the next scan's raw
+        coordinates put each point's surface; the static town moves by the ego's motion); False: the
+        surfaces' own motion (0 on the static town). None for the last scan or a dataset without it.
+        """
+        if self.seq is None:
+            return None
+        scan = self.scan(index)
+        got = read_scene_flow(self.seq.dir, index, len(scan.xyz))
+        if got is None or not ego_motion:
+            return got
+        obj, flag = got
+        src = str(self.seq.dir / "lidar_meta.json")
+        sweeps = md.sweep_poses(md.load_metadata(self.seq.dir / "lidar_meta.json"), src)
+        if index + 1 >= len(sweeps):
+            raise UserError(f"{src}: sweep_poses_world: no poses of sweeps {index} and {index + 1}")
+        rec = [{"t_s": t, "T_world_lidar": T} for t, T in sweeps[index:index + 2]]
+        times = read_sidecar(self.seq.dir, TIMES_DIR, index, len(scan.xyz))
+        return ego_flow(scan.xyz, obj, times, rec[0], rec[1]), flag
+
+    def _seq_dir(self) -> Path:
+        return self.root / "lidar" / "sequences" / self.sequence
 
     def __iter__(self):
         """Image frames in order (each with its sweep); every sweep when there are no images."""
@@ -219,6 +274,10 @@ class Dataset:
                                "val", src, 0, 2**32)
                 out.setdefault(int(key), []).append(Box(int(uid), types.get(uid, ""), v[:3], v[3:7], v[7:10], n))
         return out
+
+
+def _maybe(path: Path, read):
+    return read(path) if os.path.lexists(path) else None
 
 
 def _mapping(value, source: str, where: str) -> dict:

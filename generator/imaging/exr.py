@@ -251,3 +251,44 @@ def read_exr(path: str | Path) -> LabelledImage:
     rgb = np.stack([ch["R"], ch["G"], ch["B"]], -1).astype(np.float32)
     return LabelledImage(rgb, class_id, ch["instance.id"].astype(np.uint32), ch["depth.Z"].astype(np.float32),
                          {k: v for k, v in hdr.items() if isinstance(k, str) and k.startswith("urbangen.")})
+
+
+def read_channels(path: str | Path, names: list[str]) -> tuple[dict[str, np.ndarray], dict]:
+    """Channels ``names`` of any EXR (and its ``urbangen.*`` header), without decoding the label masks'
+    class map: what a reader needing only depth and instances (:mod:`generator.motion`) reads.
+
+    Raises
+    ------
+    UserError
+        Not a (complete) EXR, too large, or a channel in ``names`` missing or of another size; one line.
+    """
+    data = safeload.read_bytes(path, max_bytes=MAX_EXR_BYTES)
+    hdr, _ = _open(data, path, header_only=True)
+    try:
+        lo, hi = (np.asarray(v, np.int64) for v in hdr["dataWindow"])
+        w, h = (int(v) + 1 for v in hi - lo)
+        n_channels = len(hdr["channels"])
+    except (KeyError, TypeError, ValueError):
+        raise UserError(f"{printable(path)}: EXR header without a data window or channel list") from None
+    if not (0 < w and 0 < h and w * h <= MAX_PIXELS) or n_channels > MAX_CHANNELS:
+        raise UserError(f"{printable(path)}: EXR of {w}x{h} pixels and {n_channels} channels; at most "
+                        f"{MAX_PIXELS} pixels and {MAX_CHANNELS} channels are read")
+    _, ch = _open(data, path, header_only=False)
+    missing = [c for c in names if c not in ch]
+    if missing:
+        raise UserError(f"{printable(path)}: missing channel(s) {', '.join(missing)}")
+    for c in names:
+        if np.shape(ch[c]) != (h, w):
+            raise UserError(f"{printable(path)}: channel {c} must have {w}x{h} samples")
+    return {c: ch[c] for c in names}, {k: v for k, v in hdr.items() if isinstance(k, str) and k.startswith("urbangen.")}
+
+
+def channel_names(path: str | Path) -> list[str]:
+    """The channel names of an EXR (its header only is decoded); a bad file is one line."""
+    data = safeload.read_bytes(path, max_bytes=MAX_EXR_BYTES)
+    hdr, _ = _open(data, path, header_only=True)
+    chans = hdr.get("channels")
+    try:
+        return [c.name if hasattr(c, "name") else str(c) for c in chans]
+    except TypeError:
+        raise UserError(f"{printable(path)}: EXR header without a channel list") from None

@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from generator.world.actors import MOVING_THRESHOLD_MPS
+from generator.world.kinematics import camera_motion, ego_motion
 
 
 def expose(renderer, rig, t: float, T_ego_camera: np.ndarray) -> np.ndarray:
@@ -43,7 +44,7 @@ def expose(renderer, rig, t: float, T_ego_camera: np.ndarray) -> np.ndarray:
     return T_world_camera
 
 
-def visible_actors(world, t: float, instance: np.ndarray) -> list[dict]:
+def visible_actors(world, t: float, instance: np.ndarray, T_world_camera: np.ndarray | None = None) -> list[dict]:
     """Every actor with pixels in an image's instance pass, with its motion at ``t``.
 
     Parameters
@@ -53,13 +54,16 @@ def visible_actors(world, t: float, instance: np.ndarray) -> list[dict]:
         Image time, seconds.
     instance : (H, W) uint16
         The image's instance ids (label pass, the masks').
+    T_world_camera : (4, 4) float64, optional
+        The camera's pose (optical frame): adds ``velocity_camera_mps``.
 
     Returns
     -------
     list of dict
         In ``world.actors`` order: ``uid``, ``name``, ``kind``, ``class``, ``instance_id``,
         ``pixels``, ``velocity_mps`` (world frame, the track's central difference at ``t``),
-        ``speed_mps`` (horizontal) and ``moving`` (faster than the moving-* threshold).
+        ``speed_mps`` (horizontal), ``moving`` (faster than the moving-* threshold) and, with
+        the camera pose, ``velocity_camera_mps`` (the same velocity in the camera's optical axes).
     """
     if world is None or not world.actors:
         return []
@@ -71,13 +75,24 @@ def visible_actors(world, t: float, instance: np.ndarray) -> list[dict]:
             continue
         v = a.track.velocity(t)[0]
         speed = float(a.track.speed(t)[0])
-        out.append({"uid": a.uid, "name": a.name, "kind": a.kind, "class": a.cls, "instance_id": a.instance_id,
-                    "pixels": pixels, "velocity_mps": [float(x) for x in v], "speed_mps": speed,
-                    "moving": speed > MOVING_THRESHOLD_MPS})
+        rec = {"uid": a.uid, "name": a.name, "kind": a.kind, "class": a.cls, "instance_id": a.instance_id,
+               "pixels": pixels, "velocity_mps": [float(x) for x in v], "speed_mps": speed,
+               "moving": speed > MOVING_THRESHOLD_MPS}
+        if T_world_camera is not None:
+            rec["velocity_camera_mps"] = [float(x) for x in np.asarray(T_world_camera)[:3, :3].T @ v]
+        out.append(rec)
     return out
 
 
-def motion_record(renderer, t: float, instance: np.ndarray) -> dict:
+def motion_record(renderer, t: float, instance: np.ndarray, T_world_camera: np.ndarray | None = None,
+                  T_ego_camera: np.ndarray | None = None) -> dict:
     """The ``motion`` section of an image's metadata: the motion-blur settings the RGB was rendered
-    with and the visible actors (:func:`visible_actors`) at the image time ``t``."""
-    return {"motion_blur": renderer.motion_blur, "actors": visible_actors(renderer.world, t, instance)}
+    with, the visible actors (:func:`visible_actors`) at the image time ``t`` and, given the camera's
+    mount ``T_ego_camera``, the ego's motion and the camera's twist then (``ego``,
+    :func:`generator.world.kinematics.ego_motion` and :func:`~generator.world.kinematics.camera_motion`):
+    the ego part and the object part of the image's optical flow."""
+    world = renderer.world
+    record = {"motion_blur": renderer.motion_blur, "actors": visible_actors(world, t, instance, T_world_camera)}
+    if world is not None and T_ego_camera is not None:
+        record["ego"] = {**ego_motion(world.ego, t), "camera": camera_motion(world.ego, T_ego_camera, t)}
+    return record

@@ -37,7 +37,8 @@ from generator.atomic import clean_temporaries
 from generator.errors import SpecError, UserError
 from generator.jobs import manifest as mf
 from generator.jobs.executors import make_jobs, run_jobs
-from generator.jobs.plan import MAX_FRAME_INDEX, MAX_IMAGES, Plan, check_free_space, check_plan, image_bytes, scan_bytes
+from generator.jobs.plan import (MAX_FRAME_INDEX, MAX_IMAGES, Plan, check_free_space, check_plan, image_bytes, motion_bytes,
+                                 scan_bytes)
 from generator.jobs.stereo import pair_done, stereo_frames
 from generator.jobs.towns import town_runs
 from generator.safeload import MAX_METADATA_BYTES, load_json
@@ -188,6 +189,7 @@ def preflight(spec, cfg, opts: GenerateOptions) -> Preflight:
             built[run.index] = (scene, drive)
     per_image = image_bytes(cfg.width, cfg.height, cfg.exr_codec, len(class_table().names), cfg.preview)
     need = (len(todo) * len(plan.combos) + 2 * n_pairs) * per_image
+    need += (len(todo) + 3 * n_pairs) * motion_bytes(cfg.width, cfg.height)  # flows (a frame; both cameras) + disparity
     need += scans * scan_bytes(sensor.rays_per_sweep)
     check_free_space(out, need, f"{len(todo) * len(plan.combos)} images and {n_pairs} stereo pairs at "
                                 f"{cfg.width}x{cfg.height}, {scans} scans" + (f" of {len(towns)} towns" if len(towns) > 1
@@ -213,7 +215,9 @@ def run_generate(spec, cfg, opts: GenerateOptions) -> dict:
     manifest["finished"]["images"] = [n for k in plan.frames if k in done for n in plan.images_of(k)]
     manifest["finished"].setdefault("stereo", [])
     results, n_todo, n_stereo = [], 0, 0
+    from generator.dataset import Dataset
     from generator.jobs.finish import write_openlabel, write_stats
+    from generator.jobs.motion import motion_done, write_motion
 
     for town in pre.towns:
         tplan, tspec = town.plan, town.spec
@@ -243,6 +247,10 @@ def run_generate(spec, cfg, opts: GenerateOptions) -> dict:
             results.append(run_jobs(opts.executor, jobs, len(todo) + len(stereo_todo), on_frame, opts.ray_address))
             shutil.rmtree(out / ".scratch", ignore_errors=True)
             n_todo, n_stereo = n_todo + len(todo), n_stereo + len(stereo_todo)
+        if todo or stereo_todo or not motion_done(out, tplan, pairs):  # flow and disparity from the passes
+            t = time.perf_counter()
+            write_motion(Dataset(out, tplan.sequence), drive.world, tplan.frames, tplan.sequence, cfg.exr_codec)
+            run["motion_s"] = round(run.get("motion_s", 0.0) + time.perf_counter() - t, 2)
         write_openlabel(tspec, out, tplan, scene, drive.world)  # the world the sequence was cast in
         mf.save(out, manifest)
         del scene, drive

@@ -8,7 +8,8 @@ rings x columns float32, 0 = no return) and ``ply/NNNNNN.ply``; ``lidar_meta.jso
 how the data was made (sensor, conventions, remission placeholder, point counts); the
 dataset's ``semantic-kitti.yaml`` label config sits in ``out/``.
 Side files for fusion: ``point_times/`` and ``native_labels/`` per scan
-(:mod:`generator.formats.point_sidecars`) and, in ``lidar_meta.json``,
+(:mod:`generator.formats.point_sidecars`), the scene flow of every scan but the last
+(``scene_flow/``, :mod:`generator.formats.scene_flow`, :mod:`generator.jobs.scan_flow`) and, in ``lidar_meta.json``,
 ``sweep_poses_world`` (the LiDAR world poses during each sweep, :meth:`generator.world.rig.Rig.sweep_record`).
 
 Write order: calib first, then scans; ``poses.txt``, ``times.txt`` and the metadata last,
@@ -36,6 +37,8 @@ from generator.previews.bev import write_bev
 from generator.labels import class_table
 from generator.labels.sets import semantickitti_labels
 from generator.formats.point_sidecars import write_point_sidecars
+from generator.formats.scene_flow import DESCRIPTION as SCENE_FLOW
+from generator.jobs.scan_flow import ScanFlowWriter, remove_last
 from generator.scan_effects.pipeline import process_scan, processing_for_spec
 from generator.spec.towns import angle_record, town_record
 from generator.remission.models import IntensityFn, intensity_fn_for_spec
@@ -169,7 +172,8 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
     starts, n_points, counts, records = [], [], {}, []
     sweeps = []  # LiDAR world poses during each sweep (fusion de-skews with them)
     actors = world.actors if world is not None else []
-    with Scanner(scene, sensor, threads=options.threads, world=world) as scanner:
+    flows = ScanFlowWriter(seq, rig, world, sensor, skew)  # scene_flow/ of each sweep, once the next is cast
+    with Scanner(scene, sensor, threads=options.threads, world=world) as scanner, flows:
         for j in progress_bar(range(options.frames), desc=f"lidar {name}", unit="scan", enabled=progress):
             t_j = times[j]
             scan = scanner.sweep(rig, t_j, skew)
@@ -181,6 +185,7 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
             sk.write_scan(seq / "velodyne" / f"{stem}.bin", scan.xyz, remission)
             sk.write_labels(seq / "labels" / f"{stem}.label", semantic, pts["instance"])
             write_point_sidecars(seq, stem, pts["time"], pts["class"])  # fusion: de-skew times, native classes
+            flows.add(j, t_j, pts)
             if options.bev:
                 write_bev(seq / "bev" / f"{stem}.png", scan.xyz, pts["class"], title=f"{spec.name} {name}/{stem}",
                           moving=pts["moving"])
@@ -195,6 +200,7 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
             n_points.append(int(len(pts)))
             counts = merge_counts(counts, count_raw_ids(semantic))
     _remove_stale(seq, options.frames)
+    remove_last(seq, options.frames)  # the last sweep has no scene flow
     sk.write_poses(seq / "poses.txt", kitti_calib.camera_poses(np.array(starts), tr))
     sk.write_times(seq / "times.txt", times)
     meta = _metadata(scene, spec, sensor, options, intensity_fn, n_points, counts)
@@ -208,6 +214,7 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
         meta["image_frames"] = [list(p) for p in options.image_frames]
     meta["processing"], meta["scans"] = processing.describe(), records
     meta["sweep_poses_world"] = {"period_s": sensor.period_s, "frames": sweeps}
+    meta["scene_flow"] = {**SCENE_FLOW, "dt_s": SWEEP_PERIOD_S}
     write_json(seq / META_NAME, meta)
     write_dataset_label_config(out)
     return meta

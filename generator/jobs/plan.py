@@ -118,8 +118,8 @@ EXR_BYTES_PER_PIXEL = 8.0
 PREVIEW_BYTES_PER_PIXEL = 1.5
 #: Per image: metadata JSON and file-system slack.
 IMAGE_OVERHEAD_BYTES = 16 * 1024
-#: Per LiDAR ray that returns: .bin (16) + .label (4) + point_times (4) + native_labels (1).
-SCAN_BYTES_PER_POINT = 25
+#: Per LiDAR ray that returns: .bin (16) + .label (4) + point_times (4) + native_labels (1) + scene_flow (16).
+SCAN_BYTES_PER_POINT = 41
 #: Per scan: bird's-eye PNG and file-system slack.
 SCAN_OVERHEAD_BYTES = 96 * 1024
 
@@ -129,6 +129,16 @@ def image_bytes(width: int, height: int, codec: str = "zip", classes: int = 35, 
     px = int(width) * int(height)
     per_px = (6 + 2 * classes + 8) if codec == "none" else EXR_BYTES_PER_PIXEL
     return int(px * (per_px + (PREVIEW_BYTES_PER_PIXEL if preview else 0.0))) + IMAGE_OVERHEAD_BYTES
+
+
+#: Per pixel of a frame's or a stereo camera's motion files: the float flow EXR (two directions, ZIP: ~5 bytes
+#: measured at 640x360) and the KITTI PNGs (~1), with room to spare.
+MOTION_BYTES_PER_PIXEL = 12
+
+
+def motion_bytes(width: int, height: int) -> int:
+    """Estimated bytes of one image's motion files (:mod:`generator.jobs.motion`): flows or disparity."""
+    return int(width) * int(height) * MOTION_BYTES_PER_PIXEL
 
 
 def scan_bytes(rays: int, range_image: bool = False, ply: bool = False, bev: bool = True) -> int:

@@ -128,7 +128,8 @@ def render_pair(renderer, spec, cfg, rig, sensor, index: int, seq_dir: Path) -> 
             "exposure_offset_s": t_exp - t_scan, "T_world_camera": T_world_camera.tolist(),
             "K": renderer.k.tolist(), "width": cfg.width, "height": cfg.height, "time_of_day": tod,
             "weather": weather, "lighting": {k: v for k, v in lighting.items() if k != "light_objects"},
-            "seed": spec.seed, "spec_hash": spec.spec_hash, "motion": motion_record(renderer, t_exp, labels.instance)}
+            "seed": spec.seed, "spec_hash": spec.spec_hash,
+            "motion": motion_record(renderer, t_exp, labels.instance, T_world_camera, rig.T_ego_stereo(cam))}
         if camera is not None:
             record["camera_model"] = camera
         write_json(seq_dir / f"passes_{cam}" / f"{stem}.json", record)

@@ -198,7 +198,8 @@ def render_frame(renderer, spec, cfg, frame, out: Path, combos: list[tuple[str, 
     if labels is None:
         labels = renderer.render_labels()
     label_s = sum(labels.seconds.values())
-    motion = None if rig is None else motion_record(renderer, frame.t, labels.instance)
+    motion = None if rig is None else motion_record(renderer, frame.t, labels.instance, frame.T_world_camera,
+                                                    frame.T_ego_camera)
     timings = {}
     for tod, wet, overcast in renders_needed(combos):
         kinds = [k for t_, k in combos if t_ == tod and render_key(k) == (wet, overcast)]
