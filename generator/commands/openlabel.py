@@ -1,4 +1,4 @@
-"""``urbangen openlabel SPEC DIR [--sequence NN] [--classes car truck person] [--min-points N]``.
+"""``urbangen openlabel SPEC DIR [--sequence NN] [--classes car person ...] [--min-points N]``.
 
 Writes ``DIR/openlabel/NN.json`` (ASAM OpenLABEL 1.0, validated against its schema) for the
 LiDAR sequence ``DIR/lidar/sequences/NN`` cast from SPEC: coordinate systems (odom,
@@ -19,7 +19,7 @@ from pathlib import Path
 from generator.commands.options import Integer, path, sequence_id, text_path
 from generator.commands.preflight import input_dir, output_file
 from generator.errors import UserError
-from generator.jobs.boxes import DEFAULT_CLASSES
+from generator.labels.detection import detection_classes
 from generator.safeload import MAX_METADATA_BYTES, load_json
 
 log = logging.getLogger(__name__)
@@ -34,8 +34,9 @@ def register(sub) -> None:
     p.add_argument("spec", type=text_path, help="scene spec JSON the sequence was cast from")
     p.add_argument("dataset", type=path, help="dataset folder (reads lidar/sequences/NN, writes openlabel/NN.json)")
     p.add_argument("--sequence", type=sequence_id, default="00", help="sequence, 00..99 (default 00)")
-    p.add_argument("--classes", nargs="+", default=list(DEFAULT_CLASSES),
-                   help=f"object classes (thing classes of the class table; default {' '.join(DEFAULT_CLASSES)})")
+    boxes = list(detection_classes().boxes)
+    p.add_argument("--classes", nargs="+", default=boxes,
+                   help=f"box classes (generator/labels/detection.yaml; default all: {' '.join(boxes)})")
     p.add_argument("--min-points", type=Integer(0, MAX_MIN_POINTS), default=None,
                    help="leave out objects with fewer LiDAR points in a frame, 0..10000000 "
                         "(default: spec labels.openlabel_min_points)")
@@ -65,15 +66,13 @@ def check_replaceable(target: Path, spec) -> None:
 def run(args) -> int:
     from generator.formats.openlabel import object_counts
     from generator.jobs.boxes import write_sequence_openlabel
-    from generator.labels import class_table
     from generator.spec import load_spec
 
     spec = load_spec(args.spec)
-    table = class_table()
-    bad = [c for c in args.classes if c not in table.names or not table[c].thing]
+    boxes = detection_classes().boxes
+    bad = [c for c in args.classes if c not in boxes]
     if bad:
-        things = [r.name for r in table.rows if r.thing]
-        raise UserError(f"--classes: {', '.join(bad[:5])} not a thing class; choose from {', '.join(things)}")
+        raise UserError(f"--classes: {', '.join(bad[:5])} not a box class; choose from {', '.join(boxes)}")
     min_points = spec.labels.openlabel_min_points if args.min_points is None else args.min_points
     root = input_dir(args.dataset, what="dataset folder")
     check_replaceable(root / "openlabel" / f"{args.sequence}.json", spec)
