@@ -28,7 +28,8 @@ import numpy as np
 from generator.detection.frames import corners
 from generator.detection.raster import NEAR_M, coverage_outside, footprint
 
-#: KITTI difficulty limits: (min 2D box height px, max occlusion level, max truncation), devkit readme.
+#: KITTI difficulty limits: (2D box height above, max occlusion level, max truncation), devkit readme and
+#: evaluate_object.cpp (a ground truth box of height <= the limit is ignored at that level).
 KITTI_LEVELS = ((40.0, 0, 0.15), (25.0, 1, 0.30), (25.0, 2, 0.50))
 #: Lower edges of the nuScenes visibility bins (tokens "1".."4").
 NUSCENES_BINS = (0.0, 0.4, 0.6, 0.8)
@@ -77,9 +78,12 @@ def occlusion_level(visibility: float, pixels_visible: int) -> int:
 
 
 def difficulty(height_px: float, occlusion: int, truncation: float) -> int:
-    """KITTI difficulty (0 easy, 1 moderate, 2 hard, -1 none) of a 2D box height, occlusion level, truncation."""
+    """KITTI difficulty (0 easy, 1 moderate, 2 hard, -1 none) of a 2D box height, occlusion level, truncation.
+
+    As the devkit's evaluation counts them: a box of exactly the minimum height is too small.
+    """
     for level, (h, occ, trunc) in enumerate(KITTI_LEVELS):
-        if height_px >= h and occlusion <= occ and truncation <= trunc:
+        if height_px > h and occlusion <= occ and truncation <= trunc:
             return level
     return -1
 

@@ -56,6 +56,6 @@ def test_nothing_in_view_gives_no_boxes(seen):
 def test_kitti_levels_and_nuscenes_bins():
     assert occlusion_level(1.0, 10) == 0 and occlusion_level(0.6, 10) == 1 and occlusion_level(0.1, 10) == 2
     assert occlusion_level(0.0, 0) == 3
-    assert difficulty(40, 0, 0.15) == 0 and difficulty(39.9, 0, 0.0) == 1 and difficulty(30, 2, 0.4) == 2
-    assert difficulty(24, 0, 0.0) == -1 and difficulty(100, 3, 0.0) == -1 and difficulty(100, 0, 0.6) == -1
+    assert difficulty(40.5, 0, 0.15) == 0 and difficulty(40, 0, 0.0) == 1 and difficulty(30, 2, 0.4) == 2
+    assert difficulty(25, 0, 0.0) == -1 and difficulty(100, 3, 0.0) == -1 and difficulty(100, 0, 0.6) == -1
     assert [nuscenes_bin(v) for v in (0.0, 0.39, 0.4, 0.59, 0.6, 0.79, 0.8, 1.0)] == list("11223344")
