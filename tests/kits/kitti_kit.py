@@ -64,8 +64,8 @@ def synthetic(seed: int = 26, frames: int = 24) -> tuple[list[list[KittiObject]]
     g = np.random.default_rng(seed)
     gts, dts = [], []
     for _ in range(frames):
-        gt = [_object(g, str(c)) for c in g.choice(["Car", "Car", "Car", "Pedestrian", "Pedestrian", "Cyclist", "Cyclist",
-                                                     "Van", "Truck"], size=int(g.integers(6, 12)))]
+        kinds = ["Car", "Car", "Car", "Pedestrian", "Pedestrian", "Cyclist", "Cyclist", "Van", "Truck"]
+        gt = [_object(g, str(c)) for c in g.choice(kinds, size=int(g.integers(6, 12)))]
         if g.random() < 0.5:
             gt.append(dont_care((float(g.uniform(0, 1000)), 170.0, float(g.uniform(1000, 1240)), 200.0)))
         dt = [_detect(g, o, float(g.uniform(0.2, 1.0))) for o in gt if o.type != "DontCare" and g.random() < 0.85]

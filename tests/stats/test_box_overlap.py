@@ -9,7 +9,8 @@ from generator.stats.box_overlap import bev_iou, box3d_iou, convex_intersection_
 
 
 def _box(x, z, length=4.0, width=2.0, h=1.5, ry=0.0, y=1.6):
-    return {"location": np.array([[x, y, z]]), "dimensions": np.array([[h, width, length]]), "rotation_y": np.array([ry])}
+    return {"location": np.array([[x, y, z]]), "dimensions": np.array([[h, width, length]]),
+            "rotation_y": np.array([ry])}
 
 
 def test_image_iou_and_the_dontcare_criterion():
