@@ -1,6 +1,7 @@
 """``urbangen openlabel SPEC DIR [--sequence NN] [--classes car person ...] [--min-points N]``.
 
-Writes ``DIR/openlabel/NN.json`` (ASAM OpenLABEL 1.0, validated against its schema) for the
+Writes ``DIR/openlabel/NN.json`` (ASAM OpenLABEL 1.0, validated against its schema) and the box
+file ``DIR/boxes/NN.npz`` (box records per sweep, visibility per image; 10 Hz streams) for the
 LiDAR sequence ``DIR/lidar/sequences/NN`` cast from SPEC: coordinate systems (odom,
 vehicle-iso8855, lidar, camera), camera and LiDAR streams, the ego transform per frame, and
 per frame a cuboid in the vehicle frame with the LiDAR point count of every object of the
@@ -65,7 +66,8 @@ def check_replaceable(target: Path, spec) -> None:
 
 def run(args) -> int:
     from generator.formats.openlabel import object_counts
-    from generator.jobs.boxes import write_sequence_openlabel
+    from generator.jobs.box_labels import write_sequence_boxes
+    from generator.jobs.boxes import open_sequence, write_sequence_openlabel
     from generator.spec import load_spec
 
     spec = load_spec(args.spec)
@@ -76,8 +78,14 @@ def run(args) -> int:
     min_points = spec.labels.openlabel_min_points if args.min_points is None else args.min_points
     root = input_dir(args.dataset, what="dataset folder")
     check_replaceable(root / "openlabel" / f"{args.sequence}.json", spec)
-    out, doc = write_sequence_openlabel(spec, root, args.sequence, list(dict.fromkeys(args.classes)), min_points)
+    sw = open_sequence(spec, root, args.sequence)   # scene and world rebuilt once for both files
+    out, doc = write_sequence_openlabel(spec, root, args.sequence, list(dict.fromkeys(args.classes)), min_points,
+                                        scene=sw.scene, world=sw.world)
     per = object_counts(doc)
     print(f"wrote {out}: {len(doc['openlabel']['frames'])} frames, " + ", ".join(
         f"{c}: {v['objects']} objects / {v['cuboids']} cuboids" for c, v in per.items()) + f" (>= {min_points} points)")
+    if sw.stream:
+        path, stats = write_sequence_boxes(spec, root, args.sequence, scene=sw.scene, world=sw.world,
+                                           min_points=min_points)
+        print(f"wrote {path}: {stats['records']} box records, {stats['images']} images with visibility")
     return 0

@@ -47,7 +47,7 @@ def _samples(root: Path, sequences) -> list[tuple[str, int, object, object]]:
     for name in sequences:
         path = root / "boxes" / f"{name}.npz"
         if not path.is_file():
-            raise UserError(f"{path}: missing (run generate, or urbangen boxes, to write the box file)")
+            raise UserError(f"{path}: missing (generate writes it; for an older dataset: urbangen openlabel SPEC DIR)")
         bf = read_box_file(path)
         for key in sorted(k for k in bf.image_names if k.startswith("image_2/")):
             j = int(key.split("/")[1])
