@@ -71,11 +71,11 @@ def _silhouette(center, size, T_cw, K) -> np.ndarray:
     return (p @ K.T)[:, :2] / p[:, 2:3]
 
 
-def box_scene() -> BoxScene:
+def box_scene(hfov: float = HFOV, width: int = WIDTH, height: int = HEIGHT) -> BoxScene:
     """The scene, the camera and the analytic answers (see the module docstring)."""
     T_wc = rig.camera_extrinsics(CAM_XYZ, (0.0, 0.0, 0.0))  # optical axis along world +x, level
     T_cw = np.linalg.inv(T_wc)
-    K = rig.intrinsics(HFOV, WIDTH, HEIGHT)
+    K = rig.intrinsics(hfov, width, height)
     car, truck = (4.2, 1.8, 1.5), (2.5, 2.6, 3.2)
     truck_c = np.array([14.0, 0.0, truck[2] / 2])
     hidden_c = np.array([30.0, 0.0, car[2] / 2])
@@ -91,7 +91,7 @@ def box_scene() -> BoxScene:
     a, poly = hull_area(_silhouette(hidden_c, car, T_cw, K))
     hidden_share = area_right_of(poly, edge) / a
     # a car at 12 m whose left part leaves the image (world +y is image left)
-    cut_c = np.array([12.0, 12.0 * np.tan(np.radians(HFOV / 2)) + 0.3, car[2] / 2])
+    cut_c = np.array([12.0, 12.0 * np.tan(np.radians(hfov / 2)) + 0.3, car[2] / 2])
     a, poly = hull_area(_silhouette(cut_c, car, T_cw, K))
     cut_trunc = 1.0 - area_right_of(poly, 0.0) / a
     parts = [("ground", M.rect(-10, -40, 80, 40, 0.0, "road", "asphalt"), np.eye(4), 0),
