@@ -132,12 +132,12 @@ def write_sequence_boxes(spec, root: Path, sequence: str = "00", *, scene=None, 
         records += sweep_boxes(subs, j, float(seq.times[j]), sw.lidar_pose, counts[j], clock, min_points)
     t1 = time.perf_counter()
     images = []
+    by_id = {s.track_id: s for s in subs}
     for name, j, meta_path, exr, k_sup in _image_sources(sw, supersample):
         meta = md.load_metadata(meta_path)
         t, T_wc, K = _camera(meta, str(meta_path))
         inst = read_exr(exr).instance
         vis = image_boxes(subs, t, T_wc, K, inst, k_sup)
-        by_id = {s.track_id: s for s in subs}
         cnt = counts.get(j, {})
         T_wl = sw.lidar_pose(t)
         pairs = [(record(by_id[b.track_id], j, t, T_wl, sum(cnt.get(i, 0) for i in by_id[b.track_id].instance_ids)), b)
