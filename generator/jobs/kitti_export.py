@@ -58,16 +58,17 @@ def _samples(root: Path, sequences) -> list[tuple[str, int, object, object]]:
 
 
 def labels_of(entry, bf_info: dict, min_points: int) -> list:
-    """The KITTI label objects of one image_2 entry (see the module docstring)."""
+    """The KITTI label objects of one image_2 entry (see the module docstring): the labelled things, then the
+    DontCare regions, as KITTI's files order them (OpenPCDet's reader takes the non-DontCare rows first)."""
     dc = detection_classes()
     T_cam_world = np.linalg.inv(entry.T_world_camera)
-    out = []
+    things, regions = [], []
     for rec, vis in entry.boxes:
         if rec.num_lidar_pts >= max(min_points, 1):
-            out.append(kitti_object(rec, vis, T_cam_world, dc.kitti_type(rec.cls, rec.kind)))
+            things.append(kitti_object(rec, vis, T_cam_world, dc.kitti_type(rec.cls, rec.kind)))
         elif vis.pixels_visible > 0:
-            out.append(dont_care_of(vis))
-    return out
+            regions.append(dont_care_of(vis))
+    return things + regions
 
 
 def export_kitti_object(root: Path, out: Path, sequences: list[str] | None = None, min_points: int = 1,
