@@ -23,6 +23,10 @@ from generator.commands.preflight import input_dir, output_file
 MAX_MIN_POINTS = 10_000_000
 
 
+#: ``--detection`` benchmark -> the module whose ``run(args)`` evaluates it.
+DETECTION = {"kitti": "generator.commands.eval_kitti"}
+
+
 def register(sub) -> None:
     from generator.stats.evaluate import LABEL_SETS, MEAN_OVER
     from generator.stats.panoptic import MIN_POINTS
@@ -45,10 +49,21 @@ def register(sub) -> None:
                    help=f"panoptic: smallest unmatched segment counted as FP/FN, 1..{MAX_MIN_POINTS} "
                         f"(default {MIN_POINTS}, as the reference)")
     p.add_argument("--json", type=path, default=None, help="result file (default PRED/eval_<labels>.json)")
+    p.add_argument("--detection", choices=sorted(DETECTION), default=None,
+                   help="evaluate 3D object detections instead: kitti (AP R40; --gt a label_2 folder or a KITTI "
+                        "export root, --pred a folder of KITTI result files)")
+    p.add_argument("--classes", nargs="+", default=None,
+                   help="--detection kitti: classes (default Car Pedestrian Cyclist)")
+    p.add_argument("--split", default=None,
+                   help="--detection kitti: only the samples of GT/ImageSets/SPLIT.txt (e.g. val)")
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
+    if args.detection is not None:
+        import importlib
+
+        return importlib.import_module(DETECTION[args.detection]).run(args)
     from generator.stats.evaluate import evaluate_trees, format_table
     from generator.stats.panoptic import format_panoptic
 

@@ -1,4 +1,7 @@
-"""``urbangen export cityscapes DIR OUT [--split train|val|test]``.
+"""``urbangen export cityscapes|kitti-object DIR OUT [--split train|val|test]``.
+
+``kitti-object``: the KITTI 3D object layout of the LiDAR sequences' stereo pairs with their boxes
+(:mod:`generator.commands.export_kitti_object`).
 
 Writes the images of a generated dataset (DIR/images/*.exr and their metadata JSON) in the
 Cityscapes layout under OUT: leftImg8bit/<split>/<city>/<city>_<seq>_<frame>_leftImg8bit.png
@@ -17,7 +20,7 @@ import os
 from pathlib import Path
 from typing import Iterator
 
-from generator.commands.options import path
+from generator.commands.options import Integer, Number, path, sequence_id
 from generator.commands.preflight import input_dir, output_dir
 from generator.errors import UserError
 from generator.jobs.plan import MAX_FRAME_INDEX, check_free_space
@@ -25,17 +28,25 @@ from generator.safeload import MAX_METADATA_BYTES, load_json, printable
 from generator.weather import TIMES, combinations
 from generator.formats.cityscapes import DEFAULT_SPLIT, SPLITS, CityscapesImage, city_name, export, image_stem
 
-FORMATS = ("cityscapes",)
+FORMATS = ("cityscapes", "kitti-object")
+#: format -> the module whose ``run(args)`` exports it (cityscapes: :func:`run` here)
+EXPORTERS = {"kitti-object": "generator.commands.export_kitti_object"}
 
 
 def register(sub) -> None:
-    p = sub.add_parser("export", help="write a dataset's images in the Cityscapes layout",
-                       description=__doc__.split("\n\n")[1])
-    p.add_argument("format", choices=FORMATS, help="target layout: cityscapes")
+    p = sub.add_parser("export", help="write a dataset in the Cityscapes or KITTI 3D object layout",
+                       description=__doc__.split("\n\n")[1] + " " + __doc__.split("\n\n")[2])
+    p.add_argument("format", choices=FORMATS, help="target layout: cityscapes or kitti-object")
     p.add_argument("dataset", type=path, help="generated dataset (holds images/*.exr)")
     p.add_argument("out", type=path, help="export root (leftImg8bit/ and gtFine/ are written inside)")
     p.add_argument("--split", default=DEFAULT_SPLIT, choices=SPLITS,
                    help=f"split folder: train, val or test (default {DEFAULT_SPLIT}, what cityscapesScripts evaluates)")
+    p.add_argument("--sequences", nargs="+", type=sequence_id, default=None,
+                   help="kitti-object: LiDAR sequences to export, 00..99 (default all)")
+    p.add_argument("--min-points", type=Integer(0, 10_000_000), default=1,
+                   help="kitti-object: things with fewer LiDAR points are DontCare regions (default 1)")
+    p.add_argument("--val-share", type=Number(0.0, 1.0), default=0.5,
+                   help="kitti-object: share of each sequence's samples in val.txt, its last ones (default 0.5)")
     p.set_defaults(func=run)
 
 
@@ -67,6 +78,10 @@ def _sequence(dataset: Path) -> int:
 
 
 def run(args) -> int:
+    if args.format in EXPORTERS:
+        import importlib
+
+        return importlib.import_module(EXPORTERS[args.format]).run(args)
     from generator.progress import progress
 
     from generator.imaging.exr import read_exr

@@ -251,7 +251,7 @@ def run_generate(spec, cfg, opts: GenerateOptions) -> dict:
             t = time.perf_counter()
             write_motion(Dataset(out, tplan.sequence), drive.world, tplan.frames, tplan.sequence, cfg.exr_codec)
             run["motion_s"] = round(run.get("motion_s", 0.0) + time.perf_counter() - t, 2)
-        write_openlabel(tspec, out, tplan, scene, drive.world)  # the world the sequence was cast in
+        write_openlabel(tspec, out, tplan, scene, drive.world, cfg.label_supersample)  # the world it was cast in
         mf.save(out, manifest)
         del scene, drive
     if results:
