@@ -22,7 +22,7 @@ from generator.errors import SpecError
 from generator.layout.appearance import fleet_paint
 from generator.layout.streets import make_grid
 from generator.rng import stream
-from generator.traffic.fleet import EGO_SIZE_M, KINDS, fleet_proto
+from generator.traffic.fleet import EGO_SIZE_M, KINDS, drives, fleet_proto, how_many
 from generator.traffic.lane_clearance import MARGIN_M, blocked_lanes, too_narrow, widest_half_width
 from generator.traffic.lanes import LaneGraph
 from generator.traffic.mapped_tracks import map_track
@@ -100,7 +100,7 @@ def build_world(spec, scene, duration_s: float, distance_m: float = 0.0) -> Worl
 
 
 def _pedestrians(spec, grid, scene, signals, lib, n_steps: int) -> list[Mover]:
-    if spec.traffic.pedestrians_per_100m <= 0 and spec.traffic.standing_pedestrians_per_100m <= 0:
+    if not (drives(spec.traffic, "pedestrians_per_100m") or drives(spec.traffic, "standing_pedestrians_per_100m")):
         return []
     from generator.traffic.pedestrians import simulate_pedestrians
 
@@ -219,7 +219,7 @@ def _drive(spec, graph, scene, signals, lib, blocked, crossing, duration_s, dist
     paint = stream(spec.seed, "traffic", "vehicles", "paint")   # colours never move a vehicle
     taken: dict[int, list] = {route[0]: [(0.0, EGO_SIZE_M[0])]}
     for field_name, (kind, n_var, speed, a_max, _) in KINDS.items():
-        for _ in range(round(getattr(tr, field_name) * km)):
+        for _ in range(how_many(tr, field_name, km)):
             proto = fleet_proto(lib, kind, int(g.integers(n_var)))
             length, width = float(proto.hi[0] - proto.lo[0]), float(proto.hi[1] - proto.lo[1])
             avoid = frozenset(too_narrow(graph, scene, width / 2, set(route), length))

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from generator.traffic.fleet import fleet_proto
+from generator.traffic.fleet import drives, fleet_proto
 from generator.traffic.lanes import CAR_BOX_M, boxes_overlap
 
 MARGIN_M = 0.05      #: clearance beyond the widest box's side, metres
@@ -37,7 +37,7 @@ def widest_half_width(spec, lib, kinds: dict, ego_width: float) -> tuple[float, 
     """
     best, key = ego_width / 2, "ego"
     for field_name, (kind, n_var, *_rest) in kinds.items():
-        if getattr(spec.traffic, field_name) <= 0:
+        if not drives(spec.traffic, field_name):
             continue
         for i in range(n_var):
             proto = fleet_proto(lib, kind, i)

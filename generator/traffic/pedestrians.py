@@ -34,7 +34,7 @@ from generator.traffic import walk_sim as ws
 from generator.traffic import walk_zones as wz
 from generator.traffic.movers import DT_S, Mover
 from generator.traffic.walk_lines import R_TURN
-from generator.traffic.fleet import EGO_SIZE_M, KINDS
+from generator.traffic.fleet import EGO_SIZE_M, KINDS, how_many
 from generator.traffic.lane_clearance import widest_half_width
 from generator.traffic.walk_shared import shared_standers
 from generator.traffic.walkways import Walkways, build_walkways, obstacles_of
@@ -96,8 +96,8 @@ def simulate_pedestrians(spec: SceneSpec, grid: Grid, scene, signals, lib: Libra
     """
     tr = spec.traffic
     length = sidewalk_length(grid)
-    n_walk = round(tr.pedestrians_per_100m * length / 100.0)
-    n_stand = round(tr.standing_pedestrians_per_100m * length / 100.0)
+    n_walk = how_many(tr, "pedestrians_per_100m", length / 100.0)
+    n_stand = how_many(tr, "standing_pedestrians_per_100m", length / 100.0)
     if n_walk == 0 and n_stand == 0:
         return []
     t0 = time.perf_counter()
