@@ -43,8 +43,11 @@ ALLOWED: dict[str, set[str]] = {
     "blender": {"geometry", "labels", "materials", "spec", "weather", "world"},
     "jobs": {"blender", "detection", "formats", "geometry", "imaging", "labels", "layout", "lidar", "materials",
              "postfx", "previews", "remission", "scan_effects", "spec", "stats", "traffic", "weather", "world"},
-    "commands": {"detection", "formats", "fusion", "geometry", "imaging", "jobs", "labels", "layout", "lidar",
-                 "materials", "previews", "remission", "scan_effects", "spec", "stats", "traffic", "weather", "world"},
+    "exports": {"dataset", "detection", "formats", "fusion", "geometry", "imaging", "jobs", "labels", "lidar",
+                "previews", "spec", "world"},
+    "commands": {"detection", "exports", "formats", "fusion", "geometry", "imaging", "jobs", "labels", "layout",
+                 "lidar", "materials", "previews", "remission", "scan_effects", "spec", "stats", "traffic", "weather",
+                 "world"},
     "dataset": {"formats", "imaging", "labels"},
     "cli": {"commands"},
 }
