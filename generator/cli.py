@@ -42,6 +42,7 @@ COMMANDS = [
     "fuse",
     "eval",
     "export",
+    "process",
     "openlabel",
     "render",
     "stats",
