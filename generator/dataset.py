@@ -28,8 +28,14 @@ Arrays and frames
   ``remission`` (n,) float32 in [0, 1]; ``semantic`` (n,) uint16 SemanticKITTI raw ids;
   ``instance`` (n,) uint16; ``native`` (n,) uint8 native classes (urbangen side file, or None);
   ``pose`` (4, 4) float64 LiDAR pose in the first scan's LiDAR frame; ``time`` seconds.
-* ``Box``: an OpenLABEL cuboid in the ego (``vehicle-iso8855``) frame of its frame: ``center``
-  (3,), ``quaternion`` (x, y, z, w), ``size`` (3,) metres, ``cls``, ``uid``, ``points``.
+* ``Box`` (:mod:`generator.formats.box_frames`): a 3D box in the frame of the scan it belongs to, the
+  LiDAR frame at the instant the LiDAR saw it (read from ``boxes/NN.npz``): ``center`` (3,),
+  ``quaternion`` (x, y, z, w), ``size`` (length, width, height) metres, ``yaw``, ``velocity``, ``cls``,
+  ``uid`` (track id), ``points`` (``num_lidar_pts``), ``attribute``; ``box.to("ego" | "camera" |
+  "world" | "lidar")`` moves it. A dataset without a box file gives its OpenLABEL cuboids instead
+  (ego frame at the sweep start, not movable).
+* :meth:`Dataset.image_boxes`: every thing an image shows, its box at the exposure instant in the
+  camera frame and its visibility (amodal/visible 2D boxes, truncation, occlusion...).
 """
 
 from __future__ import annotations
@@ -42,6 +48,8 @@ import numpy as np
 
 from generator.errors import SpecError, UserError
 from generator.formats import semantickitti as sk
+from generator.formats.box_file import read_box_file
+from generator.formats.box_frames import Box, box_of_record
 from generator.formats.point_sidecars import NATIVE_DIR, read_sidecar
 from generator.imaging import meta_fields as md
 from generator.imaging.exr import read_exr
@@ -62,25 +70,15 @@ class ImageSample:
     meta: dict
 
     def labels(self, label_set: str = "native") -> np.ndarray:
-        """(H, W) class map in ``native``, ``cityscapes`` (label ids), ``semantickitti`` (learning ids) or ``unified11``."""
+        """(H, W) class map in ``native``, ``cityscapes`` (label ids), ``semantickitti`` (learning ids) or
+        ``unified11``."""
         if label_set == "cityscapes":
             return class_table().to_cityscapes[self.class_id]
         sets = label_sets()
         if label_set not in sets:
-            raise UserError(f"label set {label_set!r}: use native, cityscapes, {', '.join(s for s in sets if s != 'native')}")
+            others = ", ".join(s for s in sets if s != "native")
+            raise UserError(f"label set {label_set!r}: use native, cityscapes, {others}")
         return sets[label_set].from_native[self.class_id]
-
-
-@dataclass
-class Box:
-    """An OpenLABEL cuboid (ego frame of its frame)."""
-
-    uid: int
-    cls: str
-    center: np.ndarray
-    quaternion: np.ndarray
-    size: np.ndarray
-    points: int
 
 
 @dataclass
@@ -127,7 +125,9 @@ class Dataset:
         has_seq = (lidar / "sequences" / self.sequence / "velodyne").is_dir()
         self.seq = sk.Sequence(lidar, self.sequence) if has_seq else None
         self._poses = self.seq.lidar_poses() if self.seq is not None else None
-        self._boxes = self._read_boxes(self.root / "openlabel" / f"{self.sequence}.json")
+        box_file = self.root / "boxes" / f"{self.sequence}.npz"
+        self._box_file = read_box_file(box_file) if box_file.is_file() else None
+        self._boxes = {} if self._box_file else self._read_boxes(self.root / "openlabel" / f"{self.sequence}.json")
         meta = self.seq.dir / "lidar_meta.json" if self.seq is not None else None
         #: image frame -> the sweep it was exposed with (identity without ``image_frames``)
         self._sweep_of = md.image_sweeps(md.load_metadata(meta), str(meta)) if meta and meta.exists() else {}
@@ -169,8 +169,26 @@ class Dataset:
                           rec.time)
 
     def boxes(self, index: int) -> list[Box]:
-        """The OpenLABEL cuboids of sweep ``index`` (empty when the dataset has none)."""
+        """The 3D boxes of sweep ``index`` in its LiDAR frame (empty when the dataset has none)."""
+        if self._box_file is not None:
+            return [box_of_record(r, self._box_file.info) for r in self._box_file.records(index)]
         return list(self._boxes.get(index, []))
+
+    def image_boxes(self, name: str) -> list[tuple[Box, dict]]:
+        """What image ``name`` shows (``NNNNNN_<time>_<weather>``, ``image_2/NNNNNN`` or ``image_3/NNNNNN``):
+        per thing its box at the exposure instant in that image's camera frame, and its visibility
+        (``bbox_amodal``, ``bbox_visible`` (x0, y0, x1, y1) px, ``truncation``, ``visibility``,
+        ``occlusion``, ``difficulty``, ``nuscenes_visibility``, pixel counts). Empty without a box file."""
+        entry = self._box_file.image(name) if self._box_file is not None else None
+        if entry is None:
+            return []
+        out = []
+        for rec, vis in entry.boxes:
+            box = box_of_record(rec, self._box_file.info).to("camera", entry.T_world_camera)
+            out.append((box, {k: getattr(vis, k) for k in ("bbox_amodal", "bbox_visible", "pixels_amodal",
+                                                              "pixels_visible", "truncation", "visibility", "occlusion",
+                                                              "difficulty", "nuscenes_visibility")}))
+        return out
 
     def frame(self, index: int) -> FrameSample:
         """Every image variant of image frame ``index``, with the scan and boxes of its sweep, in one call."""

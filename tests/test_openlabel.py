@@ -15,7 +15,9 @@ from generator.formats.openlabel import (SCHEMA_PATH, cuboid_contains, cuboid_va
                                          write_openlabel)
 from generator.formats.point_sidecars import TIMES_DIR, read_sidecar
 from generator.fusion.projection import deskew, transform
+from generator.detection import subjects
 from generator.labels import class_table
+from generator.labels.detection import detection_classes
 from generator.world.scene import OrientedBox
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -54,7 +56,7 @@ def test_file_validates_against_the_schema(town_dataset):
     assert sorted(ol["frames"], key=int) == ["0", "1", "2"]
     for f in ol["frames"].values():
         assert "vehicle-iso8855_to_odom" in f["frame_properties"]["transforms"]
-    assert {o["type"] for o in ol["objects"].values()} <= {"car", "truck", "person"}
+    assert {o["type"] for o in ol["objects"].values()} <= set(detection_classes().boxes)
     assert any(o["type"] == "car" for o in ol["objects"].values())
 
 
@@ -88,23 +90,25 @@ def test_every_cuboid_holds_its_objects_points_and_no_other_objects(town_dataset
     min_points = ol["metadata"]["urbangen"]["min_points"]
     thing = np.array([r.thing for r in class_table().rows])
     thing_instances = {o.instance_id for o in scene.objects if o.instance_id > 0 and thing[class_table().id(o.cls)]}
+    by_track = {s.track_id: s.instance_ids for s in subjects(scene)}
     checked = 0
     for key, frame in ol["frames"].items():
         xyz, inst = _vehicle_points(root, int(key), meta, Rig.from_spec(test_spec).T_ego_lidar)
         counts = np.bincount(inst, minlength=65536)
         for uid, data in frame["objects"].items():
             val = data["object_data"]["cuboid"][0]["val"]
-            mine = inst == int(uid)
-            assert data["object_data"]["num"][0]["val"] == counts[int(uid)] >= min_points
+            ids = by_track[int(uid)]
+            mine = np.isin(inst, ids)
+            assert data["object_data"]["num"][0]["val"] == sum(int(counts[i]) for i in ids) >= min_points
             inside = cuboid_contains(val, xyz, margin=0.02)
             assert inside[mine].all(), f"frame {key} object {uid}: {np.count_nonzero(~inside[mine])} own points outside"
-            others = inside & ~mine & np.isin(inst, list(thing_instances - {int(uid)}))
+            others = inside & ~mine & np.isin(inst, list(thing_instances - set(ids)))
             assert not others.any(), f"frame {key} object {uid} holds points of {np.unique(inst[others])}"
             checked += 1
-        # objects of the classes with enough points are all there; the rest are left out
-        for o in scene.objects:
-            if o.cls in ("car", "truck", "person"):
-                assert (str(o.instance_id) in frame["objects"]) == (counts[o.instance_id] >= min_points)
+        # every boxed thing with enough points is there (vehicle and rider counted together); the rest are left out
+        for s in subjects(scene):
+            n = sum(int(counts[i]) for i in s.instance_ids)
+            assert (str(s.track_id) in frame["objects"]) == (n >= max(min_points, 1))
     assert checked >= 10
 
 

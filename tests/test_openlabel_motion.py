@@ -13,12 +13,13 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
+from generator.detection import subjects
 from generator.formats import openlabel_motion as om
 from generator.formats.openlabel import build_openlabel, validate_openlabel
 from generator.jobs.boxes import SweepFrame
 from generator.world import rig
 from generator.world.actors import MOVING_THRESHOLD_MPS, Actor, Track, TrackTrajectory, World
-from generator.world.scene import OrientedBox
+from generator.world.scene import OrientedBox, SceneObject
 
 DT = 0.05
 N_SWEEPS = 21
@@ -52,7 +53,9 @@ def world():
 
 @pytest.fixture(scope="module")
 def doc(world):
-    static = [SimpleNamespace(instance_id=7, name="car_0007", cls="car", box=OrientedBox((20.0, 8.0, 0.75), (4.0, 1.8, 1.5), 0.5))]
+    parked = SceneObject(0, "car_0007", "car", "car", 7, "p", np.eye(4), OrientedBox((20.0, 8.0, 0.75), (4.0, 1.8, 1.5), 0.5),
+                         attrs={"placement": "parked"})
+    subs = subjects(SimpleNamespace(objects=[parked], prototypes={}), world)
     times = [rig.Rig.sweep_time(j) for j in range(N_SWEEPS)]
     T_cam = rig.camera_extrinsics((1.0, 0.0, 1.6), (0.0, 0.0, 0.0))
     frames = [SweepFrame(j, t, world.ego.T_world_ego(t)[0], T_cam if j % 5 == 0 else None, j // 5 if j % 5 == 0 else None)
@@ -60,12 +63,12 @@ def doc(world):
     uris = [{"lidar": f"velodyne/{j:06d}.bin", **({"camera": f"images/{j // 5:06d}.exr"} if j % 5 == 0 else {})}
             for j in range(N_SWEEPS)]
     counts = [{7: 50, 101: 80, 102: 40, 103: 20, 104: 20} for _ in times]
-    d = build_openlabel(objects=static, frames=frames, times=times, counts=counts, min_points=5,
+    d = build_openlabel(subjects=subs, frames=frames, times=times, counts=counts, min_points=5,
                         T_ego_lidar=rig.mount((0, 0, 1.73), (0, 0, 0)), T_ego_camera_nominal=T_cam,
                         K=rig.intrinsics(90, 64, 48), width=64, height=48,
                         streams={"camera": {"uri": "images/", "description": "cam"},
                                  "lidar": {"uri": "velodyne/", "description": "lidar"}},
-                        frame_uris=uris, info={"scene": "synthetic"}, actors=world.actors)
+                        frame_uris=uris, info={"scene": "synthetic"})
     return d["openlabel"]
 
 

@@ -1,5 +1,5 @@
 """``urbangen eval --pred DIR --gt DIR [--labels unified11|semantickitti|native] [--panoptic] [--json PATH]``;
-``urbangen eval --detection nuscenes --pred FILE --gt DIR [--split NAME] [--classes ...] [--json PATH]``.
+``urbangen eval --detection kitti|nuscenes --pred PRED --gt DIR [--split NAME] [--classes ...] [--json PATH]``.
 
 Compares two SemanticKITTI-layout label trees scan by scan and prints IoU per class and
 the mIoU exactly as semantic-kitti-api's evaluate_semantics.py computes them: confusion
@@ -11,22 +11,22 @@ included) -- and a class absent from both prediction and ground truth counts as 
 PRED/sequences/NN/predictions/ when that folder exists (the reference's layout), else from
 labels/. --panoptic adds PQ, SQ and RQ per class and their means (SemanticKITTI panoptic:
 segments matched at IoU > 0.5, unmatched segments under --min-points ignored). The result
-is written as JSON (default PRED/eval_<labels>.json). --detection scores 3D boxes instead: nuscenes
-(--pred a nuScenes results file, --gt an 'urbangen export nuscenes' dataroot; mAP, NDS and the
-TP errors computed by nuscenes-devkit itself, pip install -e ".[detection]"); the result goes to
---json (default beside the predictions: <pred>.eval_<metric>.json).
+is written as JSON (default PRED/eval_<labels>.json). --detection scores 3D boxes instead: kitti
+(AP R40, generator.commands.eval_kitti) or nuscenes (--pred a nuScenes results file, --gt an 'urbangen
+export nuscenes' dataroot; mAP, NDS and the TP errors computed by nuscenes-devkit itself, pip install
+-e ".[detection]"; generator.commands.eval_nuscenes).
 """
 
 from __future__ import annotations
 
 from generator.atomic import write_json
 from generator.commands.options import Integer, path, sequence_id
-from generator.commands.preflight import input_dir, input_file, output_file
+from generator.commands.preflight import input_dir, output_file
 
 #: Largest --min-points (a segment of more points than a scan holds never counts).
 MAX_MIN_POINTS = 10_000_000
-#: --detection metric -> its module (``evaluate(pred, gt, args)``-style API: see :func:`_detection`)
-DETECTION_METRICS = {"nuscenes": "generator.stats.detection_nuscenes"}
+#: ``--detection`` benchmark -> the module whose ``run(args)`` evaluates it.
+DETECTION = {"kitti": "generator.commands.eval_kitti", "nuscenes": "generator.commands.eval_nuscenes"}
 
 
 def register(sub) -> None:
@@ -51,36 +51,24 @@ def register(sub) -> None:
                    help=f"panoptic: smallest unmatched segment counted as FP/FN, 1..{MAX_MIN_POINTS} "
                         f"(default {MIN_POINTS}, as the reference)")
     p.add_argument("--json", type=path, default=None, help="result file (default PRED/eval_<labels>.json)")
-    p.add_argument("--detection", choices=list(DETECTION_METRICS), default=None,
-                   help="score 3D boxes instead of point labels: nuscenes (--pred a results JSON, --gt an "
-                        "'urbangen export nuscenes' dataroot; computed by nuscenes-devkit)")
-    p.add_argument("--split", default=None, help="--detection nuscenes: the split of GT/v1.0-*/splits.json to score "
-                                                 "(default urbangen_val when it has scenes, else urbangen_all)")
+    p.add_argument("--detection", choices=sorted(DETECTION), default=None,
+                   help="evaluate 3D object detections instead: kitti (AP R40; --gt a label_2 folder or a KITTI "
+                        "export root, --pred a folder of KITTI result files) or nuscenes (mAP, NDS and TP errors "
+                        "by nuscenes-devkit; --gt an 'urbangen export nuscenes' dataroot, --pred a results JSON)")
     p.add_argument("--classes", nargs="+", default=None,
-                   help="--detection nuscenes: detection classes scored (default: those in the ground truth of "
-                        "the split; 'all': nuScenes' ten)")
+                   help="--detection kitti: classes (default Car Pedestrian Cyclist); nuscenes: detection classes "
+                        "scored (default: those in the ground truth of the split; 'all': nuScenes' ten)")
+    p.add_argument("--split", default=None,
+                   help="--detection kitti: only the samples of GT/ImageSets/SPLIT.txt (e.g. val); nuscenes: a split "
+                        "of GT/v1.0-*/splits.json (default urbangen_val when it has scenes, else urbangen_all)")
     p.set_defaults(func=run)
-
-
-def _detection(args) -> int:
-    """``--detection NAME``: the metric module's ``evaluate(pred, gt, split, classes)`` and ``format_result``."""
-    import importlib
-
-    metric = importlib.import_module(DETECTION_METRICS[args.detection])
-    pred, gt = input_file(args.pred, "--pred", "predictions file"), input_dir(args.gt, "--gt")
-    out = output_file(args.json or pred.with_name(f"{pred.name}.eval_{args.detection}.json"), "--json")
-    classes = args.classes[0] if args.classes == ["all"] else args.classes
-    result = metric.evaluate(pred, gt, args.split, classes)
-    result["pred"], result["gt"] = str(pred), str(gt)
-    write_json(out, result)
-    print(metric.format_result(result))
-    print(f"wrote {out}")
-    return 0
 
 
 def run(args) -> int:
     if args.detection is not None:
-        return _detection(args)
+        import importlib
+
+        return importlib.import_module(DETECTION[args.detection]).run(args)
     from generator.stats.evaluate import evaluate_trees, format_table
     from generator.stats.panoptic import format_panoptic
 

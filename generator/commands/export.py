@@ -1,9 +1,10 @@
-"""``urbangen export cityscapes|nuscenes|coco DIR OUT [--split train|val|test] [--spec SPEC]``.
+"""``urbangen export cityscapes|kitti-object|nuscenes|coco DIR OUT [--split train|val|test] [...]``.
 
 Writes a generated dataset under OUT in the layout another ecosystem reads: cityscapes (the images,
-scored by cityscapesScripts), nuscenes (the LiDAR sequences as a nuScenes v1.0 dataroot with 2 Hz
-samples, 10 Hz sweeps and 3D boxes, loaded by nuscenes-devkit) or coco (2D instance boxes and RLE
-masks of every image, plus COCO panoptic). Nothing is written on error; existing files are never
+scored by cityscapesScripts), kitti-object (the KITTI 3D object layout of the LiDAR sequences' stereo
+pairs with their boxes, as OpenPCDet and MMDetection3D read it), nuscenes (the LiDAR sequences as a
+nuScenes v1.0 dataroot with 2 Hz samples, 10 Hz sweeps and 3D boxes, loaded by nuscenes-devkit) or
+coco (2D instance boxes and RLE masks of every image, plus COCO panoptic). Nothing is written on error; existing files are never
 overwritten.
 
 cityscapes: the images of DIR/images/*.exr (and their metadata JSON) in the
@@ -16,8 +17,8 @@ urbangen-night-rain-fog, ...), so the 12 variants of a frame keep distinct names
 dataset's LiDAR sequence number. The default split is val, where cityscapesScripts'
 evaluation looks.
 
-nuscenes and coco live in their own modules (:mod:`generator.commands.export_nuscenes`,
-:mod:`generator.commands.export_coco`); this one dispatches.
+kitti-object, nuscenes and coco live in their own modules (:mod:`generator.commands.export_kitti_object`,
+:mod:`generator.commands.export_nuscenes`, :mod:`generator.commands.export_coco`); this one dispatches.
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ import os
 from pathlib import Path
 from typing import Iterator
 
-from generator.commands.options import path, text_path
+from generator.commands.options import Integer, Number, path, sequence_id, text_path
 from generator.commands.preflight import input_dir, output_dir
 from generator.errors import UserError
 from generator.jobs.plan import MAX_FRAME_INDEX, check_free_space
@@ -35,14 +36,14 @@ from generator.weather import TIMES, combinations
 from generator.formats.cityscapes import DEFAULT_SPLIT, SPLITS, CityscapesImage, city_name, export, image_stem
 
 #: format -> the module whose ``run(args)`` writes it (None: this module, cityscapes)
-FORMATS = {"cityscapes": None, "nuscenes": "generator.commands.export_nuscenes",
-           "coco": "generator.commands.export_coco"}
+FORMATS = {"cityscapes": None, "kitti-object": "generator.commands.export_kitti_object",
+           "nuscenes": "generator.commands.export_nuscenes", "coco": "generator.commands.export_coco"}
 
 
 def register(sub) -> None:
-    p = sub.add_parser("export", help="write a dataset in the Cityscapes, nuScenes or COCO layout",
+    p = sub.add_parser("export", help="write a dataset in the Cityscapes, KITTI 3D object, nuScenes or COCO layout",
                        description=__doc__.split("\n\n")[1])
-    p.add_argument("format", choices=list(FORMATS), help="target layout: cityscapes, nuscenes or coco")
+    p.add_argument("format", choices=list(FORMATS), help="target layout: cityscapes, kitti-object, nuscenes or coco")
     p.add_argument("dataset", type=path, help="generated dataset (images/, lidar/sequences/)")
     p.add_argument("out", type=path, help="export root (the format's folders are written inside)")
     p.add_argument("--split", default=None, choices=SPLITS,
@@ -52,6 +53,12 @@ def register(sub) -> None:
     p.add_argument("--spec", type=text_path, default=None,
                    help="nuscenes: the scene spec the dataset was made from, when it has no manifest.json "
                         "(made with 'urbangen lidar'); the boxes are rebuilt from it")
+    p.add_argument("--sequences", nargs="+", type=sequence_id, default=None,
+                   help="kitti-object: LiDAR sequences to export, 00..99 (default all)")
+    p.add_argument("--min-points", type=Integer(0, 10_000_000), default=1,
+                   help="kitti-object: things with fewer LiDAR points are DontCare regions (default 1)")
+    p.add_argument("--val-share", type=Number(0.0, 1.0), default=0.5,
+                   help="kitti-object: share of each sequence's samples in val.txt, its last ones (default 0.5)")
     p.set_defaults(func=run)
 
 

@@ -27,7 +27,8 @@ def run(args) -> int:
         raise UserError(f"{root}: nothing to validate (no images/*.exr, lidar/sequences or openlabel/*.json)")
     for line in problems:
         print(line, file=sys.stderr)
-    summary = f"{counts['images']} images, {counts['scans']} scans, {counts['openlabel']} OpenLABEL files"
+    summary = (f"{counts['images']} images, {counts['scans']} scans, {counts['openlabel']} OpenLABEL files, "
+               f"{counts['box files']} box files")
     if problems:
         print(f"urbangen validate: {len(problems)} problem(s) in {summary}", file=sys.stderr)
         return EXIT_INVALID

@@ -34,8 +34,8 @@ class Part:
 
     Attributes
     ----------
-    mesh : generator.geometry.Mesh
-        Local frame (x forward, y left, z up), metres.
+    mesh : generator.geometry.Mesh or None
+        Local frame (x forward, y left, z up), metres (None: a box without geometry, as in tests).
     transform : (4, 4) float64 or None
         ``T_world_local`` of a static part; None for an actor (pose from ``track``).
     track : generator.world.actors.Track or None
@@ -162,12 +162,12 @@ def _static_subjects(scene) -> list[Subject]:
         box = union_box([m.box for m in members], o.box.yaw) if len(members) > 1 else o.box
         out.append(Subject(o.instance_id, tuple(m.instance_id for m in members), o.cls, o.kind, o.name, True, b.group,
                            bool(b.parts) and len(members) > 1, str(o.attrs.get("placement", "")),
-                           tuple(Part(scene.prototypes[m.prototype], np.asarray(m.transform, np.float64))
+                           tuple(Part(scene.prototypes.get(m.prototype), np.asarray(m.transform, np.float64))
                                  for m in members), box))
     for v in spare.values():  # a ridden vehicle without its rider (none is placed so): boxed alone, riderless
         cls = part_of[v.cls]
         log.warning("%s: ridden vehicle without a rider; boxed alone", v.name)
-        part = Part(scene.prototypes[v.prototype], np.asarray(v.transform, np.float64))
+        part = Part(scene.prototypes.get(v.prototype), np.asarray(v.transform, np.float64))
         out.append(Subject(v.instance_id, (v.instance_id,), cls, v.kind, v.name, True, dc.boxes[cls].group, False,
                            str(v.attrs.get("placement", "")), (part,), v.box))
     return out
@@ -182,7 +182,7 @@ def _actor_subjects(world) -> list[Subject]:
             continue
         b = dc.boxes[cls]
         out.append(Subject(a.instance_id, (a.instance_id,), cls, a.kind, a.name, False, b.group, bool(b.parts), "",
-                           (Part(world.prototypes[a.prototype], None, a.track),), None, a))
+                           (Part(world.prototypes.get(a.prototype), None, a.track),), None, a))
     return out
 
 

@@ -24,13 +24,19 @@ the parent). Per frame ``frame_properties.transforms`` holds
   frame time, i.e. vehicle points -> odom;
 * ``camera_to_vehicle-iso8855``: the camera pose of that frame (jitter included).
 
-Objects: key = the object's instance id (the high 16 bits of the ``.label`` files), ``type``
-= native class name. Static town objects and actors (:mod:`generator.world.actors`) share the
-key space in disjoint ranges: actors' instance ids follow every static one, and an actor
-keeps its id (its uid) for the whole sequence. Per frame each object present has one cuboid
-in ``vehicle-iso8855`` at the frame time (the sweep start): ``(x, y, z, qx, qy, qz, qw, sx,
-sy, sz)`` with size = length (along the heading), width, height in metres; ``num``
-``lidar_points`` = points of that instance in the frame's scan; and its motion at the same
+Objects: every boxed thing (:mod:`generator.detection`: vehicles, riders, people of every thing
+class, parked and moving); key = its track id, the instance id (the high 16 bits of the ``.label``
+files) of the object naming the box, ``type`` = its box class (``generator/labels/detection.yaml``).
+A ridden two-wheeler is one object holding vehicle and rider, typed by the rider's class
+(``bicyclist``/``motorcyclist``), its points those of both instance ids. Static town objects and
+actors (:mod:`generator.world.actors`) share the key space in disjoint ranges: actors' instance ids
+follow every static one, and an actor keeps its id for the whole sequence.
+
+Per frame each object present has one cuboid in ``vehicle-iso8855`` at the frame time (the sweep
+start): ``(x, y, z, qx, qy, qz, qw, sx, sy, sz)`` with size = length (along the heading), width,
+height in metres; ``num`` ``lidar_points`` = points of its instance ids in the frame's scan;
+``text`` ``attribute`` = its nuScenes attribute (``vehicle.moving|stopped|parked``, ``cycle.with_rider|without_rider``,
+``pedestrian.moving|standing``); and its motion at the same
 instant (:mod:`generator.formats.openlabel_motion`): ``vec`` ``velocity`` (m/s) and
 ``acceleration`` (m/s^2) of the cuboid centre over ground, expressed in ``odom``; ``num``
 ``speed`` and ``acceleration_magnitude``; ``boolean`` ``moving``. Objects with fewer points
@@ -65,6 +71,7 @@ SCHEMA_PATH = Path(__file__).resolve().parent / "schemas" / "openlabel_json_sche
 ODOM, VEHICLE, LIDAR, CAMERA = "odom", "vehicle-iso8855", "lidar", "camera"
 POINTS_NAME = "lidar_points"
 CUBOID_NAME = "box3d"
+ATTRIBUTE_NAME = "attribute"
 
 
 @functools.cache
@@ -128,25 +135,26 @@ def _intervals(frames: list[int]) -> list[dict]:
     return out
 
 
-def _candidates(objects, actors) -> dict[int, tuple[str, str, object]]:
-    """Instance id -> (name, class, state at t) of static objects and actors."""
-    out = {o.instance_id: (o.name, o.cls, (lambda t, box=o.box: om.static_motion(box))) for o in objects}
-    for a in actors:
-        if a.instance_id in out:
-            raise ValueError(f"actor {a.name}: instance id {a.instance_id} is a static object's too")
-        out[a.instance_id] = (a.name, a.cls, (lambda t, a=a: om.actor_motion(a, t)))
-    return out
+def _candidates(subjects) -> dict[int, tuple]:
+    """Track id -> (name, box class, state at t, instance ids, attribute at t) of every boxed subject."""
+    def state(s):
+        def at(t):
+            v, a = s.motion(t)
+            return om.Motion(s.box(t), v, a, s.moving(t))
+        return at
+
+    return {s.track_id: (s.name, s.cls, state(s), s.instance_ids, s.attribute) for s in subjects}
 
 
-def build_openlabel(*, objects, frames, times, counts, min_points: int, T_ego_lidar: np.ndarray,
+def build_openlabel(*, subjects, frames, times, counts, min_points: int, T_ego_lidar: np.ndarray,
                     T_ego_camera_nominal: np.ndarray, K: np.ndarray, width: int, height: int,
-                    streams: dict, frame_uris: list[dict], info: dict, actors=()) -> dict:
+                    streams: dict, frame_uris: list[dict], info: dict) -> dict:
     """The OpenLABEL document of one sequence.
 
     Parameters
     ----------
-    objects : list of generator.world.scene.SceneObject
-        Candidate static objects (their ``box``, ``instance_id``, ``name``, ``cls``).
+    subjects : list of generator.detection.Subject
+        The boxed things (parked statics and actors; a ridden two-wheeler is one with its rider).
     frames : list
         The sequence's frames (sweeps): each with ``index``, ``T_world_ego`` (4, 4) at the sweep
         start and ``T_ego_camera`` (4, 4, optical camera in the ego frame, jitter included) or
@@ -154,7 +162,8 @@ def build_openlabel(*, objects, frames, times, counts, min_points: int, T_ego_li
     times : (n_frames,) float
         Sweep starts, seconds on the world timeline (``times.txt``); actors are evaluated there.
     counts : list of dict
-        Per frame: instance id -> LiDAR points of that instance in the scan.
+        Per frame: instance id -> LiDAR points of that instance in the scan (a subject counts the
+        points of all its instance ids).
     min_points : int
         Objects with fewer points in a frame are left out of it.
     T_ego_lidar, T_ego_camera_nominal : (4, 4) float64
@@ -167,26 +176,25 @@ def build_openlabel(*, objects, frames, times, counts, min_points: int, T_ego_li
         Per frame ``{"lidar": uri}`` and ``"camera": uri`` when the frame has an image.
     info : dict
         Extra ``metadata.urbangen`` fields (scene, seed, spec hash...).
-    actors : sequence of generator.world.actors.Actor
-        Movers: cuboid and motion from their tracks at each frame's time.
     """
     T_world_odom = frames[0].T_world_ego
     T_odom_world = rig.invert(T_world_odom)
     doc_frames: dict[str, dict] = {}
     present: dict[int, list[int]] = {}
-    cands = _candidates(objects, actors)
-    for f, t, cnt, uris in zip(frames, times, counts, frame_uris):
+    cands = _candidates(subjects)
+    for f, t, cnt, uris in zip(frames, times, counts, frame_uris, strict=True):
         T_vehicle_world = rig.invert(f.T_world_ego)
         objs = {}
         for uid in sorted(cands):
-            n = int(cnt.get(uid, 0))
+            n = sum(int(cnt.get(i, 0)) for i in cands[uid][3])
             if n < max(min_points, 1):
                 continue
             m = cands[uid][2](float(t))
             objs[str(uid)] = {"object_data": {
                 "cuboid": [{"name": CUBOID_NAME, "coordinate_system": VEHICLE,
                             "val": cuboid_val(m.box, T_vehicle_world)}],
-                "num": [{"name": POINTS_NAME, "type": "value", "val": n}]}}
+                "num": [{"name": POINTS_NAME, "type": "value", "val": n}],
+                "text": [{"name": ATTRIBUTE_NAME, "val": cands[uid][4](float(t))}]}}
             for kind, items in om.motion_data(m, T_odom_world[:3, :3], ODOM).items():
                 objs[str(uid)]["object_data"].setdefault(kind, []).extend(items)
             present.setdefault(uid, []).append(f.index)
@@ -210,22 +218,28 @@ def build_openlabel(*, objects, frames, times, counts, min_points: int, T_ego_li
         "metadata": {
             "schema_version": "1.0.0", "file_version": "1",
             "name": f"{info.get('scene', 'scene')} sequence {info.get('sequence', '00')}",
-            "annotator": f"urbangen {__version__} (automatic: boxes from the scene model, counts from the ray-cast labels)",
+            "annotator": f"urbangen {__version__} (automatic: boxes from the scene model, counts from the "
+                         "ray-cast labels)",
             "comment": ("matrix4x4 row-major, X_dst = M X_src; pose_wrt_parent maps child -> parent; cuboids "
                         "(x,y,z,qx,qy,qz,qw,length,width,height) in vehicle-iso8855 at the frame time (sweep "
                         "start); velocity/acceleration of the cuboid centre over ground at the same instant, in "
-                        f"odom (central differences, h = 0.05 s); moving = speed > {om.MOVING_THRESHOLD_MPS} m/s; objects with fewer than {min_points} LiDAR points left out of a frame"),
+                        f"odom (central differences, h = 0.05 s); moving = speed > {om.MOVING_THRESHOLD_MPS} m/s; "
+                        f"objects with fewer than {min_points} LiDAR points left out of a frame; attribute = "
+                        "nuScenes attribute"),
             "urbangen": {**info, "T_world_odom": [float(v) for v in np.round(T_world_odom.reshape(-1), 9)],
                          "min_points": int(min_points)},
         },
         "coordinate_systems": {
             ODOM: {"type": "scene_cs", "parent": "", "children": [VEHICLE]},
-            VEHICLE: {"type": "local_cs", "parent": ODOM, "pose_wrt_parent": _m(np.eye(4)), "children": [LIDAR, CAMERA]},
+            VEHICLE: {"type": "local_cs", "parent": ODOM, "pose_wrt_parent": _m(np.eye(4)),
+                      "children": [LIDAR, CAMERA]},
             LIDAR: {"type": "sensor_cs", "parent": VEHICLE, "pose_wrt_parent": _m(T_ego_lidar), "children": []},
-            CAMERA: {"type": "sensor_cs", "parent": VEHICLE, "pose_wrt_parent": _m(T_ego_camera_nominal), "children": []},
+            CAMERA: {"type": "sensor_cs", "parent": VEHICLE, "pose_wrt_parent": _m(T_ego_camera_nominal),
+                     "children": []},
         },
         "streams": {
-            "camera": {"type": "camera", "uri": streams["camera"]["uri"], "description": streams["camera"]["description"],
+            "camera": {"type": "camera", "uri": streams["camera"]["uri"],
+                       "description": streams["camera"]["description"],
                        "stream_properties": {"intrinsics_pinhole": {
                            "width_px": int(width), "height_px": int(height),
                            "camera_matrix": [float(v) for v in camera_matrix.reshape(-1)],
@@ -259,7 +273,7 @@ def object_counts(doc: dict) -> dict[str, dict[str, int]]:
     """Per class: objects in the file and object-frame cuboids (for reports)."""
     ol = doc["openlabel"]
     out: dict[str, dict[str, int]] = {}
-    for uid, o in ol.get("objects", {}).items():
+    for o in ol.get("objects", {}).values():
         d = out.setdefault(o["type"], {"objects": 0, "cuboids": 0})
         d["objects"] += 1
     for f in ol.get("frames", {}).values():

@@ -24,13 +24,14 @@ from generator.errors import SpecError, UserError
 from generator.formats import semantickitti as sk
 from generator.formats.openlabel import build_openlabel, write_openlabel
 from generator.imaging import meta_fields as md
+from generator.imaging.locate import image_files
+from generator.labels.detection import detection_classes
 from generator.safeload import printable
 from generator.spec.towns import spec_for_record
 from generator.world.rig import SWEEP_PERIOD_S, Rig
 
 log = logging.getLogger(__name__)
 
-DEFAULT_CLASSES = ("car", "truck", "person")
 
 
 @dataclass(frozen=True)
@@ -102,8 +103,7 @@ def sweep_frames(rig: Rig, meta: dict, frames: list[int], times: np.ndarray, sou
 
 def _camera(root: Path, seq, meta: dict, meta_source: str) -> tuple[np.ndarray, int, int, str]:
     """Intrinsics from the first image's metadata, else from calib.txt and the sequence metadata."""
-    images = sorted((root / "images").glob("*.json")) if (root / "images").is_dir() else []
-    for p in images:
+    for p in image_files(root, "json"):
         try:
             K, w, h = md.intrinsics(md.load_metadata(p), str(p))
         except UserError as e:  # another JSON in images/, or a damaged one: the next may do
@@ -152,14 +152,89 @@ def _output(root: Path, name: str) -> Path:
     return out
 
 
-def write_sequence_openlabel(spec, root: Path, sequence: str = "00", classes=DEFAULT_CLASSES,
+@dataclass
+class SequenceWorld:
+    """A dataset's LiDAR sequence with the scene, world and rig it was cast in (every box writer's input).
+
+    Attributes
+    ----------
+    spec : SceneSpec
+        The spec of the sequence's town (a re-drawn town's own spec).
+    root : Path
+        Dataset folder.
+    name : str
+        Sequence ``NN``.
+    seq : generator.formats.semantickitti.Sequence
+    meta : dict
+        ``lidar_meta.json``; ``src`` its path.
+    scene : SceneModel
+    world : World or None
+        The world in time (None: the older one-sweep-per-image layout).
+    rig : Rig
+    stream : bool
+        A 10 Hz stream (``sweep_period_s`` present).
+    """
+
+    spec: object
+    root: Path
+    name: str
+    seq: object
+    meta: dict
+    src: str
+    scene: object
+    world: object
+    rig: Rig
+    stream: bool
+
+    def lidar_pose(self, t: float) -> np.ndarray:
+        """(4, 4) ``T_world_lidar`` at ``t`` seconds."""
+        return self.rig.T_world_lidar(float(t))[0]
+
+
+def open_sequence(spec, root: Path, sequence: str = "00", scene=None, world=None) -> SequenceWorld:
+    """Open ``root/lidar/sequences/NN`` cast from ``spec`` and rebuild (or check) its world.
+
+    ``scene``, ``world``: the ones the sequence was cast in, if the caller has them (``generate``);
+    otherwise they are rebuilt from the spec (the world checked against the recorded digest).
+
+    Raises
+    ------
+    UserError
+        Another spec, no labelled scans, no ``times.txt``, or times outside a drive.
+    """
+    root = Path(root)
+    name = sk.sequence_name(sequence)
+    seq = sk.Sequence(root / "lidar", name)
+    meta_path = seq.dir / "lidar_meta.json"
+    meta = md.load_metadata(meta_path)
+    src = str(meta_path)
+    if md.field(meta, "scene.spec_hash", src, default=None) != spec.spec_hash:
+        raise UserError(f"{meta_path}: cast from another spec (spec_hash differs from {spec.source})")
+    spec = spec_for_record(spec, md.field(meta, "scene", src, default=None), src)  # a re-drawn town's own spec
+    if not seq.has_labels or not seq.frames:
+        raise UserError(f"{seq.dir}: needs scans with labels")
+    if seq.times is None:
+        raise UserError(f"{seq.dir / 'times.txt'}: missing")
+    _check_times(seq.times, seq.dir / "times.txt")
+    if scene is None:
+        from generator.layout import build_scene
+
+        scene = build_scene(spec)
+    route = md.integer(meta, "scene.route", src, 0, max(len(scene.paths) - 1, 0), default=0)
+    stream = md.field(meta, "sweep_period_s", src, default=None) is not None
+    world = sequence_world(spec, scene, meta, seq.times, src, world) if stream else None
+    rig = Rig.from_world(spec, world) if world is not None else Rig.from_spec(spec, scene, route)
+    return SequenceWorld(spec, root, name, seq, meta, src, scene, world, rig, stream)
+
+
+def write_sequence_openlabel(spec, root: Path, sequence: str = "00", classes=None,
                              min_points: int | None = None, scene=None, world=None) -> tuple[Path, dict]:
     """Write ``root/openlabel/NN.json`` for ``root/lidar/sequences/NN`` cast from ``spec``.
 
     Parameters
     ----------
-    classes : sequence of str
-        Thing classes whose objects get cuboids.
+    classes : sequence of str, optional
+        Box classes (``generator/labels/detection.yaml``) that get cuboids (default: every one).
     min_points : int, optional
         Objects with fewer LiDAR points in a frame are left out (default ``spec.labels.openlabel_min_points``).
     scene : SceneModel, optional
@@ -173,40 +248,19 @@ def write_sequence_openlabel(spec, root: Path, sequence: str = "00", classes=DEF
     (Path, dict)
         The file written and the OpenLABEL document.
     """
-    min_points = spec.labels.openlabel_min_points if min_points is None else min_points
-    root = Path(root)
-    name = sk.sequence_name(sequence)
-    out = _output(root, name)  # where it goes is checked before any work
-    seq = sk.Sequence(root / "lidar", name)
-    meta_path = seq.dir / "lidar_meta.json"
-    meta = md.load_metadata(meta_path)
-    src = str(meta_path)
-    if md.field(meta, "scene.spec_hash", src, default=None) != spec.spec_hash:
-        raise UserError(f"{meta_path}: cast from another spec (spec_hash differs from {spec.source})")
-    spec = spec_for_record(spec, md.field(meta, "scene", src, default=None), src)  # a re-drawn town's own spec
-    if not seq.has_labels or not seq.frames:
-        raise UserError(f"{seq.dir}: needs scans with labels")
-    if seq.times is None:
-        raise UserError(f"{seq.dir / 'times.txt'}: missing")
-    _check_times(seq.times, seq.dir / "times.txt")
-    sensor = _sensor(meta, src)
-    if scene is None:
-        from generator.layout.assemble import build_scene
+    from generator.detection import instance_counts, subjects
 
-        scene = build_scene(spec)
-    route = md.integer(meta, "scene.route", src, 0, max(len(scene.paths) - 1, 0), default=0)
-    stream = md.field(meta, "sweep_period_s", src, default=None) is not None
-    world = sequence_world(spec, scene, meta, seq.times, src, world) if stream else None
-    rig = Rig.from_world(spec, world) if world is not None else Rig.from_spec(spec, scene, route)
+    classes = tuple(detection_classes().boxes) if classes is None else tuple(classes)
+    min_points = spec.labels.openlabel_min_points if min_points is None else min_points
+    out = _output(Path(root), sk.sequence_name(sequence))  # where it goes is checked before any work
+    sw = open_sequence(spec, root, sequence, scene, world)
+    spec, seq, meta, src, name = sw.spec, sw.seq, sw.meta, sw.src, sw.name
+    sensor = _sensor(meta, src)
+    rig, stream = sw.rig, sw.stream
     frames = sweep_frames(rig, meta, seq.frames, seq.times, src) if stream else [rig.frame(k) for k in seq.frames]
-    actors = [a for a in world.actors if a.cls in classes] if world is not None else []
-    counts = []
-    for k in seq.frames:
-        _, _, inst = seq.read_labelled(k)  # whole scan and labels, one label per point
-        c = np.bincount(inst)
-        counts.append({int(i): int(c[i]) for i in np.flatnonzero(c) if i > 0})
-    objects = [o for o in scene.objects if o.cls in classes and o.instance_id > 0]
-    K, w, h, k_src = _camera(root, seq, meta, src)
+    subs = [s for s in subjects(sw.scene, sw.world) if s.cls in classes]
+    counts = [instance_counts(seq.read_labelled(k)[2]) for k in seq.frames]
+    K, w, h, k_src = _camera(sw.root, seq, meta, src)
     cam = spec.sensors.camera
     streams = {
         "camera": {"uri": "images/", "description": f"rig camera, hfov {cam.hfov_deg} deg, intrinsics from {k_src}"},
@@ -215,18 +269,18 @@ def write_sequence_openlabel(spec, root: Path, sequence: str = "00", classes=DEF
                   "stream_properties": {"lasers": sensor["lasers"], "range_m": sensor["range_m"],
                                         "motion_skew": sensor["motion_skew"]}},
     }
-    info = {"scene": spec.name, "seed": spec.seed, "spec_hash": spec.spec_hash, "sequence": name, "route": route,
-            "classes": list(classes)}
-    exr = {int(p.name[:6]): p.name for p in sorted((root / "images").glob("[0-9]*_*.exr"), reverse=True)}
+    info = {"scene": spec.name, "seed": spec.seed, "spec_hash": spec.spec_hash, "sequence": name,
+            "route": md.integer(meta, "scene.route", src, 0, 10**6, default=0), "classes": list(classes)}
+    exr = {int(p.name[:6]): p.name for p in sorted(image_files(sw.root, "exr"), reverse=True)}
     frame_uris = []
     for f in frames:
         k = f.image if stream else f.index
         uris = {"camera": f"images/{exr.get(k, f'{k:06d}_day_clear.exr')}"} if k is not None else {}
         frame_uris.append({**uris, "lidar": f"lidar/sequences/{name}/velodyne/{f.index:06d}.bin"})
-    doc = build_openlabel(objects=objects, frames=frames, times=[seq.times[k] for k in seq.frames], counts=counts,
+    doc = build_openlabel(subjects=subs, frames=frames, times=[seq.times[k] for k in seq.frames], counts=counts,
                           min_points=min_points, T_ego_lidar=rig.T_ego_lidar,
                           T_ego_camera_nominal=rig.T_ego_camera(), K=K, width=w, height=h,
-                          streams=streams, frame_uris=frame_uris, info=info, actors=actors)
+                          streams=streams, frame_uris=frame_uris, info=info)
     try:
         write_openlabel(out, doc)
     except ValueError as e:  # a bug, not a user error: say so loudly

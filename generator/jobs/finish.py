@@ -1,4 +1,4 @@
-"""Dataset-level outputs written after the frames: OpenLABEL per sequence and statistics."""
+"""Dataset-level outputs written after the frames: OpenLABEL and the box file per sequence, statistics."""
 
 from __future__ import annotations
 
@@ -17,12 +17,16 @@ def write_stats(out: Path) -> list[Path]:
     return write_report(Path(out) / "stats", out, sections) if sections else []
 
 
-def write_openlabel(spec, out: Path, plan, scene=None, world=None) -> Path:
-    """Write ``out/openlabel/NN.json`` for the plan's sequence (cuboids of cars, trucks, people).
+def write_openlabel(spec, out: Path, plan, scene=None, world=None, supersample: int = 1) -> Path:
+    """Write ``out/openlabel/NN.json`` (cuboids of every boxed thing) and ``out/boxes/NN.npz`` (box
+    records per sweep, visibility per image) for the plan's sequence.
 
-    ``world``: the world the sequence was cast in, when the caller has it (else rebuilt).
+    ``world``: the world the sequence was cast in, when the caller has it (else rebuilt);
+    ``supersample``: the render config's ``label_supersample``.
     """
+    from generator.jobs.box_labels import write_sequence_boxes
     from generator.jobs.boxes import write_sequence_openlabel
 
     path, _ = write_sequence_openlabel(spec, out, plan.sequence, scene=scene, world=world)
+    write_sequence_boxes(spec, out, plan.sequence, scene=scene, world=world, supersample=supersample)
     return path

@@ -243,7 +243,7 @@ def run_generate(spec, cfg, opts: GenerateOptions) -> dict:
             results.append(run_jobs(opts.executor, jobs, len(todo) + len(stereo_todo), on_frame, opts.ray_address))
             shutil.rmtree(out / ".scratch", ignore_errors=True)
             n_todo, n_stereo = n_todo + len(todo), n_stereo + len(stereo_todo)
-        write_openlabel(tspec, out, tplan, scene, drive.world)  # the world the sequence was cast in
+        write_openlabel(tspec, out, tplan, scene, drive.world, cfg.label_supersample)  # the world it was cast in
         mf.save(out, manifest)
         del scene, drive
     if results:

@@ -160,6 +160,21 @@ def check_openlabel(root: Path) -> tuple[list[str], int]:
     return problems, len(files)
 
 
+def check_boxes(root: Path) -> tuple[list[str], int]:
+    """Every box file (``boxes/NN.npz``) reads back whole: arrays, shapes, finite numbers, row references."""
+    from generator.errors import UserError
+    from generator.formats.box_file import read_box_file
+
+    files = sorted((root / "boxes").glob("*.npz")) if (root / "boxes").is_dir() else []
+    problems = []
+    for f in files:
+        try:
+            read_box_file(f)
+        except UserError as e:
+            problems.append(str(e).replace(str(root) + "/", "", 1))
+    return problems, len(files)
+
+
 def check_manifest(root: Path) -> list[str]:
     p = root / "manifest.json"
     if not os.path.lexists(p):
@@ -189,5 +204,6 @@ def validate_dataset(root: Path) -> tuple[list[str], dict]:
     images, n_img = check_images(root)
     lidar, n_scan = check_lidar(root)
     openlabel, n_ol = check_openlabel(root)
-    return (links + images + lidar + openlabel + check_manifest(root),
-            {"images": n_img, "scans": n_scan, "openlabel": n_ol})
+    boxes, n_box = check_boxes(root)
+    return (links + images + lidar + openlabel + boxes + check_manifest(root),
+            {"images": n_img, "scans": n_scan, "openlabel": n_ol, "box files": n_box})
