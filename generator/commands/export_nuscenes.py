@@ -24,7 +24,10 @@ def run(args) -> int:
     images = [p for n in names for c in (2, 3) for p in (root / "lidar" / "sequences" / n / f"image_{c}").glob("*.png")]
     need = sum(p.stat().st_size for p in scans) * 5 // 4 + sum(p.stat().st_size for p in images) + 50_000_000
     check_free_space(args.out, need, f"{len(scans)} sweeps, {len(images)} images", flag="OUT")
-    spec = dataset_spec(root, args.spec)
+    from generator.jobs.sequence_boxes import box_file_of
+
+    # the boxes come from each sequence's box file; only a sequence without one needs the spec
+    spec = None if all(box_file_of(root, n) for n in names) and args.spec is None else dataset_spec(root, args.spec)
     summary = export_nuscenes(root, args.out, spec, args.split, names)
     n = summary["tables"]
     print(f"exported {len(summary['scenes'])} scene(s) to {args.out} as nuScenes {VERSION}: {n['sample']} samples, "

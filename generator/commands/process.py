@@ -1,15 +1,15 @@
-"""``urbangen process DIR OUT --domain-gap seed002 [--dropout F] [--jitter-m M] [--gap-intensity V] [--spec SPEC]``.
+"""``urbangen process DIR OUT --domain-gap seed002 [--dropout F] [--jitter-m M] [--gap-intensity V]``.
 
 Writes the processed twin of a dataset into OUT: the same scenes, images, poses and boxes, every scan
 through seed 002's domain-gap processing (10 % of the points removed, +-0.05 m uniform jitter per axis,
 constant intensity 1 of 255), with every point count that follows (labels, side files, lidar_meta.json,
-semantic-kitti.yaml, OpenLABEL num lidar_points) recounted, so raw and processed evaluations run on
+semantic-kitti.yaml, the box file's and OpenLABEL's num_lidar_pts) recounted, so raw and processed evaluations run on
 identical scenes. The parts can be changed one by one. Nothing is written on error.
 """
 
 from __future__ import annotations
 
-from generator.commands.options import Number, path, text_path
+from generator.commands.options import Number, path
 from generator.commands.preflight import input_dir, output_dir
 from generator.errors import UserError
 
@@ -27,17 +27,13 @@ def register(sub) -> None:
     p.add_argument("--jitter-m", type=Number(0, 1), default=None, help="uniform per-axis jitter half-width, m")
     p.add_argument("--gap-intensity", type=Number(0, 1, none=True), default=None,
                    help="constant remission in [0, 1] ('none' keeps the scans' own)")
-    p.add_argument("--spec", type=text_path, default=None,
-                   help="the scene spec the dataset was made from, when it has OpenLABEL boxes but no manifest.json")
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
     import dataclasses
-    import os
 
     from generator.jobs.process import process_dataset
-    from generator.jobs.sequence_boxes import dataset_spec
     from generator.scan_effects.domain_gap import preset
 
     root = input_dir(args.dataset, what="dataset folder")
@@ -49,13 +45,10 @@ def run(args) -> int:
     if args.gap_intensity is not None:
         parts["constant_intensity"] = None if args.gap_intensity == "none" else args.gap_intensity
     gap = dataclasses.replace(gap, **parts)
-    has_boxes = any((root / "openlabel").glob("*.json")) if (root / "openlabel").is_dir() else False
-    spec = None
-    if has_boxes or args.spec is not None:
-        spec = dataset_spec(root, args.spec) if args.spec or os.path.lexists(root / "manifest.json") else None
-    summary = process_dataset(root, args.out, gap, spec)
+    summary = process_dataset(root, args.out, gap)
     kept = summary["points_out"] / max(summary["points_in"], 1)
     print(f"wrote the processed twin of {root} to {args.out}: {len(summary['sequences'])} sequence(s), "
           f"{summary['points_out']} of {summary['points_in']} points kept ({100 * kept:.1f} %), "
-          f"jitter +-{gap.jitter_m} m, intensity {gap.constant_intensity}")
+          f"jitter +-{gap.jitter_m} m, intensity {gap.constant_intensity}; {summary['box_records']} box records "
+          f"recounted ({summary['boxes_dropped']} left without points dropped)")
     return 0

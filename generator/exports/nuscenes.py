@@ -41,6 +41,7 @@ from generator.formats.point_sidecars import RINGS_DIR, TIMES_DIR, read_sidecar
 from generator.geometry.transforms import mount
 from generator.imaging import meta_fields as md
 from generator.labels.nuscenes import nuscenes_labels
+from generator.safeload import printable
 
 log = logging.getLogger(__name__)
 
@@ -51,6 +52,9 @@ CAMERA_CHANNELS = {2: "CAM_FRONT", 3: "CAM_FRONT_STEREO"}
 MAP_IDS = (40, 44, 48, 60)
 MAP_RES_M = 0.1          #: nuScenes' map mask resolution
 MAP_CELL_M = 0.5         #: points are binned, closed and dilated on this grid, then upsampled
+#: Visibility of a box no camera image of its sample shows: nuScenes bins the share visible in all of a
+#: sample's images, so a box outside them is in the lowest bin (0-40 %).
+NOT_SEEN = "1"
 SPLIT_NAMES = {"train": "urbangen_train", "valid": "urbangen_val", "val": "urbangen_val", "test": "urbangen_test"}
 
 
@@ -121,8 +125,10 @@ class SceneExport:
         self.T_ego_lidar = mount(md.matrix(self.meta, "mount.lidar_xyz_m", (3,), self.meta_src),
                                  md.matrix(self.meta, "mount.lidar_rpy_deg", (3,), self.meta_src))
         self.boxes = sequence_boxes(self.root, name, spec, [j for j in self.seq.frames if j % nu.KEY_EVERY == 0])
-        self.spec = self.boxes.spec
-        self.scene_name = f"{self.spec.name}-{name}"
+        self.town = md.field(self.meta, "scene.name", self.meta_src)
+        if not isinstance(self.town, str) or not self.town.replace("_", "").replace("-", "").isalnum():
+            raise UserError(f"{self.meta_src}: scene.name: must be a scene name (letters, digits, _ and -)")
+        self.scene_name = f"{self.town}-{name}"
         self.t0_us = nu.EPOCH_US + index * nu.SCENE_SPACING_US
         self.log_name = f"urbangen-{self.scene_name}"
         reach = float(md.matrix(self.meta, "sensor.range_m", (2,), self.meta_src)[1])
@@ -145,9 +151,14 @@ class SceneExport:
         if rings is not None:
             return rings.astype(np.int64)
         if self._sensor is None:
-            from generator.lidar.sensors import sensor_for_spec
+            from generator.lidar.sensors import load_preset
 
-            self._sensor = sensor_for_spec(self.spec)
+            preset = md.field(self.meta, "sensor.name", self.meta_src)
+            try:
+                self._sensor = load_preset(str(preset))
+            except UserError:
+                raise UserError(f"{self.seq.dir / RINGS_DIR}: missing, and the sensor {printable(str(preset), 40)} "
+                                "is no preset to take the rings from; re-make the sequence") from None
             log.warning("%s: no %s/; rings taken from each point's elevation", self.seq.dir, RINGS_DIR)
         return rings_from_elevation(xyz, self._sensor)
 
@@ -204,22 +215,24 @@ class SceneExport:
         labels = nuscenes_labels()
         out = []
         for j, recs in sorted(self.boxes.records.items()):
+            seen = self.boxes.visibility.get(j, {})
             for r in recs:
                 c = self.shift[:3, :3] @ r.center + self.shift[:3, 3]
                 out.append(nu.Annotation(j, r.track_id, labels.category(r.cls, r.kind), r.attribute, c, r.size,
-                                         float(r.yaw), r.num_lidar_pts))
+                                         float(r.yaw), r.num_lidar_pts, seen.get(r.track_id, NOT_SEEN)))
         return out
 
     def scene_input(self, sweeps: list[nu.Sweep], cameras: list[nu.CameraImage]) -> nu.SceneInput:
-        town = self.spec.town_index
-        desc = (f"urbangen {self.spec.name}, sequence {self.name}" + (f", town {town}" if town is not None else "")
-                + f", seed {self.spec.seed}: {len(sweeps)} LiDAR sweeps at 10 Hz")
+        town = md.field(self.meta, "scene.town.index", self.meta_src, default=None)
+        seed = md.field(self.meta, "scene.seed", self.meta_src, default=None)
+        desc = (f"urbangen {self.town}, sequence {self.name}" + (f", town {town}" if town is not None else "")
+                + f", seed {seed}: {len(sweeps)} LiDAR sweeps at 10 Hz; boxes {self.boxes.source}")
         map_rel = f"maps/{nu.token(self.scene_name, 'map')}.png"
         from PIL import Image
 
         (self.stage / "maps").mkdir(parents=True, exist_ok=True)
         Image.fromarray(self.map.png()).save(self.stage / map_rel)
-        return nu.SceneInput(self.scene_name, desc, self.spec.name, self.T_ego_lidar, sweeps, self.annotations(),
+        return nu.SceneInput(self.scene_name, desc, self.town, self.T_ego_lidar, sweeps, self.annotations(),
                              cameras, map_rel)
 
 
@@ -233,7 +246,7 @@ def _split_of(root: Path, name: str, split: str | None) -> str:
     return SPLIT_NAMES["valid"]
 
 
-def export_nuscenes(root: Path, out: Path, spec, split: str | None = None, sequences: list[str] | None = None,
+def export_nuscenes(root: Path, out: Path, spec=None, split: str | None = None, sequences: list[str] | None = None,
                     progress=None) -> dict:
     """Write the nuScenes dataroot of ``root``'s sequences under ``out`` (all at once or nothing).
 

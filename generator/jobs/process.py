@@ -9,9 +9,11 @@ random removal, per-axis jitter, constant intensity), and everything that counts
   ``point_rings``) keep the same rows (the kept points, in order);
 * ``lidar_meta.json``: ``points_per_scan``, ``raw_id_counts`` recounted, ``twin_of`` records the source,
   the parameters and the random stream; ``semantic-kitti.yaml``'s ``content`` recounted;
-* ``openlabel/NN.json`` rewritten from the spec with ``num lidar_points`` counted in the processed
-  labels (an object left without points leaves that frame); the box records of the exports count
-  points in the labels they read, so they follow by themselves.
+* the box file ``boxes/NN.npz`` and ``openlabel/NN.json``: every record's ``num_lidar_pts`` counted
+  again in the processed labels (a ridden two-wheeler's rider and vehicle summed, from the box file's
+  tracks); a box left with fewer points than the file's threshold leaves that sweep; image boxes keep
+  their 2D boxes and visibility (the images do not change) with the new counts. Pure data: no spec,
+  no rebuild.
 
 Randomness: scan ``k`` of sequence ``NN`` draws from ``stream(seed, "process", "domain_gap", NN, k)``
 of the sequence's own seed (``lidar_meta.json`` ``scene.seed``): a new stream, so the same source and
@@ -25,6 +27,7 @@ are not: make them again on the twin.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import logging
 import os
@@ -101,15 +104,87 @@ def process_sequence(src: Path, dest: Path, gap: DomainGap, name: str) -> dict:
     return meta
 
 
-def process_dataset(root: Path, out: Path, gap: DomainGap, spec=None, progress=None) -> dict:
-    """Write the processed twin of dataset ``root`` into ``out`` (all at once or nothing).
+def _counts(seq_dir: Path, name: str) -> dict[int, dict[int, int]]:
+    """Per sweep: points per instance id of the (processed) labels of ``seq_dir``."""
+    from generator.detection import instance_counts
 
-    Parameters
-    ----------
-    spec : generator.spec.SceneSpec, optional
-        The dataset's spec, to rewrite ``openlabel/NN.json`` with recounted points (needed only when the
-        dataset has OpenLABEL files).
-    """
+    seq = sk.Sequence(seq_dir.parent.parent, name)
+    return {j: instance_counts(sk.read_labels(seq.label_path(j))[1]) for j in seq.frames}
+
+
+def _instances_of(box_file) -> dict[int, tuple[int, ...]]:
+    a = box_file.arrays if box_file is not None else None
+    if a is None:
+        return {}
+    return {int(t): tuple(int(i) for i in ids if i > 0) for t, ids in zip(a["track_id"], a["track_instance_ids"],
+                                                                         strict=True)}
+
+
+def recount_box_file(src: Path, dest: Path, counts: dict[int, dict[int, int]]) -> dict:
+    """Write ``src``'s box file to ``dest`` with every ``num_lidar_pts`` counted again from ``counts``."""
+    from generator.formats.box_file import read_box_file, write_box_file
+
+    bf = read_box_file(src)
+    min_points = int(bf.info.get("min_points", 1))
+
+    def n_of(r, j) -> int:
+        return sum(counts.get(j, {}).get(i, 0) for i in r.instance_ids)
+
+    records = [dataclasses.replace(r, num_lidar_pts=n_of(r, j)) for j in sorted(bf.sweeps) for r in bf.records(j)]
+    kept = [r for r in records if r.num_lidar_pts >= min_points]
+    images = []
+    for name in bf.image_names:
+        e = bf.image(name)
+        boxes = [(dataclasses.replace(r, num_lidar_pts=n_of(r, e.sweep)) if e.sweep is not None and r.num_lidar_pts >= 0
+                  else r, b) for r, b in e.boxes]
+        images.append(dataclasses.replace(e, boxes=boxes))
+    info = {**bf.info, "recounted": "num_lidar_pts counted again in the labels of the processed twin "
+                                    "(urbangen process)"}
+    dest.parent.mkdir(parents=True, exist_ok=True)
+    write_box_file(dest, bf.sweeps, kept, images, info)
+    return {"records": len(kept), "dropped": len(records) - len(kept)}
+
+
+def recount_openlabel(src: Path, dest: Path, counts: dict[int, dict[int, int]], instances: dict) -> None:
+    """Write ``src``'s OpenLABEL file to ``dest`` with ``lidar_points`` counted again (objects below the
+    file's threshold leave their frame; frame intervals follow)."""
+    from generator.formats.openlabel import POINTS_NAME, validate_openlabel
+
+    doc = md.load_metadata(src)
+    ol = doc.get("openlabel") if isinstance(doc, dict) else None
+    if not isinstance(ol, dict) or not isinstance(ol.get("frames"), dict):
+        raise UserError(f"{src}: not an OpenLABEL file urbangen wrote (openlabel.frames)")
+    min_points = int(((ol.get("metadata") or {}).get("urbangen") or {}).get("min_points", 1))
+    present: dict[str, list[int]] = {}
+    for key, frame in ol["frames"].items():
+        j = int(key)
+        for uid in list(frame.get("objects") or {}):
+            n = sum(counts.get(j, {}).get(i, 0) for i in instances.get(int(uid), (int(uid),)))
+            nums = frame["objects"][uid].get("object_data", {}).get("num", [])
+            if n < max(min_points, 1) or not nums:
+                del frame["objects"][uid]
+                continue
+            for v in nums:
+                if v.get("name") == POINTS_NAME:
+                    v["val"] = int(n)
+            present.setdefault(uid, []).append(j)
+    objects = ol.get("objects") or {}
+    for uid in list(objects):
+        if uid not in present:
+            del objects[uid]
+        else:
+            ks = sorted(present[uid])
+            runs = np.split(np.array(ks), np.flatnonzero(np.diff(ks) > 1) + 1)
+            objects[uid]["frame_intervals"] = [{"frame_start": int(r[0]), "frame_end": int(r[-1])} for r in runs]
+    problems = validate_openlabel(doc)
+    if problems:
+        raise UserError(f"{src}: the recounted document does not match the OpenLABEL schema ({problems[0]})")
+    dest.parent.mkdir(parents=True, exist_ok=True)
+    dest.write_text(json.dumps(doc, indent=1) + "\n", encoding="utf-8")
+
+
+def process_dataset(root: Path, out: Path, gap: DomainGap, progress=None) -> dict:
+    """Write the processed twin of dataset ``root`` into ``out`` (all at once or nothing)."""
     from generator.jobs.lidar_sequence import write_dataset_label_config
     from generator.progress import progress as bar
 
@@ -118,20 +193,28 @@ def process_dataset(root: Path, out: Path, gap: DomainGap, spec=None, progress=N
     names = [p.name for p in sorted((root / "lidar" / "sequences").glob("[0-9][0-9]")) if (p / META_NAME).is_file()]
     if not names:
         raise UserError(f"{root / 'lidar' / 'sequences'}: no LiDAR sequences (sequences/NN with {META_NAME})")
-    for top in ("lidar", "images", "openlabel", "manifest.json"):
+    for top in ("lidar", "images", "openlabel", "boxes", "manifest.json"):
         if os.path.lexists(out / top):
             raise UserError(f"{out / top}: exists; the twin goes into a new or empty folder")
-    labelled = [n for n in names if (root / "openlabel" / f"{n}.json").is_file()]
-    if labelled and spec is None:
-        raise UserError(f"{root / 'openlabel'}: rewriting the OpenLABEL boxes needs the dataset's spec "
-                        "(manifest.json, or name it with --spec)")
-    summary = {"sequences": names, "points_in": 0, "points_out": 0}
+    summary = {"sequences": names, "points_in": 0, "points_out": 0, "box_records": 0, "boxes_dropped": 0}
     with staging(out, "process") as stage:
         for name in progress(names, desc="process", unit="sequence"):
             src = root / "lidar" / "sequences" / name
             meta = process_sequence(src, stage / "lidar" / "sequences" / name, gap, name)
             summary["points_out"] += sum(meta["points_per_scan"])
             summary["points_in"] += sum(r["points_in"] for r in meta["twin_of"]["scans"])
+            counts = _counts(stage / "lidar" / "sequences" / name, name)
+            box_file = None
+            if (root / "boxes" / f"{name}.npz").is_file():
+                from generator.formats.box_file import read_box_file
+
+                box_file = read_box_file(root / "boxes" / f"{name}.npz")
+                n = recount_box_file(root / "boxes" / f"{name}.npz", stage / "boxes" / f"{name}.npz", counts)
+                summary["box_records"] += n["records"]
+                summary["boxes_dropped"] += n["dropped"]
+            if (root / "openlabel" / f"{name}.json").is_file():
+                recount_openlabel(root / "openlabel" / f"{name}.json", stage / "openlabel" / f"{name}.json", counts,
+                                  _instances_of(box_file))
         split_cfg = root / "lidar" / "semantic-kitti.yaml"
         if split_cfg.is_file():
             shutil.copy2(split_cfg, stage / "lidar" / "semantic-kitti.yaml")   # its split, then new content
@@ -140,11 +223,6 @@ def process_dataset(root: Path, out: Path, gap: DomainGap, spec=None, progress=N
             _link_or_copy(root / "images", stage / "images")
         if (root / "manifest.json").is_file():
             shutil.copy2(root / "manifest.json", stage / "manifest.json")
-        if labelled:
-            from generator.jobs.boxes import write_sequence_openlabel
-
-            for name in labelled:
-                write_sequence_openlabel(spec, stage, name)   # the spec's threshold, as generate wrote them
         for top in sorted(stage.iterdir()):
             os.replace(top, out / top.name)
     return summary

@@ -1,14 +1,13 @@
-"""The 3D box records of a dataset's LiDAR sequence, rebuilt from the spec it was cast from.
+"""The 3D box records of a dataset's LiDAR sequence, for the exports (nuScenes) and ``urbangen process``.
 
-The exports (nuScenes) and ``urbangen process`` need one :class:`generator.detection.BoxRecord` per
-boxed thing per sweep. The world is deterministic from the spec (the seed names every draw), so the
-records are rebuilt: the sequence's town (``lidar_meta.json`` ``scene`` record, a re-drawn town's own
-spec), its traffic over the recorded duration (checked against the recorded digest, as ``openlabel``
-and ``fuse`` do), and ``num_lidar_pts`` counted in the labels on disk -- so a processed twin (points
-removed) gets its own counts from its own labels.
+Read from the sequence's box file (``boxes/NN.npz``, :mod:`generator.formats.box_file`, which
+``generate`` and ``urbangen openlabel`` write) when it is there: no spec, no rebuild. Without it (a
+dataset made with ``urbangen lidar``, or before box files existed) they are rebuilt from the spec as
+the box file's writer does (:func:`generator.jobs.boxes.open_sequence`: the sequence's town, its
+traffic checked against the recorded digest, ``num_lidar_pts`` counted in the labels on disk).
 
 Where the spec comes from: the dataset's ``manifest.json`` (``generate``), or the spec file the caller
-names (datasets made with ``urbangen lidar``, which writes no manifest).
+names (``urbangen lidar`` writes no manifest).
 """
 
 from __future__ import annotations
@@ -18,16 +17,13 @@ import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
-
-from generator.detection import SweepClock, instance_counts, subjects, sweep_boxes
 from generator.errors import UserError
-from generator.formats import semantickitti as sk
 from generator.imaging import meta_fields as md
 
 log = logging.getLogger(__name__)
 
-META_NAME = "lidar_meta.json"
+#: The stereo camera whose image boxes give a nuScenes annotation its visibility (the left one, CAM_FRONT).
+VISIBILITY_IMAGE = "image_2"
 
 
 def dataset_spec(root: Path, spec_path: str | None = None):
@@ -55,72 +51,72 @@ def dataset_spec(root: Path, spec_path: str | None = None):
 
 @dataclass
 class SequenceBoxes:
-    """One sequence's world and its box records.
+    """One sequence's box records.
 
     Attributes
     ----------
-    spec : generator.spec.SceneSpec
-        The sequence's own spec (a re-drawn town's).
-    rig : generator.world.rig.Rig
-        Riding the sequence's ego: ``rig.T_world_lidar(t)`` is the pose the records were made with.
-    times : (n,) float64
-        Sweep starts (``times.txt``), seconds.
     records : dict of int to list of BoxRecord
-        Per sweep asked for.
-    subjects : list of generator.detection.Subject
+        Per sweep asked for (``num_lidar_pts`` >= the threshold they were made with).
+    visibility : dict of int to dict of int to str
+        Per sweep: track id -> nuScenes visibility token of the box in that sweep's ``image_2`` (only
+        sweeps with such an image, only boxes whose footprint touches it).
+    source : str
+        ``"box file"`` or ``"rebuilt from the spec"``.
     """
 
-    spec: object
-    rig: object
-    times: np.ndarray
     records: dict = field(default_factory=dict)
-    subjects: list = field(default_factory=list)
+    visibility: dict = field(default_factory=dict)
+    source: str = ""
 
 
-def sequence_boxes(root: Path, sequence: str, spec, sweeps=None, min_points: int = 1) -> SequenceBoxes:
+def box_file_of(root: Path, name: str) -> Path | None:
+    """``root/boxes/NN.npz`` when it exists."""
+    p = Path(root) / "boxes" / f"{name}.npz"
+    return p if os.path.lexists(p) else None
+
+
+def sequence_boxes(root: Path, name: str, spec=None, sweeps=None, min_points: int = 1) -> SequenceBoxes:
     """Box records of ``root/lidar/sequences/NN`` (every sweep, or those of ``sweeps``).
 
     Parameters
     ----------
-    root : Path
-        Dataset folder (``lidar/sequences/NN`` inside).
-    sequence : str
-        ``NN``.
-    spec : generator.spec.SceneSpec
-        The dataset's spec (:func:`dataset_spec`); must have the hash the sequence recorded.
-    sweeps : iterable of int, optional
+    spec : generator.spec.SceneSpec, optional
+        Needed only without a box file (:func:`dataset_spec`).
     min_points : int
-        Keep boxes with at least this many points in their sweep (default 1, seed 002).
+        Threshold of rebuilt records (a box file keeps its own).
     """
-    from generator.jobs.boxes import sequence_world
-    from generator.layout import build_scene
-    from generator.lidar.sensors import sensor_for_spec
-    from generator.spec.towns import spec_for_record
-    from generator.world.rig import Rig
+    from generator.formats import semantickitti as sk
 
-    seq = sk.Sequence(Path(root) / "lidar", sequence)
-    meta_path = seq.dir / META_NAME
-    meta = md.load_metadata(meta_path)
-    src = str(meta_path)
-    if md.field(meta, "scene.spec_hash", src, default=None) != spec.spec_hash:
-        raise UserError(f"{meta_path}: cast from another spec (spec_hash differs from {spec.source})")
-    spec = spec_for_record(spec, md.field(meta, "scene", src, default=None), src)
-    if seq.times is None:
-        raise UserError(f"{seq.dir / 'times.txt'}: missing")
-    if not seq.has_labels:
-        raise UserError(f"{seq.labels_dir}: missing (box records count points in the labels)")
-    log.info("rebuilding %s (sequence %s) for its boxes", spec.name, sequence)
-    scene = build_scene(spec)
-    stream = md.field(meta, "sweep_period_s", src, default=None) is not None
-    world = sequence_world(spec, scene, meta, seq.times, src) if stream else None
-    route = md.integer(meta, "scene.route", src, 0, max(len(scene.paths) - 1, 0), default=0)
-    rig = Rig.from_world(spec, world) if world is not None else Rig.from_spec(spec, scene, route)
-    things = subjects(scene, world)
-    skew = md.field(meta, "motion_skew", src, default=False) is True
-    clock = SweepClock.of(sensor_for_spec(spec)) if skew else None
-    out = SequenceBoxes(spec, rig, np.asarray(seq.times, np.float64), {}, things)
-    for j in seq.frames if sweeps is None else sweeps:
-        _, inst = sk.read_labels(seq.label_path(j))
-        out.records[j] = sweep_boxes(things, j, float(seq.times[j]), lambda t: rig.T_world_lidar(t)[0],
-                                     instance_counts(inst), clock, min_points)
+    root = Path(root)
+    path = box_file_of(root, name)
+    if path is not None:
+        from generator.formats.box_file import read_box_file
+
+        bf = read_box_file(path)
+        js = sorted(bf.sweeps) if sweeps is None else list(sweeps)
+        out = SequenceBoxes({j: bf.records(j) for j in js}, {}, "box file")
+        for j in js:
+            entry = bf.image(f"{VISIBILITY_IMAGE}/{j:06d}")
+            if entry is not None:
+                out.visibility[j] = {r.track_id: b.nuscenes_visibility for r, b in entry.boxes}
+        return out
+    if spec is None:
+        raise UserError(f"{root / 'boxes' / f'{name}.npz'}: missing, so the boxes are rebuilt from the spec: "
+                        "name it with --spec (or write the box file with 'urbangen openlabel SPEC DIR')")
+    from generator.detection import SweepClock, instance_counts, subjects, sweep_boxes
+    from generator.jobs.boxes import open_sequence
+
+    sw = open_sequence(spec, root, name)
+    log.info("no box file for %s: rebuilding %s (sequence %s) for its boxes", name, sw.spec.name, name)
+    things = subjects(sw.scene, sw.world)
+    clock = None
+    if md.field(sw.meta, "motion_skew", sw.src, default=False) is True:
+        from generator.lidar.sensors import sensor_for_spec
+
+        clock = SweepClock.of(sensor_for_spec(sw.spec))
+    out = SequenceBoxes({}, {}, "rebuilt from the spec")
+    for j in sw.seq.frames if sweeps is None else sweeps:
+        _, inst = sk.read_labels(sw.seq.label_path(j))
+        out.records[j] = sweep_boxes(things, j, float(sw.seq.times[j]), sw.lidar_pose, instance_counts(inst), clock,
+                                     min_points)
     return out
