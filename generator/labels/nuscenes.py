@@ -15,6 +15,8 @@ from generator.labels.registry import _load_yaml
 #: The attributes nuScenes v1.0 defines (attribute.json), in its order.
 ATTRIBUTES = ("vehicle.moving", "vehicle.stopped", "vehicle.parked", "cycle.with_rider", "cycle.without_rider",
               "pedestrian.sitting_lying_down", "pedestrian.standing", "pedestrian.moving")
+#: The six classes seed 002 scores (its Tables 1-3), in its order.
+SEED002_CLASSES = ("car", "truck", "bus", "pedestrian", "motorcycle", "bicycle")
 #: Visibility bin edges (fraction visible): bin token ``str(i + 1)`` holds [edge i, edge i + 1).
 VISIBILITY_EDGES = (0.0, 0.4, 0.6, 0.8, 1.0)
 
@@ -35,6 +37,8 @@ class NuScenesLabels:
         Attribute name -> description.
     visibility : list of dict
         ``{"token", "level", "description"}`` per bin.
+    detection : dict of str to str
+        Category -> the detection benchmark class it folds into (categories it scores only).
     """
 
     categories: dict[str, str]
@@ -42,10 +46,15 @@ class NuScenesLabels:
     kinds: dict[str, str]
     attributes: dict[str, str]
     visibility: list[dict]
+    detection: dict[str, str]
 
     def category(self, cls: str, kind: str = "") -> str:
         """The nuScenes category of a box of class ``cls`` built from asset ``kind``."""
         return self.kinds.get(kind) or self.boxes[cls]
+
+    def detection_class(self, cls: str, kind: str = "") -> str | None:
+        """The detection benchmark class of a box (``car``, ``pedestrian``...), None when it scores none."""
+        return self.detection.get(self.category(cls, kind))
 
 
 def visibility_token(fraction: float) -> str:
@@ -74,4 +83,7 @@ def nuscenes_labels() -> NuScenesLabels:
     vis = [dict(v) for v in doc["visibility"]]
     if [v["token"] for v in vis] != [str(i) for i in range(1, len(VISIBILITY_EDGES))]:
         raise ValueError("nuscenes.yaml: visibility tokens must be 1..4")
-    return NuScenesLabels(cats, boxes, kinds, attrs, vis)
+    det = {str(c): str(d) for d, cs in doc["detection"].items() for c in cs}
+    if set(det) - set(cats) or len(doc["detection"]) != 10:
+        raise ValueError("nuscenes.yaml: detection: ten classes, each of listed categories")
+    return NuScenesLabels(cats, boxes, kinds, attrs, vis, det)
