@@ -9,7 +9,8 @@ converters of MMDetection3D / OpenPCDet read)::
     OUT/samples/LIDAR_TOP/<log>__LIDAR_TOP__<timestamp>.pcd.bin   key-frame sweeps (2 Hz)
     OUT/sweeps/LIDAR_TOP/...                   the sweeps between them (10 Hz in all)
     OUT/samples/CAM_FRONT/..., CAM_FRONT_STEREO/...   the sequence's stereo pair (image_2, image_3)
-    OUT/maps/<token>.png                       per scene: where the LiDAR saw road, parking, sidewalk
+    OUT/maps/<token>.png                       per scene: where the LiDAR saw road, parking, sidewalk (and
+                                               the ground under the ego's path), 0.1 m per pixel
 
 Every sequence ``lidar/sequences/NN`` is a scene (its own log and map); the tables follow
 :mod:`generator.formats.nuscenes`. Points are de-skewed to the sweep start (urbangen scans keep
@@ -52,6 +53,9 @@ CAMERA_CHANNELS = {2: "CAM_FRONT", 3: "CAM_FRONT_STEREO"}
 MAP_IDS = (40, 44, 48, 60)
 MAP_RES_M = 0.1          #: nuScenes' map mask resolution
 MAP_CELL_M = 0.5         #: points are binned, closed and dilated on this grid, then upsampled
+#: The ego drives on the road: the ground within this radius of it, which its own LiDAR cannot see (an
+#: HDL-64E's lowest beam meets the ground 3.7 m out), joins the prior.
+EGO_GROUND_M = 3.0
 #: Visibility of a box no camera image of its sample shows: nuScenes bins the share visible in all of a
 #: sample's images, so a box outside them is in the lowest bin (0-40 %).
 NOT_SEEN = "1"
@@ -94,6 +98,12 @@ class MapRaster:
     def __init__(self, size_m: np.ndarray):
         self.shape = tuple(int(v) for v in np.ceil(np.asarray(size_m) / MAP_CELL_M)[::-1])   # (rows=y, cols=x)
         self.hits = np.zeros(self.shape, bool)
+
+    def add_disk(self, xy_global: np.ndarray, radius_m: float) -> None:
+        """Mark the cells within ``radius_m`` of a point (the ground the ego stands on, which its LiDAR cannot see)."""
+        r = int(np.ceil(radius_m / MAP_CELL_M))
+        off = np.stack(np.meshgrid(np.arange(-r, r + 1), np.arange(-r, r + 1)), -1).reshape(-1, 2) * MAP_CELL_M
+        self.add(np.asarray(xy_global, np.float64)[:2] + off[np.hypot(off[:, 0], off[:, 1]) <= radius_m])
 
     def add(self, xy_global: np.ndarray) -> None:
         ij = np.floor(xy_global / MAP_CELL_M).astype(np.int64)
@@ -183,7 +193,9 @@ class SceneExport:
         T_global_lidar = self.shift @ poses[0]
         ground = np.isin(sem, MAP_IDS)
         self.map.add(xyz[ground] @ T_global_lidar[:3, :3].T[:, :2] + T_global_lidar[:2, 3])
-        return nu.Sweep(j, self.timestamp(t), self.shift @ self.T_world_ego(j), rel)
+        T_global_ego = self.shift @ self.T_world_ego(j)
+        self.map.add_disk(T_global_ego[:2, 3], EGO_GROUND_M)
+        return nu.Sweep(j, self.timestamp(t), T_global_ego, rel)
 
     def cameras(self) -> list[nu.CameraImage]:
         """The stereo pair's images (``image_2``/``image_3`` with their ``passes_N`` JSON), copied over."""
