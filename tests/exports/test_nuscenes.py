@@ -131,10 +131,10 @@ def test_ten_sweeps_accumulate_and_static_things_stay_in_their_boxes(nusc):
     assert parked
     for b in parked:   # a parked car's points from all ten sweeps pile up inside its box (ego motion undone)
         local = b.rotation_matrix.T @ (pc.points[:3] - b.center[:, None])
-        w, l, h = b.wlh
+        w, length, h = b.wlh
         above = local[2] > -h / 2 + 0.3                     # off the ground and kerb
-        shell = above & (np.abs(local[0]) <= l / 2 + 0.3) & (np.abs(local[1]) <= w / 2 + 0.3) & (local[2] <= h / 2)
-        inside = above & np.all(np.abs(local) <= np.array([[l], [w], [h]]) / 2 + 0.02, axis=0)   # exact boxes:
+        shell = above & (np.abs(local[0]) <= length / 2 + 0.3) & (np.abs(local[1]) <= w / 2 + 0.3) & (local[2] <= h / 2)
+        inside = above & np.all(np.abs(local) <= np.array([[length], [w], [h]]) / 2 + 0.02, axis=0)   # exact boxes:
         assert inside.sum() >= 0.99 * shell.sum() > 0                                           # float32 on faces
 
 

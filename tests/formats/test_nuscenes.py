@@ -45,7 +45,7 @@ def test_key_frames_every_fifth_sweep_and_sweeps_belong_to_the_nearest_sample():
     data = t["sample_data"]
     assert [d["is_key_frame"] for d in data] == [j % 5 == 0 for j in range(12)]
     assert [by_tok[d["sample_token"]] for d in data] == [0, 0, 0, 1, 1, 1, 1, 1, 2, 2, 2, 2]
-    assert all(a["next"] == b_["token"] and b_["prev"] == a["token"] for a, b_ in zip(data, data[1:]))
+    assert all(a["next"] == b_["token"] and b_["prev"] == a["token"] for a, b_ in zip(data, data[1:], strict=False))
     assert {d["token"] for d in data} == {e["token"] for e in t["ego_pose"]}
 
 

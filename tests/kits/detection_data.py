@@ -35,10 +35,9 @@ def _boxes(root: Path, spec, scene) -> None:
 def frozen_dataset(root: Path, spec, scene, sweeps: int = 21, pairs=(0, 10, 20), images: int = 2) -> Path:
     """``root`` with ``lidar/sequences/00`` (``sweeps`` sweeps), the stereo pair at ``pairs``, ``images``
     seed-003 frames, ``boxes/00.npz`` and ``openlabel/00.json``."""
+    from generator.jobs.lidar_sequence import SequenceOptions, write_sequence
     from kits.fusion_kit import write_raycast_images
     from kits.stereo_kit import write_raycast_stereo
-
-    from generator.jobs.lidar_sequence import SequenceOptions, write_sequence
 
     write_sequence(scene, spec, root / "lidar", SequenceOptions(frames=sweeps, threads=2, bev=False), progress=False)
     write_raycast_stereo(root, scene, spec, pairs)
