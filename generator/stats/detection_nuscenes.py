@@ -9,14 +9,16 @@ Ground truth is a nuScenes dataroot (``urbangen export nuscenes``'s output: ``GT
 
 (global frame, metres, m/s; every sample of the split present, an empty list where nothing was
 detected). The file is checked here first -- every sample token one of the split's, every number
-finite, every class one the evaluation scores, sizes positive, rotations non-zero, at most 500 boxes
+finite, every class a nuScenes detection class (those not scored here are ignored, as the devkit
+ignores them), sizes positive, rotations non-zero, at most 500 boxes
 per sample -- so a bad file is one line naming the file and the field, and nothing is written. Then
 :class:`nuscenes.eval.detection.evaluate.DetectionEval` runs on it unchanged: AP at 0.5, 1, 2 and 4 m
 centre distance per class, mAP, the true-positive errors ATE, ASE, AOE, AVE, AAE and NDS.
 
 The configuration is the devkit's ``detection_cvpr_2019`` (class ranges, thresholds, min recall and
 precision) with its ``class_names`` restricted to the classes evaluated (default: the detection classes
-the ground truth of the split holds, so a class urbangen did not draw does not count as AP 0;
+with a ground-truth box the evaluation keeps -- within the class's range, with points -- so a class
+urbangen did not draw, or drew only beyond 40 or 50 m, does not count as AP 0;
 ``classes="all"`` keeps nuScenes' ten). The split is one of ``splits.json`` (the devkit's custom
 splits); default ``urbangen_val`` when it has scenes, else ``urbangen_all``.
 """
@@ -170,9 +172,6 @@ def read_predictions(path: Path, sample_tokens: list[str], classes: list[str], m
             if name not in detection_names:
                 raise _bad(path, f"{where}.detection_name", f"{safeload.printable(repr(name), 40)} is not a nuScenes "
                                                             f"detection class ({', '.join(detection_names)})")
-            if name not in classes:
-                raise _bad(path, f"{where}.detection_name", f"{name} is not evaluated here (classes: "
-                                                            f"{', '.join(classes)}; --classes all scores every one)")
             score = b.get("detection_score")
             if isinstance(score, bool) or not isinstance(score, (int, float)) or not math.isfinite(score):
                 raise _bad(path, f"{where}.detection_score", "must be a finite number")
@@ -189,14 +188,19 @@ def read_predictions(path: Path, sample_tokens: list[str], classes: list[str], m
     return data
 
 
-def ground_truth_classes(nusc, sample_tokens) -> list[str]:
-    """The detection classes of the annotations of ``sample_tokens``, in nuScenes' order."""
-    from nuscenes.eval.detection.utils import category_to_detection_name
+def ground_truth_classes(nusc, sample_tokens, cfg) -> list[str]:
+    """The detection classes with a ground-truth box the evaluation keeps (within the class's range, with
+    points: the devkit's own loading and filtering), in nuScenes' order."""
+    from nuscenes.eval.common.loaders import add_center_dist, filter_eval_boxes, load_gt_of_sample_tokens
+    from nuscenes.eval.detection.data_classes import DetectionBox
 
-    names = devkit()[3]
-    have = {category_to_detection_name(nusc.get("sample_annotation", a)["category_name"])
-            for t in sample_tokens for a in nusc.get("sample", t)["anns"]}
-    return [n for n in names if n in have]
+    with _quiet():
+        gt = load_gt_of_sample_tokens(nusc, sample_tokens, DetectionBox, verbose=False)
+        if not gt.all:
+            return []
+        gt = filter_eval_boxes(nusc, add_center_dist(nusc, gt), cfg.class_range, verbose=False)
+    have = {b.detection_name for b in gt.all}
+    return [n for n in devkit()[3] if n in have]
 
 
 def _config(classes: list[str]):
@@ -222,11 +226,17 @@ def evaluate(pred: Path, gt: Path, split: str | None = None, classes: list[str] 
     _, _, DetectionEval, detection_names, _ = devkit()
     nusc, split, tokens = load_ground_truth(gt, split)
     if classes is None:
-        classes = ground_truth_classes(nusc, tokens)
+        classes = ground_truth_classes(nusc, tokens, _config(detection_names))
         if not classes:
-            raise UserError(f"{gt}: split {split} has no annotation of a nuScenes detection class")
+            raise UserError(f"{gt}: split {split} has no annotation of a nuScenes detection class within its "
+                            "evaluation range")
     elif classes == "all":
         classes = list(detection_names)
+    else:
+        unknown = [c for c in classes if c not in detection_names]
+        if unknown:
+            raise UserError(f"--classes: {safeload.printable(unknown[0], 40)} is not a nuScenes detection class "
+                            f"({', '.join(detection_names)}, or all)")
     cfg = _config(classes)
     data = read_predictions(pred, tokens, classes, cfg.max_boxes_per_sample)
     n_pred = sum(len(v) for v in data["results"].values())
