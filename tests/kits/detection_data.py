@@ -61,3 +61,33 @@ def traffic_dataset(root: Path, sweeps: int = 11) -> tuple[Path, Path]:
     write_sequence(scene, spec, root / "lidar", SequenceOptions(frames=sweeps, threads=2, bev=False), progress=False)
     _boxes(root, spec, scene)
     return root, spec_path
+
+
+def tiny_nuscenes(out: Path) -> Path:
+    """A hand-made nuScenes dataroot (tables, splits, a map; no point files): one scene of 11 sweeps, the ego
+    still at the origin, four cars 25 m apart on a ring 20 m out and two pedestrians 12 m out, unmoving, in
+    every key frame -- far enough apart that a box moved by up to 3 m still has its own as nearest."""
+    import numpy as np
+    from PIL import Image
+
+    from generator.formats import nuscenes as nu
+
+    T = np.eye(4)
+    T[:2, 3] = 100.0                         # the map's corner is the global origin: stay in x, y > 0
+    sweeps = [nu.Sweep(j, nu.EPOCH_US + 100_000 * j, T, f"sweeps/LIDAR_TOP/{j}.pcd.bin") for j in range(11)]
+    things = [("vehicle.car", "vehicle.parked", 20.0 * np.cos(a), 20.0 * np.sin(a), (4.5, 1.9, 1.5))
+              for a in np.deg2rad([0, 75, 150, 225])]
+    things += [("human.pedestrian.adult", "pedestrian.standing", 12.0 * np.cos(a), 12.0 * np.sin(a), (0.6, 0.6, 1.8))
+               for a in np.deg2rad([40, 290])]
+    anns = [nu.Annotation(j, tid + 1, cat, attr, np.array([100 + x, 100 + y, 0.8]), np.array(size), 0.3, 50)
+            for j in (0, 5, 10) for tid, (cat, attr, x, y, size) in enumerate(things)]
+    b = nu.TableBuilder()
+    b.add_scene(nu.SceneInput("tiny-00", "hand case", "tiny", np.eye(4), sweeps, anns, [], "maps/tiny.png"))
+    version = out / "v1.0-urbangen"
+    version.mkdir(parents=True)
+    for table, rows in b.tables().items():
+        (version / f"{table}.json").write_text(json.dumps(rows))
+    (version / "splits.json").write_text(json.dumps({"urbangen_val": ["tiny-00"], "urbangen_all": ["tiny-00"]}))
+    (out / "maps").mkdir()
+    Image.fromarray(np.full((2000, 2000), 255, np.uint8)).save(out / "maps" / "tiny.png")
+    return out

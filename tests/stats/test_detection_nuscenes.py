@@ -25,20 +25,22 @@ def _write(tmp_path, preds, name="pred.json"):
     return p
 
 
-def _ego_xy(nusc, sample_token):
-    sd = nusc.get("sample_data", nusc.get("sample", sample_token)["data"]["LIDAR_TOP"])
-    return np.array(nusc.get("ego_pose", sd["ego_pose_token"])["translation"][:2])
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory):
+    """A hand-made dataroot whose boxes lie far apart (kits.detection_data.tiny_nuscenes) and its ground truth."""
+    from kits.detection_data import tiny_nuscenes
+
+    root = tiny_nuscenes(tmp_path_factory.mktemp("tiny") / "nus")
+    return root, dn.ground_truth_predictions(root)
 
 
-def _shifted(nuscenes_traffic, preds, metres: float) -> dict:
-    """Every box moved ``metres`` towards the ego (so no box crosses a class's evaluation range)."""
-    nusc = dn.load_ground_truth(nuscenes_traffic)[0]
+def _moved(preds, metres: float, which=None) -> dict:
+    """Boxes (all, or the ``which``-th of each sample) moved ``metres`` along +x."""
     out = copy.deepcopy(preds)
-    for tok, boxes in out["results"].items():
-        ego = _ego_xy(nusc, tok)
-        for b in boxes:
-            d = np.array(b["translation"][:2]) - ego
-            b["translation"][:2] = (np.array(b["translation"][:2]) - metres * d / np.linalg.norm(d)).tolist()
+    for boxes in out["results"].values():
+        for k, b in enumerate(boxes):
+            if which is None or k == which:
+                b["translation"][0] += metres
     return out
 
 
@@ -50,32 +52,40 @@ def test_ground_truth_as_predictions_scores_map_1_and_nds_1(nuscenes_traffic, gt
     assert all(ap == pytest.approx(1.0, abs=1e-12) for c in r["per_class"].values() for ap in c["AP"].values())
 
 
-def test_boxes_1_5_m_off_are_hits_at_2_and_4_m_only(nuscenes_traffic, gt_preds, tmp_path):
+def test_boxes_1_5_m_off_are_hits_at_2_and_4_m_only(tiny, tmp_path):
     """AP 0, 0, 1, 1 at 0.5, 1, 2, 4 m: mAP 0.5; ATE 1.5 m, the rest 0: NDS = (5 * 0.5 + 0 + 4) / 10."""
-    r = dn.evaluate(_write(tmp_path, _shifted(nuscenes_traffic, gt_preds, 1.5)), nuscenes_traffic)
+    root, gt = tiny
+    r = dn.evaluate(_write(tmp_path, _moved(gt, 1.5)), root)
+    assert r["classes"] == ["car", "pedestrian"]
     for c in r["per_class"].values():
         assert c["AP"] == pytest.approx({"0.5": 0.0, "1.0": 0.0, "2.0": 1.0, "4.0": 1.0}, abs=1e-12)
-        assert c["mATE"] == pytest.approx(1.5, abs=1e-6)
+        assert c["mATE"] == pytest.approx(1.5, abs=1e-9)
     assert r["mAP"] == pytest.approx(0.5) and r["NDS"] == pytest.approx(0.65)
 
 
-def test_boxes_3_m_off_are_hits_at_4_m_only_and_no_true_positive_is_left_at_2_m(nuscenes_traffic, gt_preds, tmp_path):
+def test_boxes_3_m_off_are_hits_at_4_m_only_and_no_true_positive_is_left_at_2_m(tiny, tmp_path):
     """mAP 0.25; at the TP threshold (2 m) nothing matches, so every TP error is 1: NDS = 5 * 0.25 / 10."""
-    r = dn.evaluate(_write(tmp_path, _shifted(nuscenes_traffic, gt_preds, 3.0)), nuscenes_traffic)
+    root, gt = tiny
+    r = dn.evaluate(_write(tmp_path, _moved(gt, 3.0)), root)
     assert r["mAP"] == pytest.approx(0.25) and r["NDS"] == pytest.approx(0.125)
     assert all(v == pytest.approx(1.0, abs=1e-12) for v in r["tp_errors"].values())
 
 
-def test_one_car_moved_by_1_m_is_a_true_positive_at_2_m_not_at_0_5_m(nuscenes_traffic, gt_preds, tmp_path):
-    preds = copy.deepcopy(gt_preds)
-    tok, k = next((t, i) for t, bs in preds["results"].items() for i, b in enumerate(bs) if b["detection_name"] == "car")
-    preds["results"][tok][k]["translation"][0] += 1.0
-    r = dn.evaluate(_write(tmp_path, preds), nuscenes_traffic)
+def test_one_car_moved_by_1_m_is_a_true_positive_at_2_m_not_at_0_5_m(tiny, tmp_path):
+    """12 cars (4 per key frame), the first of the first sample moved 1 m and scored lowest: at 0.5 and 1 m it
+    is a false positive after 11 hits, so precision is 1 up to recall 11/12 and nothing after: the devkit's AP
+    (recall 0.11..1.00 in 90 steps, precision above 0.1 rescaled) is 81/90 = 0.9; at 2 and 4 m it is a hit."""
+    root, gt = tiny
+    preds = copy.deepcopy(gt)
+    first = next(iter(preds["results"]))
+    car = next(k for k, b in enumerate(preds["results"][first]) if b["detection_name"] == "car")
+    preds["results"][first][car]["translation"][0] += 1.0
+    preds["results"][first][car]["detection_score"] = 0.5
+    r = dn.evaluate(_write(tmp_path, preds), root)
     car = r["per_class"]["car"]
-    assert car["AP"]["0.5"] < 1.0 and car["AP"]["1.0"] < 1.0          # 1 m is not closer than 1 m
-    assert car["AP"]["2.0"] == pytest.approx(1.0, abs=1e-12) and car["AP"]["4.0"] == pytest.approx(1.0, abs=1e-12)
-    assert 0 < car["mATE"] < 1.0                                     # the moved box matched at 2 m, the rest exact
-    assert all(r["per_class"][c]["mean_AP"] == pytest.approx(1.0, abs=1e-12) for c in r["classes"] if c != "car")
+    assert car["AP"] == pytest.approx({"0.5": 0.9, "1.0": 0.9, "2.0": 1.0, "4.0": 1.0}, abs=1e-12)
+    assert 0 < car["mATE"] < 0.1
+    assert r["per_class"]["pedestrian"]["mean_AP"] == pytest.approx(1.0, abs=1e-12)
 
 
 def test_perturbed_predictions_give_the_devkits_own_numbers(nuscenes_traffic, gt_preds, tmp_path):
