@@ -53,13 +53,13 @@ def world():
 
 @pytest.fixture(scope="module")
 def doc(world):
-    parked = SceneObject(0, "car_0007", "car", "car", 7, "p", np.eye(4), OrientedBox((20.0, 8.0, 0.75), (4.0, 1.8, 1.5), 0.5),
-                         attrs={"placement": "parked"})
+    box = OrientedBox((20.0, 8.0, 0.75), (4.0, 1.8, 1.5), 0.5)
+    parked = SceneObject(0, "car_0007", "car", "car", 7, "p", np.eye(4), box, attrs={"placement": "parked"})
     subs = subjects(SimpleNamespace(objects=[parked], prototypes={}), world)
     times = [rig.Rig.sweep_time(j) for j in range(N_SWEEPS)]
     T_cam = rig.camera_extrinsics((1.0, 0.0, 1.6), (0.0, 0.0, 0.0))
-    frames = [SweepFrame(j, t, world.ego.T_world_ego(t)[0], T_cam if j % 5 == 0 else None, j // 5 if j % 5 == 0 else None)
-              for j, t in enumerate(times)]
+    frames = [SweepFrame(j, t, world.ego.T_world_ego(t)[0], T_cam if j % 5 == 0 else None,
+                         j // 5 if j % 5 == 0 else None) for j, t in enumerate(times)]
     uris = [{"lidar": f"velodyne/{j:06d}.bin", **({"camera": f"images/{j // 5:06d}.exr"} if j % 5 == 0 else {})}
             for j in range(N_SWEEPS)]
     counts = [{7: 50, 101: 80, 102: 40, 103: 20, 104: 20} for _ in times]
@@ -77,7 +77,8 @@ def _centres_odom(ol, uid: str) -> np.ndarray:
     out = []
     for j in range(N_SWEEPS):
         f = ol["frames"][str(j)]
-        T = np.asarray(f["frame_properties"]["transforms"]["vehicle-iso8855_to_odom"]["transform_src_to_dst"]["matrix4x4"]).reshape(4, 4)
+        tr = f["frame_properties"]["transforms"]["vehicle-iso8855_to_odom"]["transform_src_to_dst"]
+        T = np.asarray(tr["matrix4x4"]).reshape(4, 4)
         c = om.object_data(f["objects"][uid]["object_data"], "box3d", "cuboid")["val"][:3]
         out.append(T[:3, :3] @ np.asarray(c) + T[:3, 3])
     return np.array(out)
@@ -118,8 +119,9 @@ def test_moving_flag_is_the_lidar_rule(doc, world):
     for j in range(N_SWEEPS):
         t = rig.Rig.sweep_time(j)
         moving = world.moving(t)
-        for a, m in zip(world.actors, moving):
-            flag = om.object_data(doc["frames"][str(j)]["objects"][str(a.instance_id)]["object_data"], "moving", "boolean")["val"]
+        for a, m in zip(world.actors, moving, strict=True):
+            data = doc["frames"][str(j)]["objects"][str(a.instance_id)]["object_data"]
+            flag = om.object_data(data, "moving", "boolean")["val"]
             assert flag == bool(m)
             assert flag == (np.linalg.norm(a.track.velocity(t)[0, :2]) > MOVING_THRESHOLD_MPS)
             seen.add(flag)

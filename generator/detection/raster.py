@@ -12,11 +12,10 @@ optical camera frame (x right, y down, z forward); pixel ``(row i, col j)`` cove
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 #: Triangles are clipped at this depth in front of the camera, metres (what lies closer is not imaged).
 NEAR_M = 0.05
-#: Candidate samples tested per chunk (bounds the memory of one rasterisation step).
-CHUNK_SAMPLES = 4_000_000
 
 
 def clip_near(tri: np.ndarray, near: float = NEAR_M) -> np.ndarray:
@@ -66,8 +65,30 @@ def project(tri_cam: np.ndarray, K: np.ndarray) -> np.ndarray:
     return p[..., :2] / p[..., 2:3]
 
 
+@njit(cache=True, nogil=True)
+def _fill(g: np.ndarray, mask: np.ndarray) -> None:
+    """Set the samples of ``mask`` whose centres lie in a triangle of ``g`` ((T, 3, 2), sample index space)."""
+    height, width = mask.shape
+    for t in range(g.shape[0]):
+        ax, ay, bx, by, cx, cy = g[t, 0, 0], g[t, 0, 1], g[t, 1, 0], g[t, 1, 1], g[t, 2, 0], g[t, 2, 1]
+        area = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+        if abs(area) <= 1e-12:
+            continue
+        sgn = 1.0 if area > 0 else -1.0
+        x0 = max(int(np.ceil(min(ax, bx, cx))), 0)
+        x1 = min(int(np.floor(max(ax, bx, cx))), width - 1)
+        y0 = max(int(np.ceil(min(ay, by, cy))), 0)
+        y1 = min(int(np.floor(max(ay, by, cy))), height - 1)
+        for y in range(y0, y1 + 1):
+            for x in range(x0, x1 + 1):
+                if (sgn * ((bx - ax) * (y - ay) - (by - ay) * (x - ax)) >= 0
+                        and sgn * ((cx - bx) * (y - by) - (cy - by) * (x - bx)) >= 0
+                        and sgn * ((ax - cx) * (y - cy) - (ay - cy) * (x - cx)) >= 0):
+                    mask[y, x] = True
+
+
 def rasterise(uv: np.ndarray, width: int, height: int, origin=(0.0, 0.0), step: float = 1.0) -> np.ndarray:
-    """Which sample points lie in at least one triangle.
+    """Which sample points lie in at least one triangle (edges included).
 
     Parameters
     ----------
@@ -85,51 +106,42 @@ def rasterise(uv: np.ndarray, width: int, height: int, origin=(0.0, 0.0), step: 
     -------
     (height, width) bool
     """
-    mask = np.zeros((height, width), bool)
-    g = (np.asarray(uv, np.float64) - np.asarray(origin, np.float64)) / step - 0.5   # sample index space
-    if not len(g):
-        return mask
-    a, b, c = g[:, 0], g[:, 1], g[:, 2]
-    area = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
-    lo = np.maximum(np.ceil(g.min(1)), 0).astype(np.int64)
-    hi = np.minimum(np.floor(g.max(1)), [width - 1, height - 1]).astype(np.int64)
-    keep = (np.abs(area) > 1e-12) & (hi[:, 0] >= lo[:, 0]) & (hi[:, 1] >= lo[:, 1])
-    g, area, lo, hi = g[keep], area[keep], lo[keep], hi[keep]
-    nx, ny = hi[:, 0] - lo[:, 0] + 1, hi[:, 1] - lo[:, 1] + 1
-    cost = nx * ny
-    ends = np.cumsum(cost)
-    start = 0
-    while start < len(g):
-        stop = int(np.searchsorted(ends, (ends[start - 1] if start else 0) + CHUNK_SAMPLES, side="right"))
-        stop = max(stop, start + 1)
-        sl = slice(start, stop)
-        n = cost[sl]
-        tri = np.repeat(np.arange(start, stop), n)
-        k = np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
-        x = lo[tri, 0] + k % nx[tri]
-        y = lo[tri, 1] + k // nx[tri]
-        sgn = np.sign(area[tri])
-        inside = np.ones(len(tri), bool)
-        for e0, e1 in ((0, 1), (1, 2), (2, 0)):
-            p, q = g[tri, e0], g[tri, e1]
-            inside &= sgn * ((q[:, 0] - p[:, 0]) * (y - p[:, 1]) - (q[:, 1] - p[:, 1]) * (x - p[:, 0])) >= 0
-        mask[y[inside], x[inside]] = True
-        start = stop
+    mask = np.zeros((height, width), np.bool_)
+    if len(uv):
+        g = (np.asarray(uv, np.float64) - np.asarray(origin, np.float64)) / step - 0.5   # sample index space
+        _fill(np.ascontiguousarray(g), mask)
     return mask
 
 
-def footprint(tri_cam: np.ndarray, K: np.ndarray, width: int, height: int, supersample: int = 1) -> np.ndarray:
-    """(height, width) bool amodal mask of camera-frame triangles in the image, sampled as the label pass.
+def footprint(tri_cam: np.ndarray, K: np.ndarray, width: int, height: int,
+              supersample: int = 1) -> tuple[np.ndarray, tuple[int, int]]:
+    """The amodal mask of camera-frame triangles in the image, sampled as the label pass, over the window
+    of the image they cover.
 
     ``supersample`` ``k`` > 1: a pixel is covered when more than half of its ``k x k`` sub-samples are
     (the label pass's majority vote); 1: when its centre is.
+
+    Returns
+    -------
+    mask : (h, w) bool
+        The window's pixels (empty when the triangles miss the image).
+    origin : (int, int)
+        Column and row of the window's top-left pixel in the image.
     """
     uv = project(clip_near(tri_cam), K)
+    if not len(uv):
+        return np.zeros((0, 0), bool), (0, 0)
+    flat = uv.reshape(-1, 2)
+    x0, y0 = (int(max(np.floor(v), 0)) for v in flat.min(0))
+    x1, y1 = int(min(np.ceil(flat[:, 0].max()), width)), int(min(np.ceil(flat[:, 1].max()), height))
+    if x1 <= x0 or y1 <= y0:
+        return np.zeros((0, 0), bool), (0, 0)
+    w, h = x1 - x0, y1 - y0
     k = int(supersample)
     if k <= 1:
-        return rasterise(uv, width, height)
-    sub = rasterise(uv, width * k, height * k, step=1.0 / k)
-    return sub.reshape(height, k, width, k).sum((1, 3)) * 2 > k * k
+        return rasterise(uv, w, h, origin=(x0, y0)), (x0, y0)
+    sub = rasterise(uv, w * k, h * k, origin=(x0, y0), step=1.0 / k)
+    return sub.reshape(h, k, w, k).sum((1, 3)) * 2 > k * k, (x0, y0)
 
 
 def coverage_outside(tri_cam: np.ndarray, K: np.ndarray, width: int, height: int,

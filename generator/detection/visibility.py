@@ -93,11 +93,34 @@ def nuscenes_bin(visibility: float) -> str:
     return str(int(np.searchsorted(NUSCENES_BINS, visibility, side="right")))
 
 
-def _extent(mask: np.ndarray) -> np.ndarray:
+def _extent(mask: np.ndarray, origin=(0, 0)) -> np.ndarray:
     rows, cols = np.flatnonzero(mask.any(1)), np.flatnonzero(mask.any(0))
     if not len(rows):
         return np.zeros(4)
-    return np.array([cols[0], rows[0], cols[-1] + 1, rows[-1] + 1], np.float64)
+    x, y = origin
+    return np.array([x + cols[0], y + rows[0], x + cols[-1] + 1, y + rows[-1] + 1], np.float64)
+
+
+def instance_extents(instance: np.ndarray) -> dict[int, tuple[int, np.ndarray]]:
+    """Per instance id > 0 of an instance pass: (pixel count, (x0, y0, x1, y1) extent), in one pass."""
+    h, w = instance.shape
+    flat = instance.reshape(-1).astype(np.int64)
+    ids, inv, counts = np.unique(flat, return_inverse=True, return_counts=True)
+    rows, cols = np.divmod(np.arange(flat.size), w)
+    ext = np.stack([np.full(len(ids), w), np.full(len(ids), h), np.zeros(len(ids), np.int64),
+                    np.zeros(len(ids), np.int64)], 1)
+    np.minimum.at(ext[:, 0], inv, cols)
+    np.minimum.at(ext[:, 1], inv, rows)
+    np.maximum.at(ext[:, 2], inv, cols + 1)
+    np.maximum.at(ext[:, 3], inv, rows + 1)
+    return {int(i): (int(c), e.astype(np.float64)) for i, c, e in zip(ids, counts, ext, strict=True) if i > 0}
+
+
+def _union(extents) -> np.ndarray:
+    if not extents:
+        return np.zeros(4)
+    e = np.array(extents)
+    return np.r_[e[:, :2].min(0), e[:, 2:].max(0)]
 
 
 def _may_show(subject, t: float, T_camera_world: np.ndarray, K: np.ndarray, width: int, height: int) -> bool:
@@ -140,24 +163,23 @@ def image_boxes(subjects, t: float, T_world_camera: np.ndarray, K: np.ndarray, i
     height, width = instance.shape
     T_cw = np.linalg.inv(np.asarray(T_world_camera, np.float64))
     K = np.asarray(K, np.float64)
-    ids, counts = np.unique(instance, return_counts=True)
-    visible_count = dict(zip(ids.tolist(), counts.tolist(), strict=True))
+    seen = instance_extents(instance)
     out = []
     for s in subjects:
         if not _may_show(s, t, T_cw, K, width, height):
             continue
         v, f = s.triangles(t)
         tri = (v @ T_cw[:3, :3].T + T_cw[:3, 3])[f]
-        amodal = footprint(tri, K, width, height, supersample)
+        amodal, origin = footprint(tri, K, width, height, supersample)
         n_amodal = int(amodal.sum())
         if n_amodal == 0:
             continue
-        n_vis = sum(visible_count.get(i, 0) for i in s.instance_ids)
-        vis_mask = np.isin(instance, s.instance_ids) if n_vis else np.zeros((height, width), bool)
+        parts = [seen[i] for i in s.instance_ids if i in seen]
+        n_vis = sum(c for c, _ in parts)
         trunc = coverage_outside(tri, K, width, height)
         visibility = min(1.0, n_vis / n_amodal)
-        box = _extent(amodal)
+        box = _extent(amodal, origin)
         occ = occlusion_level(visibility, n_vis)
-        out.append(ImageBox(s.track_id, box, _extent(vis_mask), n_amodal, n_vis, trunc, visibility, occ,
+        out.append(ImageBox(s.track_id, box, _union([e for _, e in parts]), n_amodal, n_vis, trunc, visibility, occ,
                             difficulty(box[3] - box[1], occ, trunc), nuscenes_bin(visibility)))
     return out

@@ -177,8 +177,19 @@ def write_box_file(path: str | Path, sweeps: dict[int, float], records: list, im
         "ib_nuscenes_visibility": np.array([b.nuscenes_visibility for _, _, b in ib], "U1").reshape(nb),
     })
     with atomic_path(path, suffix=".npz") as tmp:
-        with open(tmp, "wb") as f:
-            np.savez_compressed(f, **cols)
+        write_npz(tmp, cols)
+
+
+def write_npz(path, arrays: dict[str, np.ndarray]) -> None:
+    """A compressed ``.npz`` that ``numpy.load`` reads, byte for byte the same for the same arrays
+    (``numpy.savez_compressed`` stamps every member with the time of writing)."""
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
+        for key in sorted(arrays):
+            info = zipfile.ZipInfo(f"{key}.npy", date_time=(1980, 1, 1, 0, 0, 0))
+            info.compress_type = zipfile.ZIP_DEFLATED
+            buf = io.BytesIO()
+            np.lib.format.write_array(buf, np.asanyarray(arrays[key]), allow_pickle=False)
+            z.writestr(info, buf.getvalue())
 
 
 #: name -> (dtype kind(s), trailing shape, length key) of every array a box file holds

@@ -6,7 +6,7 @@ sample, numbered ``000000..`` in (sequence, sweep) order::
     OUT/training/velodyne/NNNNNN.bin    the sweep's scan (float32 x, y, z, reflectance; LiDAR frame, raw)
     OUT/training/image_2/NNNNNN.png     left image (image_3: right)
     OUT/training/label_2/NNNNNN.txt     the 15 KITTI fields per object (generator.formats.kitti_object)
-    OUT/training/calib/NNNNNN.txt       P0..P3, R0_rect (identity: the pair is rendered rectified),
+    OUT/training/calib/NNNNNN.txt       P0..P3 (the image's intrinsics), R0_rect (identity: the pair is rectified),
                                         Tr_velo_to_cam (LiDAR -> camera 2), Tr_imu_to_velo (ego -> LiDAR)
     OUT/ImageSets/train.txt, val.txt, trainval.txt, test.txt (empty: no testing/ split)
     OUT/mapping.txt                     sample id, sequence, sweep
@@ -55,6 +55,14 @@ def _samples(root: Path, sequences) -> list[tuple[str, int, object, object]]:
             if (seq_dir / "image_2" / f"{j:06d}.png").is_file() and (seq_dir / "velodyne" / f"{j:06d}.bin").is_file():
                 out.append((name, j, bf, bf.image(key)))
     return out
+
+
+def projections(K: np.ndarray, baseline_m: float) -> dict[str, np.ndarray]:
+    """KITTI ``P0``..``P3`` of the rectified pair whose left camera (2, the reference) has intrinsics ``K``
+    (the image's own, as rendered): ``P2 = P0 = K [I | 0]``, ``P3 = P1 = K [I | (-baseline, 0, 0)]``."""
+    left = np.hstack([K, np.zeros((3, 1))])
+    right = np.hstack([K, (K @ np.array([-baseline_m, 0.0, 0.0]))[:, None]])
+    return {"P0": left, "P1": right, "P2": left, "P3": right}
 
 
 def labels_of(entry, bf_info: dict, min_points: int) -> list:
@@ -109,7 +117,7 @@ def export_kitti_object(root: Path, out: Path, sequences: list[str] | None = Non
             calib = read_calib(seq_dir / "calib.txt")
             T_ego_lidar = np.asarray(bf.info["T_ego_lidar"], np.float64)
             (stage / "training" / "calib" / f"{sid}.txt").write_text(calib_text(
-                {p: calib[p].reshape(3, 4) for p in ("P0", "P1", "P2", "P3")}, np.eye(3),
+                projections(entry.K, float(bf.info.get("baseline_m", 0.54))), np.eye(3),
                 tr_matrix(calib, str(seq_dir / "calib.txt")), np.linalg.inv(T_ego_lidar)))
             mapping.append(f"{sid} {name} {j:06d}")
         for ids in by_seq.values():

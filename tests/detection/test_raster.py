@@ -26,9 +26,11 @@ def test_a_square_covers_exactly_the_pixel_centres_inside_it():
 
 def test_the_footprint_votes_like_the_label_pass():
     tri = _square(0.0, 0.0, 0.54, 1.0)          # u in [0, 5.4]: the 6th column is 40 % covered
-    assert footprint(tri, K, 10, 10).sum() == 50      # centres at 0.5..4.5 only
-    assert footprint(tri, K, 10, 10, supersample=3).sum() == 50   # 1 of 3 sub-columns: no majority
-    assert footprint(_square(0.0, 0.0, 0.57, 1.0), K, 10, 10, supersample=3).sum() == 60  # 2 of 3
+    assert footprint(tri, K, 10, 10)[0].sum() == 50      # centres at 0.5..4.5 only
+    assert footprint(tri, K, 10, 10, supersample=3)[0].sum() == 50   # 1 of 3 sub-columns: no majority
+    assert footprint(_square(0.0, 0.0, 0.57, 1.0), K, 10, 10, supersample=3)[0].sum() == 60  # 2 of 3
+    mask, origin = footprint(_square(0.3, 0.2, 0.6, 0.5), K, 10, 10)   # a window round it: pixels 3..5
+    assert origin == (3, 2) and mask.shape == (3, 3) and mask.all()
 
 
 def test_near_plane_clipping_keeps_what_is_in_front():

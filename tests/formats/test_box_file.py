@@ -50,6 +50,13 @@ def test_records_and_images_round_trip(written):
     assert bf.image("images/000004") is None
 
 
+def test_same_records_same_bytes(written, tmp_path):
+    path, recs, entry = written
+    again = tmp_path / "again.npz"
+    write_box_file(again, {0: 0.0, 1: 0.1}, recs, [entry], {"sequence": "00", "T_ego_lidar": np.eye(4).tolist()})
+    assert again.read_bytes() == path.read_bytes()
+
+
 def test_a_damaged_file_is_one_line(written, tmp_path):
     path, _, _ = written
     data = path.read_bytes()
