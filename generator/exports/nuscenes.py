@@ -52,7 +52,8 @@ CAMERA_CHANNELS = {2: "CAM_FRONT", 3: "CAM_FRONT_STEREO"}
 #: SemanticKITTI raw ids the map's semantic prior holds: road, parking, sidewalk, lane-marking.
 MAP_IDS = (40, 44, 48, 60)
 MAP_RES_M = 0.1          #: nuScenes' map mask resolution
-MAP_CELL_M = 0.5         #: points are binned, closed and dilated on this grid, then upsampled
+MAP_CELL_M = 0.2         #: points are binned and closed on this grid, then upsampled
+CLOSE_CELLS = 13         #: gaps up to ~2.6 m between hit cells (rings 40 m out) are closed
 #: The ego drives on the road: the ground within this radius of it, which its own LiDAR cannot see (an
 #: HDL-64E's lowest beam meets the ground 3.7 m out), joins the prior.
 EGO_GROUND_M = 3.0
@@ -112,8 +113,7 @@ class MapRaster:
 
     def png(self) -> np.ndarray:
         """(H, W) uint8 at :data:`MAP_RES_M`, 255 = prior, row 0 the top (largest y), as MapMask reads it."""
-        m = ndimage.binary_closing(self.hits, np.ones((5, 5), bool))
-        m = ndimage.binary_dilation(m, np.ones((3, 3), bool))
+        m = ndimage.binary_closing(self.hits, np.ones((CLOSE_CELLS, CLOSE_CELLS), bool))   # far rings are sparse
         k = int(round(MAP_CELL_M / MAP_RES_M))
         return np.repeat(np.repeat(m[::-1], k, 0), k, 1).astype(np.uint8) * 255
 
