@@ -4,8 +4,8 @@ Writes a generated dataset under OUT in the layout another ecosystem reads: city
 scored by cityscapesScripts), kitti-object (the KITTI 3D object layout of the LiDAR sequences' stereo
 pairs with their boxes, as OpenPCDet and MMDetection3D read it), nuscenes (the LiDAR sequences as a
 nuScenes v1.0 dataroot with 2 Hz samples, 10 Hz sweeps and 3D boxes, loaded by nuscenes-devkit) or
-coco (2D instance boxes and RLE masks of every image, plus COCO panoptic). Nothing is written on error; existing files are never
-overwritten.
+coco (2D instance boxes and RLE masks of every image, plus COCO panoptic). Nothing is written on
+error; existing files are never overwritten.
 
 cityscapes: the images of DIR/images/*.exr (and their metadata JSON) in the
 Cityscapes layout under OUT: leftImg8bit/<split>/<city>/<city>_<seq>_<frame>_leftImg8bit.png

@@ -28,7 +28,8 @@ EXIT_MISMATCH = 1
 
 
 def register(sub) -> None:
-    p = sub.add_parser("stats", help="dataset statistics: pixels per class, images per weather x time of day, boxes per class",
+    p = sub.add_parser("stats", help="dataset statistics: pixels per class, images per weather x time of day, "
+                                     "boxes per class",
                        description=__doc__.split("\n\n")[1])
     p.add_argument("dataset", type=path, help="dataset folder (with images/*.json)")
     p.add_argument("--out", type=path, default=None, help="output folder (default: DIR/stats)")
