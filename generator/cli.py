@@ -43,6 +43,7 @@ COMMANDS = [
     "flow",
     "eval",
     "export",
+    "process",
     "openlabel",
     "render",
     "stats",

@@ -68,3 +68,31 @@ if _hyp_settings is not None:
     _hyp_settings.register_profile("dev", max_examples=100, **_common)
     _hyp_settings.register_profile("thorough", max_examples=1000, **_common)
     _hyp_settings.load_profile(_os.environ.get("HYPOTHESIS_PROFILE") or ("ci" if _os.environ.get("CI") else "dev"))
+
+
+# -- detection datasets and their exports (tests/kits/detection_data.py), built once per session ---------
+@pytest.fixture(scope="session")
+def frozen_detection_dataset(tmp_path_factory, test_spec, test_scene):
+    """The cast test town with a ray-cast stereo stream, seed-003 images, box file and OpenLABEL (read-only)."""
+    from kits.detection_data import frozen_dataset
+
+    return frozen_dataset(tmp_path_factory.mktemp("frozen_det"), test_spec, test_scene)
+
+
+@pytest.fixture(scope="session")
+def traffic_detection_dataset(tmp_path_factory):
+    """(dataset, spec file) of a small town with moving traffic, its box file and OpenLABEL (read-only)."""
+    from kits.detection_data import traffic_dataset
+
+    return traffic_dataset(tmp_path_factory.mktemp("traffic_det") / "ds")
+
+
+@pytest.fixture(scope="session")
+def nuscenes_traffic(traffic_detection_dataset, tmp_path_factory):
+    """``urbangen export nuscenes`` of the traffic dataset (read-only)."""
+    from generator import cli
+
+    root, _ = traffic_detection_dataset
+    out = tmp_path_factory.mktemp("nus_traffic") / "nus"
+    assert cli.main(["export", "nuscenes", str(root), str(out)]) == 0
+    return out

@@ -46,9 +46,11 @@ ALLOWED: dict[str, set[str]] = {
     "jobs": {"blender", "dataset", "detection", "formats", "geometry", "imaging", "labels", "layout", "lidar",
              "materials", "motion", "postfx", "previews", "remission", "scan_effects", "spec", "stats", "traffic",
              "weather", "world"},
-    "commands": {"dataset", "detection", "formats", "fusion", "geometry", "imaging", "jobs", "labels", "layout",
+    "commands": {"dataset", "detection", "exports", "formats", "fusion", "geometry", "imaging", "jobs", "labels", "layout",
                  "lidar", "materials", "motion", "previews", "remission", "scan_effects", "spec", "stats", "traffic",
                  "weather", "world"},
+    "exports": {"dataset", "detection", "formats", "fusion", "geometry", "imaging", "jobs", "labels", "lidar",
+                "previews", "spec", "world"},
     "dataset": {"formats", "imaging", "labels"},
     "cli": {"commands"},
 }

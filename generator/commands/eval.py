@@ -1,4 +1,5 @@
-"""``urbangen eval --pred DIR --gt DIR [--labels unified11|semantickitti|native] [--panoptic] [--json PATH]``.
+"""``urbangen eval --pred DIR --gt DIR [--labels unified11|semantickitti|native] [--panoptic] [--json PATH]``;
+``urbangen eval --detection kitti|nuscenes --pred PRED --gt DIR [--split NAME] [--classes ...] [--json PATH]``.
 
 Compares two SemanticKITTI-layout label trees scan by scan and prints IoU per class and
 the mIoU exactly as semantic-kitti-api's evaluate_semantics.py computes them: confusion
@@ -10,7 +11,10 @@ included) -- and a class absent from both prediction and ground truth counts as 
 PRED/sequences/NN/predictions/ when that folder exists (the reference's layout), else from
 labels/. --panoptic adds PQ, SQ and RQ per class and their means (SemanticKITTI panoptic:
 segments matched at IoU > 0.5, unmatched segments under --min-points ignored). The result
-is written as JSON (default PRED/eval_<labels>.json).
+is written as JSON (default PRED/eval_<labels>.json). --detection scores 3D boxes instead: kitti
+(AP R40, generator.commands.eval_kitti) or nuscenes (--pred a nuScenes results file, --gt an 'urbangen
+export nuscenes' dataroot; mAP, NDS and the TP errors computed by nuscenes-devkit itself, pip install
+-e ".[detection]"; generator.commands.eval_nuscenes).
 """
 
 from __future__ import annotations
@@ -21,10 +25,8 @@ from generator.commands.preflight import input_dir, output_file
 
 #: Largest --min-points (a segment of more points than a scan holds never counts).
 MAX_MIN_POINTS = 10_000_000
-
-
 #: ``--detection`` benchmark -> the module whose ``run(args)`` evaluates it.
-DETECTION = {"kitti": "generator.commands.eval_kitti"}
+DETECTION = {"kitti": "generator.commands.eval_kitti", "nuscenes": "generator.commands.eval_nuscenes"}
 
 
 def register(sub) -> None:
@@ -51,11 +53,14 @@ def register(sub) -> None:
     p.add_argument("--json", type=path, default=None, help="result file (default PRED/eval_<labels>.json)")
     p.add_argument("--detection", choices=sorted(DETECTION), default=None,
                    help="evaluate 3D object detections instead: kitti (AP R40; --gt a label_2 folder or a KITTI "
-                        "export root, --pred a folder of KITTI result files)")
+                        "export root, --pred a folder of KITTI result files) or nuscenes (mAP, NDS and TP errors "
+                        "by nuscenes-devkit; --gt an 'urbangen export nuscenes' dataroot, --pred a results JSON)")
     p.add_argument("--classes", nargs="+", default=None,
-                   help="--detection kitti: classes (default Car Pedestrian Cyclist)")
+                   help="--detection kitti: classes (default Car Pedestrian Cyclist); nuscenes: detection classes "
+                        "scored (default: those in the ground truth of the split; 'all': nuScenes' ten)")
     p.add_argument("--split", default=None,
-                   help="--detection kitti: only the samples of GT/ImageSets/SPLIT.txt (e.g. val)")
+                   help="--detection kitti: only the samples of GT/ImageSets/SPLIT.txt (e.g. val); nuscenes: a split "
+                        "of GT/v1.0-*/splits.json (default urbangen_val when it has scenes, else urbangen_all)")
     p.set_defaults(func=run)
 
 

@@ -1,9 +1,13 @@
-"""``urbangen export cityscapes|kitti-object DIR OUT [--split train|val|test]``.
+"""``urbangen export cityscapes|kitti-object|nuscenes|coco DIR OUT [--split train|val|test] [...]``.
 
-``kitti-object``: the KITTI 3D object layout of the LiDAR sequences' stereo pairs with their boxes
-(:mod:`generator.commands.export_kitti_object`).
+Writes a generated dataset under OUT in the layout another ecosystem reads: cityscapes (the images,
+scored by cityscapesScripts), kitti-object (the KITTI 3D object layout of the LiDAR sequences' stereo
+pairs with their boxes, as OpenPCDet and MMDetection3D read it), nuscenes (the LiDAR sequences as a
+nuScenes v1.0 dataroot with 2 Hz samples, 10 Hz sweeps and 3D boxes, loaded by nuscenes-devkit) or
+coco (2D instance boxes and RLE masks of every image, plus COCO panoptic). Nothing is written on
+error; existing files are never overwritten.
 
-Writes the images of a generated dataset (DIR/images/*.exr and their metadata JSON) in the
+cityscapes: the images of DIR/images/*.exr (and their metadata JSON) in the
 Cityscapes layout under OUT: leftImg8bit/<split>/<city>/<city>_<seq>_<frame>_leftImg8bit.png
 (8-bit sRGB as the preview shows it: the camera model's response curve, or the
 fixed tone mapping for images made without the model) and gtFine/<split>/<city>/..._gtFine_labelIds.png,
@@ -11,7 +15,10 @@ _instanceIds.png (label id x 1000 + k for person, rider and vehicles), _labelTra
 _color.png. The weather x time variant of an image is its city (urbangen-day-clear,
 urbangen-night-rain-fog, ...), so the 12 variants of a frame keep distinct names; <seq> is the
 dataset's LiDAR sequence number. The default split is val, where cityscapesScripts'
-evaluation looks. Nothing is written on error; existing files are never overwritten.
+evaluation looks.
+
+kitti-object, nuscenes and coco live in their own modules (:mod:`generator.commands.export_kitti_object`,
+:mod:`generator.commands.export_nuscenes`, :mod:`generator.commands.export_coco`); this one dispatches.
 """
 
 from __future__ import annotations
@@ -20,7 +27,7 @@ import os
 from pathlib import Path
 from typing import Iterator
 
-from generator.commands.options import Integer, Number, path, sequence_id
+from generator.commands.options import Integer, Number, path, sequence_id, text_path
 from generator.commands.preflight import input_dir, output_dir
 from generator.errors import UserError
 from generator.jobs.plan import MAX_FRAME_INDEX, check_free_space
@@ -28,19 +35,24 @@ from generator.safeload import MAX_METADATA_BYTES, load_json, printable
 from generator.weather import TIMES, combinations
 from generator.formats.cityscapes import DEFAULT_SPLIT, SPLITS, CityscapesImage, city_name, export, image_stem
 
-FORMATS = ("cityscapes", "kitti-object")
-#: format -> the module whose ``run(args)`` exports it (cityscapes: :func:`run` here)
-EXPORTERS = {"kitti-object": "generator.commands.export_kitti_object"}
+#: format -> the module whose ``run(args)`` writes it (None: this module, cityscapes)
+FORMATS = {"cityscapes": None, "kitti-object": "generator.commands.export_kitti_object",
+           "nuscenes": "generator.commands.export_nuscenes", "coco": "generator.commands.export_coco"}
 
 
 def register(sub) -> None:
-    p = sub.add_parser("export", help="write a dataset in the Cityscapes or KITTI 3D object layout",
-                       description=__doc__.split("\n\n")[1] + " " + __doc__.split("\n\n")[2])
-    p.add_argument("format", choices=FORMATS, help="target layout: cityscapes or kitti-object")
-    p.add_argument("dataset", type=path, help="generated dataset (holds images/*.exr)")
-    p.add_argument("out", type=path, help="export root (leftImg8bit/ and gtFine/ are written inside)")
-    p.add_argument("--split", default=DEFAULT_SPLIT, choices=SPLITS,
-                   help=f"split folder: train, val or test (default {DEFAULT_SPLIT}, what cityscapesScripts evaluates)")
+    p = sub.add_parser("export", help="write a dataset in the Cityscapes, KITTI 3D object, nuScenes or COCO layout",
+                       description=__doc__.split("\n\n")[1])
+    p.add_argument("format", choices=list(FORMATS), help="target layout: cityscapes, kitti-object, nuscenes or coco")
+    p.add_argument("dataset", type=path, help="generated dataset (images/, lidar/sequences/)")
+    p.add_argument("out", type=path, help="export root (the format's folders are written inside)")
+    p.add_argument("--split", default=None, choices=SPLITS,
+                   help=f"cityscapes: split folder (default {DEFAULT_SPLIT}, what cityscapesScripts evaluates); "
+                        "nuscenes: the split every scene joins (default: each sequence's split in "
+                        "lidar/semantic-kitti.yaml); coco: the name of the annotation files (default val)")
+    p.add_argument("--spec", type=text_path, default=None,
+                   help="nuscenes: the scene spec the dataset was made from, when it has no manifest.json "
+                        "(made with 'urbangen lidar'); the boxes are rebuilt from it")
     p.add_argument("--sequences", nargs="+", type=sequence_id, default=None,
                    help="kitti-object: LiDAR sequences to export, 00..99 (default all)")
     p.add_argument("--min-points", type=Integer(0, 10_000_000), default=1,
@@ -78,10 +90,11 @@ def _sequence(dataset: Path) -> int:
 
 
 def run(args) -> int:
-    if args.format in EXPORTERS:
+    if FORMATS[args.format] is not None:
         import importlib
 
-        return importlib.import_module(EXPORTERS[args.format]).run(args)
+        return importlib.import_module(FORMATS[args.format]).run(args)
+    args.split = args.split or DEFAULT_SPLIT
     from generator.progress import progress
 
     from generator.imaging.exr import read_exr

@@ -107,6 +107,18 @@ def input_dir(path: Path, flag: str = "", what: str = "folder") -> Path:
     return path
 
 
+def input_file(path: Path, flag: str = "", what: str = "file") -> Path:
+    """An existing regular file to read (``what`` names it in the message: ``predictions file``)."""
+    st = _stat(path, flag)
+    if st is None:
+        _fail(flag, path, f"{what} not found")
+    if not stat.S_ISREG(st.st_mode):
+        _fail(flag, path, f"is {file_kind(st.st_mode)}, expected a {what}")
+    if not os.access(path, os.R_OK):
+        _fail(flag, path, "permission denied")
+    return path
+
+
 def _writable_ancestor(path: Path, flag: str) -> None:
     """The nearest existing ancestor of a path to be created: a writable folder; new names not too long."""
     for part in path.parts:

@@ -3,7 +3,8 @@
 Writes the dataset statistics of DIR into OUT (default DIR): ``stats.md`` with seed 003
 Table I (annotated pixels per class, total and average per image) and Table II (images per
 weather x time of day), the tables as CSV (``table1_pixels.csv``, ``table2_conditions.csv``)
-and a bar chart ``pixels_per_class.png``. Reads the per-image metadata only; ``--verify``
+and a bar chart ``pixels_per_class.png``; the LiDAR class mix; and seed 002 Table 1 (3D box annotations
+per class, ``table1_annotations.csv``, from the box files). Reads the per-image metadata only; ``--verify``
 also recomputes the pixel counts from the EXR masks and fails (exit 1, nothing written)
 when they differ.
 """
@@ -27,7 +28,8 @@ EXIT_MISMATCH = 1
 
 
 def register(sub) -> None:
-    p = sub.add_parser("stats", help="dataset statistics: pixels per class, images per weather x time of day",
+    p = sub.add_parser("stats", help="dataset statistics: pixels per class, images per weather x time of day, "
+                                     "boxes per class",
                        description=__doc__.split("\n\n")[1])
     p.add_argument("dataset", type=path, help="dataset folder (with images/*.json)")
     p.add_argument("--out", type=path, default=None, help="output folder (default: DIR/stats)")

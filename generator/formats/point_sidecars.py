@@ -11,10 +11,13 @@ file                               dtype    content
 ``point_times/NNNNNN.bin``         float32  firing offset after the sweep start, seconds (0 with
                                             motion skew off): what de-skewing needs
 ``native_labels/NNNNNN.bin``       uint8    native class id (``generator/labels/classes.yaml``)
+``point_rings/NNNNNN.bin``         uint8    beam row by elevation, 0 = highest (the scanner's
+                                            ``ring``): what the nuScenes export's ring column needs
 =================================  =======  ==================================================
 
-Both little-endian, one value per point in the order of the ``.bin`` rows. Datasets from
-elsewhere lack them; readers return None then.
+All little-endian, one value per point in the order of the ``.bin`` rows. Datasets from
+elsewhere lack them (and datasets made before ``point_rings`` existed lack that one); readers
+return None then.
 """
 
 from __future__ import annotations
@@ -31,12 +34,14 @@ from generator.labels import class_table
 
 TIMES_DIR = "point_times"
 NATIVE_DIR = "native_labels"
+RINGS_DIR = "point_rings"
 #: (folder, dtype) of each side file.
-SIDECARS = {TIMES_DIR: "<f4", NATIVE_DIR: "u1"}
+SIDECARS = {TIMES_DIR: "<f4", NATIVE_DIR: "u1", RINGS_DIR: "u1"}
 
 
-def write_point_sidecars(seq_dir: str | Path, stem: str, times: np.ndarray, native: np.ndarray) -> None:
-    """Write both side files of scan ``stem`` (atomically).
+def write_point_sidecars(seq_dir: str | Path, stem: str, times: np.ndarray, native: np.ndarray,
+                         rings: np.ndarray | None = None) -> None:
+    """Write the side files of scan ``stem`` (atomically; ``point_rings`` only when ``rings`` is given).
 
     Parameters
     ----------
@@ -48,11 +53,16 @@ def write_point_sidecars(seq_dir: str | Path, stem: str, times: np.ndarray, nati
         Firing offsets, seconds.
     native : (n,) uint8
         Native class ids.
+    rings : (n,) uint8, optional
+        Beam rows (0 = highest beam).
     """
-    if len(times) != len(native):
-        raise ValueError(f"{len(times)} times but {len(native)} native labels")
+    if len(times) != len(native) or (rings is not None and len(rings) != len(times)):
+        raise ValueError(f"{len(times)} times but {len(native)} native labels"
+                         + ("" if rings is None else f" and {len(rings)} rings"))
     write_bytes(Path(seq_dir) / TIMES_DIR / f"{stem}.bin", np.asarray(times, "<f4").tobytes())
     write_bytes(Path(seq_dir) / NATIVE_DIR / f"{stem}.bin", np.asarray(native, "u1").tobytes())
+    if rings is not None:
+        write_bytes(Path(seq_dir) / RINGS_DIR / f"{stem}.bin", np.asarray(rings, "u1").tobytes())
 
 
 def read_sidecar(seq_dir: str | Path, folder: str, index: int, n_points: int) -> np.ndarray | None:

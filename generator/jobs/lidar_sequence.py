@@ -184,7 +184,7 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
             semantic = semantickitti_labels(pts["class"], pts["moving"])  # moving-* ids on movers
             sk.write_scan(seq / "velodyne" / f"{stem}.bin", scan.xyz, remission)
             sk.write_labels(seq / "labels" / f"{stem}.label", semantic, pts["instance"])
-            write_point_sidecars(seq, stem, pts["time"], pts["class"])  # fusion: de-skew times, native classes
+            write_point_sidecars(seq, stem, pts["time"], pts["class"], pts["ring"])  # de-skew times, classes, rings
             flows.add(j, t_j, pts)
             if options.bev:
                 write_bev(seq / "bev" / f"{stem}.png", scan.xyz, pts["class"], title=f"{spec.name} {name}/{stem}",
@@ -222,7 +222,7 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
 
 def _remove_stale(seq: Path, n: int) -> None:
     for sub, ext in (("velodyne", ".bin"), ("labels", ".label"), ("bev", ".png"), ("range", ".npy"), ("ply", ".ply"),
-                     ("point_times", ".bin"), ("native_labels", ".bin")):
+                     ("point_times", ".bin"), ("native_labels", ".bin"), ("point_rings", ".bin")):
         for p in sorted((seq / sub).glob(f"*{ext}")):
             if p.stem.isdigit() and int(p.stem) >= n:
                 log.warning("removing %s left by an earlier, longer run", p)

@@ -36,9 +36,9 @@ def parse_spec(document: object, source: str) -> SceneSpec:
 
 
 def spec_hash(spec: SceneSpec) -> str:
-    """The spec's :func:`canonical_hash`; ``town.redraw_every_frames``, ``streets.roundabouts`` and ``streets.closed_streets`` count
-    only when set, so the hash of every spec written before those options is unchanged (resumable
-    datasets stay resumable)."""
+    """The spec's :func:`canonical_hash`; ``town.redraw_every_frames``, ``streets.roundabouts``,
+    ``streets.closed_streets``, ``traffic.vans_per_km`` and ``traffic.counts`` count only when set, so the
+    hash of every spec written before those options is unchanged (resumable datasets stay resumable)."""
     d = spec.to_dict()
     if d["town"].get("redraw_every_frames") is None:
         d["town"].pop("redraw_every_frames", None)
@@ -47,6 +47,10 @@ def spec_hash(spec: SceneSpec) -> str:
             d["streets"].pop(key, None)
     if d.get("streets") is not None and list(d["streets"].get("intersection_angle_deg", (90, 90))) == [90, 90]:
         d["streets"].pop("intersection_angle_deg", None)   # and the angle while right
+    if not d["traffic"].get("vans_per_km"):             # and the traffic's vans and counts while unused
+        d["traffic"].pop("vans_per_km", None)
+    if d["traffic"].get("counts") is None:
+        d["traffic"].pop("counts", None)
     return canonical_hash(d)
 
 

@@ -82,6 +82,21 @@ class Paths:
 
 
 @dataclass(frozen=True)
+class Counts:
+    """Exact actors per scene (``traffic.counts``); None = the kind's density decides."""
+
+    cars: int | None = None
+    trucks: int | None = None
+    vans: int | None = None
+    buses: int | None = None
+    other_vehicles: int | None = None
+    cyclists: int | None = None
+    motorcyclists: int | None = None
+    pedestrians: int | None = None
+    standing_pedestrians: int | None = None
+
+
+@dataclass(frozen=True)
 class Traffic:
     cars_per_km: float
     trucks_per_km: float
@@ -94,11 +109,15 @@ class Traffic:
     speed_limit_mps: float
     pedestrian_speed_mps: float
     ego_stop_probability: float
+    vans_per_km: float = 0.0
+    counts: Counts | None = None
 
     @property
     def enabled(self) -> bool:
-        """Whether anything moves besides the ego (all densities 0: the frozen town)."""
-        return any(v > 0 for k, v in dataclasses.asdict(self).items() if k.endswith(("_per_km", "_per_100m")))
+        """Whether anything moves besides the ego (all densities and counts 0: the frozen town)."""
+        counts = dataclasses.asdict(self.counts).values() if self.counts is not None else ()
+        return any(v > 0 for k, v in dataclasses.asdict(self).items() if k.endswith(("_per_km", "_per_100m"))) \
+            or any(v is not None and v > 0 for v in counts)
 
 
 @dataclass(frozen=True)

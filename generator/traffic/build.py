@@ -34,7 +34,7 @@ from generator.traffic.lanes.signals import CLEAR_S, Signals
 from generator.traffic.mapped_tracks import map_track
 from generator.traffic.movers import DT_S, Mover
 from generator.traffic.pedestrians.simulate import simulate_pedestrians
-from generator.traffic.vehicles.fleet import KINDS, fleet_proto, widest_half_width
+from generator.traffic.vehicles.fleet import KINDS, drives, fleet_proto, how_many, widest_half_width
 from generator.traffic.vehicles.sim import Vehicle, VehicleSim, arm_towards
 from generator.world.actors import Actor, Track, TrackTrajectory, World, frozen_world
 from generator.world.trajectory import EgoTrajectory
@@ -110,7 +110,7 @@ def build_world(spec, scene: Town, duration_s: float, distance_m: float = 0.0) -
 
 
 def _pedestrians(spec, grid, scene, signals, lib, n_steps: int) -> list[Mover]:
-    if spec.traffic.pedestrians_per_100m <= 0 and spec.traffic.standing_pedestrians_per_100m <= 0:
+    if not (drives(spec.traffic, "pedestrians_per_100m") or drives(spec.traffic, "standing_pedestrians_per_100m")):
         return []
     return simulate_pedestrians(spec, grid, scene, signals, lib, n_steps, DT_S)
 
@@ -222,7 +222,7 @@ def _drive(spec, graph, scene, signals, lib, blocked, crossing, duration_s, dist
     paint = stream(spec.seed, "traffic", "vehicles", "paint")   # colours never move a vehicle
     taken: dict[int, list] = {route[0]: [(0.0, EGO_SIZE_M[0])]}
     for field_name, (kind, n_var, speed, a_max, _) in KINDS.items():
-        for _ in range(round(getattr(tr, field_name) * km)):
+        for _ in range(how_many(tr, field_name, km)):
             proto = fleet_proto(lib, kind, int(g.integers(n_var)))
             length, width = float(proto.hi[0] - proto.lo[0]), float(proto.hi[1] - proto.lo[1])
             avoid = frozenset(too_narrow(graph, scene, width / 2, set(route), length))

@@ -38,7 +38,7 @@ from generator.traffic.pedestrians import zones as wz
 from generator.traffic.pedestrians.lines import R_TURN
 from generator.traffic.pedestrians.shared import shared_standers
 from generator.traffic.pedestrians.walkways import Walkways, build_walkways, obstacles_of
-from generator.traffic.vehicles.fleet import KINDS, widest_half_width
+from generator.traffic.vehicles.fleet import KINDS, how_many, widest_half_width
 from generator.world.actors import Track
 
 log = logging.getLogger(__name__)
@@ -97,8 +97,8 @@ def simulate_pedestrians(spec: SceneSpec, grid: Grid, scene, signals, lib: Libra
     """
     tr = spec.traffic
     length = sidewalk_length(grid)
-    n_walk = round(tr.pedestrians_per_100m * length / 100.0)
-    n_stand = round(tr.standing_pedestrians_per_100m * length / 100.0)
+    n_walk = how_many(tr, "pedestrians_per_100m", length / 100.0)
+    n_stand = how_many(tr, "standing_pedestrians_per_100m", length / 100.0)
     if n_walk == 0 and n_stand == 0:
         return []
     t0 = time.perf_counter()

@@ -33,7 +33,23 @@ KINDS = {
     "other_vehicles_per_km": ("construction_vehicle", 4, (0.5, 0.7), 1.0, 7.0),
     "cyclists_per_km": ("bicyclist", 4, (0.35, 0.55), 1.0, 1.8),
     "motorcyclists_per_km": ("motorcyclist", 4, (0.8, 1.0), 2.5, 2.2),
+    # last, so towns without vans draw every other vehicle as before
+    "vans_per_km": ("box_van", 3, (0.75, 0.9), 1.5, 6.6),
 }
+
+
+def how_many(traffic, field_name: str, extent: float) -> int:
+    """Actors of the kind of density ``field_name`` (``"cars_per_km"``, ``"pedestrians_per_100m"``...) in a
+    scene of ``extent`` (km of lane, or hundreds of metres of sidewalk): ``traffic.counts`` when it names
+    the kind (exact per scene, as seed 002 loads its scenes), else the density times the extent."""
+    n = getattr(traffic.counts, field_name.rsplit("_per_", 1)[0], None) if traffic.counts is not None else None
+    return int(n) if n is not None else round(getattr(traffic, field_name) * extent)
+
+
+def drives(traffic, field_name: str) -> bool:
+    """Whether the kind of density ``field_name`` may appear at all (a count or a density above 0)."""
+    n = getattr(traffic.counts, field_name.rsplit("_per_", 1)[0], None) if traffic.counts is not None else None
+    return n > 0 if n is not None else getattr(traffic, field_name) > 0
 
 
 def fleet_proto(lib: Library, kind: str, i: int) -> Proto:
@@ -84,7 +100,7 @@ def widest_half_width(spec, lib: Library, kinds: dict, ego_width: float) -> tupl
     """
     best, key = ego_width / 2, "ego"
     for field_name, (kind, n_var, *_rest) in kinds.items():
-        if getattr(spec.traffic, field_name) <= 0:
+        if not drives(spec.traffic, field_name):
             continue
         for i in range(n_var):
             proto = fleet_proto(lib, kind, i)
