@@ -1,5 +1,7 @@
 """``urbangen eval --pred DIR --gt DIR [--labels unified11|semantickitti|native] [--panoptic] [--json PATH]``.
 
+Scans by default; ``--images`` scores image label maps instead (:mod:`generator.commands.eval_images`).
+
 Compares two SemanticKITTI-layout label trees scan by scan and prints IoU per class and
 the mIoU exactly as semantic-kitti-api's evaluate_semantics.py computes them: confusion
 [prediction, ground truth]; class 0 (unlabeled) ignored only as ground truth, so a labelled
@@ -10,12 +12,16 @@ included) -- and a class absent from both prediction and ground truth counts as 
 PRED/sequences/NN/predictions/ when that folder exists (the reference's layout), else from
 labels/. --panoptic adds PQ, SQ and RQ per class and their means (SemanticKITTI panoptic:
 segments matched at IoU > 0.5, unmatched segments under --min-points ignored). The result
-is written as JSON (default PRED/eval_<labels>.json).
+is written as JSON (default PRED/eval_<labels>.json). --images scores predicted image label
+maps (PNGs in PRED, any label set) against a Cityscapes export or a dataset's images as
+cityscapesScripts does: IoU and iIoU per class and category, their averages, per image, and
+seed 001's per-image table (default PRED/eval_images.json).
 """
 
 from __future__ import annotations
 
 from generator.atomic import write_json
+from generator.commands.eval_images import add_image_args, run_images
 from generator.commands.options import Integer, path, sequence_id
 from generator.commands.preflight import input_dir, output_file
 
@@ -30,8 +36,13 @@ def register(sub) -> None:
     p = sub.add_parser("eval", help="IoU per class and mIoU (and PQ) of predicted labels against ground truth",
                        description=__doc__.split("\n\n")[1])
     p.add_argument("--pred", required=True, type=path,
-                   help="prediction root (sequences/NN/predictions/ or sequences/NN/labels/)")
-    p.add_argument("--gt", required=True, type=path, help="ground-truth root (sequences/NN/labels/)")
+                   help="prediction root (sequences/NN/predictions/ or sequences/NN/labels/; with --images: a "
+                        "folder of label PNGs)")
+    p.add_argument("--gt", required=True, type=path,
+                   help="ground-truth root (sequences/NN/labels/; with --images: a Cityscapes export or a dataset)")
+    p.add_argument("--images", action="store_true",
+                   help="score image label maps (cityscapesScripts conventions) instead of scans")
+    add_image_args(p)
     p.add_argument("--labels", default="unified11", choices=LABEL_SETS,
                    help="label set: unified11, semantickitti or native (default unified11; native needs "
                         "native_labels/ in both trees)")
@@ -49,6 +60,8 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    if args.images:
+        return run_images(args)
     from generator.stats.evaluate import evaluate_trees, format_table
     from generator.stats.panoptic import format_panoptic
 
