@@ -41,6 +41,7 @@ COMMANDS = [
     "import_carla",
     "fuse",
     "eval",
+    "gap",
     "export",
     "openlabel",
     "render",

@@ -45,7 +45,7 @@ ALLOWED: dict[str, set[str]] = {
     "commands": {"dataset", "formats", "fusion", "gap", "geometry", "imaging", "jobs", "labels", "layout", "lidar",
                  "materials", "previews", "remission", "scan_effects", "spec", "stats", "traffic", "weather", "world"},
     "dataset": {"formats", "imaging", "labels"},
-    "gap": {"dataset", "formats", "labels", "lidar", "stats"},
+    "gap": {"dataset", "formats", "geometry", "imaging", "labels", "lidar", "stats"},
     "cli": {"commands"},
 }
 
