@@ -16,7 +16,7 @@ import logging
 from pathlib import Path
 
 from generator.commands.options import Integer, path
-from generator.commands.preflight import output_dir
+from generator.commands.preflight import input_dir, output_dir
 from generator.errors import UserError
 
 log = logging.getLogger(__name__)
@@ -44,7 +44,7 @@ def register(sub) -> None:
 
 def _names(args) -> list[str]:
     if args.names is None:
-        names = [Path(p).resolve().name or str(p) for p in args.datasets]
+        names = [Path(p).absolute().name or str(p) for p in args.datasets]
         return [n if names.count(n) == 1 else f"{n}#{i + 1}" for i, n in enumerate(names)]
     names = [n.strip() for n in args.names.split(",")]
     if len(names) != len(args.datasets) or not all(names) or len(set(names)) != len(names):
@@ -76,12 +76,14 @@ def run(args) -> int:
 
     if len(args.datasets) < 2:
         raise UserError("DATASET: name at least two datasets (SYNTH REAL)")
+    roles = _roles(len(args.datasets))
+    for p, role in zip(args.datasets, roles, strict=True):
+        input_dir(p, role, "dataset folder")
     names = _names(args)
     reference = args.reference or names[-1]
     if reference not in names:
         raise UserError(f"--reference: {reference!r} is none of the names ({', '.join(names)})")
     sensor = _sensor(args.sensor)
-    roles = _roles(len(names))
     sources = [open_source(p, role, args.every) for p, role in zip(args.datasets, roles, strict=True)]
     mode = objects_mode(args.objects, sources)
     out = output_dir(args.out, "--out")

@@ -16,11 +16,13 @@ Ring
 Eliminating ``d``: a point lies on laser ``i``'s cone exactly when ``z cos(v_i) - A_i sin(v_i) = vo_i``,
 with ``A_i = sqrt(x^2 + y^2 - h_i^2)``. The signed left-hand side minus ``vo_i`` is the point's vertical
 distance from that cone in the beam's vertical plane (metres). Each point takes the laser with the
-smallest such distance divided by its range (the angular miss), searched among the four lasers nearest
-in elevation to the point's elevation seen from the mean emission point (the offsets differ by a few
-centimetres, so the nearest cone is always among them). The miss is kept (``vertical_m``): on a simulated
-sensor it is zero to float precision; jitter, range noise of a real unit, a calibration that is not the
-unit's own, and vibration make it spread -- seed 002's "rings are not perfect circles", measured.
+smallest such distance, searched among the lasers next to the point's elevation as seen from each group
+of lasers' emission height (the HDL-64E's upper and lower blocks sit 6 cm apart, which at the 0.9 m
+minimum range is worth several lasers; within a block the offset changes by under a millimetre from
+one laser to the next, so the neighbours of the refined elevation hold the right cone). The miss is
+kept (``vertical_m``): on a simulated sensor it is zero to float precision; jitter, range noise of a real
+unit, a calibration that is not the unit's own, and vibration make it spread -- seed 002's "rings are not
+perfect circles", measured.
 
 Column
 ------
@@ -45,8 +47,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-#: Lasers tried per point (nearest in elevation first).
-CANDIDATES = 4
+#: Lasers tried per point and laser group: the one below the estimated elevation and the next above.
+CANDIDATES = 3
+#: A jump in emission height (vert_offset) larger than this starts a new laser group, metres.
+GROUP_GAP_M = 0.02
 
 
 @dataclass
@@ -82,26 +86,43 @@ class RingModel:
         self.h = sensor.horiz_offset[order].astype(np.float64)
         self.rot = sensor.rot_correction[order].astype(np.float64)
         self.ring_of = sensor.ring[order].astype(np.int16)
-        self.vo_mean = float(np.mean(self.vo))
-        self.cos, self.sin, self.h2 = (np.cos(self.elev).astype(np.float32), np.sin(self.elev).astype(np.float32),
-                                       (self.h ** 2).astype(np.float32))
         self.steps = int(sensor.azimuth_steps)
+        self.cos, self.sin = np.cos(self.elev).astype(np.float32), np.sin(self.elev).astype(np.float32)
+        self.h2, self.vo32 = (self.h ** 2).astype(np.float32), self.vo.astype(np.float32)
+        # lasers grouped by emission height (the HDL-64E's two blocks sit ~6 cm apart): within a group the
+        # offset changes slowly with elevation, so the elevation seen from the group's own offset finds the
+        # laser's neighbours even at the minimum range
+        by_vo = np.argsort(self.vo, kind="stable")
+        cuts = np.flatnonzero(np.diff(self.vo[by_vo]) > GROUP_GAP_M) + 1
+        self.groups = [np.sort(g) for g in np.split(by_vo, cuts)]
+
+    def _candidates(self, rho: np.ndarray, z: np.ndarray) -> list[np.ndarray]:
+        """Laser indices (into the elevation-sorted table) to try for each point: per group, the lasers
+        around the point's elevation seen from the group's emission point (for the true laser,
+        ``atan2(z - vo cos v, rho + vo sin v) = v`` exactly; two refinements get there)."""
+        out = []
+        for g in self.groups:
+            elev, vo = self.elev[g], self.vo[g]
+            guess = np.arctan2(z - vo.mean(), rho)
+            for _ in range(2):  # the elevation seen from the emission point, which sits at vo (-sin v, cos v)
+                off = np.interp(guess, elev, vo)
+                guess = np.arctan2(z - off * np.cos(guess), rho + off * np.sin(guess))
+            k = np.searchsorted(elev, guess)
+            for j in range(-1, CANDIDATES - 1):
+                out.append(g[np.clip(k + j, 0, len(g) - 1)])
+        return out
 
     def fit(self, xyz: np.ndarray) -> RingFit:
         """The beam of every point of ``xyz`` (n, 3) (sensor frame, metres)."""
         p = np.asarray(xyz, np.float32)  # float32 holds 120 m to 10 um: far below a laser's 0.3-deg spacing
         x, y, z = p[:, 0], p[:, 1], p[:, 2]
         rho2 = x * x + y * y
-        k = np.searchsorted(self.elev, np.arctan2(z - self.vo_mean, np.sqrt(rho2)))
-        lo = np.clip(k - CANDIDATES // 2, 0, len(self.elev) - CANDIDATES)
         best_miss = np.full(len(p), np.inf, np.float32)
-        laser = lo.copy()
+        laser = np.zeros(len(p), np.int64)
         a_best = np.zeros(len(p), np.float32)
-        vo = self.vo.astype(np.float32)
-        for j in range(CANDIDATES):  # one candidate at a time: (n,) arrays, no (n, C) temporaries
-            c = lo + j
+        for c in self._candidates(np.sqrt(rho2), z):  # one candidate at a time: (n,) arrays, no (n, C)
             a = np.sqrt(np.maximum(rho2 - self.h2[c], 0.0))
-            miss = z * self.cos[c] - a * self.sin[c] - vo[c]
+            miss = z * self.cos[c] - a * self.sin[c] - self.vo32[c]
             better = np.abs(miss) < np.abs(best_miss)
             best_miss = np.where(better, miss, best_miss)
             laser = np.where(better, c, laser)
