@@ -6,7 +6,10 @@ Per scan (:meth:`Profile.add`), with the beams derived from the geometry (:mod:`
   counts points sharing a cell). A cell without a point is a lost ray. Its range is estimated from the
   nearest returned cell of the same ring within :data:`GAP_COLUMNS` columns (the nearer one; on a tie
   the nearer range): a ray lost amid returns had a surface to hit at about that distance. A cell with no
-  return that near (sky, beyond the range) has no estimate and counts only per ring.
+  return that near (sky, beyond the range) has no estimate and counts only per ring. Per range bin,
+  every point is a returned ray and each point that shares its cell cancels one empty cell of its bin
+  (it was fired into one of the empty cells near it: jittered points, or a real unit's own azimuths);
+  the lost share of a bin is lost / (lost + returned).
 * **range**: points per range bin.
 * **ring regularity**: along each ring (points in column order), the distance of each point's range
   from the median of the 5 consecutive points centred on it, where those 5 lie within 8 columns: on any
@@ -113,10 +116,12 @@ class Profile:
         self.merge(self.measure(xyz, remission, learning, objects, ring))
 
     def _rays(self, fit) -> dict:
+        cells_all = fit.ring.astype(np.int64) * self.steps + fit.column
+        order = np.lexsort((fit.range_m, cells_all))  # by cell, nearest first
+        cells, ranges = cells_all[order], fit.range_m[order]
+        kept = np.r_[True, cells[1:] != cells[:-1]]
         grid = np.full((self.rings, self.steps), np.inf, np.float32)
-        order = np.argsort(-fit.range_m, kind="stable")  # the nearest point of a cell is written last
-        cells = fit.ring.astype(np.int64)[order] * self.steps + fit.column[order]
-        grid.ravel()[cells] = fit.range_m[order]
+        grid.ravel()[cells[kept]] = ranges[kept]
         occ = np.isfinite(grid)
         w = GAP_COLUMNS
         pad = np.concatenate([grid[:, -w:], grid, grid[:, :w]], axis=1)  # the turn is a circle
@@ -130,11 +135,15 @@ class Profile:
         rr = pad[rows, np.clip(right, 0, pad.shape[1] - 1)]
         est = np.where(dl < dr, rl, np.where(dr < dl, rr, np.minimum(rl, rr)))
         est = np.where(np.minimum(dl, dr) <= w, est, np.inf)[:, w:-w]
-        lost = ~occ & np.isfinite(est)
+        empty = ~occ & np.isfinite(est)
         n = len(LOST_RANGE_EDGES) - 1
-        return {"collisions": len(cells) - int(np.count_nonzero(np.bincount(cells, minlength=grid.size))),
-                "returned_range": np.bincount(_bin(grid[occ], LOST_RANGE_EDGES), minlength=n),
-                "lost_range": np.bincount(_bin(est[lost], LOST_RANGE_EDGES), minlength=n)}
+        # every point is a returned ray; one that lost its cell to a nearer point (jitter, a calibration that
+        # is not the unit's own, more firings per turn than the grid) came from one of the empty cells near
+        # it, so each such point cancels one empty cell of its range bin
+        extra = np.bincount(_bin(ranges[~kept], LOST_RANGE_EDGES), minlength=n)
+        return {"collisions": int((~kept).sum()),
+                "returned_range": np.bincount(_bin(ranges, LOST_RANGE_EDGES), minlength=n),
+                "lost_range": np.maximum(np.bincount(_bin(est[empty], LOST_RANGE_EDGES), minlength=n) - extra, 0)}
 
     def _regularity(self, fit) -> np.ndarray:
         nb = len(RESIDUAL_EDGES) - 1
