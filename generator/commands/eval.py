@@ -1,7 +1,5 @@
 """``urbangen eval --pred DIR --gt DIR [--labels unified11|semantickitti|native] [--panoptic] [--json PATH]``.
 
-Scans by default; ``--images`` scores image label maps instead (:mod:`generator.commands.eval_images`).
-
 Compares two SemanticKITTI-layout label trees scan by scan and prints IoU per class and
 the mIoU exactly as semantic-kitti-api's evaluate_semantics.py computes them: confusion
 [prediction, ground truth]; class 0 (unlabeled) ignored only as ground truth, so a labelled
