@@ -7,6 +7,7 @@ import shutil
 
 import numpy as np
 import pytest
+from kits.fusion_kit import write_raycast_images, write_raycast_stream
 from PIL import Image
 
 from generator.cli import main
@@ -15,7 +16,6 @@ from generator.imaging.exr import read_exr
 from generator.labels import class_table
 from generator.labels.class_sets import builtin_sets
 from generator.stats.evaluate import iou_from_confusion
-from kits.fusion_kit import write_raycast_images, write_raycast_stream
 
 T = class_table()
 HEAD = "occlusion=on,boundaries_and_proxies=excluded"
@@ -97,6 +97,14 @@ def test_a_swapped_class_costs_exactly_the_analytic_loss(dataset, perfect, tmp_p
         assert got["iou"]["truck"] == want.iou[TRUCK]
     # seed 001 merges car and truck into vehicle: the swap costs nothing there
     assert swapped["points"]["seed001"] == perfect["points"]["seed001"]
+
+
+def test_without_deskew_the_stream_is_projected_the_kitti_way(dataset, perfect, tmp_path):
+    """--no-deskew: raw points, P2 @ Tr for image_2 (what KITTI tools do); still mostly right, a little worse."""
+    raw = _run(dataset, _predictions(dataset, tmp_path / "raw"), "--no-deskew")
+    assert raw["settings"]["deskew"].startswith("off")
+    r, p = raw["points"]["cityscapes"][HEAD], perfect["points"]["cityscapes"][HEAD]
+    assert 0.9 < r["accuracy"] <= p["accuracy"]
 
 
 def _bad(dataset, tmp_path, capsys, name, array=None, extra=()):

@@ -141,3 +141,23 @@ def test_bad_predictions_are_one_line_exit_2_and_nothing_is_written(perturbed, t
     code, err = run(good, name="something_else.png")
     assert code == 2 and len(err) == 1 and "no prediction for any of the" in err[0]
     assert not out.exists()
+
+
+def test_train_id_predictions_score_as_their_label_ids(perturbed, tmp_path, capsys):
+    """A model writing train ids (255 = void) is read through --label-set cityscapes_trainids."""
+    from generator.formats.cityscapes import train_ids
+
+    ds, export, pred = perturbed
+    trained = tmp_path / "trainids"
+    trained.mkdir()
+    for p in pred.rglob("*.png"):
+        Image.fromarray(train_ids(np.array(Image.open(p)))).save(trained / p.name)
+    ours = _ours(pred, export, tmp_path / "a.json")
+    out = tmp_path / "b.json"
+    # read as label ids, 255 is no Cityscapes class: refused, not scored as something else
+    assert cli.main(["eval", "--images", "--pred", str(trained), "--gt", str(export), "--json", str(out)]) == 2
+    assert "ids: values [255] are not classes of the label set cityscapes" in capsys.readouterr().err
+    assert cli.main(["eval", "--images", "--pred", str(trained), "--gt", str(export), "--json", str(out),
+                     "--label-set", "cityscapes_trainids"]) == 0
+    via_set = json.loads(out.read_text())
+    assert via_set["classScores"] == ours["classScores"] and via_set["categoryScores"] == ours["categoryScores"]
