@@ -10,7 +10,7 @@ SYNTH and REAL are SemanticKITTI-layout folders (e.g. two 100-sweep ``urbangen l
 * reading every scan and its labels (the baseline: what any tool must do),
 * the ring fit alone (:mod:`generator.gap.rings`),
 * the whole measurement (:func:`generator.gap.measure.measure`, on ``--threads`` threads),
-* the whole command (measurement, report, 9 charts), as ``urbangen gap`` runs it.
+* the whole command (measurement, report, 10 charts), as ``urbangen gap`` runs it.
 """
 
 from __future__ import annotations

@@ -39,16 +39,20 @@ def _median_from_hist(h: np.ndarray, edges: np.ndarray) -> float | None:
     return float((edges[i] + edges[i + 1]) / 2)
 
 
-def _object_medians(p: PR.Profile) -> list:
+def _cars(p: PR.Profile) -> np.ndarray:
+    return p.object_classes.get("car", np.zeros_like(p.objects))
+
+
+def _object_medians(hist: np.ndarray) -> list:
     return [None if m is None else float(10 ** m) for m in
-            (_median_from_hist(row, PR.LOG_POINTS_EDGES) for row in p.objects)]
+            (_median_from_hist(row, PR.LOG_POINTS_EDGES) for row in hist)]
 
 
-def _objects_w1(a: PR.Profile, b: PR.Profile) -> float | None:
-    weights = a.objects.sum(1) / max(a.objects.sum(), 1) + b.objects.sum(1) / max(b.objects.sum(), 1)
+def _objects_w1(ha: np.ndarray, hb: np.ndarray) -> float | None:
+    weights = ha.sum(1) / max(ha.sum(), 1) + hb.sum(1) / max(hb.sum(), 1)
     num = den = 0.0
     for i, w in enumerate(weights):
-        d = D.w1(a.objects[i], b.objects[i], PR.LOG_POINTS_EDGES)
+        d = D.w1(ha[i], hb[i], PR.LOG_POINTS_EDGES)
         if d is not None:
             num, den = num + w * d, den + w
     return num / den if den else None
@@ -131,8 +135,12 @@ METRICS: dict[str, Metric] = {
     "points_per_object": Metric(
         "median points per object by distance of its centre; distance: the W1 of log10(points per object) "
         "in each distance bin, averaged with the bins' mean object shares", "distance, m",
-        lambda p: _centres(PR.OBJECT_DISTANCE_EDGES), _object_medians, _objects_w1, "wasserstein-1",
-        "log10(points)", "objects"),
+        lambda p: _centres(PR.OBJECT_DISTANCE_EDGES), lambda p: _object_medians(p.objects),
+        lambda a, b: _objects_w1(a.objects, b.objects), "wasserstein-1", "log10(points)", "objects"),
+    "points_per_car": Metric(
+        "points_per_object for cars only (box type or SemanticKITTI class car)", "distance, m",
+        lambda p: _centres(PR.OBJECT_DISTANCE_EDGES), lambda p: _object_medians(_cars(p)),
+        lambda a, b: _objects_w1(_cars(a), _cars(b)), "wasserstein-1", "log10(points)", "objects"),
 }
 
 

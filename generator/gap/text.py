@@ -10,7 +10,7 @@ Y_LABELS = {"rays_lost_per_ring": "share of rays lost", "rays_lost_per_range": "
             "points_per_range": "points per scan", "ring_regularity": "median |range - median5|, m",
             "ring_fit_vertical": "share of points", "intensity": "share of points",
             "intensity_per_class": "mean remission", "class_mix": "share of points",
-            "points_per_object": "median points per object"}
+            "points_per_object": "median points per object", "points_per_car": "median points per car"}
 
 
 def _value(v) -> str:

@@ -38,7 +38,7 @@ def test_a_sequence_against_itself_is_0_everywhere(pair, tmp_path):
     raw, _ = pair
     rep = _gap(tmp_path / "self", raw, raw, extra=("--names", "a,b"))
     dist = _distances(rep)
-    assert len(dist) == 9  # every metric measured (labels and instances present)
+    assert len(dist) == 10  # every metric measured (labels and instances present)
     assert all(v == {"a vs b": 0.0} for v in dist.values()), dist
     assert rep["objects_from"] == "instances"
     for name in ("gap.md", "gap.png", "gap_rays_lost_per_ring.png", "gap_intensity.png"):
