@@ -42,6 +42,7 @@ COMMANDS = [
     "fuse",
     "flow",
     "eval",
+    "gap",
     "export",
     "process",
     "openlabel",

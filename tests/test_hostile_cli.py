@@ -58,6 +58,9 @@ COMMANDS: dict[str, list[str]] = {
     "eval": ["eval", "--pred", "{ds}", "--gt", "{ds}", "--json", "{json}"],
     "export": ["export", "cityscapes", "{ds}", "{out}"],
     "openlabel": ["openlabel", "{spec}", "{ds}"],
+    "fuse_labels": ["fuse", "{ds}", "--image-labels", "{ds}"],
+    "eval_images": ["eval", "--images", "--pred", "{ds}", "--gt", "{ds}", "--json", "{json}"],
+    "gap": ["gap", "{ds}", "{ds}", "--out", "{out}"],
 }
 #: What each path slot must be: an existing input (file or folder) or an output (folder or file).
 ROLES = {"spec": "in_file", "config": "in_file", "ds": "in_dir", "out": "out_dir", "json": "out_file"}

@@ -14,12 +14,16 @@ segments matched at IoU > 0.5, unmatched segments under --min-points ignored). T
 is written as JSON (default PRED/eval_<labels>.json). --detection scores 3D boxes instead: kitti
 (AP R40, generator.commands.eval_kitti) or nuscenes (--pred a nuScenes results file, --gt an 'urbangen
 export nuscenes' dataroot; mAP, NDS and the TP errors computed by nuscenes-devkit itself, pip install
--e ".[detection]"; generator.commands.eval_nuscenes).
+-e ".[detection]"; generator.commands.eval_nuscenes). --images scores predicted image label
+maps (PNGs in PRED, any label set) against a Cityscapes export or a dataset's images as
+cityscapesScripts does: IoU and iIoU per class and category, their averages, per image, and
+seed 001's per-image table (default PRED/eval_images.json).
 """
 
 from __future__ import annotations
 
 from generator.atomic import write_json
+from generator.commands.eval_images import add_image_args, run_images
 from generator.commands.options import Integer, path, sequence_id
 from generator.commands.preflight import input_dir, output_file
 
@@ -36,8 +40,13 @@ def register(sub) -> None:
     p = sub.add_parser("eval", help="IoU per class and mIoU (and PQ) of predicted labels against ground truth",
                        description=__doc__.split("\n\n")[1])
     p.add_argument("--pred", required=True, type=path,
-                   help="prediction root (sequences/NN/predictions/ or sequences/NN/labels/)")
-    p.add_argument("--gt", required=True, type=path, help="ground-truth root (sequences/NN/labels/)")
+                   help="prediction root (sequences/NN/predictions/ or sequences/NN/labels/; with --images: a "
+                        "folder of label PNGs)")
+    p.add_argument("--gt", required=True, type=path,
+                   help="ground-truth root (sequences/NN/labels/; with --images: a Cityscapes export or a dataset)")
+    p.add_argument("--images", action="store_true",
+                   help="score image label maps (cityscapesScripts conventions) instead of scans")
+    add_image_args(p)
     p.add_argument("--labels", default="unified11", choices=LABEL_SETS,
                    help="label set: unified11, semantickitti or native (default unified11; native needs "
                         "native_labels/ in both trees)")
@@ -65,6 +74,8 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    if args.images:
+        return run_images(args)
     if args.detection is not None:
         import importlib
 

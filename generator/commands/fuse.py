@@ -7,6 +7,8 @@ the mask class with each point's ray-cast class, and writes ``DIR/fusion/``:
 agreement, confusion matrices), and the semantic map of the sequence (seed 001 Eq. 2)
 twice: ``semantic_map_lidar.{ply,png}`` (every point, its ray-cast class) and
 ``semantic_map_camera.{ply,png}`` (points the camera sees, labelled from the masks).
+With --image-labels PRED it fuses a segmentation model's predicted label maps instead (seed 001's
+pipeline: :mod:`generator.commands.fuse_predictions`).
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from generator.atomic import atomic_path, staging, write_json, write_text
+from generator.commands.fuse_predictions import add_prediction_args, run_predictions
 from generator.commands.options import Integer, Number, path, sequence_id
 from generator.commands.preflight import input_dir, output_dir
 from generator.errors import UserError
@@ -42,8 +45,10 @@ def register(sub) -> None:
     p.add_argument("--voxel", type=Number(MIN_VOXEL_M, MAX_VOXEL_M), default=0.2,
                    help=f"semantic-map voxel edge, metres, in [{MIN_VOXEL_M}, {MAX_VOXEL_M:g}] (default 0.2)")
     p.add_argument("--no-deskew", action="store_true", help="project the raw (motion-skewed) points")
+    add_prediction_args(p)
     p.add_argument("--overlay-frame", type=Integer(0, MAX_FRAME_INDEX), default=None,
-                   help="frame drawn in agreement.png (default: the one where the occlusion test rejects most mislabelled points)")
+                   help="frame drawn in agreement.png (default: the one where the occlusion test rejects most "
+                        "mislabelled points)")
     p.set_defaults(func=run)
 
 
@@ -68,9 +73,8 @@ def dataset_actors(root: Path, ds):
     from generator.jobs.boxes import sequence_world
     from generator.layout.assemble import build_scene
     from generator.spec.load import parse_spec
-    from generator.world.rig import Rig
-
     from generator.spec.towns import spec_for_record
+    from generator.world.rig import Rig
 
     meta_src = str(ds.seq.dir / "lidar_meta.json")
     spec = spec_for_record(parse_spec(spec_doc, str(path)), ds.meta.get("scene"), meta_src)  # the sequence's town
@@ -82,6 +86,8 @@ def dataset_actors(root: Path, ds):
 
 
 def run(args) -> int:
+    if args.image_labels is not None:
+        return run_predictions(args, dataset_actors)
     from generator.fusion import projection as P
     from generator.fusion.agreement import HEADLINE, Agreement, fuse_frame
     from generator.fusion.dataset import FusionDataset, deskewed
@@ -95,7 +101,8 @@ def run(args) -> int:
     ds = FusionDataset(root, args.sequence)
     overlay_k = args.overlay_frame
     if overlay_k is not None and overlay_k not in ds.frames:
-        raise UserError(f"--overlay-frame: frame {overlay_k} has no image and scan (have {ds.frames[0]}..{ds.frames[-1]})")
+        raise UserError(f"--overlay-frame: frame {overlay_k} has no image and scan "
+                        f"(have {ds.frames[0]}..{ds.frames[-1]})")
     deskew = not args.no_deskew
     actors = dataset_actors(root, ds)
     movers = set(actors or ())
@@ -135,8 +142,9 @@ def run(args) -> int:
     }
     report = agree.to_dict(settings)
     if raw.frames:
+        no_test = ("off",) + HEADLINE[1:]
         report["without_deskew"] = {"agreement_native": raw.agreement("native", HEADLINE),
-                                    "agreement_native_no_occlusion_test": raw.agreement("native", ("off",) + HEADLINE[1:])}
+                                    "agreement_native_no_occlusion_test": raw.agreement("native", no_test)}
     text = markdown(report)
     if raw.frames:
         text += (f"\nWithout de-skew (raw skewed points), the headline agreement is "

@@ -9,19 +9,19 @@ from __future__ import annotations
 
 import logging
 import os
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Iterator
 
 import numpy as np
 
-from generator.world import rig
 from generator.errors import SpecError, UserError
 from generator.formats import semantickitti as sk
 from generator.formats.point_sidecars import NATIVE_DIR, TIMES_DIR, read_sidecar
 from generator.imaging import meta_fields as md
 from generator.imaging.exr import read_exr
 from generator.labels import class_table
+from generator.world import rig
 
 log = logging.getLogger(__name__)
 
@@ -95,19 +95,26 @@ def native_from_raw(raw: np.ndarray) -> np.ndarray:
     return lut[np.asarray(raw, np.int64)]
 
 
-def frame_images(root: Path) -> dict[int, Path]:
-    """Frame index -> metadata JSON of one image variant per frame (``day_clear`` preferred)."""
+def frame_variants(root: Path) -> dict[int, list[Path]]:
+    """Frame index -> metadata JSON of every image variant of the frame (weather x time), sorted by name."""
     folder = root / "images"
     if not folder.is_dir():
         raise UserError(f"{folder}: missing (render images first: urbangen render SPEC --out {root})")
-    out: dict[int, Path] = {}
+    out: dict[int, list[Path]] = {}
     for p in sorted(folder.glob("*.json")):
         stem = p.stem.split("_", 1)[0]
         if not (stem.isascii() and stem.isdigit() and len(stem) <= 9):
             continue
-        k = int(stem)
-        if k not in out or p.stem.endswith("_day_clear"):
-            out[k] = p
+        out.setdefault(int(stem), []).append(p)
+    return out
+
+
+def frame_images(root: Path) -> dict[int, Path]:
+    """Frame index -> metadata JSON of one image variant per frame (``day_clear`` preferred)."""
+    out: dict[int, Path] = {}
+    for k, paths in frame_variants(root).items():
+        clear = [p for p in paths if p.stem.endswith("_day_clear")]
+        out[k] = clear[0] if clear else paths[0]
     return out
 
 
@@ -138,6 +145,9 @@ class FusionDataset:
         Dataset folder with ``images/`` and ``lidar/sequences/NN/``.
     sequence : str
         Sequence name (default ``00``).
+    images : bool
+        Whether images are required (default); with False a folder without ``images/`` reads as
+        scans only (:attr:`frames` empty).
 
     Raises
     ------
@@ -146,9 +156,9 @@ class FusionDataset:
         (without poses every scan would be stacked at the origin of the map).
     """
 
-    def __init__(self, root: str | Path, sequence: str = "00"):
+    def __init__(self, root: str | Path, sequence: str = "00", images: bool = True):
         self.root = Path(root)
-        self.images = frame_images(self.root)
+        self.images = frame_images(self.root) if images or (self.root / "images").is_dir() else {}
         self.seq = sk.Sequence(self.root / "lidar", sequence)
         self.meta, self.sweeps = self._lidar_meta()
         #: (n, 4, 4) LiDAR poses in the first LiDAR frame (poses.txt + calib.txt)
@@ -164,7 +174,7 @@ class FusionDataset:
         # belong to another sequence); without them, the one-sweep-per-image layout
         self.scan_of = {k: pairs[k] for k in self.images if k in pairs} if pairs else {k: k for k in self.images}
         self.frames = [k for k in sorted(self.scan_of) if self.scan_of[k] in scans]
-        if not self.frames:
+        if not self.frames and images:
             raise UserError(f"{self.root}: no frame has both an image in images/ and its scan in {self.seq.velodyne}")
         self.paired_scans = {self.scan_of[k] for k in self.frames}
         unpaired = len(scans - self.paired_scans)
@@ -218,7 +228,8 @@ class FusionDataset:
                     native=native if native is not None else native_from_raw(rec.semantic),
                     native_exact=native is not None, times=times, T_world_lidar_start=sweep_poses[0],
                     sweep_times=sweep_times, sweep_poses=sweep_poses, pose=rec.pose,
-                    t_sweep=float(self.seq.times[k]) if self.seq.times is not None and k < len(self.seq.times) else None)
+                    t_sweep=(float(self.seq.times[k]) if self.seq.times is not None and k < len(self.seq.times)
+                             else None))
 
     def read(self, k: int) -> FusionFrame:
         """Frame ``k`` (must be in :attr:`frames`)."""

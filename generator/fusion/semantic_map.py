@@ -170,7 +170,8 @@ def _font(size: int) -> ImageFont.ImageFont:
 
 
 def top_down_image(xyz: np.ndarray, label: np.ndarray, trajectory: np.ndarray | None = None,
-                   res_m: float = 0.2, max_px: int = 1600, title: str = "") -> Image.Image:
+                   res_m: float = 0.2, max_px: int = 1600, title: str = "", colors: np.ndarray | None = None,
+                   names: list[str] | None = None, bounds: tuple | None = None) -> Image.Image:
     """Map seen from above: x to the right, y up; each cell shows its highest voxel's class.
 
     Parameters
@@ -183,16 +184,25 @@ def top_down_image(xyz: np.ndarray, label: np.ndarray, trajectory: np.ndarray | 
         Sensor positions, drawn as a white line with a dot per scan.
     res_m : float
         Metres per pixel (grown if the map would exceed ``max_px``).
+    colors : (n, 3) uint8, optional
+        RGB per label (default: the class table's, for native labels).
+    names : list of str, optional
+        Name per label for the legend (default: the native class names).
+    bounds : ((2,), (2,)), optional
+        Map corners ``(lo, hi)`` in x, y, metres (default: the voxels' extent plus 2 m), so two maps
+        of the same place can be drawn to the same scale.
     """
     t = class_table()
-    lo, hi = xyz[:, :2].min(0) - 2.0, xyz[:, :2].max(0) + 2.0
+    colors = t.colors if colors is None else np.asarray(colors, np.uint8)
+    names = t.names if names is None else names
+    lo, hi = (xyz[:, :2].min(0) - 2.0, xyz[:, :2].max(0) + 2.0) if bounds is None else map(np.asarray, bounds)
     res = max(res_m, float((hi - lo).max()) / max_px)
     w, h = (np.ceil((hi - lo) / res).astype(int) + 1)
     col = ((xyz[:, 0] - lo[0]) / res).astype(np.int64)
     row = ((hi[1] - xyz[:, 1]) / res).astype(np.int64)
     order = np.argsort(xyz[:, 2], kind="stable")  # low first; the highest voxel wins a cell
     img = np.zeros((h, w, 3), np.uint8)
-    img[row[order], col[order]] = t.colors[label[order]]
+    img[row[order], col[order]] = colors[label[order]]
     canvas = Image.fromarray(img, "RGB")
     d = ImageDraw.Draw(canvas)
     if trajectory is not None and len(trajectory):
@@ -202,7 +212,7 @@ def top_down_image(xyz: np.ndarray, label: np.ndarray, trajectory: np.ndarray | 
         for x, y in pts:
             d.ellipse((x - 3, y - 3, x + 3, y + 3), outline=(255, 255, 255), fill=(0, 0, 0))
     strip = 190
-    out = Image.new("RGB", (w + strip, max(h, 60 + 18 * len(t))), (24, 24, 24))
+    out = Image.new("RGB", (w + strip, max(h, 60 + 18 * len(names))), (24, 24, 24))
     out.paste(canvas, (0, 0))
     d = ImageDraw.Draw(out)
     y = 6
@@ -213,10 +223,10 @@ def top_down_image(xyz: np.ndarray, label: np.ndarray, trajectory: np.ndarray | 
     d.line((w + 8, y + 6, w + 8 + 10 / res, y + 6), fill=(255, 255, 255), width=3)
     d.text((w + 14 + 10 / res, y), "10 m", fill=(230, 230, 230), font=_font(12))
     y += 22
-    counts = np.bincount(label, minlength=len(t))
+    counts = np.bincount(label, minlength=len(names))
     for c in np.flatnonzero(counts):
-        d.rectangle((w + 8, y, w + 20, y + 12), fill=tuple(int(v) for v in t.colors[c]), outline=(255, 255, 255))
-        d.text((w + 26, y), f"{t.names[c]} ({counts[c]})", fill=(255, 255, 255), font=_font(12))
+        d.rectangle((w + 8, y, w + 20, y + 12), fill=tuple(int(v) for v in colors[c]), outline=(255, 255, 255))
+        d.text((w + 26, y), f"{names[c]} ({counts[c]})", fill=(255, 255, 255), font=_font(12))
         y += 18
     return out
 

@@ -22,11 +22,17 @@ class CityscapesLabels:
 
     Attributes
     ----------
-    table : dict of int to (str, int, bool, (int, int, int))
-        Label id -> (name, train id (255: ignored), has instances, RGB colour).
+    table : dict of int to (str, int, bool, (int, int, int), int)
+        Label id -> (name, train id (255: ignored), has instances, RGB colour, the SemanticKITTI raw id
+        a point takes when a model predicts the label for its pixel).
     """
 
-    table: dict[int, tuple[str, int, bool, tuple[int, int, int]]]
+    table: dict[int, tuple[str, int, bool, tuple[int, int, int], int]]
+
+    @property
+    def names(self) -> list[str]:
+        """Name of every label id."""
+        return [self.table[i][0] for i in range(len(self.table))]
 
     @property
     def train_ids(self) -> np.ndarray:
@@ -37,6 +43,11 @@ class CityscapesLabels:
     def colors(self) -> np.ndarray:
         """(n, 3) uint8 RGB colour of every label id."""
         return np.array([self.table[i][3] for i in range(len(self.table))], np.uint8)
+
+    @property
+    def semantickitti(self) -> np.ndarray:
+        """(n,) uint16 SemanticKITTI raw id of every label id (for predicted labels projected onto points)."""
+        return np.array([self.table[i][4] for i in range(len(self.table))], np.uint16)
 
     @property
     def instance_ids(self) -> tuple[int, ...]:
@@ -57,15 +68,18 @@ def cityscapes_labels() -> CityscapesLabels:
     Raises
     ------
     ValueError
-        If the ids are not ``0 .. n - 1`` or a row is not ``[name, train id, has instances, [r, g, b]]``.
+        If the ids are not ``0 .. n - 1`` or a row lacks a field (see the file's header).
     """
-    raw = _load_yaml("cityscapes.yaml")["labels"]
+    raw = _load_yaml("cityscapes.yaml")["ids"]
     if sorted(raw) != list(range(len(raw))):
         raise ValueError(f"cityscapes.yaml: label ids must be 0..{len(raw) - 1}")
     table = {}
     for i in range(len(raw)):
         row = raw[i]
-        if not (isinstance(row, list) and len(row) == 4 and len(row[3]) == 3):
-            raise ValueError(f"cityscapes.yaml: label {i}: expected [name, train id, has instances, [r, g, b]]")
-        table[i] = (str(row[0]), int(row[1]), bool(row[2]), tuple(int(c) for c in row[3]))
+        if not (isinstance(row, dict) and {"name", "train", "instances", "color", "semantickitti"} <= set(row)
+                and len(row["color"]) == 3):
+            raise ValueError(f"cityscapes.yaml: label {i}: expected name, train, instances, color [r, g, b], "
+                             "semantickitti")
+        table[i] = (str(row["name"]), int(row["train"]), bool(row["instances"]), tuple(int(c) for c in row["color"]),
+                    int(row["semantickitti"]))
     return CityscapesLabels(table)

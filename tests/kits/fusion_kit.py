@@ -49,3 +49,33 @@ def write_raycast_images(root: Path, scene, spec, n_frames: int, width: int = 16
                            "intrinsics": {"width": width, "height": height, "K": K.tolist()}},
                 "ego": {"T_world_ego": f.T_world_ego.tolist()}}
         (root / "images" / f"{name}.json").write_text(json.dumps(meta))
+
+
+def write_raycast_stream(seq_dir: Path, scene, spec, scans, width: int = 640, height: int = 360) -> None:
+    """The KITTI camera stream of ``scans`` ray-cast instead of rendered: ``image_2`` (black), ``semantic_2``
+    (Cityscapes label ids) and ``passes_2`` EXRs, from camera 2 at the instant the LiDAR faces forward, as
+    :mod:`generator.jobs.stereo` exposes it, with the pair's record (``passes_2/NNNNNN.json``: pose, K,
+    exposure offset); the size must be the sequence's ``calib.txt`` resolution."""
+    from PIL import Image
+
+    from generator.jobs.stereo import exposure_offset
+    from generator.lidar.caster import EmbreeCaster
+    from generator.lidar.sensors import sensor_for_spec
+    from generator.world.rig import Rig
+
+    caster = EmbreeCaster.from_scene(scene)
+    r = Rig.from_spec(spec, scene)
+    K = r.K(width, height)
+    offset = exposure_offset(sensor_for_spec(spec), spec.sensors.lidar.motion_skew)
+    for k in scans:
+        T_world_camera = r.T_world_ego(r.sweep_time(k) + offset)[0] @ r.T_ego_stereo(2)
+        cls, inst, depth = raycast_image(caster, scene, T_world_camera, K, width, height)
+        write_exr(seq_dir / "passes_2" / f"{k:06d}.exr",
+                  LabelledImage(np.zeros((height, width, 3), np.float32), cls, inst, depth))
+        record = {"scan": k, "exposure_offset_s": offset, "T_world_camera": T_world_camera.tolist(), "K": K.tolist(),
+                  "width": width, "height": height}
+        (seq_dir / "passes_2" / f"{k:06d}.json").write_text(json.dumps(record))
+        for folder, arr in (("image_2", np.zeros((height, width, 3), np.uint8)),
+                            ("semantic_2", class_table().to_cityscapes[cls])):
+            (seq_dir / folder).mkdir(parents=True, exist_ok=True)
+            Image.fromarray(arr).save(seq_dir / folder / f"{k:06d}.png")

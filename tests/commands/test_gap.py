@@ -1,0 +1,90 @@
+"""``urbangen gap``: seed 002 §3.2 measured on a raw sequence and its seed-002-processed twin."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from generator.cli import main
+from generator.formats import semantickitti as sk
+from generator.scan_effects.domain_gap import SEED002_INTENSITY
+
+FRAMES = 4
+
+
+@pytest.fixture(scope="module")
+def pair(tmp_path_factory, root):
+    """The test town's first 4 sweeps, raw and with seed 002's processing (10 % dropout, +-5 cm, intensity 1/255)."""
+    base = tmp_path_factory.mktemp("gap")
+    spec = str(root / "scenes" / "test_town.json")
+    for name, extra in (("raw", []), ("seed002", ["--domain-gap", "seed002"])):
+        assert main(["-q", "lidar", spec, "--out", str(base / name), "--frames", str(FRAMES), "--no-bev",
+                     "--threads", "2", *extra]) == 0
+    return base / "raw", base / "seed002"
+
+
+def _gap(out, *datasets, extra=()) -> dict:
+    assert main(["-q", "gap", *map(str, datasets), "--out", str(out), *extra]) == 0
+    return json.loads((out / "gap.json").read_text())
+
+
+def _distances(report: dict) -> dict:
+    return {k: m["distance"]["values"] for k, m in report["metrics"].items() if "distance" in m}
+
+
+def test_a_sequence_against_itself_is_0_everywhere(pair, tmp_path):
+    raw, _ = pair
+    rep = _gap(tmp_path / "self", raw, raw, extra=("--names", "a,b"))
+    dist = _distances(rep)
+    assert len(dist) == 10  # every metric measured (labels and instances present)
+    assert all(v == {"a vs b": 0.0} for v in dist.values()), dist
+    assert rep["objects_from"] == "instances"
+    for name in ("gap.md", "gap.png", "gap_rays_lost_per_ring.png", "gap_intensity.png"):
+        assert (tmp_path / "self" / name).stat().st_size > 1000
+
+
+def test_seed002_processing_shows_as_the_three_differences_it_adds(pair, tmp_path):
+    raw, processed = pair
+    rep = _gap(tmp_path / "rp", raw, processed, extra=("--names", "raw,seed002"))
+    d = {k: v["raw vs seed002"] for k, v in _distances(rep).items()}
+    lost = rep["metrics"]["rays_lost_per_ring"]["curves"]
+    kept = 1 - np.array(lost["raw"])
+    # 1. rays lost: a 10 % dropout of the returns adds 0.1 x (1 - loss) per ring, on average over the rings
+    assert d["rays_lost_per_ring"] == pytest.approx(0.1 * kept.mean(), rel=0.1)
+    # ... at every range: near bins lose 10 % more of their rays (jittered points sharing a cell are not losses)
+    per_range = rep["metrics"]["rays_lost_per_range"]["curves"]
+    added = np.array(per_range["seed002"][:6]) - np.array(per_range["raw"][:6])  # 0-30 m
+    assert np.abs(added - 0.1).max() < 0.05, added
+    # the dropout is uniform in range: the range distribution of the points stays the same
+    assert d["points_per_range"] < 0.02
+    # 2. rings: +-5 cm jitter moves points centimetres off their cone and along their ring
+    assert d["ring_fit_vertical"] > 0.01 and d["ring_regularity"] > 0.005
+    # 3. intensity: W1 to a point mass at c is the mean distance to c
+    rem = np.concatenate([sk.read_scan(p)[:, 3] for p in sorted((raw / "sequences/00/velodyne").glob("*.bin"))])
+    assert d["intensity"] == pytest.approx(np.abs(rem - SEED002_INTENSITY).mean(), abs=0.01)
+    assert d["class_mix"] < 0.01  # a uniform dropout leaves the mix
+
+
+def test_a_third_dataset_and_pairwise(pair, tmp_path):
+    raw, processed = pair
+    rep = _gap(tmp_path / "three", raw, processed, raw, extra=("--names", "raw,seed002,raw2", "--pairwise"))
+    assert rep["pairs"] == ["raw vs seed002", "raw vs raw2", "seed002 vs raw2"]
+    d = _distances(rep)["intensity"]
+    assert d["raw vs raw2"] == 0.0 and d["raw vs seed002"] == d["seed002 vs raw2"] > 0
+
+
+def test_an_empty_real_folder_is_one_line_exit_2_and_nothing_written(pair, tmp_path, capsys):
+    raw, _ = pair
+    empty = tmp_path / "real"
+    empty.mkdir()
+    out = tmp_path / "report"
+    assert main(["gap", str(raw), str(empty), "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"REAL: {empty}: the folder is empty" in err[0]
+    (empty / "sequences" / "00" / "velodyne").mkdir(parents=True)
+    assert main(["gap", str(raw), str(empty), "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "REAL:" in err[0] and "no scans" in err[0]
+    assert not out.exists()
