@@ -15,21 +15,18 @@ import logging
 
 from generator.commands.preflight import input_dir, output_file
 from generator.errors import UserError
+from generator.safeload import printable
 
 log = logging.getLogger(__name__)
 
 
 def add_image_args(p) -> None:
     """The options only ``--images`` reads."""
-    from generator.formats.cityscapes import DEFAULT_SPLIT, SPLITS
     from generator.labels.class_sets import BUILTIN
 
     p.add_argument("--label-set", default="cityscapes", metavar="SET",
                    help=f"--images: what the predicted pixel values are: {', '.join(BUILTIN)} or a label-set "
                         "YAML file (default cityscapes: label ids)")
-    p.add_argument("--split", default=DEFAULT_SPLIT, choices=SPLITS,
-                   help=f"--images with a Cityscapes export: the split folder scored (default {DEFAULT_SPLIT}, "
-                        "as cityscapesScripts)")
 
 
 def run_images(args) -> int:
@@ -43,6 +40,12 @@ def run_images(args) -> int:
 
     if args.panoptic:
         raise UserError("--panoptic: scores scans; it cannot be combined with --images")
+    from generator.formats.cityscapes import DEFAULT_SPLIT, SPLITS
+
+    split = args.split or DEFAULT_SPLIT
+    if split not in SPLITS:
+        raise UserError(f"--split: --images scores a Cityscapes split folder, one of {', '.join(SPLITS)}; got "
+                        f"{printable(split)}")
     seqs = args.sequences or ["00"]
     if len(set(seqs)) != 1:
         raise UserError("--sequences: --images reads the KITTI stream of one sequence; name one")
@@ -54,7 +57,7 @@ def run_images(args) -> int:
     input_dir(args.pred, "--pred")
     input_dir(args.gt, "--gt")
     out = output_file(args.json or args.pred / "eval_images.json", "--json")
-    gts = ground_truth(args.gt, args.split, seqs[0])
+    gts = ground_truth(args.gt, split, seqs[0])
     folder = PredictionFolder(args.pred)
     pairs = [(g, folder.by_stem(g.name) if g.by == "stem" else folder.by_name(g.name)) for g in gts]
     matched = [(g, p) for g, p in pairs if p is not None]
