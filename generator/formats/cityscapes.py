@@ -52,7 +52,8 @@ CITY_PREFIX = "urbangen"
 
 #: Cityscapes labels (cityscapesScripts ``helpers/labels.py``, as data in ``generator/labels/cityscapes.yaml``):
 #: id -> (name, train id, has instances, RGB colour).
-LABELS: dict[int, tuple[str, int, bool, tuple[int, int, int]]] = cityscapes_labels().table
+LABELS: dict[int, tuple[str, int, bool, tuple[int, int, int]]] = {
+    i: row[:4] for i, row in cityscapes_labels().table.items()}
 INSTANCE_LABEL_IDS = cityscapes_labels().instance_ids
 _TRAIN = cityscapes_labels().train_ids
 _COLOR = cityscapes_labels().colors
