@@ -30,7 +30,7 @@ ALLOWED: dict[str, set[str]] = {
     "assets_procedural": {"geometry", "labels", "materials"},
     "layout": {"assets_procedural", "geometry", "labels", "materials", "spec", "world"},
     "traffic": {"geometry", "labels", "layout", "spec", "world"},
-    "lidar": {"geometry", "labels", "spec", "world"},
+    "lidar": {"geometry", "labels", "materials", "spec", "world"},
     "postfx": {"weather"},
     "imaging": {"labels", "spec", "weather"},
     "formats": {"geometry", "labels", "spec", "world"},

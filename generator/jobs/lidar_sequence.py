@@ -11,6 +11,13 @@ Side files for fusion: ``point_times/`` and ``native_labels/`` per scan
 (:mod:`generator.formats.point_sidecars`) and, in ``lidar_meta.json``,
 ``sweep_poses_world`` (the LiDAR world poses during each sweep, :meth:`generator.world.rig.Rig.sweep_record`).
 
+With the physical sensor (:mod:`generator.lidar.returns`) in dual mode, ``velodyne/`` and ``labels/``
+(and every side file above) keep one point per beam, its strongest return, exactly the points of
+strongest mode; the second returns go to ``second_return/velodyne/NNNNNN.bin`` and
+``second_return/labels/NNNNNN.label`` (the same formats, so any KITTI reader reads them) with
+``second_return/first_index/NNNNNN.bin`` (uint32 per second return: the row of its beam's strongest
+return in ``velodyne/NNNNNN.bin``; 0xFFFFFFFF if the post-processing dropped that one).
+
 Write order: calib first, then scans; ``poses.txt``, ``times.txt`` and the metadata last,
 so a sequence with ``poses.txt`` is complete. Re-running into the same folder overwrites
 (each file atomically) and removes frames beyond the new frame count.
@@ -27,7 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from generator import __version__
-from generator.atomic import atomic_path, inside, write_json
+from generator.atomic import atomic_path, inside, write_bytes, write_json
 from generator.errors import UserError
 from generator.formats import kitti_calib, semantickitti as sk
 from generator.formats.label_config import count_raw_ids, merge_counts, write_label_config
@@ -39,8 +46,11 @@ from generator.formats.point_sidecars import write_point_sidecars
 from generator.scan_effects.pipeline import process_scan, processing_for_spec
 from generator.spec.towns import angle_record, town_record
 from generator.remission.models import IntensityFn, intensity_fn_for_spec
+from generator.lidar.returns import ReturnModel, frame_key, optics_from_materials
 from generator.lidar.scan import Scanner
 from generator.lidar.sensors import Sensor, sensor_for_spec
+from generator.remission.models import reflectivity_config
+from generator.scan_effects.weather import extinction_per_m, frame_weather
 from generator.world.actors import MOVING_THRESHOLD_MPS
 from generator.world.rig import SWEEP_PERIOD_S, Rig
 from generator.progress import progress as progress_bar
@@ -152,6 +162,7 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
     sensor = sensor_for_spec(spec) if sensor is None else sensor
     intensity_fn = intensity_fn_for_spec(spec) if intensity_fn is None else intensity_fn
     processing = processing_for_spec(spec, sensor, options.weather, intensity_fn)
+    returns = return_model(sensor, spec.seed)
     check_sweeps(scene, spec, options.frames, options.route)
     name = sk.sequence_name(options.sequence)
     seq = inside(out, "sequences", name)
@@ -169,11 +180,17 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
     starts, n_points, counts, records = [], [], {}, []
     sweeps = []  # LiDAR world poses during each sweep (fusion de-skews with them)
     actors = world.actors if world is not None else []
-    with Scanner(scene, sensor, threads=options.threads, world=world) as scanner:
+    with Scanner(scene, sensor, threads=options.threads, world=world, returns=returns) as scanner:
         for j in progress_bar(range(options.frames), desc=f"lidar {name}", unit="scan", enabled=progress):
             t_j = times[j]
-            scan = scanner.sweep(rig, t_j, skew)
+            if returns is None:
+                scan = scanner.sweep(rig, t_j, skew)
+            else:
+                scan = scanner.sweep(rig, t_j, skew, alpha_per_m=sweep_alpha(spec, processing, j),
+                                     noise_key=frame_key(spec.seed, j))
             pts, remission, record = process_scan(scan.points, processing, spec, j)
+            if returns is not None and returns.params.mode == "dual":
+                pts, remission = write_second_returns(seq, f"{j:06d}", pts, remission, sensor.n_lasers)
             scan = dataclasses.replace(scan, points=pts)  # xyz, range image and side files follow the processed points
             records.append(record)
             stem = f"{j:06d}"
@@ -207,15 +224,54 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
     if options.image_frames:
         meta["image_frames"] = [list(p) for p in options.image_frames]
     meta["processing"], meta["scans"] = processing.describe(), records
+    if returns is not None:
+        meta["returns"] = returns.describe()
     meta["sweep_poses_world"] = {"period_s": sensor.period_s, "frames": sweeps}
     write_json(seq / META_NAME, meta)
     write_dataset_label_config(out)
     return meta
 
 
+def return_model(sensor: Sensor, seed: int) -> ReturnModel | None:
+    """The physical return model of ``sensor`` for a dataset of ``seed`` (None: the ideal sensor)."""
+    if not sensor.returns.physical:
+        return None
+    p = reflectivity_config()["physical"]
+    optics = optics_from_materials(p["retro_gain"], p["retro_exponent"], p["reference_range_m"], p["min_range_m"])
+    return ReturnModel.build(sensor, optics, seed)
+
+
+def sweep_alpha(spec, processing, frame_index: int) -> float:
+    """Extinction (fog + rain, 1/m) the physical sensor sees in sweep ``frame_index`` (0 without LiDAR weather)."""
+    if processing.weather is None:
+        return 0.0
+    return float(sum(extinction_per_m(frame_weather(spec, frame_index)[1])))
+
+
+SECOND_DIR = "second_return"
+
+
+def write_second_returns(seq: Path, stem: str, pts: np.ndarray, remission: np.ndarray, n_lasers: int):
+    """Write the second returns of a dual scan (see the module docstring); returns the strongest ones."""
+    second = pts["echo"] == 1
+    first, other = pts[~second], pts[second]
+    key_first = first["column"].astype(np.int64) * n_lasers + first["ring"]
+    key_other = other["column"].astype(np.int64) * n_lasers + other["ring"]
+    at = np.minimum(np.searchsorted(key_first, key_other), max(len(first) - 1, 0))
+    found = (len(first) > 0) & (key_first[at] == key_other) if len(first) else np.zeros(len(other), bool)
+    index = np.where(found, at, 0xFFFFFFFF).astype("<u4")
+    sk.write_scan(seq / SECOND_DIR / "velodyne" / f"{stem}.bin", np.stack([other["x"], other["y"], other["z"]], -1),
+                  remission[second])
+    sk.write_labels(seq / SECOND_DIR / "labels" / f"{stem}.label", semantickitti_labels(other["class"], other["moving"]),
+                    other["instance"])
+    write_bytes(seq / SECOND_DIR / "first_index" / f"{stem}.bin", index.tobytes())
+    return first, remission[~second]
+
+
 def _remove_stale(seq: Path, n: int) -> None:
     for sub, ext in (("velodyne", ".bin"), ("labels", ".label"), ("bev", ".png"), ("range", ".npy"), ("ply", ".ply"),
-                     ("point_times", ".bin"), ("native_labels", ".bin")):
+                     ("point_times", ".bin"), ("native_labels", ".bin"), (f"{SECOND_DIR}/velodyne", ".bin"),
+                     (f"{SECOND_DIR}/labels", ".label"), (f"{SECOND_DIR}/first_index", ".bin")):
         for p in sorted((seq / sub).glob(f"*{ext}")):
             if p.stem.isdigit() and int(p.stem) >= n:
                 log.warning("removing %s left by an earlier, longer run", p)

@@ -47,6 +47,8 @@ def spec_hash(spec: SceneSpec) -> str:
             d["streets"].pop(key, None)
     if d.get("streets") is not None and list(d["streets"].get("intersection_angle_deg", (90, 90))) == [90, 90]:
         d["streets"].pop("intersection_angle_deg", None)   # and the angle while right
+    if d["sensors"]["lidar"].get("returns") is None:        # and the LiDAR return model while the sensor's own
+        d["sensors"]["lidar"].pop("returns", None)
     return canonical_hash(d)
 
 
