@@ -34,7 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from generator import __version__
-from generator.atomic import atomic_path, inside, write_bytes, write_json
+from generator.atomic import atomic_path, inside, write_json
 from generator.errors import UserError
 from generator.formats import kitti_calib, semantickitti as sk
 from generator.formats.label_config import count_raw_ids, merge_counts, write_label_config
@@ -46,11 +46,10 @@ from generator.formats.point_sidecars import write_point_sidecars
 from generator.scan_effects.pipeline import process_scan, processing_for_spec
 from generator.spec.towns import angle_record, town_record
 from generator.remission.models import IntensityFn, intensity_fn_for_spec
-from generator.lidar.returns import ReturnModel, frame_key, optics_from_materials
+from generator.jobs.lidar_returns import SECOND_DIR, return_model, sweep_alpha, write_second_returns
+from generator.lidar.returns import frame_key
 from generator.lidar.scan import Scanner
 from generator.lidar.sensors import Sensor, sensor_for_spec
-from generator.remission.models import reflectivity_config
-from generator.scan_effects.weather import extinction_per_m, frame_weather
 from generator.world.actors import MOVING_THRESHOLD_MPS
 from generator.world.rig import SWEEP_PERIOD_S, Rig
 from generator.progress import progress as progress_bar
@@ -188,9 +187,14 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
             else:
                 scan = scanner.sweep(rig, t_j, skew, alpha_per_m=sweep_alpha(spec, processing, j),
                                      noise_key=frame_key(spec.seed, j))
-            pts, remission, record = process_scan(scan.points, processing, spec, j)
+            pts = scan.points
             if returns is not None and returns.params.mode == "dual":
-                pts, remission = write_second_returns(seq, f"{j:06d}", pts, remission, sensor.n_lasers)
+                second = pts[pts["echo"] == 1]
+                pts = pts[pts["echo"] == 0]
+            pts, remission, record = process_scan(pts, processing, spec, j)
+            if returns is not None and returns.params.mode == "dual":
+                second, rem2, record["second_return"] = process_scan(second, processing, spec, j, SECOND_DIR)
+                write_second_returns(seq, f"{j:06d}", pts, second, rem2, sensor.n_lasers)
             scan = dataclasses.replace(scan, points=pts)  # xyz, range image and side files follow the processed points
             records.append(record)
             stem = f"{j:06d}"
@@ -230,42 +234,6 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
     write_json(seq / META_NAME, meta)
     write_dataset_label_config(out)
     return meta
-
-
-def return_model(sensor: Sensor, seed: int) -> ReturnModel | None:
-    """The physical return model of ``sensor`` for a dataset of ``seed`` (None: the ideal sensor)."""
-    if not sensor.returns.physical:
-        return None
-    p = reflectivity_config()["physical"]
-    optics = optics_from_materials(p["retro_gain"], p["retro_exponent"], p["reference_range_m"], p["min_range_m"])
-    return ReturnModel.build(sensor, optics, seed)
-
-
-def sweep_alpha(spec, processing, frame_index: int) -> float:
-    """Extinction (fog + rain, 1/m) the physical sensor sees in sweep ``frame_index`` (0 without LiDAR weather)."""
-    if processing.weather is None:
-        return 0.0
-    return float(sum(extinction_per_m(frame_weather(spec, frame_index)[1])))
-
-
-SECOND_DIR = "second_return"
-
-
-def write_second_returns(seq: Path, stem: str, pts: np.ndarray, remission: np.ndarray, n_lasers: int):
-    """Write the second returns of a dual scan (see the module docstring); returns the strongest ones."""
-    second = pts["echo"] == 1
-    first, other = pts[~second], pts[second]
-    key_first = first["column"].astype(np.int64) * n_lasers + first["ring"]
-    key_other = other["column"].astype(np.int64) * n_lasers + other["ring"]
-    at = np.minimum(np.searchsorted(key_first, key_other), max(len(first) - 1, 0))
-    found = (len(first) > 0) & (key_first[at] == key_other) if len(first) else np.zeros(len(other), bool)
-    index = np.where(found, at, 0xFFFFFFFF).astype("<u4")
-    sk.write_scan(seq / SECOND_DIR / "velodyne" / f"{stem}.bin", np.stack([other["x"], other["y"], other["z"]], -1),
-                  remission[second])
-    sk.write_labels(seq / SECOND_DIR / "labels" / f"{stem}.label", semantickitti_labels(other["class"], other["moving"]),
-                    other["instance"])
-    write_bytes(seq / SECOND_DIR / "first_index" / f"{stem}.bin", index.tobytes())
-    return first, remission[~second]
 
 
 def _remove_stale(seq: Path, n: int) -> None:

@@ -43,7 +43,7 @@ def _actor_hits(scanner, plan, cols, o, d, dist, face, rows=None, offset=None):
 
 
 def _labels(face: np.ndarray, inst: np.ndarray, faces: np.ndarray, dist=None, lo=0.0, hi=np.inf) -> np.ndarray:
-    """(n,) int64 class << 16 | instance of each hit (-1 without one, or outside ``[lo, hi)`` when ``dist`` is given)."""
+    """(n,) int64 class << 16 | instance of each hit (-1 without one, or out of ``[lo, hi)`` given ``dist``)."""
     f = np.maximum(face, 0)
     ins = np.where(inst >= 0, inst, faces["instance"][f].astype(np.int64))
     ok = face >= 0 if dist is None else (face >= 0) & (dist >= lo) & (dist < hi)

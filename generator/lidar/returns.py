@@ -193,7 +193,7 @@ class ReturnModel:
 
     @classmethod
     def build(cls, sensor, optics: Optics, seed: int) -> ReturnModel:
-        """The model of ``sensor.returns`` for a dataset of ``seed`` (per-laser draws from ``("lidar_sensor", ...)``)."""
+        """The model of ``sensor.returns`` for a dataset of ``seed`` (per-laser draws: ``("lidar_sensor", ...)``)."""
         p = sensor.returns
         sigma = laser_range_sigma(p, sensor.n_lasers, seed)
         ring_sigma = np.empty(sensor.n_lasers, np.float32)
@@ -208,12 +208,14 @@ class ReturnModel:
             **p.to_dict(),
             "power": "P = w tau rho (cos + lobe_gain cos^lobe_exponent) (R0 / max(R, R_min))^2 exp(-2 alpha R); "
                      "1 = reflectivity-1 Lambertian target at R0 = 10 m, normal incidence, clear air",
-            "divergence_model": f"Gaussian footprint, {p.divergence_mrad} mrad full angle (1/e^2), {p.subrays} sub-rays "
+            "divergence_model": f"Gaussian footprint, {p.divergence_mrad} mrad full angle (1/e^2), {p.subrays} "
+                                "sub-rays "
                                 f"(centre + {max(p.subrays - 1, 0)} at {1e3 * self.spread:.3f} mrad, equal power) cast "
                                 "where the beam and its range-image neighbours do not see one continuous surface",
             "returns": "strongest: one point per beam; dual: strongest and last (second strongest when the strongest "
                        "is the last); returns nearer than separation_m merge (power-weighted range, dominant label)",
-            "second_return_files": "dual only: second_return/velodyne/*.bin, second_return/labels/*.label (one point per "
+            "second_return_files": "dual only: second_return/velodyne/*.bin, second_return/labels/*.label (one point "
+                                   "per "
                                    "second return) and second_return/first_index/*.bin (uint32 row of the same beam's "
                                    "first point in velodyne/*.bin); velodyne/ and labels/ hold one point per beam",
             "glass": "transmittance per material (materials.yaml); a beam that crossed an object's glass and meets "

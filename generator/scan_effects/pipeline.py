@@ -38,7 +38,8 @@ from generator.scan_effects.weather import (LidarWeatherParams, apply_lidar_weat
                                      weather_config)
 from generator.rng import stream
 
-ORDER = "intensity model -> laser gains (physical sensor) -> domain gap -> LiDAR weather"
+ORDER = "intensity model -> domain gap -> LiDAR weather"
+ORDER_GAINS = "intensity model -> laser gains (physical sensor) -> domain gap -> LiDAR weather"
 
 
 @dataclass(frozen=True)
@@ -65,7 +66,7 @@ class ScanProcessing:
     def describe(self) -> dict:
         """The parameters, for ``lidar_meta.json``."""
         return {
-            "order": ORDER,
+            "order": ORDER if self.laser_gain is None else ORDER_GAINS,
             "intensity": dict(getattr(self.intensity_fn, "description",
                                       {"model": getattr(self.intensity_fn, "__name__", "custom")})),
             **({} if self.laser_gain is None else {"laser_gain": {
@@ -117,8 +118,13 @@ def laser_gains(sensor, seed: int) -> np.ndarray:
     return out
 
 
-def process_scan(points: np.ndarray, processing: ScanProcessing, spec, frame_index: int) -> tuple[np.ndarray, np.ndarray, dict]:
+def process_scan(points: np.ndarray, processing: ScanProcessing, spec, frame_index: int,
+                 part: str | None = None) -> tuple[np.ndarray, np.ndarray, dict]:
     """Run the chain on the points of frame ``frame_index``.
+
+    ``part`` names a second set of points of the same frame (``"second_return"``: the second returns
+    of a dual scan), processed on streams of their own (the frame's names plus ``part``), so the
+    strongest returns of a dual scan come out as the points of a strongest scan, byte for byte.
 
     Parameters
     ----------
@@ -134,17 +140,19 @@ def process_scan(points: np.ndarray, processing: ScanProcessing, spec, frame_ind
         ``frame``, ``points_cast``, ``points``, and per stage what it did (None = off).
     """
     seed = spec.seed
+    more = () if part is None else (part,)
     record = {"frame": int(frame_index), "points_cast": int(len(points)), "domain_gap": None, "weather": None}
-    remission = np.asarray(processing.intensity_fn(points, stream(seed, "frame", frame_index, "lidar_intensity")), np.float32)
+    remission = np.asarray(processing.intensity_fn(points, stream(seed, "frame", frame_index, "lidar_intensity", *more)),
+                           np.float32)
     if processing.laser_gain is not None:
         remission = np.clip(remission * processing.laser_gain[points["laser"]], 0.0, 1.0).astype(np.float32)
     if processing.domain_gap is not None:
         points, remission, record["domain_gap"] = apply_to_points(
-            points, remission, processing.domain_gap, stream(seed, "frame", frame_index, "lidar_domain_gap"))
+            points, remission, processing.domain_gap, stream(seed, "frame", frame_index, "lidar_domain_gap", *more))
     if processing.weather is not None:
         tod, w = frame_weather(spec, frame_index)
         points, remission, info = apply_lidar_weather(points, remission, w, processing.weather,
-                                                      stream(seed, "frame", frame_index, "lidar_weather"))
+                                                      stream(seed, "frame", frame_index, "lidar_weather", *more))
         record["weather"] = {"time_of_day": tod, **info}
     record["points"] = int(len(points))
     return points, remission, record

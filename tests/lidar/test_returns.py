@@ -7,6 +7,7 @@ import dataclasses
 
 import numpy as np
 import pytest
+from kits.lidar_helpers import scene_of
 
 from generator.geometry import box, polygon, rect
 from generator.labels import class_table
@@ -14,7 +15,6 @@ from generator.lidar.returns import ReturnModel, ReturnParams, optics_from_mater
 from generator.lidar.scan import Scanner
 from generator.lidar.sensors import load_preset, with_returns
 from generator.world import rig
-from kits.lidar_helpers import scene_of
 
 H = 1.73
 POSE = rig.mount((0, 0, H), (0, 0, 0))
