@@ -120,14 +120,13 @@ def run_physical_chunk(scanner, sweep, i: int, cols: slice) -> None:
                 for key in parts:
                     if key in ("weight", "offset", "tau"):
                         continue
-                    parts[key].append(probe[key][keep])
-                    parts[key].append(rest[key])
+                    parts[key].append(np.concatenate([probe[key][keep], rest[key]]))
                 m = int(keep.sum()) + len(rb)
                 parts["weight"].append(np.full(m, share, np.float32))
                 parts["offset"].append(np.zeros(m, np.float32))
                 parts["tau"].append(np.ones(m, np.float32))
         _behind_glass(scanner, plan, cols, parts, opt.transmittance, faces, p.glass_layers, hi_r, n_in)
-        cat = {key: np.concatenate(v) if len(v) > 1 else v[0] for key, v in parts.items()}
+        cat = {key: np.concatenate(v) if len(v) > 1 else v[0] for key, v in parts.items() if key not in ("o", "dw")}
         per_beam = 2 if p.mode == "dual" else 1
         buf = np.empty(per_beam * n_in, POINT_DTYPE)
         got = beam_returns(buf, n_in, cols.start * L, cat["beam"], cat["weight"], cat["offset"], cat["tau"],
@@ -146,12 +145,21 @@ def run_physical_chunk(scanner, sweep, i: int, cols: slice) -> None:
 
 def _behind_glass(scanner, plan, cols, parts, transmittance, faces, layers, max_range, n_in) -> None:
     """Append to ``parts`` the rays continued behind every pane their ray list hits (``layers`` deep)."""
-    layer = {key: v[0] if len(v) == 1 else np.concatenate(v) for key, v in parts.items()}
+    is_glass = transmittance > 0
+    # the first layer: the rows of the ray list that end on glass, gathered part by part (no copy of the rest)
+    picked = []
+    for i, f in enumerate(parts["face"]):
+        g = np.flatnonzero(is_glass[faces["material"][np.maximum(f, 0)]] & (f >= 0))
+        if len(g):
+            picked.append((i, g))
+    if not picked:
+        return
+    layer = {key: np.concatenate([v[i][g] for i, g in picked]) for key, v in parts.items()}
     for _ in range(layers):
         f = layer["face"]
         hit = (f >= 0) & (layer["offset"] + layer["dist"] < max_range)
         mat = faces["material"][np.maximum(f, 0)]
-        glass = np.flatnonzero(hit & (transmittance[mat] > 0))
+        glass = np.flatnonzero(hit & is_glass[mat])
         if len(glass) == 0:
             return
         step = layer["dist"][glass] + np.float32(GLASS_STEP_M)

@@ -130,6 +130,29 @@ def _mix64(x):  # pragma: no cover - compiled
     return (np.float64(x >> np.uint64(11)) + 0.5) / 9007199254740992.0
 
 
+@njit(nogil=True, cache=True, inline="always")
+def _write(rec, qq, col, ring, t32, o_loc, d_loc, azimuth, column_time, laser_of, n_l, f, cos, inst, moving, mixed,
+           echo, power, skew):  # pragma: no cover - compiled
+    """One point record (see :data:`generator.lidar.points.POINT_DTYPE`) of sweep ray ``qq`` at range ``t32``."""
+    rec.x = o_loc[qq, 0] + t32 * d_loc[qq, 0]
+    rec.y = o_loc[qq, 1] + t32 * d_loc[qq, 1]
+    rec.z = o_loc[qq, 2] + t32 * d_loc[qq, 2]
+    rec.range = t32
+    rec.azimuth = azimuth[qq]
+    rec.time = column_time[col] if skew else np.float32(0.0)
+    rec.cos_incidence = cos
+    rec.ring = ring
+    rec.column = col
+    rec.laser = laser_of[qq - col * n_l]
+    rec["class"] = f["class"]
+    rec.instance = inst if inst >= 0 else f.instance
+    rec.material = f.material
+    rec.moving = moving
+    rec.mixed = mixed
+    rec.echo = echo
+    rec.power = power
+
+
 @njit(nogil=True, cache=True)
 def beam_returns(out, n_beams, ray0, beam, weight, offset, tau, dist, face, d_f, inst, moving,
                  o_loc, d_loc, azimuth, column_time, ring_of, laser_of, faces,
@@ -200,6 +223,29 @@ def beam_returns(out, n_beams, ray0, beam, weight, offset, tau, dist, face, d_f,
             continue
         if ne > cap:
             ne = cap
+        if ne == 1:  # one hit (most beams): no sorting, no clusters
+            r = ev[lo]
+            f = faces[face[r]]
+            c = abs(d_f[r, 0] * f.normal[0] + d_f[r, 1] * f.normal[1] + d_f[r, 2] * f.normal[2])
+            mat = f.material
+            t = total[r]
+            g = c + lobe_gain[mat] * c ** lobe_exp[mat] if lobe_gain[mat] > 0 else c
+            rr = r0 / max(t, r_min)
+            pw = weight[r] * tau[r] * refl[mat] * g * rr * rr
+            if alpha > 0:
+                pw *= np.exp(-2.0 * alpha * t)
+            if pw < threshold:
+                continue
+            qq = ray0 + q
+            col = qq // n_l
+            ring = ring_of[qq - col * n_l]
+            rng_out = t + ring_sigma[ring] * _normal01(key, qq * 2) if ring_sigma[ring] > 0 else t
+            if rng_out < min_range:
+                rng_out = min_range
+            _write(out[m], qq, col, ring, np.float32(rng_out), o_loc, d_loc, azimuth, column_time, laser_of, n_l,
+                   f, np.float32(c), inst[r], moving[r], 0, 0, np.float32(pw), skew)
+            m += 1
+            continue
         # insertion sort of the beam's events by range
         for i in range(1, ne):
             e = ev[lo + i]
@@ -286,27 +332,10 @@ def beam_returns(out, n_beams, ray0, beam, weight, offset, tau, dist, face, d_f,
             rng_out = c_rng[k] + ring_sigma[ring] * _normal01(key, qq * 2 + echo)
             if rng_out < min_range:
                 rng_out = min_range
-            t32 = np.float32(rng_out)
-            rec = out[m]
-            rec.x = o_loc[qq, 0] + t32 * d_loc[qq, 0]
-            rec.y = o_loc[qq, 1] + t32 * d_loc[qq, 1]
-            rec.z = o_loc[qq, 2] + t32 * d_loc[qq, 2]
-            rec.range = t32
-            rec.azimuth = azimuth[qq]
-            rec.time = column_time[col] if skew else np.float32(0.0)
             c = d_f[r, 0] * f.normal[0]
             c += d_f[r, 1] * f.normal[1]
             c += d_f[r, 2] * f.normal[2]
-            rec.cos_incidence = abs(c)
-            rec.ring = ring
-            rec.column = col
-            rec.laser = laser_of[qq - col * n_l]
-            rec["class"] = f["class"]
-            rec.instance = inst[r] if inst[r] >= 0 else f.instance
-            rec.material = f.material
-            rec.moving = moving[r]
-            rec.mixed = 1 if c_mix[k] else 0
-            rec.echo = echo
-            rec.power = np.float32(c_pow[k])
+            _write(out[m], qq, col, ring, np.float32(rng_out), o_loc, d_loc, azimuth, column_time, laser_of, n_l, f,
+                   np.float32(abs(c)), inst[r], moving[r], 1 if c_mix[k] else 0, echo, np.float32(c_pow[k]), skew)
             m += 1
     return m
