@@ -133,28 +133,30 @@ def _corner(plt, scans, cls, path):
 
 
 def _windows(plt, scans, glass, cls, path):
-    """Range images round the car whose glass the ideal sensor hit most."""
+    """Range images round the car 8-25 m away whose glass the ideal sensor hit most."""
     best = None
     for j, s in enumerate(scans["ideal"]):
         p = s.points
-        g = p[np.isin(p["material"], glass) & np.isin(p["class"], [cls.id("car")])]
+        g = p[np.isin(p["material"], glass) & (p["class"] == cls.id("car")) & (p["range"] > 8) & (p["range"] < 25)]
         if len(g) and (best is None or len(g) > best[0]):
             best = (len(g), j, int(np.median(g["column"])))
     if best is None:
         return
     _, j, col = best
-    c0, c1 = max(0, col - 90), col + 90
+    c0, c1 = max(0, col - 60), col + 60
     fig, axes = plt.subplots(2, 1, figsize=(12, 6), dpi=120)
     for ax, name in zip(axes, ("ideal", "physical"), strict=True):
         s = scans[name][j]
         img = s.range_image()[:, c0:c1]
         shown = np.where(img > 0, np.minimum(img, 40.0), np.nan)
-        ax.imshow(shown, cmap="viridis_r", aspect="auto", interpolation="nearest", vmin=0, vmax=40)
+        ax.set_facecolor("white")
+        ax.imshow(shown, cmap="viridis", aspect="auto", interpolation="nearest", vmin=0, vmax=40)
         ideal = scans["ideal"][j].points
-        g = ideal[np.isin(ideal["material"], glass) & (ideal["column"] >= c0) & (ideal["column"] < c1)]
+        g = ideal[np.isin(ideal["material"], glass) & (ideal["column"] >= c0) & (ideal["column"] < c1)
+                  & (ideal["class"] == cls.id("car"))]
         ax.scatter(g["column"] - c0, g["ring"], s=10, facecolors="none", edgecolors="deepskyblue", linewidths=0.6)
         ax.set_title(f"{name} range image, sweep {j}, columns {c0}-{c1} (white: no return; blue rings: rays the ideal "
-                     "sensor ended on glass)", fontsize=9)
+                     "sensor ended on car glass; colour: range 0-40 m)", fontsize=9)
         ax.set_ylabel("ring")
     axes[-1].set_xlabel("column")
     fig.savefig(path, bbox_inches="tight")

@@ -7,11 +7,14 @@ returns come from its received power (the *waveform* of :mod:`generator.lidar.re
 Received power, normalised so that a Lambertian target of reflectivity 1 at ``R0`` = 10 m, seen at
 normal incidence in clear air, gives 1 (the ``physical`` intensity model's scale)::
 
-    P = w * tau * rho * (cos + lobe_gain * cos^lobe_exponent) * (R0 / max(R, R_min))^2 * exp(-2 alpha R)
+    P = w * tau * rho * (cos^k + lobe_gain * cos^lobe_exponent) * (R0 / max(R, R_min))^2 * exp(-2 alpha R)
 
 ``rho`` is the material's 905 nm reflectivity (``generator/materials.yaml``; times ``1 - transmittance``
 for glass, whose own reflection is mostly the mirror glint), the lobe is the
 retroreflective lobe of lane paint and signs (``reflectivity.yaml``) or the specular glint of glass,
+``k`` the incidence exponent (rough ground and walls scatter back far more at grazing incidence than
+Lambert's cosine: with k = 1 the S3 datasheet's "50 m on 10 % pavement" could never hold for the
+road ahead, seen at 2 degrees; k = 0.25 keeps asphalt to ~28 m and concrete to ~45 m ahead),
 ``alpha`` the atmosphere's extinction (fog and rain of the frame's weather), ``w`` the share of the
 beam's power a sub-ray carries and ``tau`` what the glass it crossed let through. A return is
 detected when its power reaches ``detection_threshold``.
@@ -81,6 +84,7 @@ class ReturnParams:
     intensity_gain_spread: float = 0.1
     glass_layers: int = 2
     edge_step: float = 0.05
+    incidence_exponent: float = 0.25
 
     @property
     def physical(self) -> bool:
@@ -206,7 +210,7 @@ class ReturnModel:
         p = self.params
         return {
             **p.to_dict(),
-            "power": "P = w tau rho (cos + lobe_gain cos^lobe_exponent) (R0 / max(R, R_min))^2 exp(-2 alpha R); "
+            "power": "P = w tau rho (cos^incidence_exponent + lobe_gain cos^lobe_exponent) (R0 / max(R, R_min))^2 exp(-2 alpha R); "
                      "1 = reflectivity-1 Lambertian target at R0 = 10 m, normal incidence, clear air",
             "divergence_model": f"Gaussian footprint, {p.divergence_mrad} mrad full angle (1/e^2), {p.subrays} "
                                 "sub-rays "

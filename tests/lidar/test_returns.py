@@ -57,12 +57,11 @@ def test_dark_and_grazing_surfaces_lose_more_points(hdl64e):
         b = phys[(phys["class"] == cls) & (phys["range"] >= lo) & (phys["range"] < hi)]
         return len(b) / max(len(a), 1)
 
-    bright_near, dark_near = kept(side[0], 0, 8), kept(side[1], 0, 8)
-    bright_far, dark_far = kept(side[0], 25, 60), kept(side[1], 25, 60)
-    assert bright_near > 0.99                       # near, steep: everything returns
-    assert dark_near < bright_near or dark_near > 0.99
-    assert dark_far < bright_far < 0.9              # far: grazing, dark first
-    assert bright_far < bright_near and dark_far < dark_near
+    # received power ~ rho cos^0.25 / R^2, and on flat ground cos = h / R: dark asphalt lasts to ~28 m,
+    # bright plaster to ~66 m
+    assert kept(side[0], 0, 8) > 0.99 and kept(side[1], 0, 8) > 0.99  # near, steep: everything returns
+    assert kept(side[1], 32, 60) < 0.05 < 0.95 < kept(side[0], 32, 60)  # farther, more grazing: dark first
+    assert kept(side[0], 75, 120) < 0.05                               # and then the bright too
     assert len(phys) < len(ideal)
 
 
@@ -128,7 +127,8 @@ def test_car_windows_are_holes_and_a_free_standing_pane_shows_what_is_behind(hdl
         return (p["x"] < 20.5) & (p["x"] > 19.5) & (np.abs(p["y"]) < 1.4) & (p["z"] > 0.85 - H) & (p["z"] < 1.25 - H)
 
     assert in_window(ideal).sum() >= 30 and in_window(phys).sum() == 0   # the classic hole
-    assert not np.any((phys["instance"] == 7) & (phys["x"] > 20.2))      # nothing from inside the car
+    inside = (phys["x"] > 20.05) & (phys["x"] < 21.95) & (np.abs(phys["y"]) < 1.95) & (phys["z"] < 0.7 - H)
+    assert not inside.any()                                               # nothing from inside the car
     # the beams the ideal sensor stops on the pane reach the wall behind it (the pane's return is weaker)
     on_pane = ideal[ideal["class"] == CLS.id("fence")]
     beam = lambda p: p["column"].astype(np.int64) * 64 + p["ring"]  # noqa: E731
