@@ -157,3 +157,30 @@ def test_physical_scans_do_not_depend_on_threads_or_chunks_and_noise_is_keyed(hd
     assert len(a) == len(c) and not np.array_equal(a["range"], c["range"])
     sigma = np.std((a["range"] - c["range"])[a["mixed"] == 0]) / np.sqrt(2)
     assert 0.012 < sigma < 0.03  # the per-laser noise about the datasheet's 2 cm
+
+
+def test_points_that_are_not_mixed_agree_with_the_camera(hdl64e, test_spec, test_scene):
+    """Project a physical sweep of the test town into a camera image ray-cast at the same instant: the
+    points the camera sees (occlusion test) carry the class of their pixel, >= 99.5 % of those not mixed."""
+    from generator.fusion.projection import camera_from_lidar, project, transform, visible
+    from generator.lidar.caster import EmbreeCaster
+    from generator.world.rig import Rig
+    from kits.fusion_kit import raycast_image
+
+    r = Rig.from_spec(test_spec, test_scene)
+    f = r.frame(0)
+    w, h = 640, 360
+    K = rig.intrinsics(test_spec.sensors.camera.hfov_deg, w, h)
+    caster = EmbreeCaster.from_scene(test_scene)
+    cls_img, _, depth = raycast_image(caster, test_scene, f.T_world_camera, K, w, h)
+    T_lidar = r.T_world_lidar(np.array([f.t]))[0]
+    with Scanner(test_scene, hdl64e, threads=2, caster=caster, returns=model_of(hdl64e)) as sc:
+        p = sc.scan(T_lidar).points
+    xyz = np.stack([p["x"], p["y"], p["z"]], -1).astype(np.float64)
+    proj = project(transform(camera_from_lidar(f.T_world_camera, T_lidar), xyz), K, w, h)
+    seen = visible(proj, depth, K)
+    idx = proj.index[seen]
+    same = p["class"][idx] == cls_img[proj.row[seen], proj.col[seen]]
+    clean = p["mixed"][idx] == 0
+    assert clean.sum() > 5000 and (~clean).sum() > 20
+    assert same[clean].mean() >= 0.995
