@@ -135,7 +135,7 @@ def run_physical_chunk(scanner, sweep, i: int, cols: slice) -> None:
                            tables._o, tables._d, tables._azimuth, tables._column_time, tables._ring, tables._laser,
                            faces, opt.reflectivity, opt.lobe_gain, opt.lobe_exponent, opt.reference_range_m,
                            opt.min_range_m, sweep.alpha, p.detection_threshold, p.separation_m, p.mode == "dual",
-                           lo_r, hi_r, sweep.key, model.ring_sigma, sweep.skew, float(p.incidence_exponent))
+                           lo_r, hi_r, sweep.key, model.ring_sigma, sweep.skew, model.k_inc)
         start = sweep.claim(i, got)
     except BaseException:
         sweep.fail(i)

@@ -181,8 +181,8 @@ def beam_returns(out, n_beams, ray0, beam, weight, offset, tau, dist, face, d_f,
     r0, r_min, alpha, threshold, separation : float
         Reference range, minimum range of the 1/R^2 law, extinction (1/m), detection threshold,
         merge distance (m).
-    k_inc : float
-        Incidence exponent of the diffuse term (``cos^k_inc``).
+    k_inc : (M,) float32
+        Per material the incidence exponent of its diffuse term (``cos^k_inc``).
     dual : bool
     min_range, max_range : float
         The sensor's.
@@ -231,7 +231,7 @@ def beam_returns(out, n_beams, ray0, beam, weight, offset, tau, dist, face, d_f,
             c = abs(d_f[r, 0] * f.normal[0] + d_f[r, 1] * f.normal[1] + d_f[r, 2] * f.normal[2])
             mat = f.material
             t = total[r]
-            g = c ** k_inc + lobe_gain[mat] * c ** lobe_exp[mat] if lobe_gain[mat] > 0 else c ** k_inc
+            g = c ** k_inc[mat] + lobe_gain[mat] * c ** lobe_exp[mat] if lobe_gain[mat] > 0 else c ** k_inc[mat]
             rr = r0 / max(t, r_min)
             pw = weight[r] * tau[r] * refl[mat] * g * rr * rr
             if alpha > 0:
@@ -262,7 +262,7 @@ def beam_returns(out, n_beams, ray0, beam, weight, offset, tau, dist, face, d_f,
             c = abs(d_f[r, 0] * f.normal[0] + d_f[r, 1] * f.normal[1] + d_f[r, 2] * f.normal[2])
             mat = f.material
             t = total[r]
-            g = c ** k_inc + lobe_gain[mat] * c ** lobe_exp[mat] if lobe_gain[mat] > 0 else c ** k_inc
+            g = c ** k_inc[mat] + lobe_gain[mat] * c ** lobe_exp[mat] if lobe_gain[mat] > 0 else c ** k_inc[mat]
             rr = r0 / max(t, r_min)
             power[i] = weight[r] * tau[r] * refl[mat] * g * rr * rr * np.exp(-2.0 * alpha * t)
             rng_e[i] = t

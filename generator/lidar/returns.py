@@ -9,8 +9,8 @@ normal incidence in clear air, gives 1 (the ``physical`` intensity model's scale
 
     P = w * tau * rho * (cos^k + lobe_gain * cos^lobe_exponent) * (R0 / max(R, R_min))^2 * exp(-2 alpha R)
 
-``rho`` is the material's 905 nm reflectivity (``generator/materials.yaml``; times ``1 - transmittance``
-for glass, whose own reflection is mostly the mirror glint), the lobe is the
+``rho`` is the material's 905 nm reflectivity (``generator/materials.yaml``; 0.002 for glass, whose own
+reflection is the mirror glint, Lambertian: ``k = 1``), the lobe is the
 retroreflective lobe of lane paint and signs (``reflectivity.yaml``) or the specular glint of glass,
 ``k`` the incidence exponent (rough ground and walls scatter back far more at grazing incidence than
 Lambert's cosine: with k = 1 the S3 datasheet's "50 m on 10 % pavement" could never hold for the
@@ -106,6 +106,8 @@ class Optics:
         Retroreflective lobe (or the glint of glass): ``lobe_gain * cos^lobe_exponent`` added to ``cos``.
     transmittance : (M,) float32
         Share of the power a pane lets through, one way (0: opaque).
+    smooth : (M,) bool
+        Smooth surfaces (glass) whose diffuse term keeps Lambert's cosine.
     reference_range_m, min_range_m : float
         ``R0`` of the normalisation and the range below which ``P`` stops growing.
     """
@@ -114,12 +116,15 @@ class Optics:
     lobe_gain: np.ndarray
     lobe_exponent: np.ndarray
     transmittance: np.ndarray
+    smooth: np.ndarray
     reference_range_m: float = 10.0
     min_range_m: float = 1.0
 
 
 #: The specular glint of glass: half its peak at ~3.4 degrees off normal incidence.
 GLASS_LOBE = (10.0, 400.0)
+#: Diffuse back-scatter of a (dirty) pane of glass: a return within ~6 m at normal incidence.
+GLASS_DIFFUSE = 0.002
 
 
 def optics_from_materials(retro_gain: float = 20.0, retro_exponent: float = 8.0, reference_range_m: float = 10.0,
@@ -127,12 +132,12 @@ def optics_from_materials(retro_gain: float = 20.0, retro_exponent: float = 8.0,
     """:class:`Optics` of ``generator/materials.yaml`` (the retro lobe constants are ``reflectivity.yaml``'s)."""
     mats = material_table()
     trans = mats.transmittance.astype(np.float32)
-    # glass: of what the pane does not let through, only a dirt film scatters back diffusely; the rest
-    # is a mirror reflection, which the lobe stands for
-    refl = (mats.reflectivity * (1.0 - trans)).astype(np.float32)
+    # glass is smooth: what it does not let through it mirrors (the glint of the lobe); only a dirt film
+    # scatters back diffusely (GLASS_DIFFUSE, Lambertian), enough for a return within a few metres
+    refl = np.where(trans > 0, GLASS_DIFFUSE, mats.reflectivity).astype(np.float32)
     gain = np.where(mats.retro, retro_gain, np.where(trans > 0, GLASS_LOBE[0], 0.0)).astype(np.float32)
     expo = np.where(mats.retro, retro_exponent, np.where(trans > 0, GLASS_LOBE[1], 1.0)).astype(np.float32)
-    return Optics(refl, gain, expo, trans, float(reference_range_m), float(min_range_m))
+    return Optics(refl, gain, expo, trans, trans > 0, float(reference_range_m), float(min_range_m))
 
 
 def probe_index(pattern: np.ndarray, clockwise: bool) -> np.ndarray:
@@ -190,6 +195,9 @@ class ReturnModel:
     ring_sigma: np.ndarray
     probes: np.ndarray
 
+    def __post_init__(self):
+        self.k_inc = self.incidence_exponents()
+
     @property
     def spread(self) -> float:
         """Largest angle of a sub-ray from its beam's centre, radians."""
@@ -204,6 +212,10 @@ class ReturnModel:
         ring_sigma[sensor.ring] = sigma
         pattern = subray_pattern(p)
         return cls(p, optics, pattern, ring_sigma, probe_index(pattern, sensor.clockwise))
+
+    def incidence_exponents(self) -> np.ndarray:
+        """(M,) float32 ``k`` of each material's diffuse term ``cos^k`` (1 for smooth glass)."""
+        return np.where(self.optics.smooth, 1.0, self.params.incidence_exponent).astype(np.float32)
 
     def describe(self) -> dict:
         """For ``lidar_meta.json``."""

@@ -162,10 +162,11 @@ def test_physical_scans_do_not_depend_on_threads_or_chunks_and_noise_is_keyed(hd
 def test_points_that_are_not_mixed_agree_with_the_camera(hdl64e, test_spec, test_scene):
     """Project a physical sweep of the test town into a camera image ray-cast at the same instant: the
     points the camera sees (occlusion test) carry the class of their pixel, >= 99.5 % of those not mixed."""
+    from kits.fusion_kit import raycast_image
+
     from generator.fusion.projection import camera_from_lidar, project, transform, visible
     from generator.lidar.caster import EmbreeCaster
     from generator.world.rig import Rig
-    from kits.fusion_kit import raycast_image
 
     r = Rig.from_spec(test_spec, test_scene)
     f = r.frame(0)
