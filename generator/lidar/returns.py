@@ -222,8 +222,9 @@ class ReturnModel:
         p = self.params
         return {
             **p.to_dict(),
-            "power": "P = w tau rho (cos^incidence_exponent + lobe_gain cos^lobe_exponent) (R0 / max(R, R_min))^2 exp(-2 alpha R); "
-                     "1 = reflectivity-1 Lambertian target at R0 = 10 m, normal incidence, clear air",
+            "power": "P = w tau rho (cos^k + lobe_gain cos^lobe_exponent) (R0 / max(R, R_min))^2 exp(-2 alpha R), "
+                     "k = incidence_exponent (1 for glass); 1 = reflectivity-1 Lambertian target at R0 = 10 m, "
+                     "normal incidence, clear air",
             "divergence_model": f"Gaussian footprint, {p.divergence_mrad} mrad full angle (1/e^2), {p.subrays} "
                                 "sub-rays "
                                 f"(centre + {max(p.subrays - 1, 0)} at {1e3 * self.spread:.3f} mrad, equal power) cast "
