@@ -207,8 +207,8 @@ def main(argv=None) -> int:
                 best[k][:, i] = np.minimum(best[k][:, i], (wall, cpu))
     best = {k: tuple(v.sum(1)) for k, v in best.items()}
     scans = [scanners[(True, args.threads)].scan(p, t0=float(x)) for p, x in zip(poses, times)]
-    kept = {k: np.mean([len(sc.scan(p, t0=float(x), noise_key=i).points) for i, (p, x) in enumerate(zip(poses, times))])
-            for k, sc in physical.items()}
+    kept = {k: np.mean([len(sc.scan(p, t0=float(x), noise_key=i).points)
+                        for i, (p, x) in enumerate(zip(poses, times, strict=True))]) for k, sc in physical.items()}
     for sc in scanners.values():
         sc.close()
     pool.shutdown()
@@ -239,9 +239,11 @@ def main(argv=None) -> int:
     base = best[("ours: Scanner.scan, actors moving", args.threads)][0]
     for k in physical:
         w = best[(k, args.threads)][0]
-        print(f"{k}: {n / w:.1f} sweeps/s = {n / w / sensor.rotation_hz:.2f}x the real sensor's {sensor.rotation_hz:.0f} Hz "
-              f"(target >= 2x), {w / base:.2f}x the ideal scanner's time; {kept[k]:,.0f} points per sweep "
-              f"({100 * kept[k] / sensor.rays_per_sweep:.1f} % of the rays; ideal {np.mean([len(s.points) for s in scans]):,.0f})")
+        ideal_pts = np.mean([len(s.points) for s in scans])
+        print(f"{k}: {n / w:.1f} sweeps/s = {n / w / sensor.rotation_hz:.2f}x the real sensor's "
+              f"{sensor.rotation_hz:.0f} Hz (target >= 2x), {w / base:.2f}x the ideal scanner's time; "
+              f"{kept[k]:,.0f} points per sweep ({100 * kept[k] / sensor.rays_per_sweep:.1f} % of the rays; "
+              f"ideal {ideal_pts:,.0f})")
     print(f"ideal, actors moving: {n / base:.1f} sweeps/s = {n / base / sensor.rotation_hz:.2f}x real time")
     print(f"per sweep: {np.mean(seen):.0f} actors in range, {np.mean(cand):,.0f} rays in their column windows (before "
           f"the per-laser azimuth and static-distance culls), {on_actor.mean():,.0f} points on actors "
