@@ -17,7 +17,10 @@ Rows, on the rays of the same HDL-64E sweeps (2083 x 64 = 133,312 rays each, mot
   (contiguous chunks, as many as the scanner's), against the static town and against the town
   with every actor frozen into it at the first sweep's start (the same triangles, no motion);
 * ours: ``Scanner.scan`` -- rays -> labelled points -- static town only, then with the world's
-  actors moving through every sweep (:mod:`generator.lidar.actors`), 1 and 2 threads.
+  actors moving through every sweep (:mod:`generator.lidar.actors`), 1 and 2 threads;
+* the physical sensor (:mod:`generator.lidar.returns`) with the actors moving, 2 threads: received
+  power only (one ray per beam: the cost of the detection test), strongest return with beam
+  divergence (the HDL-64E preset), dual returns with beam divergence.
 
 Timings: each sweep of each method is timed in each of ``--rounds`` interleaved rounds and the
 best time per sweep is kept (a burst of load from other processes spoils one sample, not a row);
@@ -27,6 +30,7 @@ CPU seconds per sweep are printed as well (load-independent).
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import itertools
 import json
 import os
@@ -40,8 +44,10 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from generator.jobs.lidar_returns import return_model
 from generator.layout.assemble import build_scene
 from generator.lidar.caster import EmbreeCaster
+from generator.lidar.sensors import with_returns
 from generator.lidar.scan import Scanner
 from generator.lidar.sensors import sensor_for_spec
 from generator.spec import parse_spec
@@ -177,6 +183,18 @@ def main(argv=None) -> int:
     for (w, th), sc in scanners.items():
         name = "ours: Scanner.scan, actors moving" if w else "ours: Scanner.scan, static town"
         methods[(name, th)] = lambda i, sc=sc: sc.scan(poses[i], t0=float(times[i]))
+    physical = {}
+    for label, mode, subrays in (("physical: received power only", "strongest", 1),
+                                 ("physical: strongest + divergence", "strongest", None),
+                                 ("physical: dual + divergence", "dual", None)):
+        s_mode = with_returns(sensor, mode)
+        if subrays is not None:
+            s_mode = dataclasses.replace(s_mode, returns=dataclasses.replace(s_mode.returns, subrays=subrays))
+        sc = Scanner(scene, s_mode, threads=args.threads, caster=static, world=world,
+                     returns=return_model(s_mode, spec.seed))
+        physical[label] = sc
+        scanners[(label, args.threads)] = sc
+        methods[(label, args.threads)] = lambda i, sc=sc: sc.scan(poses[i], t0=float(times[i]), noise_key=i)
     # best of the rounds for every sweep on its own: a burst of load from other processes spoils one
     # sweep of one method, not a whole row
     best = {k: np.full((2, args.sweeps), np.inf) for k in methods}
@@ -189,6 +207,8 @@ def main(argv=None) -> int:
                 best[k][:, i] = np.minimum(best[k][:, i], (wall, cpu))
     best = {k: tuple(v.sum(1)) for k, v in best.items()}
     scans = [scanners[(True, args.threads)].scan(p, t0=float(x)) for p, x in zip(poses, times)]
+    kept = {k: np.mean([len(sc.scan(p, t0=float(x), noise_key=i).points)
+                        for i, (p, x) in enumerate(zip(poses, times, strict=True))]) for k, sc in physical.items()}
     for sc in scanners.values():
         sc.close()
     pool.shutdown()
@@ -216,6 +236,15 @@ def main(argv=None) -> int:
     plan = [scanners[(True, 1)].actors.plan(p, float(x), sensor.column_time()) for p, x in zip(poses, times)]
     cand = [0 if pl is None else int(np.clip(pl.ring1 - pl.ring0, 0, None).sum()) for pl in plan]
     seen = [0 if pl is None else len(np.unique(pl.actor)) for pl in plan]
+    base = best[("ours: Scanner.scan, actors moving", args.threads)][0]
+    for k in physical:
+        w = best[(k, args.threads)][0]
+        ideal_pts = np.mean([len(s.points) for s in scans])
+        print(f"{k}: {n / w:.1f} sweeps/s = {n / w / sensor.rotation_hz:.2f}x the real sensor's "
+              f"{sensor.rotation_hz:.0f} Hz (target >= 2x), {w / base:.2f}x the ideal scanner's time; "
+              f"{kept[k]:,.0f} points per sweep ({100 * kept[k] / sensor.rays_per_sweep:.1f} % of the rays; "
+              f"ideal {ideal_pts:,.0f})")
+    print(f"ideal, actors moving: {n / base:.1f} sweeps/s = {n / base / sensor.rotation_hz:.2f}x real time")
     print(f"per sweep: {np.mean(seen):.0f} actors in range, {np.mean(cand):,.0f} rays in their column windows (before "
           f"the per-laser azimuth and static-distance culls), {on_actor.mean():,.0f} points on actors "
           f"({mov.mean():,.0f} moving)")

@@ -20,6 +20,7 @@ class MaterialInfo:
     retro: bool
     color: tuple[int, int, int]
     emissive: str | None
+    transmittance: float = 0.0
 
 
 class MaterialTable:
@@ -56,6 +57,11 @@ class MaterialTable:
         return np.array([r.retro for r in self.rows], bool)
 
     @functools.cached_property
+    def transmittance(self) -> np.ndarray:
+        """(n_materials,) float32 share of a 905 nm beam a pane lets through, one way (0: opaque)."""
+        return np.array([r.transmittance for r in self.rows], np.float32)
+
+    @functools.cached_property
     def colors(self) -> np.ndarray:
         """(n_materials, 3) uint8 preview colour."""
         return np.array([r.color for r in self.rows], np.uint8)
@@ -69,7 +75,8 @@ def material_table() -> MaterialTable:
     return MaterialTable(
         [
             MaterialInfo(int(r["id"]), str(r["name"]), float(r["reflectivity"]), bool(r["retro"]),
-                         tuple(int(c) for c in r["color"]), r["emissive"])
+                         tuple(int(c) for c in r["color"]), r["emissive"],
+                         float(r.get("transmittance", 0.0)))
             for r in raw
         ]
     )

@@ -31,7 +31,7 @@ ALLOWED: dict[str, set[str]] = {
     "assets_procedural": {"geometry", "labels", "materials"},
     "layout": {"assets_procedural", "geometry", "labels", "materials", "spec", "world"},
     "traffic": {"geometry", "labels", "layout", "spec", "world"},
-    "lidar": {"geometry", "labels", "spec", "world"},
+    "lidar": {"geometry", "labels", "materials", "spec", "world"},
     "postfx": {"weather"},
     "imaging": {"labels", "spec", "weather"},
     "detection": {"geometry", "labels", "spec", "world"},

@@ -42,7 +42,8 @@ def _mixed_town(seed: int):
 
 def _kitti_town(seed: int):
     """kitti_like, 3 x 3 blocks, 3.0 m lanes (a bus with its mirrors fits one), buses 4/km."""
-    doc = json.loads((ROOT / "scenes" / "kitti_like.json").read_text())
+    # kitti_like as it was when these towns were chosen (the failures the cases hold were found in them)
+    doc = json.loads((ROOT / "tests" / "kits" / "kitti_like_2026.json").read_text())
     doc.update(seed=seed, traffic={"cars_per_km": 10, "trucks_per_km": 1, "buses_per_km": 4,
                                    "other_vehicles_per_km": 1, "cyclists_per_km": 1})
     doc["town"] = {**doc["town"], "blocks_x": 3, "blocks_y": 3, "lane_width_m": 3.0}

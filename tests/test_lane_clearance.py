@@ -23,8 +23,13 @@ ROOT = Path(__file__).parents[1]
 BUSES = {"cars_per_km": 10, "trucks_per_km": 1, "buses_per_km": 4, "other_vehicles_per_km": 1, "cyclists_per_km": 1}
 
 
+#: kitti_like as it was when these towns were chosen (the later preset, with traffic and more parking strips,
+#: leaves no lane a bus fits at these seeds): the towns stay the ones the cases below were found in
+KITTI_2026 = ROOT / "tests" / "kits" / "kitti_like_2026.json"
+
+
 def _bus_town(scene: str, seed: int, **town):
-    doc = json.loads((ROOT / "scenes" / scene).read_text())
+    doc = json.loads((KITTI_2026 if scene == "kitti_like.json" else ROOT / "scenes" / scene).read_text())
     doc.update(seed=seed, traffic=BUSES)
     doc["town"] = {**doc["town"], "blocks_x": 3, "blocks_y": 3, **town}
     return parse_spec(doc, f"{scene}")

@@ -155,8 +155,10 @@ def test_scan_shares_the_frame_weather_draw(test_spec):
 def test_sequence_with_weather_records_it_per_scan(test_spec, tmp_path):
     scene = scene_of([("ground", rect(-150, -150, 150, 150, 0.0, "road", "asphalt"), 0),
                       ("wall", box((2.0, 40.0, 10.0), "building", "facade_brick", center=(60.0, 0.0, 5.0)), 5)])
-    spec = dataclasses.replace(test_spec, lidar=dataclasses.replace(
-        test_spec.lidar, intensity_model="physical"))
+    # the ideal sensor: the weather's own detection test (the physical sensor detects in the scanner)
+    lidar = dataclasses.replace(test_spec.sensors.lidar, returns="ideal")
+    spec = dataclasses.replace(test_spec, lidar=dataclasses.replace(test_spec.lidar, intensity_model="physical"),
+                               sensors=dataclasses.replace(test_spec.sensors, lidar=lidar))
     meta = write_sequence(scene, spec, tmp_path, SequenceOptions(frames=4, threads=1, bev=False, weather=True),
                           progress=False)
     kinds = [s["weather"]["kind"] for s in meta["scans"]]

@@ -70,6 +70,10 @@ def add_processing_args(p, weather: bool = False) -> None:
     if weather:
         g.add_argument("--lidar-weather", choices=tuple(WEATHER_CHOICES), default=None,
                        help="LiDAR weather of each frame (auto: on for generate datasets, off here)")
+        g.add_argument("--returns", choices=("ideal", "strongest", "dual"), default=None,
+                       help="how beams become points: ideal = every ray's first hit; strongest / dual = physical "
+                            "returns (received power, beam divergence, noise) with one or two points per beam "
+                            "(default: the spec's, else the sensor's: physical strongest for the HDL-64E)")
 
 
 def _profile_value(text: str | None) -> str | None:
@@ -116,6 +120,8 @@ def spec_with_processing_args(spec, args):
     lidar["domain_gap"] = dict(g, enabled=gap is not None, **(gap.to_dict() if gap else {}))
     if getattr(args, "lidar_weather", None) is not None:
         lidar["weather"]["enabled"] = WEATHER_CHOICES[args.lidar_weather]
+    if getattr(args, "returns", None) is not None:
+        d["sensors"]["lidar"]["returns"] = args.returns
     return parse_spec(d, spec.source)
 
 

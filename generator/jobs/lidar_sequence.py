@@ -12,6 +12,13 @@ Side files for fusion: ``point_times/`` and ``native_labels/`` per scan
 (``scene_flow/``, :mod:`generator.formats.scene_flow`, :mod:`generator.jobs.scan_flow`) and, in ``lidar_meta.json``,
 ``sweep_poses_world`` (the LiDAR world poses during each sweep, :meth:`generator.world.rig.Rig.sweep_record`).
 
+With the physical sensor (:mod:`generator.lidar.returns`) in dual mode, ``velodyne/`` and ``labels/``
+(and every side file above) keep one point per beam, its strongest return, exactly the points of
+strongest mode; the second returns go to ``second_return/velodyne/NNNNNN.bin`` and
+``second_return/labels/NNNNNN.label`` (the same formats, so any KITTI reader reads them) with
+``second_return/first_index/NNNNNN.bin`` (uint32 per second return: the row of its beam's strongest
+return in ``velodyne/NNNNNN.bin``; 0xFFFFFFFF if the post-processing dropped that one).
+
 Write order: calib first, then scans; ``poses.txt``, ``times.txt`` and the metadata last,
 so a sequence with ``poses.txt`` is complete. Re-running into the same folder overwrites
 (each file atomically) and removes frames beyond the new frame count.
@@ -42,6 +49,8 @@ from generator.jobs.scan_flow import ScanFlowWriter, remove_last
 from generator.scan_effects.pipeline import process_scan, processing_for_spec
 from generator.spec.towns import angle_record, town_record
 from generator.remission.models import IntensityFn, intensity_fn_for_spec
+from generator.jobs.lidar_returns import SECOND_DIR, return_model, sweep_alpha, write_second_returns
+from generator.lidar.returns import frame_key
 from generator.lidar.scan import Scanner
 from generator.lidar.sensors import Sensor, sensor_for_spec
 from generator.world.actors import MOVING_THRESHOLD_MPS
@@ -155,6 +164,7 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
     sensor = sensor_for_spec(spec) if sensor is None else sensor
     intensity_fn = intensity_fn_for_spec(spec) if intensity_fn is None else intensity_fn
     processing = processing_for_spec(spec, sensor, options.weather, intensity_fn)
+    returns = return_model(sensor, spec.seed)
     check_sweeps(scene, spec, options.frames, options.route)
     name = sk.sequence_name(options.sequence)
     seq = inside(out, "sequences", name)
@@ -173,11 +183,22 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
     sweeps = []  # LiDAR world poses during each sweep (fusion de-skews with them)
     actors = world.actors if world is not None else []
     flows = ScanFlowWriter(seq, rig, world, sensor, skew)  # scene_flow/ of each sweep, once the next is cast
-    with Scanner(scene, sensor, threads=options.threads, world=world) as scanner, flows:
+    with Scanner(scene, sensor, threads=options.threads, world=world, returns=returns) as scanner, flows:
         for j in progress_bar(range(options.frames), desc=f"lidar {name}", unit="scan", enabled=progress):
             t_j = times[j]
-            scan = scanner.sweep(rig, t_j, skew)
-            pts, remission, record = process_scan(scan.points, processing, spec, j)
+            if returns is None:
+                scan = scanner.sweep(rig, t_j, skew)
+            else:
+                scan = scanner.sweep(rig, t_j, skew, alpha_per_m=sweep_alpha(spec, processing, j),
+                                     noise_key=frame_key(spec.seed, j))
+            pts = scan.points
+            if returns is not None and returns.params.mode == "dual":
+                second = pts[pts["echo"] == 1]
+                pts = pts[pts["echo"] == 0]
+            pts, remission, record = process_scan(pts, processing, spec, j)
+            if returns is not None and returns.params.mode == "dual":
+                second, rem2, record["second_return"] = process_scan(second, processing, spec, j, SECOND_DIR)
+                write_second_returns(seq, f"{j:06d}", pts, second, rem2, sensor.n_lasers)
             scan = dataclasses.replace(scan, points=pts)  # xyz, range image and side files follow the processed points
             records.append(record)
             stem = f"{j:06d}"
@@ -213,6 +234,8 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
     if options.image_frames:
         meta["image_frames"] = [list(p) for p in options.image_frames]
     meta["processing"], meta["scans"] = processing.describe(), records
+    if returns is not None:
+        meta["returns"] = returns.describe()
     meta["sweep_poses_world"] = {"period_s": sensor.period_s, "frames": sweeps}
     meta["scene_flow"] = {**SCENE_FLOW, "dt_s": SWEEP_PERIOD_S}
     write_json(seq / META_NAME, meta)
@@ -222,7 +245,9 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
 
 def _remove_stale(seq: Path, n: int) -> None:
     for sub, ext in (("velodyne", ".bin"), ("labels", ".label"), ("bev", ".png"), ("range", ".npy"), ("ply", ".ply"),
-                     ("point_times", ".bin"), ("native_labels", ".bin"), ("point_rings", ".bin")):
+                     ("point_times", ".bin"), ("native_labels", ".bin"), ("point_rings", ".bin"),
+                     (f"{SECOND_DIR}/velodyne", ".bin"), (f"{SECOND_DIR}/labels", ".label"),
+                     (f"{SECOND_DIR}/first_index", ".bin")):
         for p in sorted((seq / sub).glob(f"*{ext}")):
             if p.stem.isdigit() and int(p.stem) >= n:
                 log.warning("removing %s left by an earlier, longer run", p)

@@ -111,7 +111,7 @@ class ActorCaster:
         Every actor's track, evaluated in bulk.
     """
 
-    def __init__(self, world, sensor, face_offset: int, center: np.ndarray):
+    def __init__(self, world, sensor, face_offset: int, center: np.ndarray, spread: float = 0.0):
         actors = world.actors
         keys = list(dict.fromkeys(a.prototype for a in actors))
         self.protos = [world.prototypes[k] for k in keys]
@@ -128,7 +128,7 @@ class ActorCaster:
         self.bank = TrackBank([a.track for a in actors])
         self.center = np.asarray(center, np.float64)
         self.sensor = sensor
-        self.beams = BeamTable.of(sensor)
+        self.beams = BeamTable.of(sensor, spread)  # windows widened for sub-rays (beam divergence)
         self._column_windows = column_windows
 
     def face_normals(self) -> list[np.ndarray]:
@@ -166,14 +166,22 @@ class ActorCaster:
 
     # -- per chunk of columns -----------------------------------------------------------------------
     def cast(self, plan: SweepPlan, cols: slice, o_w: np.ndarray, d_w: np.ndarray, dist: np.ndarray,
-             face: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+             face: np.ndarray, rows: tuple[np.ndarray, np.ndarray] | None = None,
+             offset: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray] | None:
         """Let the actors occlude the static hits of one chunk of columns (arrays updated in place).
 
         Parameters
         ----------
         plan : SweepPlan
         cols : slice
-            The chunk's firing columns; its rays are ``(column - cols.start) * L + ring``.
+            The chunk's firing columns; its beams are ``(column - cols.start) * L + ring``, and so are
+            its rays unless ``rows`` says otherwise.
+        rows : (ptr, ids), optional
+            Rays of each beam when they are not one per beam (sub-rays, rays continued behind
+            glass): beam ``q``'s rays are rows ``ids[ptr[q]:ptr[q + 1]]`` of the ray arrays.
+        offset : (n,) float32, optional
+            Distance each ray's origin lies along its beam (behind glass), metres: the actors'
+            nearest distance is measured from the sensor.
         o_w, d_w : (n, 3) float32
             The chunk's ray origins (minus the static centre) and directions, world axes. Rows of
             ``d_w`` that end on an actor are replaced by the direction in the actor's frame (the
@@ -204,7 +212,17 @@ class ActorCaster:
         ray = (col - cols.start) * L + ring
         off = self.beams.psi.take(col) + self.beams.rot.take(ring) - plan.azimuth.take(pair)
         off = np.abs(np.mod(off + np.pi, 2 * np.pi) - np.pi)  # this laser's beam vs the actor's direction
-        keep = np.flatnonzero((off <= plan.half.take(pair)) & (dist.take(ray) > plan.near.take(pair)))
+        if rows is not None:  # beams -> their rays
+            ptr, ids = rows
+            aim = np.flatnonzero(off <= plan.half.take(pair))
+            ray, pair, cand = ray.take(aim), pair.take(aim), cand.take(aim)
+            n_r = ptr[ray + 1] - ptr[ray]
+            owner, at = _ragged(ptr[ray], n_r)
+            ray, pair, cand = ids.take(at), pair.take(owner), cand.take(owner)
+            reach = dist.take(ray) if offset is None else dist.take(ray) + offset.take(ray)
+            keep = np.flatnonzero(reach > plan.near.take(pair))
+        else:
+            keep = np.flatnonzero((off <= plan.half.take(pair)) & (dist.take(ray) > plan.near.take(pair)))
         if len(keep) == 0:
             return None
         ray, pair, cand = ray.take(keep), pair.take(keep), cand.take(keep)

@@ -145,3 +145,6 @@ def fill_records(out, hit, ray0, dist, face, d_w, o_loc, d_loc, azimuth, column_
         rec.instance = f.instance
         rec.material = f.material
         rec.moving = 0
+        rec.mixed = 0
+        rec.echo = 0
+        rec.power = zero

@@ -19,7 +19,13 @@ class           uint8   native class id (``scene.face_class``; an actor's ``face
 instance        uint16  instance id (``scene.face_instance``, 0 for stuff; ``actor.instance_id``)
 material        uint16  material id (``scene.face_material``; an actor's ``face_material``)
 moving          uint8   1 on an actor faster than ``MOVING_THRESHOLD_MPS`` at the firing time
+mixed           uint8   1 where the return merges sub-rays of different surfaces (physical returns)
+echo            uint8   0 = the beam's strongest return, 1 = its second (dual mode)
+power           float32 normalised received power of the return (0 with the ideal sensor)
 =============== ======= ==========================================================
+
+With the physical return model (:mod:`generator.lidar.returns`) the records are written by
+:func:`generator.lidar.return_kernels.beam_returns` instead, the same fields.
 
 How the records are filled: :meth:`RecordTables.fill` runs one compiled pass over a chunk's
 hits (:func:`generator.lidar.kernels.fill_records`) from tables built once per scanner: the
@@ -38,7 +44,7 @@ from generator.lidar.kernels import FACE_DTYPE, fill_records
 POINT_DTYPE = np.dtype([
     ("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("range", "<f4"), ("azimuth", "<f4"), ("time", "<f4"),
     ("cos_incidence", "<f4"), ("ring", "u1"), ("column", "<u2"), ("laser", "u1"), ("class", "u1"),
-    ("instance", "<u2"), ("material", "<u2"), ("moving", "u1"),
+    ("instance", "<u2"), ("material", "<u2"), ("moving", "u1"), ("mixed", "u1"), ("echo", "u1"), ("power", "<f4"),
 ])
 
 

@@ -37,7 +37,9 @@ import numpy as np
 from generator.lidar.actors import ActorCaster
 from generator.lidar.caster import RayCaster, make_caster
 from generator.lidar.kernels import returns, world_rays
+from generator.lidar.physical_chunk import run_physical_chunk
 from generator.lidar.points import POINT_DTYPE, RecordTables
+from generator.lidar.returns import ReturnModel
 from generator.lidar.sensors import Sensor
 
 __all__ = ["POINT_DTYPE", "Scan", "Scanner"]
@@ -100,6 +102,9 @@ class Scanner:
         Its ``actors`` move through every sweep (None, or a world without actors: the static
         town only, byte for byte the same points). The ego must not be one of them (its own
         body would surround the sensor).
+    returns : ReturnModel, optional
+        The physical return model (:mod:`generator.lidar.returns`); None (default) or an
+        ``ideal`` model: every ray's first hit is a point, whatever the sensor table says.
 
     Notes
     -----
@@ -115,12 +120,14 @@ class Scanner:
     """
 
     def __init__(self, scene, sensor: Sensor, threads: int | None = None, caster: RayCaster | None = None,
-                 chunks_per_thread: int = 4, world=None):
+                 chunks_per_thread: int = 4, world=None, returns: ReturnModel | None = None):
         self.sensor = sensor
         self.threads = max(1, int(threads or os.cpu_count() or 1))
         self.caster = caster if caster is not None else make_caster(scene)
+        self.returns = returns if returns is not None and returns.params.physical else None
         n_static = len(self.caster.face_normals)
-        self.actors = (ActorCaster(world, sensor, n_static, self.caster.center)
+        spread = self.returns.spread if self.returns is not None else 0.0
+        self.actors = (ActorCaster(world, sensor, n_static, self.caster.center, spread)
                        if world is not None and world.actors else None)
         # face-table rows: the town's faces, then each prototype's (instance filled per hit)
         protos = self.actors.protos if self.actors is not None else []
@@ -148,7 +155,8 @@ class Scanner:
     def __exit__(self, *exc) -> None:
         self.close()
 
-    def scan(self, T_world_sensor: np.ndarray, t0: float | None = None) -> Scan:
+    def scan(self, T_world_sensor: np.ndarray, t0: float | None = None, alpha_per_m: float = 0.0,
+             noise_key: int = 0) -> Scan:
         """Cast one sweep.
 
         Parameters
@@ -160,6 +168,10 @@ class Scanner:
             Sweep start on the world's clock, seconds: actors are posed at ``t0`` plus each
             column's firing offset (skew on) or at ``t0`` (skew off). Required when the
             scanner has actors.
+        alpha_per_m : float
+            Atmospheric extinction of this sweep, 1/m (physical returns only; fog and rain).
+        noise_key : int
+            Key of this sweep's range noise (physical returns only; :func:`generator.lidar.returns.frame_key`).
 
         Returns
         -------
@@ -177,7 +189,9 @@ class Scanner:
         # one rotation and translation per column (repeated when the whole sweep has one pose)
         rot_t = np.ascontiguousarray(np.broadcast_to(rot_t, (steps, 3, 3)))
         trans = np.ascontiguousarray(np.broadcast_to(trans, (steps, 3)))
-        sweep = _Sweep(np.empty(self.sensor.rays_per_sweep, POINT_DTYPE), len(self._chunks), rot_t, trans, skew)
+        per_beam = 2 if self.returns is not None and self.returns.params.mode == "dual" else 1
+        sweep = _Sweep(np.empty(per_beam * self.sensor.rays_per_sweep, POINT_DTYPE), len(self._chunks), rot_t, trans,
+                       skew, float(alpha_per_m), int(noise_key))
 
         def plan():  # which actors each column may see; the workers need it only after their static cast
             if self.actors is None:
@@ -199,7 +213,7 @@ class Scanner:
         return Scan(sweep.out[:sweep.ends[-1]], poses[0] if skew else poses, self.sensor.rays_per_sweep,
                     self.sensor.n_lasers, self.sensor.azimuth_steps)
 
-    def sweep(self, rig, t0: float, motion_skew: bool = True) -> Scan:
+    def sweep(self, rig, t0: float, motion_skew: bool = True, alpha_per_m: float = 0.0, noise_key: int = 0) -> Scan:
         """Cast the sweep starting at ``t0`` seconds from ``rig``'s LiDAR.
 
         Parameters
@@ -211,10 +225,16 @@ class Scanner:
         motion_skew : bool
             Fire each column from the pose of its own instant (a real spinning sensor), or
             every column from the pose at ``t0`` (and every actor at ``t0``).
+        alpha_per_m, noise_key
+            As :meth:`scan`.
         """
-        return self.scan(rig.sweep_poses(t0, self.sensor.column_time() if motion_skew else None), t0=t0)
+        return self.scan(rig.sweep_poses(t0, self.sensor.column_time() if motion_skew else None), t0=t0,
+                         alpha_per_m=alpha_per_m, noise_key=noise_key)
 
     def _run_chunk(self, sweep: _Sweep, i: int, cols: slice) -> None:
+        if self.returns is not None:
+            run_physical_chunk(self, sweep, i, cols)
+            return
         try:
             n = (cols.stop - cols.start) * self.sensor.n_lasers
             o_w, d_w = np.empty((n, 3), np.float32), np.empty((n, 3), np.float32)
@@ -244,8 +264,9 @@ class Scanner:
 class _Sweep:
     """One sweep in flight: the output array, the actors' plan and the chained chunk offsets."""
 
-    def __init__(self, out: np.ndarray, n_chunks: int, rot_t, trans, skew: bool):
+    def __init__(self, out: np.ndarray, n_chunks: int, rot_t, trans, skew: bool, alpha: float = 0.0, key: int = 0):
         self.out, self.rot_t, self.trans, self.skew = out, rot_t, trans, skew
+        self.alpha, self.key = alpha, key
         self.ends: list[int | None] = [None] * n_chunks
         self._done = [threading.Event() for _ in range(n_chunks)]
         self._plan, self._plan_error = None, None

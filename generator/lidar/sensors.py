@@ -32,6 +32,7 @@ Focal distance/slope and min_intensity concern intensity calibration; ignored as
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 from dataclasses import dataclass
@@ -40,6 +41,7 @@ from pathlib import Path
 import numpy as np
 
 from generator.errors import SpecError
+from generator.lidar.returns import ReturnParams
 from generator.spec.validate import check_ranges, load_schema, read_document, validate, with_defaults
 
 #: Folder of the shipped sensor tables.
@@ -76,6 +78,8 @@ class Sensor:
         Emission point offsets per laser, metres.
     dist_correction : (L,) float64
         The real unit's range bias, metres; kept for reference, never applied.
+    returns : ReturnParams
+        How beams become points (:mod:`generator.lidar.returns`; ``model == "ideal"``: first hits).
     """
 
     name: str
@@ -94,6 +98,7 @@ class Sensor:
     vert_offset: np.ndarray
     horiz_offset: np.ndarray
     dist_correction: np.ndarray
+    returns: ReturnParams = ReturnParams()
 
     @property
     def n_lasers(self) -> int:
@@ -209,6 +214,7 @@ def parse_sensor(doc: object, source: str) -> Sensor:
         raise SpecError(source, "lasers", "give exactly one of 'lasers' (per-laser table) or 'uniform' (even fan)"
                         + (", not both" if n_forms == 2 else ""))
     full = with_defaults(doc, schema)
+    returns = ReturnParams(**full.pop("returns", {}))
     if "lasers" in doc:
         full.pop("uniform", None)  # with_defaults fills every absent object key with {}
         laser_schema = schema["$defs"]["laser"]
@@ -226,7 +232,7 @@ def parse_sensor(doc: object, source: str) -> Sensor:
         rotation_hz=float(full["rotation_hz"]), azimuth_steps=int(full["azimuth_steps"]),
         min_range_m=float(lo), max_range_m=float(hi),
         start_azimuth_rad=math.radians(full["start_azimuth_deg"]), clockwise=full["rotation"] == "clockwise",
-        ring=ring, **col,
+        ring=ring, returns=returns, **col,
     )
 
 
@@ -271,8 +277,28 @@ def sensor_for_spec(spec) -> Sensor:
         # A path inside a spec stays inside the spec's folder: no absolute path, no '..', no link out.
         base = Path(spec.source).parent if spec.source else Path(".")
         path = confined_path(base, lidar.sensor_file, spec.source or "spec", "sensors.lidar.sensor_file")
-        return load_sensor(path, str(base / lidar.sensor_file))
-    try:
-        return load_preset(lidar.preset)
-    except SpecError as e:
-        raise SpecError(spec.source or "spec", "sensors.lidar.preset", e.reason) from None
+        sensor = load_sensor(path, str(base / lidar.sensor_file))
+    else:
+        try:
+            sensor = load_preset(lidar.preset)
+        except SpecError as e:
+            raise SpecError(spec.source or "spec", "sensors.lidar.preset", e.reason) from None
+    return with_returns(sensor, getattr(lidar, "returns", None))
+
+
+def with_returns(sensor: Sensor, returns: str | None) -> Sensor:
+    """``sensor`` with the return model a spec or command line names.
+
+    Parameters
+    ----------
+    returns : {None, "ideal", "strongest", "dual"}
+        None keeps the sensor table's model; ``ideal`` switches the physical model off; ``strongest``
+        and ``dual`` switch it on (the table's parameters, else the defaults) in that mode.
+    """
+    if returns is None:
+        return sensor
+    if returns == "ideal":
+        params = dataclasses.replace(sensor.returns, model="ideal")
+    else:
+        params = dataclasses.replace(sensor.returns, model="physical", mode=returns)
+    return dataclasses.replace(sensor, returns=params)

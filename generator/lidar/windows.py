@@ -47,6 +47,9 @@ class BeamTable:
         Largest horizontal offset of an emission point across / along its own beam's azimuth,
         metres (the driver's ``horiz_offset``, and ``vert_offset`` times the sine of the elevation).
     sensor : generator.lidar.sensors.Sensor
+    spread : float
+        Largest angle of a sub-ray from its beam (beam divergence, :mod:`generator.lidar.returns`),
+        radians; every angular bound is widened by it (0: the beams themselves).
     """
 
     neg_elevation: np.ndarray
@@ -56,14 +59,15 @@ class BeamTable:
     lateral: float
     radial: float
     sensor: object
+    spread: float = 0.0
 
     @classmethod
-    def of(cls, sensor) -> BeamTable:
+    def of(cls, sensor, spread: float = 0.0) -> BeamTable:
         order = sensor.by_ring
         o, _, _ = sensor.local_rays()
         return cls(-sensor.elevation[order], sensor.rot_correction[order], sensor.column_azimuth(),
                    float(np.linalg.norm(o, axis=-1).max()), float(np.abs(sensor.horiz_offset).max()),
-                   float(np.abs(sensor.vert_offset * np.sin(sensor.elevation)).max()), sensor)
+                   float(np.abs(sensor.vert_offset * np.sin(sensor.elevation)).max()), sensor, float(spread))
 
 
 def sweep_windows(beams: BeamTable, radius: np.ndarray, lo: np.ndarray, hi: np.ndarray,
@@ -95,6 +99,8 @@ def sweep_windows(beams: BeamTable, radius: np.ndarray, lo: np.ndarray, hi: np.n
     # a beam's direction in the start frame is within `turn` of its own; its azimuth within turn / cos(elevation)
     tilt = min(float(np.abs(beams.neg_elevation).max()) + turn, 1.5)
     half = np.arcsin(np.minimum(1.0, r_tot / np.maximum(d_xy, 1e-9))) + turn / np.cos(tilt) + EPS
+    if beams.spread:
+        half = half + beams.spread / np.cos(tilt)
     az = np.arctan2(v[:, 1], v[:, 0])
     lo_psi, hi_psi = az - half - beams.rot.max(), az + half - beams.rot.min()
     k, start = s.azimuth_steps / (2 * np.pi), s.start_azimuth_rad
@@ -106,6 +112,8 @@ def sweep_windows(beams: BeamTable, radius: np.ndarray, lo: np.ndarray, hi: np.n
     width = np.where(every, s.azimuth_steps, width)
     # the sphere must also cross some beam's elevation (the per-column stage does the real work)
     el, beta = np.arctan2(v[:, 2], d_xy), np.arcsin(np.minimum(1.0, r_tot / np.maximum(d, 1e-9))) + turn + EPS
+    if beams.spread:
+        beta = beta + beams.spread
     crosses = (el - beta <= -beams.neg_elevation[0]) & (el + beta >= -beams.neg_elevation[-1])
     alive = np.flatnonzero((d - r_tot < s.max_range_m) & crosses)
     first = np.minimum(ca[alive] + width[alive], s.azimuth_steps)
@@ -151,14 +159,16 @@ def column_windows(beams: BeamTable, position: np.ndarray, yaw: np.ndarray, box_
     # its start moves along it by the vertical offset's horizontal part
     depth = rho - along - beams.radial - EPS
     half = np.where(depth > 0, np.arctan2(across + beams.lateral + EPS, np.maximum(depth, 1e-9)), 4.0) + EPS
+    if beams.spread:  # a sub-ray leaves its beam by up to `spread`, in azimuth by up to spread / cos(elevation)
+        half = half + beams.spread / np.cos(min(float(np.abs(beams.neg_elevation).max()) + beams.spread, 1.5))
     off = beams.offset + EPS
     # horizontal distance of box points: at least the depth of the box's near face, at most its far corner's
     r_lo, r_hi = rho - along - off, np.hypot(rho + along, across) + off
     z_lo, z_hi = v[:, 2] - up - off, v[:, 2] + up + off
     inside = r_lo <= 0
     r_lo = np.maximum(r_lo, 1e-9)
-    el_hi = np.where(inside, np.pi / 2, np.arctan2(z_hi, np.where(z_hi >= 0, r_lo, r_hi))) + EPS
-    el_lo = np.where(inside, -np.pi / 2, np.arctan2(z_lo, np.where(z_lo <= 0, r_lo, r_hi))) - EPS
+    el_hi = np.where(inside, np.pi / 2, np.arctan2(z_hi, np.where(z_hi >= 0, r_lo, r_hi))) + EPS + beams.spread
+    el_lo = np.where(inside, -np.pi / 2, np.arctan2(z_lo, np.where(z_lo <= 0, r_lo, r_hi))) - EPS - beams.spread
     # distance from the sensor origin to the box, in the box's axes
     q = np.stack([np.abs((a * v).sum(1)) for a in axes], -1)
     near = np.linalg.norm(np.maximum(q - box_half, 0.0), axis=1) - off

@@ -11,7 +11,10 @@ foggy image and its scan share the same visibility. Per point (constants in ``we
   ``rho * cos * (R0/R)^2``, retroreflective lobe included) times ``exp(-2 alpha R)`` (and the
   wet-ground factor) must reach ``spec.lidar.weather.detection_threshold``, else the point is lost;
   the same test runs in clear weather (alpha = 0), where the default threshold keeps
-  everything but the faintest grazing returns;
+  everything but the faintest grazing returns. With the physical sensor
+  (:mod:`generator.lidar.returns`) the scanner has already detected every return against its own
+  threshold with this ``alpha`` (each point's ``power``): only the wet-ground factor can still push
+  a return below that threshold;
 * **intensity**: every remission is multiplied by ``exp(-2 alpha R)`` (and the wet factor);
 * **fog soft returns**: with probability ``min(0.02, 0.1 m * beta)`` a ray reports the
   fog itself at ``min_range + Gamma(2, 1.5 m)`` (only when that is in front of its hard
@@ -62,6 +65,9 @@ class LidarWeatherParams:
 
     detection_threshold: float = 1e-5
     min_range_m: float = 0.9
+    #: the points carry the physical sensor's received power (``power``, atmosphere included) and were
+    #: already detected against ``detection_threshold``: the weather only adds the wet-ground loss
+    received: bool = False
 
 
 def enabled_for_spec(spec, default: bool) -> bool:
@@ -117,7 +123,7 @@ def apply_lidar_weather(points: np.ndarray, remission: np.ndarray, weather: Weat
     a_fog, a_rain = extinction_per_m(weather)
     alpha = a_fog + a_rain
     r = points["range"].astype(np.float64)
-    power = received_power(points, alpha)
+    power = points["power"].astype(np.float64) if params.received else received_power(points, alpha)
     rem = remission.astype(np.float64) * np.exp(-2.0 * alpha * r)
     lost_wet = np.zeros(n, bool)
     wet_pts = 0

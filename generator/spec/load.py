@@ -51,6 +51,8 @@ def spec_hash(spec: SceneSpec) -> str:
         d["traffic"].pop("vans_per_km", None)
     if d["traffic"].get("counts") is None:
         d["traffic"].pop("counts", None)
+    if d["sensors"]["lidar"].get("returns") is None:        # and the LiDAR return model while the sensor's own
+        d["sensors"]["lidar"].pop("returns", None)
     return canonical_hash(d)
 
 

@@ -134,6 +134,8 @@ class Lidar:
     xyz_m: Vec3
     rpy_deg: Vec3
     motion_skew: bool
+    #: None = the sensor table's model; "ideal", "strongest" or "dual" (:mod:`generator.lidar.returns`)
+    returns: str | None = None
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,186 @@
+"""One chunk of firing columns under the physical return model (:mod:`generator.lidar.returns`).
+
+Steps, per chunk ``[c0, c1)`` of a sweep (the scanner's threads run chunks in parallel):
+
+1. the central rays of ``[c0 - 1, c1 + 1)`` (one halo column each side, so a beam's neighbours are
+   known whatever the chunking) against the town, then the actors, as the ideal scanner casts them;
+2. the chunk's edge beams (:func:`generator.lidar.return_kernels.edge_beams`) get their off-centre
+   sub-rays, cast against the town and the actors;
+3. rays that end on glass go on behind it, up to ``glass_layers`` panes; a continued ray that meets
+   the object whose glass it crossed (same class and instance) is absorbed in its interior;
+4. the waveform of every beam (:func:`generator.lidar.return_kernels.beam_returns`) gives its
+   returns, written into the sweep at the chunk's offset.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from generator.lidar.kernels import world_rays
+from generator.lidar.points import POINT_DTYPE
+from generator.lidar.return_kernels import beam_returns, edge_beams, subrays
+
+#: how far behind a pane a continued ray starts, metres
+GLASS_STEP_M = 1e-3
+#: a probe sub-ray whose range differs from its centre's by more than this (metres + share of the
+#: range) splits its beam: the footprint does not lie on one smooth surface
+SPLIT_STEP_M, SPLIT_STEP_REL = 0.05, 0.01
+
+
+def _actor_hits(scanner, plan, cols, o, d, dist, face, rows=None, offset=None):
+    """Actors occlude the rays (arrays updated in place); returns per-ray (instance or -1, moving)."""
+    inst = np.full(len(dist), -1, np.int32)
+    moving = np.zeros(len(dist), np.uint8)
+    if plan is None or len(dist) == 0:
+        return inst, moving
+    hit = scanner.actors.cast(plan, cols, o, d, dist, face, rows=rows, offset=offset)
+    if hit is not None:
+        actor, mov = hit
+        m = np.flatnonzero(actor >= 0)
+        inst[m] = scanner.actors.instance[actor[m]]
+        moving[m] = mov[m]
+    return inst, moving
+
+
+def _labels(face: np.ndarray, inst: np.ndarray, faces: np.ndarray, dist=None, lo=0.0, hi=np.inf) -> np.ndarray:
+    """(n,) int64 class << 16 | instance of each hit (-1 without one, or out of ``[lo, hi)`` given ``dist``)."""
+    f = np.maximum(face, 0)
+    ins = np.where(inst >= 0, inst, faces["instance"][f].astype(np.int64))
+    ok = face >= 0 if dist is None else (face >= 0) & (dist >= lo) & (dist < hi)
+    return np.where(ok, (faces["class"][f].astype(np.int64) << 16) | ins, -1)
+
+
+def _unique_pairs(beam: np.ndarray, which: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """(beam row, sub-ray) pairs without repeats, ordered by beam."""
+    code = np.unique(beam * k + which)
+    return code // k, code % k
+
+
+def _cast_subrays(scanner, plan, cols, o_w, d_world, beam_rows, which, pattern, i0, n_in, max_range) -> dict:
+    """Cast the sub-rays ``(beam_rows, which)`` (ordered by beam) against the town and the actors."""
+    m = len(beam_rows)
+    o, d = np.empty((m, 3), np.float32), np.empty((m, 3), np.float32)
+    subrays(o_w, d_world, beam_rows, which, pattern, o, d)
+    dw = d.copy()
+    dist, face = scanner.caster.intersect_local(o, d, max_range, mark_misses=False)
+    beam = beam_rows - i0
+    ptr = np.zeros(n_in + 1, np.int64)
+    ptr[1:] = np.bincount(beam, minlength=n_in)
+    inst, moving = _actor_hits(scanner, plan, cols, o, d, dist, face, rows=(np.cumsum(ptr), np.arange(m)))
+    return {"o": o, "dw": dw, "df": d, "dist": dist, "face": face, "inst": inst, "moving": moving, "beam": beam}
+
+
+def run_physical_chunk(scanner, sweep, i: int, cols: slice) -> None:
+    """Cast chunk ``i`` (columns ``cols``) of ``sweep`` and write its returns (see the module docstring)."""
+    sensor, model, tables = scanner.sensor, scanner.returns, scanner._records
+    p, opt = model.params, model.optics
+    L, steps = sensor.n_lasers, sensor.azimuth_steps
+    lo_r, hi_r = float(sensor.min_range_m), float(sensor.max_range_m)
+    faces = tables._faces
+    try:
+        a, b = max(0, cols.start - 1), min(steps, cols.stop + 1)
+        n = (b - a) * L
+        o_w, d_w = np.empty((n, 3), np.float32), np.empty((n, 3), np.float32)
+        world_rays(scanner._o32, scanner._d32, sweep.rot_t, sweep.trans, a, b, o_w, d_w)
+        d_world = d_w.copy()  # the actors replace the directions of their hits by local ones
+        dist, face = scanner.caster.intersect_local(o_w, d_w, hi_r, mark_misses=False)
+        plan = sweep.get_plan()
+        inst, moving = _actor_hits(scanner, plan, slice(a, b), o_w, d_w, dist, face)
+        i0, i1 = (cols.start - a) * L, (cols.stop - a) * L
+        n_in = i1 - i0
+        edge, side = np.empty(n_in, np.int64), np.empty(n_in, np.uint8)
+        n_edge = edge_beams(dist, face, inst, faces, a, cols.start, cols.stop, L, lo_r, hi_r, p.edge_step, edge, side)
+        edge, side = edge[:n_edge], side[:n_edge]
+        k = len(model.pattern)
+        weight = np.ones(n_in, np.float32)
+        parts = {"o": [o_w[i0:i1]], "dw": [d_world[i0:i1]], "df": [d_w[i0:i1]], "dist": [dist[i0:i1]],
+                 "face": [face[i0:i1]], "inst": [inst[i0:i1]], "moving": [moving[i0:i1]],
+                 "beam": [np.arange(n_in, dtype=np.int64)], "weight": [weight],
+                 "offset": [np.zeros(n_in, np.float32)], "tau": [np.ones(n_in, np.float32)]}
+        if k and n_edge:
+            share = np.float32(1.0 / (k + 1))
+            # probe: the sub-ray towards each neighbour that differs
+            e, s = np.nonzero((side[:, None] >> np.arange(4, dtype=np.uint8)) & 1)
+            pb, pw = edge[e], model.probes[s]
+            pb, pw = _unique_pairs(pb, pw, k)
+            probe = _cast_subrays(scanner, plan, cols, o_w, d_world, pb, pw, model.pattern, i0, n_in, hi_r)
+            centre_lab = _labels(face[pb], inst[pb], faces, dist[pb], lo_r, hi_r)
+            probe_lab = _labels(probe["face"], probe["inst"], faces, probe["dist"], lo_r, hi_r)
+            step = np.abs(probe["dist"] - dist[pb]) > SPLIT_STEP_M + SPLIT_STEP_REL * dist[pb]
+            split = np.unique(pb[(probe_lab != centre_lab) | ((centre_lab >= 0) & step)])
+            if len(split):
+                # the split beams' other sub-rays; their probes are kept
+                keep = np.isin(pb, split)
+                have = np.zeros((len(split), k), bool)
+                have[np.searchsorted(split, pb[keep]), pw[keep]] = True
+                rb, rw = np.nonzero(~have)
+                rest = _cast_subrays(scanner, plan, cols, o_w, d_world, split[rb], rw.astype(np.int64),
+                                     model.pattern, i0, n_in, hi_r)
+                weight[split - i0] = share
+                for key in parts:
+                    if key in ("weight", "offset", "tau"):
+                        continue
+                    parts[key].append(np.concatenate([probe[key][keep], rest[key]]))
+                m = int(keep.sum()) + len(rb)
+                parts["weight"].append(np.full(m, share, np.float32))
+                parts["offset"].append(np.zeros(m, np.float32))
+                parts["tau"].append(np.ones(m, np.float32))
+        _behind_glass(scanner, plan, cols, parts, opt.transmittance, faces, p.glass_layers, hi_r, n_in)
+        cat = {key: np.concatenate(v) if len(v) > 1 else v[0] for key, v in parts.items() if key not in ("o", "dw")}
+        per_beam = 2 if p.mode == "dual" else 1
+        buf = np.empty(per_beam * n_in, POINT_DTYPE)
+        got = beam_returns(buf, n_in, cols.start * L, cat["beam"], cat["weight"], cat["offset"], cat["tau"],
+                           cat["dist"], np.ascontiguousarray(cat["face"], np.int32),
+                           np.ascontiguousarray(cat["df"], np.float32), cat["inst"], cat["moving"],
+                           tables._o, tables._d, tables._azimuth, tables._column_time, tables._ring, tables._laser,
+                           faces, opt.reflectivity, opt.lobe_gain, opt.lobe_exponent, opt.reference_range_m,
+                           opt.min_range_m, sweep.alpha, p.detection_threshold, p.separation_m, p.mode == "dual",
+                           lo_r, hi_r, sweep.key, model.ring_sigma, sweep.skew, model.k_inc)
+        start = sweep.claim(i, got)
+    except BaseException:
+        sweep.fail(i)
+        raise
+    sweep.out[start:start + got] = buf[:got]
+
+
+def _behind_glass(scanner, plan, cols, parts, transmittance, faces, layers, max_range, n_in) -> None:
+    """Append to ``parts`` the rays continued behind every pane their ray list hits (``layers`` deep)."""
+    is_glass = transmittance > 0
+    # the first layer: the rows of the ray list that end on glass, gathered part by part (no copy of the rest)
+    picked = []
+    for i, f in enumerate(parts["face"]):
+        g = np.flatnonzero(is_glass[faces["material"][np.maximum(f, 0)]] & (f >= 0))
+        if len(g):
+            picked.append((i, g))
+    if not picked:
+        return
+    layer = {key: np.concatenate([v[i][g] for i, g in picked]) for key, v in parts.items()}
+    for _ in range(layers):
+        f = layer["face"]
+        hit = (f >= 0) & (layer["offset"] + layer["dist"] < max_range)
+        mat = faces["material"][np.maximum(f, 0)]
+        glass = np.flatnonzero(hit & is_glass[mat])
+        if len(glass) == 0:
+            return
+        step = layer["dist"][glass] + np.float32(GLASS_STEP_M)
+        dw = layer["dw"][glass]
+        o = layer["o"][glass] + step[:, None] * dw
+        offset = layer["offset"][glass] + step
+        t = transmittance[mat[glass]]
+        tau = layer["tau"][glass] * t * t
+        left = np.maximum(np.float32(max_range) - offset, np.float32(1e-3)).astype(np.float32)
+        d = dw.copy()
+        dist, face = scanner.caster.intersect_local(o, d, left, mark_misses=False)
+        beam = layer["beam"][glass]
+        order = np.argsort(beam, kind="stable")  # the actors want each beam's rays together
+        ptr = np.zeros(n_in + 1, np.int64)
+        ptr[1:] = np.bincount(beam, minlength=n_in)
+        rows = (np.cumsum(ptr), order.astype(np.int64))
+        inst, moving = _actor_hits(scanner, plan, cols, o, d, dist, face, rows=rows, offset=offset)
+        # the interior of the object whose glass the ray crossed is not modelled: absorbed there
+        pane = _labels(layer["face"][glass], layer["inst"][glass], faces)
+        face = np.where((face >= 0) & (_labels(face, inst, faces) == pane), -1, face).astype(np.int32)
+        layer = {"o": o, "dw": dw, "df": d, "dist": dist, "face": face, "inst": inst, "moving": moving, "beam": beam,
+                 "weight": layer["weight"][glass], "offset": offset, "tau": tau}
+        for key, v in layer.items():
+            parts[key].append(v)

@@ -1,0 +1,343 @@
+"""Compiled loops of the physical return model (:mod:`generator.lidar.returns`): edges, sub-rays, waveform.
+
+All run with the GIL released on one chunk of firing columns. Ray arrays of a chunk:
+
+* *central* rays: the chunk's columns plus one halo column each side (``(b - a) * L`` rays,
+  column-major then ring), cast as the ideal scanner casts them;
+* the *ray list* the waveform reads: the chunk's own central rays first (inner beam ``q`` is row
+  ``q``), then the sub-rays, then the rays continued behind glass; each row names its beam.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from generator.lidar.returns import MIXED_NORMAL_COS
+
+
+@njit(nogil=True, cache=True)
+def edge_beams(dist, face, inst, faces, a, c0, c1, n_l, min_range, max_range, step, out, side):  # pragma: no cover
+    """Inner beams whose footprint may straddle an edge (see :mod:`generator.lidar.returns`).
+
+    A beam is an edge beam when a neighbour in the range image (the next column either side, the
+    next ring up or down) has no return where it has one or the other way round, hits another class or
+    instance, or -- the columns either side -- lies more than ``step`` times its range nearer or farther.
+
+    Parameters
+    ----------
+    dist, face, inst : (n,) float32, int32, int32
+        Central rays of columns ``a .. b - 1`` (``inst`` -1 = the face's own instance).
+    faces : (F,) FACE_DTYPE
+    a, c0, c1 : int
+        First halo column and the chunk's columns ``[c0, c1)``.
+    n_l : int
+        Lasers.
+    step : float
+        Relative range step between neighbouring columns that counts as an edge.
+    out : (n_inner,) int64
+        Written: halo-row indices of the edge beams, ascending.
+    side : (n_inner,) uint8
+        Written beside ``out``: which neighbours differ, bits 1 = previous column, 2 = next column,
+        4 = ring above, 8 = ring below.
+
+    Returns
+    -------
+    count : int
+    """
+    n = dist.shape[0]
+    b = n // n_l + a
+    key = np.empty(n, np.int64)
+    for r in range(n):
+        f = face[r]
+        if f < 0 or dist[r] < min_range or dist[r] >= max_range:
+            key[r] = -1
+        else:
+            ins = np.int64(inst[r]) if inst[r] >= 0 else np.int64(faces[f].instance)
+            key[r] = (np.int64(faces[f]["class"]) << 16) | ins
+    k = 0
+    for c in range(c0, c1):
+        base = (c - a) * n_l
+        for j in range(n_l):
+            r = base + j
+            own = key[r]
+            bits = 0
+            if c > a:
+                rn = r - n_l
+                if key[rn] != own or (own >= 0 and abs(dist[rn] - dist[r]) > step * dist[r]):
+                    bits |= 1
+            if c + 1 < b:
+                rn = r + n_l
+                if key[rn] != own or (own >= 0 and abs(dist[rn] - dist[r]) > step * dist[r]):
+                    bits |= 2
+            if j > 0 and key[r - 1] != own:
+                bits |= 4
+            if j + 1 < n_l and key[r + 1] != own:
+                bits |= 8
+            if bits:
+                out[k] = r
+                side[k] = bits
+                k += 1
+    return k
+
+
+@njit(nogil=True, cache=True)
+def subrays(o_w, d_w, beams, which, pattern, o_out, d_out):  # pragma: no cover - compiled
+    """Sub-rays ``d + x u + y v`` (normalised; ``u`` horizontal to the left of the beam, ``v`` up across it).
+
+    Parameters
+    ----------
+    o_w, d_w : (n, 3) float32
+        Central rays (re-centred origins, world directions).
+    beams, which : (m,) int64
+        Per sub-ray: the row of its beam and its index in ``pattern``.
+    pattern : (K - 1, 2) float64
+        Angular offsets ``(x, y)``, radians.
+    o_out, d_out : (m, 3) float32
+        Written.
+    """
+    for i in range(beams.shape[0]):
+        r = beams[i]
+        dx, dy, dz = np.float64(d_w[r, 0]), np.float64(d_w[r, 1]), np.float64(d_w[r, 2])
+        h = np.sqrt(dx * dx + dy * dy)
+        if h < 1e-9:
+            ux, uy, uz = 0.0, 1.0, 0.0
+        else:
+            ux, uy, uz = -dy / h, dx / h, 0.0
+        vx, vy, vz = dy * uz - dz * uy, dz * ux - dx * uz, dx * uy - dy * ux
+        px, py = pattern[which[i], 0], pattern[which[i], 1]
+        ex, ey, ez = dx + px * ux + py * vx, dy + px * uy + py * vy, dz + px * uz + py * vz
+        n = np.sqrt(ex * ex + ey * ey + ez * ez)
+        o_out[i, 0], o_out[i, 1], o_out[i, 2] = o_w[r, 0], o_w[r, 1], o_w[r, 2]
+        d_out[i, 0], d_out[i, 1], d_out[i, 2] = ex / n, ey / n, ez / n
+
+
+@njit(nogil=True, cache=True)
+def _normal01(key, index):  # pragma: no cover - compiled
+    """A standard normal draw hashed from ``(key, index)`` (SplitMix64, Box-Muller)."""
+    z = np.uint64(key) ^ (np.uint64(index) * np.uint64(0x9E3779B97F4A7C15))
+    u0 = _mix64(z + np.uint64(0x9E3779B97F4A7C15))
+    u1 = _mix64(z + np.uint64(0x3C6EF372FE94F82A))
+    return np.sqrt(-2.0 * np.log(u0)) * np.cos(2.0 * np.pi * u1)
+
+
+@njit(nogil=True, cache=True)
+def _mix64(x):  # pragma: no cover - compiled
+    """SplitMix64's finaliser of ``x`` as a uniform in (0, 1)."""
+    x = (x ^ (x >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+    x = (x ^ (x >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+    x = x ^ (x >> np.uint64(31))
+    return (np.float64(x >> np.uint64(11)) + 0.5) / 9007199254740992.0
+
+
+@njit(nogil=True, cache=True, inline="always")
+def _write(rec, qq, col, ring, t32, o_loc, d_loc, azimuth, column_time, laser_of, n_l, f, cos, inst, moving, mixed,
+           echo, power, skew):  # pragma: no cover - compiled
+    """One point record (see :data:`generator.lidar.points.POINT_DTYPE`) of sweep ray ``qq`` at range ``t32``."""
+    rec.x = o_loc[qq, 0] + t32 * d_loc[qq, 0]
+    rec.y = o_loc[qq, 1] + t32 * d_loc[qq, 1]
+    rec.z = o_loc[qq, 2] + t32 * d_loc[qq, 2]
+    rec.range = t32
+    rec.azimuth = azimuth[qq]
+    rec.time = column_time[col] if skew else np.float32(0.0)
+    rec.cos_incidence = cos
+    rec.ring = ring
+    rec.column = col
+    rec.laser = laser_of[qq - col * n_l]
+    rec["class"] = f["class"]
+    rec.instance = inst if inst >= 0 else f.instance
+    rec.material = f.material
+    rec.moving = moving
+    rec.mixed = mixed
+    rec.echo = echo
+    rec.power = power
+
+
+@njit(nogil=True, cache=True)
+def beam_returns(out, n_beams, ray0, beam, weight, offset, tau, dist, face, d_f, inst, moving,
+                 o_loc, d_loc, azimuth, column_time, ring_of, laser_of, faces,
+                 refl, lobe_gain, lobe_exp, r0, r_min, alpha, threshold, separation, dual,
+                 min_range, max_range, key, ring_sigma, skew, k_inc):  # pragma: no cover - compiled
+    """Every beam's returns from its hits (the waveform); writes records, returns their count.
+
+    Parameters
+    ----------
+    out : (2 * n_beams,) POINT_DTYPE
+        Destination: per beam its strongest return, then (dual) its second.
+    n_beams : int
+        Inner beams of the chunk; beam ``q`` is sweep ray ``ray0 + q``.
+    beam, weight, offset, tau : (n,) int64, float32, float32, float32
+        Per ray of the list: its beam, share of the beam's power, distance travelled before its
+        origin (behind glass), two-way transmission of the glass crossed.
+    dist, face, d_f : (n,) float32, (n,) int32, (n, 3) float32
+        Hit distance from the ray's origin, face-table row (-1: no hit, or absorbed), direction in
+        the frame of the face's normal.
+    inst, moving : (n,) int32, uint8
+        Actor instance (-1: the face's own) and moving flag.
+    o_loc, d_loc, azimuth, column_time, ring_of, laser_of, faces, skew
+        As :func:`generator.lidar.kernels.fill_records`.
+    refl, lobe_gain, lobe_exp : (M,) float32
+        Per material optics.
+    r0, r_min, alpha, threshold, separation : float
+        Reference range, minimum range of the 1/R^2 law, extinction (1/m), detection threshold,
+        merge distance (m).
+    k_inc : (M,) float32
+        Per material the incidence exponent of its diffuse term (``cos^k_inc``).
+    dual : bool
+    min_range, max_range : float
+        The sensor's.
+    key : int
+        This frame's noise key.
+    ring_sigma : (L,) float32
+        Range noise per ring, metres.
+    """
+    n = beam.shape[0]
+    count = np.zeros(n_beams + 1, np.int64)
+    total = np.empty(n, np.float64)
+    for r in range(n):
+        t = np.float64(offset[r]) + np.float64(dist[r])
+        total[r] = t
+        if face[r] >= 0 and t >= min_range and t < max_range:
+            count[beam[r] + 1] += 1
+    for q in range(n_beams):
+        count[q + 1] += count[q]
+    ev = np.empty(count[n_beams], np.int64)
+    fill = count[:n_beams].copy()
+    for r in range(n):
+        if face[r] >= 0 and total[r] >= min_range and total[r] < max_range:
+            ev[fill[beam[r]]] = r
+            fill[beam[r]] += 1
+    n_l = ring_of.shape[0]
+    m = 0
+    cap = 64
+    power = np.empty(cap)
+    rng_e = np.empty(cap)
+    lab = np.empty(cap, np.int64)
+    c_start = np.empty(cap, np.int64)
+    c_pow = np.empty(cap)
+    c_rng = np.empty(cap)
+    c_rep = np.empty(cap, np.int64)
+    c_mix = np.zeros(cap, np.bool_)
+    for q in range(n_beams):
+        lo, hi = count[q], count[q + 1]
+        ne = hi - lo
+        if ne == 0:
+            continue
+        if ne > cap:
+            ne = cap
+        if ne == 1:  # one hit (most beams): no sorting, no clusters
+            r = ev[lo]
+            f = faces[face[r]]
+            c = abs(d_f[r, 0] * f.normal[0] + d_f[r, 1] * f.normal[1] + d_f[r, 2] * f.normal[2])
+            mat = f.material
+            t = total[r]
+            g = c ** k_inc[mat] + lobe_gain[mat] * c ** lobe_exp[mat] if lobe_gain[mat] > 0 else c ** k_inc[mat]
+            rr = r0 / max(t, r_min)
+            pw = weight[r] * tau[r] * refl[mat] * g * rr * rr
+            if alpha > 0:
+                pw *= np.exp(-2.0 * alpha * t)
+            if pw < threshold:
+                continue
+            qq = ray0 + q
+            col = qq // n_l
+            ring = ring_of[qq - col * n_l]
+            rng_out = t + ring_sigma[ring] * _normal01(key, qq * 2) if ring_sigma[ring] > 0 else t
+            if rng_out < min_range:
+                rng_out = min_range
+            _write(out[m], qq, col, ring, np.float32(rng_out), o_loc, d_loc, azimuth, column_time, laser_of, n_l,
+                   f, np.float32(c), inst[r], moving[r], 0, 0, np.float32(pw), skew)
+            m += 1
+            continue
+        # insertion sort of the beam's events by range
+        for i in range(1, ne):
+            e = ev[lo + i]
+            j = i - 1
+            while j >= 0 and total[ev[lo + j]] > total[e]:
+                ev[lo + j + 1] = ev[lo + j]
+                j -= 1
+            ev[lo + j + 1] = e
+        for i in range(ne):
+            r = ev[lo + i]
+            f = faces[face[r]]
+            c = abs(d_f[r, 0] * f.normal[0] + d_f[r, 1] * f.normal[1] + d_f[r, 2] * f.normal[2])
+            mat = f.material
+            t = total[r]
+            g = c ** k_inc[mat] + lobe_gain[mat] * c ** lobe_exp[mat] if lobe_gain[mat] > 0 else c ** k_inc[mat]
+            rr = r0 / max(t, r_min)
+            power[i] = weight[r] * tau[r] * refl[mat] * g * rr * rr * np.exp(-2.0 * alpha * t)
+            rng_e[i] = t
+            ins = inst[r] if inst[r] >= 0 else np.int64(f.instance)
+            lab[i] = (np.int64(f["class"]) << 16) | ins
+        # clusters: events within `separation` of the cluster's first one merge
+        nc = 0
+        i = 0
+        while i < ne:
+            j = i
+            while j + 1 < ne and rng_e[j + 1] - rng_e[i] <= separation:
+                j += 1
+            sp, spr = 0.0, 0.0
+            for e in range(i, j + 1):
+                sp += power[e]
+                spr += power[e] * rng_e[e]
+            # dominant label: the most power; its strongest event represents the return
+            best_lab, best_p = lab[i], -1.0
+            for e in range(i, j + 1):
+                s = 0.0
+                for e2 in range(i, j + 1):
+                    if lab[e2] == lab[e]:
+                        s += power[e2]
+                if s > best_p:
+                    best_p, best_lab = s, lab[e]
+            rep, rep_p = i, -1.0
+            for e in range(i, j + 1):
+                if lab[e] == best_lab and power[e] > rep_p:
+                    rep, rep_p = e, power[e]
+            mixed = False
+            nr = faces[face[ev[lo + rep]]].normal
+            for e in range(i, j + 1):
+                if lab[e] != best_lab:
+                    mixed = True
+                else:
+                    ne_ = faces[face[ev[lo + e]]].normal
+                    if abs(ne_[0] * nr[0] + ne_[1] * nr[1] + ne_[2] * nr[2]) < MIXED_NORMAL_COS:
+                        mixed = True
+            c_start[nc] = i
+            c_pow[nc] = sp
+            c_rng[nc] = spr / sp if sp > 0 else rng_e[i]
+            c_rep[nc] = rep
+            c_mix[nc] = mixed
+            nc += 1
+            i = j + 1
+        # strongest detected, last detected, second strongest
+        s1, s2, last = -1, -1, -1
+        for k in range(nc):
+            if c_pow[k] < threshold:
+                continue
+            last = k
+            if s1 < 0 or c_pow[k] > c_pow[s1]:
+                s2 = s1
+                s1 = k
+            elif s2 < 0 or c_pow[k] > c_pow[s2]:
+                s2 = k
+        if s1 < 0:
+            continue
+        picks = (s1, (last if last != s1 else s2) if dual else -1)
+        qq = ray0 + q
+        col = qq // n_l
+        ring = ring_of[qq - col * n_l]
+        for echo in range(2):
+            k = picks[echo]
+            if k < 0:
+                continue
+            r = ev[lo + c_rep[k]]
+            f = faces[face[r]]
+            rng_out = c_rng[k] + ring_sigma[ring] * _normal01(key, qq * 2 + echo)
+            if rng_out < min_range:
+                rng_out = min_range
+            c = d_f[r, 0] * f.normal[0]
+            c += d_f[r, 1] * f.normal[1]
+            c += d_f[r, 2] * f.normal[2]
+            _write(out[m], qq, col, ring, np.float32(rng_out), o_loc, d_loc, azimuth, column_time, laser_of, n_l, f,
+                   np.float32(abs(c)), inst[r], moving[r], 1 if c_mix[k] else 0, echo, np.float32(c_pow[k]), skew)
+            m += 1
+    return m

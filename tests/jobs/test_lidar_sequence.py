@@ -1,0 +1,75 @@
+"""Sequences from the physical sensor: the ideal sensor's bytes unchanged, dual returns in side files."""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+
+import numpy as np
+import pytest
+
+from generator.formats import semantickitti as sk
+from generator.jobs.lidar_sequence import SequenceOptions, write_sequence
+
+#: sha256 of velodyne/00000[0-2].bin then labels/00000[0-2].label of ``urbangen lidar scenes/test_town.json
+#: --frames 3`` written before the physical sensor existed (commit dadd108)
+IDEAL_TEST_TOWN = "22a9ddc354cca166ed47f6df92935d37592c1dc80932b0918808512654281048"
+
+
+def _with_returns(spec, returns):
+    lidar = dataclasses.replace(spec.sensors.lidar, returns=returns)
+    return dataclasses.replace(spec, sensors=dataclasses.replace(spec.sensors, lidar=lidar))
+
+
+def _digest(seq) -> str:
+    h = hashlib.sha256()
+    for sub, ext in (("velodyne", "bin"), ("labels", "label")):
+        for f in sorted((seq / sub).glob(f"*.{ext}")):
+            h.update(f.read_bytes())
+    return h.hexdigest()
+
+
+@pytest.fixture(scope="module")
+def sequences(test_spec, test_scene, tmp_path_factory):
+    out = {}
+    for mode in ("ideal", "strongest", "dual"):
+        root = tmp_path_factory.mktemp(mode)
+        meta = write_sequence(test_scene, _with_returns(test_spec, mode), root, SequenceOptions(frames=3, bev=False),
+                              progress=False)
+        out[mode] = (root / "sequences" / "00", meta)
+    return out
+
+
+def test_the_ideal_sensor_writes_todays_bytes(sequences):
+    seq, meta = sequences["ideal"]
+    assert _digest(seq) == IDEAL_TEST_TOWN
+    assert "returns" not in meta and not (seq / "second_return").exists()
+
+
+def test_the_physical_sensor_loses_points_and_says_how(sequences):
+    ideal, phys = sequences["ideal"][1], sequences["strongest"][1]
+    assert all(p < i for p, i in zip(phys["points_per_scan"], ideal["points_per_scan"], strict=True))
+    r = phys["returns"]
+    assert r["model"] == "physical" and r["mode"] == "strongest" and "divergence_model" in r
+    assert len(r["range_noise_sigma_m_per_laser"]) == 64
+    assert "laser_gain" in phys["processing"]
+
+
+def test_dual_keeps_the_strongest_points_and_writes_second_returns_beside_them(sequences):
+    strongest, dual = sequences["strongest"][0], sequences["dual"][0]
+    assert _digest(dual) == _digest(strongest)  # velodyne/ and labels/ hold the strongest returns
+    n_second = 0
+    for k in range(3):
+        first = sk.read_scan(dual / "velodyne" / f"{k:06d}.bin")
+        xyz = sk.read_scan(dual / "second_return" / "velodyne" / f"{k:06d}.bin")
+        sem, inst = sk.read_labels(dual / "second_return" / "labels" / f"{k:06d}.label")
+        index = np.fromfile(dual / "second_return" / "first_index" / f"{k:06d}.bin", "<u4")
+        assert len(xyz) == len(sem) == len(inst) == len(index)
+        ok = index != 0xFFFFFFFF
+        assert ok.all() and np.all(index < len(first))
+        # a beam's two returns lie on one line from the sensor: same direction, another range
+        a, b = first[index, :3], xyz[:, :3]
+        cos = (a * b).sum(1) / np.linalg.norm(a, axis=1) / np.linalg.norm(b, axis=1)
+        assert np.all(cos > 0.999) and np.all(np.linalg.norm(a - b, axis=1) > 0.05)
+        n_second += len(xyz)
+    assert n_second > 100
