@@ -23,7 +23,7 @@ from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
 from generator.traffic.lanes.graph import LaneGraph
 from kits.traffic_contacts import assert_no_contact, static_quads
-from test_streets import _blender_matches_scene
+from kits.blender_scene import blender_matches_scene
 
 TRAFFIC = {"cars_per_km": 25, "trucks_per_km": 2, "buses_per_km": 1, "cyclists_per_km": 3, "motorcyclists_per_km": 2,
            "other_vehicles_per_km": 1, "pedestrians_per_100m": 1.5, "standing_pedestrians_per_100m": 0.5}
@@ -222,4 +222,4 @@ def test_blender_builds_the_pocket_parks_as_the_scene_model(tmp_path):
                        "streets": {"closed_streets": 1}}, "closed_tiny.json")
     scene = build_scene(spec)
     assert make_grid(spec).closed
-    _blender_matches_scene(spec, scene, tmp_path)
+    blender_matches_scene(spec, scene, tmp_path)

@@ -406,7 +406,7 @@ PLY_TOKENS = [MARKER, "-5", "9" * 30, "1e3", "", "list uchar int", "double", "as
 
 @pytest.fixture(scope="module")
 def town(tmp_path_factory) -> Path:
-    from test_carla_import import make_town
+    from kits.carla_town import make_town
 
     return make_town(tmp_path_factory.mktemp("carla"), frames=2, per_tag=10)[0]
 
@@ -608,7 +608,7 @@ def test_exr_masks_are_matched_by_name(kit, tmp_path):
 
 
 def _carla(tmp_path, case: str):
-    from test_carla_import import make_town
+    from kits.carla_town import make_town
 
     town, _, _ = make_town(tmp_path, frames=2)
     ply = town / "generated/frames/frame_0001.ply"

@@ -12,7 +12,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from test_render_actors import FRAME, car_world
+from kits.actor_world import FRAME, car_world
 from generator.world.rig import Rig
 
 RES = (96, 54)

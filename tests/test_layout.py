@@ -21,6 +21,7 @@ from generator.layout.network.grid import segment_frame_points
 from generator.layout.network.measures import MARK_Z_M
 from generator.layout.network.draw import make_grid
 from generator.materials import material_table
+from kits.town_checks import check_vehicles
 from generator.world.scene import OrientedBox
 from generator.spec import parse_spec
 
@@ -191,24 +192,12 @@ def test_buildings_stay_off_streets_and_sidewalks(default_spec, default_scene):
 
 
 def test_vehicles_only_in_parking_strips_or_lanes(default_spec, default_scene):
-    vehicles = _check_vehicles(default_spec, default_scene)
+    vehicles = check_vehicles(default_spec, default_scene)
     assert len(vehicles) > 20
     if default_spec.traffic.enabled:  # traffic on: nothing stands in a lane
         assert all(o.attrs.get("placement") == "parked" for o in vehicles)
     else:
         assert any(o.kind == "truck" for o in vehicles)
-
-
-def _check_vehicles(spec, scene) -> list:
-    grid = make_grid(spec)
-    rects = np.array([r for *_, r in grid.lane_rects()] + [r for *_, r in grid.parking_rects()])
-    vehicles = [o for o in scene.objects if o.kind in ("car", "truck")]
-    for o in vehicles:
-        corners = o.box.corners_xy()
-        inside = ((corners[:, None, 0] >= rects[None, :, 0] - 0.01) & (corners[:, None, 0] <= rects[None, :, 2] + 0.01)
-                  & (corners[:, None, 1] >= rects[None, :, 1] - 0.01) & (corners[:, None, 1] <= rects[None, :, 3] + 0.01))
-        assert inside.any(1).all(), f"{o.name} ({o.attrs.get('placement')}) leaves the parking strips and lanes"
-    return vehicles
 
 
 def test_objects_rest_on_their_ground(default_spec, default_scene):
@@ -245,7 +234,7 @@ def test_unusual_cross_sections_keep_the_invariants(name):
                       f"{name}.json")
     scene = build_scene(spec)
     _check_rest(spec, scene)
-    _check_vehicles(spec, scene)
+    check_vehicles(spec, scene)
     assert scene.objects_of("building") and scene.objects_of("car") and scene.objects_of("traffic_light")
 
 

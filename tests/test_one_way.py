@@ -26,73 +26,8 @@ from generator.layout.network.draw import make_grid
 from generator.spec import load_spec, parse_spec
 from generator.traffic.build import build_world
 from generator.traffic.lanes.graph import LaneGraph
-from test_streets import _no_collisions, _rests_on_ground
-
-ON_LANES = ("car", "truck", "bus", "on_rails", "other_vehicle", "ridden_bicycle", "ridden_motorcycle",
-            "bicyclist", "motorcyclist", "road")
-
-
-def one_way_spec(seed: int, lanes: int = 1, blocks=(3, 3), traffic: dict | None = None, **types):
-    doc = {"name": "one_way_town", "seed": seed,
-           "town": {"blocks_x": blocks[0], "blocks_y": blocks[1], "block_size_m": 40, "block_size_jitter_m": 8,
-                    "margin_m": 10, "lanes_per_direction": lanes},
-           "streets": {"types": types or {"plain": 1, "one_way": 3}}}
-    if traffic is not None:
-        doc["traffic"] = traffic
-        doc["density"] = {"moving_cars_per_100m": 0}
-    return parse_spec(doc, "one_way_town.json")
-
-
-def _forward(seg, direction: int) -> np.ndarray:
-    return direction * np.array([np.cos(seg.yaw), np.sin(seg.yaw)])
-
-
-def _on_carriageway(grid, xy: np.ndarray):
-    """(segment, u, v) of the one-way segment whose carriageway holds world point ``xy``, or None."""
-    for seg in grid.segments:
-        if not grid.section(seg).one_way:
-            continue
-        u, v = segment_frame_points(seg, xy)[0]
-        if 0.0 < u < seg.length and abs(v) < grid.road_half:
-            return seg, u, v
-    return None
-
-
-def check_lane_graph(grid, graph) -> None:
-    """The lane graph of ``grid`` obeys its one-way streets (also with closures and roundabouts, see
-    test_street_mix): every lane runs its direction on its slot and ends at the node it names,
-    one-way segments carry ``2 x lanes`` lanes their way and none against it, no dead end, edges
-    join end to start with the same heading, every lane is fed by a connector, and every street
-    reaches every other without a U-turn."""
-    lanes = grid.lanes
-    ow = {s.index: grid.section(s).one_way for s in grid.segments if grid.section(s).one_way}
-    segs = {s.index: s for s in grid.segments}
-    assert set(k[0] for k in graph.lane_edge) == set(segs), "lanes on a closed street, or an open one without"
-    for (si, d, k), ei in graph.lane_edge.items():
-        e, seg = graph.edges[ei], segs[si]
-        h = np.stack([np.cos(e.path.headings), np.sin(e.path.headings)], 1)
-        assert np.allclose(h @ np.array([np.cos(seg.yaw), np.sin(seg.yaw)]), d)     # it runs direction d
-        assert e.node == (seg.b if d > 0 else seg.a)                                  # it arrives where it says
-        ahead = d * np.array([np.cos(seg.yaw), np.sin(seg.yaw)])
-        assert np.dot(grid.node_xy(e.node) - e.path.points[-1, :2], ahead) == pytest.approx(graph.entry_m)
-        uv = segment_frame_points(seg, e.path.points[:, :2])
-        assert np.allclose(uv[:, 1], -d * (k + 0.5) * grid.lane_w)                    # on slot k's centre
-        if si in ow:
-            assert d == ow[si] and -lanes <= k < lanes
-        else:
-            assert 0 <= k < lanes
-    for si in ow:
-        assert sum(1 for key in graph.lane_edge if key[0] == si) == 2 * lanes
-    for e in graph.edges:
-        assert e.succ, f"{e.path.name} is a dead end"
-        for n in e.succ:
-            nxt = graph.edges[n]
-            assert np.linalg.norm(nxt.path.points[0, :2] - e.path.points[-1, :2]) < 1e-6
-            assert abs(np.angle(np.exp(1j * (nxt.path.headings[0] - e.path.headings[-1])))) < 1e-3
-    fed = {n for e in graph.edges if e.kind == "connector" for n in e.succ}
-    assert fed == {e.index for e in graph.lanes()}, "a lane no connector leads into (its traffic dies out)"
-    assert strongly_connected(grid.segments, ow)
-
+from kits.street_towns import one_way_spec
+from kits.town_checks import ON_LANES, check_lane_graph, forward, no_collisions, on_carriageway, rests_on_ground
 
 GRAPH_CASES = [(seed, 1, (3, 3)) for seed in range(16)] + [(seed, 2, (4, 3)) for seed in range(4)] \
     + [(seed, 1, (2, 2)) for seed in range(4)]
@@ -137,11 +72,11 @@ def test_routes_drive_one_way_streets_forwards_only(seed):
             assert driven.get(s.index, {d}) == {d}
     for path in make_routes(grid):
         for p, h in zip(path.points[:, :2], path.headings):
-            hit = _on_carriageway(grid, p[None])
+            hit = on_carriageway(grid, p[None])
             if hit is None or not 1.0 < hit[1] < hit[0].length - 1.0:
                 continue
             n += 1
-            assert np.dot([np.cos(h), np.sin(h)], _forward(hit[0], grid.section(hit[0]).one_way)) > 0.99, path.name
+            assert np.dot([np.cos(h), np.sin(h)], forward(hit[0], grid.section(hit[0]).one_way)) > 0.99, path.name
     assert n > 0          # the routes do drive one-way streets (else this test checks nothing)
 
 
@@ -170,11 +105,11 @@ def test_every_vehicle_drives_one_way_streets_forwards(traffic_town):
         E = world.ego.T_world_ego(t)[0]
         poses.append(((E[0, 3], E[1, 3]), float(np.arctan2(E[1, 0], E[0, 0]))))
         for xy, yaw in poses:
-            hit = _on_carriageway(grid, np.asarray(xy, float)[None])
+            hit = on_carriageway(grid, np.asarray(xy, float)[None])
             if hit is None or not STOP_U[1] < hit[1] < hit[0].length - STOP_U[1]:
                 continue
             n += 1
-            fwd = _forward(hit[0], grid.section(hit[0]).one_way)
+            fwd = forward(hit[0], grid.section(hit[0]).one_way)
             assert np.dot([np.cos(yaw), np.sin(yaw)], fwd) > 0.9, (t, xy)
     assert n > 50
 
@@ -190,15 +125,15 @@ def test_one_way_town_keeps_the_layout_invariants(traffic_town):
         x, y = o.transform[:2, 3]
         if ((x > lanes[:, 0]) & (x < lanes[:, 2]) & (y > lanes[:, 1]) & (y < lanes[:, 3])).any():
             assert o.cls in ON_LANES or o.attrs.get("placement") == "crosswalk", (o.name, o.cls)
-    _no_collisions(scene)
-    _rests_on_ground(spec, grid, scene)
+    no_collisions(scene)
+    rests_on_ground(spec, grid, scene)
     parked = [o for o in scene.objects if o.attrs.get("placement") == "parked"]
     n = 0
     for o in parked:
-        hit = _on_carriageway(grid, np.asarray(o.box.center, float)[None, :2])
+        hit = on_carriageway(grid, np.asarray(o.box.center, float)[None, :2])
         if hit is not None:
             n += 1
-            fwd = _forward(hit[0], grid.section(hit[0]).one_way)
+            fwd = forward(hit[0], grid.section(hit[0]).one_way)
             assert np.dot([np.cos(o.box.yaw), np.sin(o.box.yaw)], fwd) > 0.99, o.name
     assert n > 0
 
@@ -280,7 +215,7 @@ def test_layout_summary_records_each_streets_draw():
 hypothesis = pytest.importorskip("hypothesis")
 from hypothesis import HealthCheck, given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
-from test_hostile_specs import HOSTILE  # noqa: E402
+from kits.hostile_values import HOSTILE  # noqa: E402
 
 
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])

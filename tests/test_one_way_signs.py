@@ -23,9 +23,8 @@ from generator.layout.network.grid import segment_frame_points
 from generator.layout.network.draw import make_grid
 from generator.materials import material_table
 from generator.traffic.lanes.graph import LaneGraph
-from test_one_way import one_way_spec
-from test_street_mix import full_spec
-from test_streets import _no_collisions
+from kits.street_towns import MIX_TRAFFIC, full_spec, one_way_spec
+from kits.town_checks import no_collisions
 
 #: one-way towns: 1 and 2 lanes per direction, and the 4 x 4 mix (shared, roundabouts, closures)
 TOWNS = [("one_way", 0, 1), ("one_way", 1, 1), ("one_way", 5, 2), ("mix", 3, 1), ("mix", 8, 1)]
@@ -157,7 +156,7 @@ def test_the_signs_keep_every_placement_rule(town):
     limit = spec.paths.clearance_m + EGO_HALF_WIDTH_M
     for path in scene.paths:
         assert min(float(point_box_distance(path.points[:, :2], o.box).min()) for o in signs) >= limit - 1e-6
-    _no_collisions(scene)
+    no_collisions(scene)
 
 
 def test_towns_without_one_way_streets_get_no_regulatory_signs():
@@ -189,9 +188,8 @@ def test_no_moving_actor_touches_a_one_way_sign():
     overlaps the footprint of a one-way or no-entry sign (pedestrians walk round them)."""
     from generator.traffic.build import build_world
     from generator.geometry.boxes import quads_overlap
-    from test_street_mix import TRAFFIC
 
-    spec = full_spec(3, traffic={**TRAFFIC, "pedestrians_per_100m": 3.0})
+    spec = full_spec(3, traffic={**MIX_TRAFFIC, "pedestrians_per_100m": 3.0})
     scene = build_scene(spec)
     world = build_world(spec, scene, 20.0)
     signs = np.stack([o.box.corners_xy() for o in scene.objects if _face_kind(scene, o)])

@@ -31,7 +31,8 @@ from generator.traffic.lanes.signals import Signals
 from generator.traffic.vehicles.sim import Vehicle, VehicleSim
 from generator.world.scene import OrientedBox
 from kits.traffic_contacts import assert_no_contact, assert_vehicles_miss_people, static_quads
-from test_streets import _blender_matches_scene
+from kits.blender_scene import blender_matches_scene
+from kits.town_checks import radii
 
 TRAFFIC = {"cars_per_km": 25, "trucks_per_km": 2, "buses_per_km": 1, "cyclists_per_km": 3, "motorcyclists_per_km": 2,
            "other_vehicles_per_km": 1, "pedestrians_per_100m": 1.0, "standing_pedestrians_per_100m": 0.5}
@@ -46,12 +47,6 @@ def spec_with(blocks: int = 2, share: float = 1.0, seed: int = 11, traffic: dict
     if traffic is not None:
         doc["traffic"] = traffic
     return parse_spec(doc, "roundabout_town.json")
-
-
-def _radii(headings: np.ndarray, s: np.ndarray) -> np.ndarray:
-    """Radius of curvature between consecutive samples (inf on straights)."""
-    dh = np.abs(np.angle(np.exp(1j * np.diff(headings))))
-    return np.where(dh > 1e-9, np.diff(s) / np.maximum(dh, 1e-12), np.inf)
 
 
 # -- geometry ------------------------------------------------------------------------------------
@@ -79,7 +74,7 @@ def test_every_ring_connector_clears_the_island_turns_no_tighter_than_the_routes
                     cx = xy[:, 0] + np.cos(h) * dl - np.sin(h) * dw
                     cy = xy[:, 1] + np.sin(h) * dl + np.cos(h) * dw
                     assert np.hypot(cx, cy).min() >= ring.island_r + 0.3 - 1e-9
-                assert _radii(h, p.s).min() >= MIN_RADIUS_M * (1 - 1e-3)    # chords of 5 m arcs
+                assert radii(h, p.s).min() >= MIN_RADIUS_M * (1 - 1e-3)    # chords of 5 m arcs
                 # a 12 m bus and a 4.3 m wide excavator roll over the apron, never the raised centre
                 for size in DESIGN_VEHICLES_M:
                     assert _closest(p, size) >= ring.core_r + 0.3 - 1e-9
@@ -212,7 +207,7 @@ def test_routes_go_round_the_islands_smoothly():
     ring = grid.ring
     route = make_routes(grid)[0]
     xy, h, s = route.points[:, :2], route.headings, route.s
-    assert _radii(np.r_[h, h[0]], np.r_[s, route.length()]).min() >= 0.97 * MIN_RADIUS_M   # resampled arcs
+    assert radii(np.r_[h, h[0]], np.r_[s, route.length()]).min() >= 0.97 * MIN_RADIUS_M   # resampled arcs
     step = np.linalg.norm(np.diff(np.vstack([xy, xy[:1]]), axis=0), axis=1)
     assert step.max() <= 1.01 and step.min() > 0.5                       # no jumps, no stalls
     chord = np.arctan2(*np.diff(np.vstack([xy, xy[:1]]), axis=0).T[::-1])
@@ -369,7 +364,7 @@ def test_blender_builds_the_roundabout_as_the_scene_model(tmp_path):
                        "streets": {"roundabouts": 1}}, "roundabout_tiny.json")
     scene = build_scene(spec)
     assert make_grid(spec).roundabouts == {(1, 1)}
-    _blender_matches_scene(spec, scene, tmp_path)
+    blender_matches_scene(spec, scene, tmp_path)
 
 
 def test_a_vehicle_at_its_setback_keeps_clear_of_a_bus_swinging_out_over_its_give_way_line():

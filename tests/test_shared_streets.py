@@ -24,8 +24,8 @@ from generator.layout.network.draw import make_grid
 from generator.materials import material_table
 from generator.spec import parse_spec
 from generator.traffic.build import build_world
-from test_one_way import ON_LANES
-from test_streets import _blender_matches_scene, GROUND_KINDS, _no_collisions, _rests_on_ground
+from kits.blender_scene import blender_matches_scene
+from kits.town_checks import GROUND_KINDS, ON_LANES, no_collisions, rests_on_ground
 from kits.traffic_contacts import assert_vehicles_miss_people
 
 
@@ -136,8 +136,8 @@ def test_shared_town_keeps_the_layout_invariants(town):
             on_shared += shared and o.cls == "person"
             assert o.cls in ON_LANES or o.attrs.get("placement") == "crosswalk" or shared, (o.name, o.cls)
     assert on_shared > 0
-    _no_collisions(scene)
-    _rests_on_ground(spec, grid, scene)
+    no_collisions(scene)
+    rests_on_ground(spec, grid, scene)
 
 
 @pytest.fixture(scope="module")
@@ -228,4 +228,4 @@ def test_blender_builds_one_way_and_shared_streets_as_the_scene_model(tmp_path):
     assert {"one_way", "shared"} <= kinds
     scene = build_scene(spec)
     assert any(o.kind == "bollard" for o in scene.objects)
-    _blender_matches_scene(spec, scene, tmp_path)
+    blender_matches_scene(spec, scene, tmp_path)

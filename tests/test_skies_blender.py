@@ -97,7 +97,8 @@ def test_same_seed_same_image(rendered, tmp_path, root):
 def test_moving_cars_burn_tail_lights_at_night_parked_ones_do_not(tmp_path, test_spec, test_scene):
     """A car driving ahead of the camera shows red emitters at night (tail lights: red radiance some
     20x a lamp-lit white wall); the town's parked cars stay dark."""
-    from test_render_actors import FRAME as ACTOR_FRAME, car_world
+    from kits.actor_world import FRAME as ACTOR_FRAME
+    from kits.actor_world import car_world
 
     from generator.blender.renderer import Renderer
     from generator.jobs.exposure import expose

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from generator.layout.assemble import build_scene
-from generator.layout.network.one_way import driven_directions, strongly_connected
+from generator.layout.network.one_way import driven_directions
 from generator.layout.network.design_vehicle import MIN_RADIUS_M
 from generator.layout.network.routes import make_routes
 from generator.layout.network.measures import STOP_U
@@ -24,14 +24,13 @@ from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
 from generator.traffic.lanes.graph import LaneGraph
 from generator.traffic.vehicles.sim import conflict_key
-from test_one_way import _forward, _on_carriageway, check_lane_graph
-from test_roundabouts import _radii
-from test_streets import _blender_matches_scene, _no_collisions, _rests_on_ground
+from kits.blender_scene import blender_matches_scene
+from kits.street_towns import MIX_TRAFFIC, full_spec
+from kits.town_checks import check_lane_graph, forward, no_collisions, on_carriageway, radii, rests_on_ground
 from kits.traffic_contacts import assert_no_contact
 
 SECONDS = 20.0
-TRAFFIC = {"cars_per_km": 25, "trucks_per_km": 2, "buses_per_km": 1, "cyclists_per_km": 3,
-           "motorcyclists_per_km": 2, "pedestrians_per_100m": 1.0}
+TRAFFIC = MIX_TRAFFIC
 #: seeds whose 4 x 4 town draws every kind (one-way, shared, roundabouts, closures)
 FULL_SEEDS = [0, 1, 2, 3, 4, 5, 6, 8, 9, 11]
 
@@ -48,18 +47,6 @@ def mixed_spec(seed: int, traffic: bool = False):
     return parse_spec(doc, "mixed_town.json")
 
 
-def full_spec(seed: int, traffic: dict | None = None, one_way: float = 3):
-    """A 4 x 4 town with every street kind: one-way, shared, roundabouts and closed streets."""
-    doc = {"name": "full_mix_town", "seed": seed,
-           "town": {"blocks_x": 4, "blocks_y": 4, "block_size_m": 40, "block_size_jitter_m": 6, "margin_m": 10},
-           "density": {"moving_cars_per_100m": 0, "people_per_100m": 3},
-           "streets": {"types": {"plain": 1, "residential": 1, "shared": 1, "one_way": one_way}, "roundabouts": 0.3,
-                       "closed_streets": 0.3}}
-    if traffic is not None:
-        doc["traffic"] = traffic
-    return parse_spec(doc, "full_mix_town.json")
-
-
 @pytest.mark.parametrize("seed", [3, 8])
 def test_shared_streets_roundabouts_and_closures_together_keep_the_layout_invariants(seed):
     spec = mixed_spec(seed)
@@ -67,8 +54,8 @@ def test_shared_streets_roundabouts_and_closures_together_keep_the_layout_invari
     kinds = {grid.section(s).kind for s in grid.segments}
     assert "shared" in kinds and grid.roundabouts and grid.closed, (kinds, grid.roundabouts, grid.closed)
     scene = build_scene(spec)
-    _no_collisions(scene)
-    _rests_on_ground(spec, grid, scene)
+    no_collisions(scene)
+    rests_on_ground(spec, grid, scene)
 
 
 def test_traffic_in_a_mixed_town_never_touches():
@@ -137,7 +124,7 @@ def test_routes_in_a_full_mix_town_are_smooth_on_the_lanes_and_one_way_forwards(
     n = 0
     for route in make_routes(grid):
         xy, h, s = route.points[:, :2], route.headings, route.s
-        assert _radii(np.r_[h, h[0]], np.r_[s, route.length()]).min() >= 0.97 * MIN_RADIUS_M
+        assert radii(np.r_[h, h[0]], np.r_[s, route.length()]).min() >= 0.97 * MIN_RADIUS_M
         step = np.linalg.norm(np.diff(np.vstack([xy, xy[:1]]), axis=0), axis=1)
         assert step.max() <= 1.01 and step.min() > 0.3                          # no jumps, no stalls
         inside = ((xy[:, None, 0] >= drive[:, 0]) & (xy[:, None, 0] <= drive[:, 2])
@@ -146,11 +133,11 @@ def test_routes_in_a_full_mix_town_are_smooth_on_the_lanes_and_one_way_forwards(
         for node in grid.roundabouts:
             assert np.hypot(*(xy - grid.node_xy(node)).T).min() > grid.ring.island_r
         for p, hd in zip(xy, h):
-            hit = _on_carriageway(grid, p[None])
+            hit = on_carriageway(grid, p[None])
             if hit is None or not 1.0 < hit[1] < hit[0].length - 1.0:
                 continue
             n += 1
-            assert np.dot([np.cos(hd), np.sin(hd)], _forward(hit[0], grid.section(hit[0]).one_way)) > 0.99
+            assert np.dot([np.cos(hd), np.sin(hd)], forward(hit[0], grid.section(hit[0]).one_way)) > 0.99
     assert n > 0, "the routes drive no one-way street"
 
 
@@ -163,8 +150,8 @@ def full_town(request):
 
 def test_full_mix_town_keeps_the_layout_invariants(full_town):
     spec, grid, scene, _ = full_town
-    _no_collisions(scene)
-    _rests_on_ground(spec, grid, scene)
+    no_collisions(scene)
+    rests_on_ground(spec, grid, scene)
 
 
 def test_full_mix_traffic_obeys_one_way_never_touches_and_keeps_out_of_parks(full_town):
@@ -184,11 +171,11 @@ def test_full_mix_traffic_obeys_one_way_never_touches_and_keeps_out_of_parks(ful
             for seg in grid.closed:
                 x0, y0, x1, y1 = seg.rect_world(0.0, seg.length, -grid.road_half, grid.road_half)
                 assert not (x0 < xy[0] < x1 and y0 < xy[1] < y1), f"a vehicle in a park at t={t:.1f}"
-            hit = _on_carriageway(grid, xy[None])
+            hit = on_carriageway(grid, xy[None])
             if hit is None or not STOP_U[1] < hit[1] < hit[0].length - STOP_U[1]:
                 continue
             n += 1
-            fwd = _forward(hit[0], grid.section(hit[0]).one_way)
+            fwd = forward(hit[0], grid.section(hit[0]).one_way)
             assert np.dot([np.cos(yaw), np.sin(yaw)], fwd) > 0.9, (t, xy)
     assert n > 50, "too few vehicle poses on one-way streets to tell"
 
@@ -230,7 +217,7 @@ def test_blender_builds_a_town_with_every_street_kind_as_the_scene_model(tmp_pat
     grid = make_grid(spec)
     assert _one_way(grid) and grid.roundabouts and grid.closed
     scene = build_scene(spec)
-    _blender_matches_scene(spec, scene, tmp_path)
+    blender_matches_scene(spec, scene, tmp_path)
 
 
 @pytest.mark.parametrize("kind", ["residential", "boulevard", "arterial", "one_way", "shared"])

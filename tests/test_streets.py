@@ -22,50 +22,12 @@ from generator.layout.network.cross_sections import MEDIAN_W_M
 from generator.layout.lots.districts import DISTRICTS
 from generator.layout.lots.lot import make_lots
 from generator.layout.network.design_vehicle import EGO_HALF_WIDTH_M
-from generator.geometry.boxes import boxes_overlap, point_box_distance
+from generator.geometry.boxes import point_box_distance
 from generator.layout.network.grid import segment_frame_points
 from generator.layout.network.draw import make_grid
 from generator.spec import load_spec, parse_spec
-from test_layout import _check_vehicles
-
-GROUND_KINDS = ("street", "sidewalk", "intersection", "corner", "lot_ground", "terrain", "horizon")
-RIDERS = ("bicyclist", "motorcyclist")
-
-
-def _no_collisions(scene) -> None:
-    """Below 1 m no two placed objects overlap (a rider and the two-wheeler under it excepted),
-    as test_layout's check for the default town."""
-    boxes, names, riding = [], [], []
-    for o in scene.objects:
-        if o.kind in GROUND_KINDS or o.kind == "tram_rails":     # a tram stands on its rails
-            continue
-        m = scene.prototypes[o.prototype]
-        tri = m.vertices[m.faces]
-        low = tri[tri[:, :, 2].min(1) < 1.0].reshape(-1, 3)
-        if not len(low):
-            continue
-        lo, hi = low.min(0), low.max(0)
-        c = apply(o.transform, ((lo + hi) / 2)[None])[0]
-        boxes.append([c[0], c[1], (hi[0] - lo[0]) / 2, (hi[1] - lo[1]) / 2, o.box.yaw, 0.0, 1.0])
-        names.append(o.name)
-        riding.append(scene.objects[o.index - 1].name if o.cls in RIDERS else "")
-    b = np.array(boxes)
-    hit = boxes_overlap(b, b)
-    np.fill_diagonal(hit, False)
-    pairs = [(names[i], names[j]) for i, j in zip(*np.nonzero(np.triu(hit)))
-             if riding[i] != names[j] and riding[j] != names[i]]
-    assert not pairs
-
-
-def _rests_on_ground(spec, grid, scene) -> None:
-    """Every thing but a rider (who sits on its two-wheeler) has its lowest vertex on the ground
-    under its origin: the road (0) or curb height (sidewalks, verges, islands, lots)."""
-    things = [o for o in scene.objects if o.instance_id > 0 and o.cls not in RIDERS]
-    ground = grid.ground_height(np.array([o.transform[:2, 3] for o in things]))
-    low = np.array([apply(o.transform, scene.prototypes[o.prototype].vertices)[:, 2].min() for o in things])
-    bad = [(o.name, float(z), float(g)) for o, z, g in zip(things, low, ground) if abs(z - g) > 0.01]
-    assert not bad
-
+from kits.blender_scene import blender_matches_scene
+from kits.town_checks import GROUND_KINDS, check_vehicles, no_collisions, rests_on_ground
 
 @pytest.fixture(scope="module")
 def kitti(root):
@@ -102,7 +64,7 @@ def test_parked_vehicles_only_in_parking_strips_at_their_occupancy(which, reques
     """Verges and shoulders hold no parked car; a strip's share of taken bays follows its draw,
     so some strips are (nearly) empty and some (nearly) full: the ego is not always beside cars."""
     spec, grid, scene = request.getfixturevalue(which)
-    _check_vehicles(spec, scene)
+    check_vehicles(spec, scene)
     parked = [o for o in scene.objects if o.kind in ("car", "truck") and o.attrs.get("placement") == "parked"]
     taken: dict[tuple[int, int], int] = {}
     for o in parked:
@@ -139,8 +101,8 @@ def test_only_vehicles_on_the_lanes_none_near_a_route_none_colliding(which, requ
     for path in scene.paths:
         near = min(float(point_box_distance(path.points[:, :2], o.box).min()) for o in things)
         assert near >= limit - 1e-6, path.name
-    _no_collisions(scene)
-    _rests_on_ground(spec, grid, scene)
+    no_collisions(scene)
+    rests_on_ground(spec, grid, scene)
 
 
 def test_verges_and_medians_are_raised_ground_behind_curbs(kitti, centre):
@@ -267,19 +229,7 @@ def test_blender_builds_the_street_types_as_the_scene_model(tmp_path):
     scene = build_scene(spec)
     grid = make_grid(spec)
     assert {k for _, k, _ in grid.raised_rects()} == {"verge", "median"}
-    _blender_matches_scene(spec, scene, tmp_path)
-
-
-def _blender_matches_scene(spec, scene, tmp_path) -> None:
-    """Blender's evaluated geometry of ``scene`` has its triangle count and bounds (the street tests'
-    "reaches Blender triangle for triangle")."""
-    from generator.blender.renderer import Renderer
-    from generator.spec.render import load_render_config
-
-    n, bounds = Renderer(scene, spec, load_render_config("test"), tmp_path).evaluated_geometry()
-    assert n == len(scene.faces)
-    v = scene.vertices.astype(np.float64)
-    assert np.allclose(bounds, [v.min(0), v.max(0)], atol=1e-3)
+    blender_matches_scene(spec, scene, tmp_path)
 
 
 def _furnished(seed: int):

@@ -19,10 +19,9 @@ from generator.layout.network.draw import make_grid
 from generator.layout.mapping.town_map import TownMap, draw_town_map
 from generator.spec import parse_spec
 from generator.traffic.build import build_world
+from kits.town_checks import GROUND_KINDS, RIDERS
 from kits.traffic_contacts import assert_no_contact, assert_vehicles_miss_people, static_quads
 
-GROUND_KINDS = ("street", "sidewalk", "intersection", "corner", "lot_ground", "terrain", "horizon")
-RIDERS = ("bicyclist", "motorcyclist")
 
 
 def spec_with(angle=(65.0, 65.0), seed: int = 4, traffic: dict | None = None, speed_mps: float | None = None,
@@ -282,14 +281,14 @@ def test_traffic_touches_nothing_and_heads_where_it_goes(seed, angle, roundabout
 @pytest.mark.blender
 def test_blender_builds_the_skewed_town_triangle_for_triangle(tmp_path):
     """Baked shaped objects and turned rigid ones reach Blender as the LiDAR sees them."""
-    from test_streets import _blender_matches_scene
+    from kits.blender_scene import blender_matches_scene
 
     doc = {"name": "skewed_small", "seed": 5, "town": {"blocks_x": 1, "blocks_y": 1, "block_size_m": 40, "margin_m": 5},
            "streets": {"intersection_angle_deg": [62, 62]}}
     spec = parse_spec(doc, "skewed_small.json")
     scene = build_scene(spec)
     assert scene.town_map is not None
-    _blender_matches_scene(spec, scene, tmp_path)
+    blender_matches_scene(spec, scene, tmp_path)
 
 
 def test_metadata_records_the_angle_the_town_was_built_with(skewed):
