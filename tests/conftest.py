@@ -6,8 +6,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from kits.paths import ROOT
 
-ROOT = Path(__file__).resolve().parents[1]
 
 
 @pytest.fixture

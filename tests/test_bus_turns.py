@@ -11,7 +11,6 @@ at t = 17.8 s."""
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -27,8 +26,8 @@ from generator.geometry.boxes import quads_overlap
 from generator.traffic.lanes.turn_clearance import node_setbacks
 from generator.world.scene import OrientedBox
 from kits.traffic_contacts import assert_no_contact, assert_vehicles_miss_people, static_quads
+from kits.paths import ROOT
 
-ROOT = Path(__file__).parents[1]
 BUS = (12.13, 3.0)        #: the longest bus variant's box, mirrors included, metres
 
 

@@ -16,8 +16,8 @@ from pathlib import Path
 import pytest
 
 from generator import cli
+from kits.paths import ROOT
 
-ROOT = Path(__file__).resolve().parents[1]
 SPEC = str(ROOT / "scenes" / "test_town.json")
 
 

@@ -17,8 +17,8 @@ from generator.cli import main
 from generator.labels import class_table
 from generator.layout.network.draw import make_grid
 from generator.spec import load_spec
+from kits.paths import ROOT
 
-ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_layout_writes_map_glb_and_summary(tmp_path, capsys):

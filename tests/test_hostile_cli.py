@@ -31,8 +31,8 @@ from hypothesis import strategies as st
 from generator import cli
 from generator.commands import options
 from generator.safeload import printable
+from kits.paths import ROOT
 
-ROOT = Path(__file__).resolve().parents[1]
 SPEC = str(ROOT / "scenes" / "test_town.json")
 #: Seconds one refused command may take (option errors take milliseconds; a spec load ~0.1 s).
 TIME_LIMIT_S = 30.0  # a hang guard (a refusal must not wait on the input), not a speed measurement

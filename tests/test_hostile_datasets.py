@@ -48,8 +48,8 @@ from hypothesis import strategies as st
 
 from generator import cli
 from kits.json_kit import value_paths
+from kits.paths import ROOT
 
-ROOT = Path(__file__).resolve().parents[1]
 MARKER = "HOSTILE-MARKER-7f3a"
 SECRET = "hunter2-SECRET-7f3a"
 PASSWD = "root:x:0:0"

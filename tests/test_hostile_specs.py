@@ -37,8 +37,8 @@ from hypothesis import strategies as st
 from generator import cli
 from kits.json_kit import value_paths
 from generator.spec import load_spec
+from kits.paths import ROOT
 
-ROOT = Path(__file__).resolve().parents[1]
 BASE_SPEC = load_spec(ROOT / "scenes" / "test_town.json").to_dict()  # every field, defaults filled in
 BASE_CONFIG = yaml.safe_load((ROOT / "render_configs" / "test.yaml").read_text())
 BASE_SENSOR = yaml.safe_load((ROOT / "generator" / "lidar" / "sensors" / "vlp16.yaml").read_text())

@@ -4,7 +4,6 @@ included (generator/traffic/lane_clearance.py)."""
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -18,8 +17,8 @@ from generator.traffic.vehicles.fleet import KINDS
 from generator.traffic.vehicles.fleet import widest_half_width
 from generator.geometry.boxes import quads_overlap
 from kits.traffic_contacts import static_quads
+from kits.paths import ROOT
 
-ROOT = Path(__file__).parents[1]
 BUSES = {"cars_per_km": 10, "trucks_per_km": 1, "buses_per_km": 4, "other_vehicles_per_km": 1, "cyclists_per_km": 1}
 
 

@@ -17,9 +17,9 @@ from generator.formats.point_sidecars import TIMES_DIR, read_sidecar
 from generator.fusion.projection import deskew, transform
 from generator.labels import class_table
 from generator.world.scene import OrientedBox
+from kits.paths import SHARED
 
-ROOT = Path(__file__).resolve().parents[1]
-REFERENCE_SCHEMA = ROOT.parent / "shared" / "reference" / "openlabel_json_schema-v1.0.0.json"
+REFERENCE_SCHEMA = SHARED / "reference" / "openlabel_json_schema-v1.0.0.json"
 
 
 @pytest.fixture(scope="module")

@@ -20,8 +20,8 @@ import pytest
 from generator import cli
 from generator.errors import UserError
 from generator.jobs import plan as P
+from kits.paths import ROOT
 
-ROOT = Path(__file__).resolve().parents[1]
 SPEC = str(ROOT / "scenes" / "test_town.json")
 Usage = namedtuple("Usage", "total used free")
 

@@ -15,6 +15,7 @@ from generator import safeload
 from generator.errors import SpecError, UserError
 from generator.spec import load_spec
 from generator.spec.render import load_render_config
+from kits.paths import ROOT
 
 SECRET = "hunter2-TOP-SECRET-do-not-print"
 
@@ -433,7 +434,7 @@ def test_render_config_numbers_and_duplicates(tmp_path, line, field):
 
 
 def test_scene_spec_json_and_yaml(tmp_path):
-    text = (Path(__file__).resolve().parents[1] / "scenes" / "test_town.json").read_text()
+    text = (ROOT / "scenes" / "test_town.json").read_text()
     assert load_spec(_write(tmp_path / "t.json", text)).name == "test_town"
     assert load_spec(_write(tmp_path / "t.yaml", text)).name == "test_town"  # JSON is YAML
     _refused(load_spec, _write(tmp_path / "d.yaml", "name: x\nseed: 1\nseed: 2\n"), match="duplicate key 'seed'")

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 import pytest
 
@@ -11,8 +10,8 @@ from generator.errors import SpecError
 from generator.spec import load_spec, parse_spec
 from generator.spec.render import load_render_config
 from generator.spec.validate import load_schema
+from kits.paths import ROOT
 
-ROOT = Path(__file__).resolve().parents[1]
 
 
 @pytest.mark.parametrize("path", sorted((ROOT / "scenes").glob("*.json")), ids=lambda p: p.name)

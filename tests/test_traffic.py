@@ -16,6 +16,7 @@ from generator.geometry.boxes import quads_overlap
 from generator.world.actors import MOVING_THRESHOLD_MPS, Track
 from generator.world.rig import SWEEP_PERIOD_S, Rig
 from kits.traffic_contacts import assert_no_contact, assert_vehicles_miss_people, ego_box, static_quads
+from kits.paths import ROOT
 
 TRAFFIC = {"cars_per_km": 25, "trucks_per_km": 2, "buses_per_km": 1, "cyclists_per_km": 3, "motorcyclists_per_km": 2,
            "other_vehicles_per_km": 1}
@@ -235,9 +236,8 @@ def _sweep_town(seed: int, roundabouts: float, dense: bool = False):
     """A 3 x 3 town with the default town's traffic plus excavators (1 per km), optionally roundabouts;
     ``dense``: the roundabout tests' traffic instead (twice the cars, twice the trucks and buses)."""
     import json
-    from pathlib import Path
 
-    traffic = {**json.loads((Path(__file__).parents[1] / "scenes" / "default_town.json").read_text())["traffic"],
+    traffic = {**json.loads((ROOT / "scenes" / "default_town.json").read_text())["traffic"],
                "other_vehicles_per_km": 1}
     if dense:
         traffic = {**TRAFFIC, "pedestrians_per_100m": 1.0, "standing_pedestrians_per_100m": 0.5}
