@@ -21,7 +21,7 @@ from generator.layout import build_scene
 from generator.spec import load_spec, parse_spec
 from generator.spec.towns import town_spec
 from generator.world.rig import Rig
-from tests.test_hostile_specs import run_cli
+from kits.cli_run import run_cli
 
 
 def _spec(root, tmp_path, every: int | None = 2):
