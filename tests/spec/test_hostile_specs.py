@@ -34,17 +34,15 @@ hypothesis = pytest.importorskip("hypothesis")
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from generator import cli
 from kits.json_kit import value_paths
 from generator.spec import load_spec
+from kits.cli_run import TIME_LIMIT_S, run_cli
 from kits.paths import ROOT
 
 BASE_SPEC = load_spec(ROOT / "scenes" / "test_town.json").to_dict()  # every field, defaults filled in
 BASE_CONFIG = yaml.safe_load((ROOT / "render_configs" / "test.yaml").read_text())
 BASE_SENSOR = yaml.safe_load((ROOT / "generator" / "lidar" / "sensors" / "vlp16.yaml").read_text())
 SECRET = "hunter2-TOP-SECRET-token"
-#: Seconds one run may take (the slowest valid case builds the test town, ~2 s).
-TIME_LIMIT_S = 30.0  # a hang guard (a refusal must not wait on the input), not a speed measurement
 
 # capsys is function-scoped; reading it after every example resets it, so sharing it is safe.
 _cli_settings = settings(suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
@@ -180,32 +178,6 @@ def _taken(work: Path) -> Path:
     taken = work / "taken"
     taken.write_text("")
     return taken
-
-
-def _listing(folder: Path) -> set[str]:
-    return {str(p.relative_to(folder)) for p in folder.rglob("*")}
-
-
-def run_cli(capsys, argv: list[str], workdir: Path, out: Path) -> tuple[int, str]:
-    """Run ``urbangen argv``; check the hostile-input promise; return (exit code, stderr)."""
-    before = _listing(workdir)
-    capsys.readouterr()
-    t0 = time.perf_counter()
-    try:
-        rc = cli.main(argv)
-    except SystemExit as e:  # argparse
-        rc = e.code
-    elapsed = time.perf_counter() - t0
-    _, err = capsys.readouterr()
-    assert elapsed < TIME_LIMIT_S, f"took {elapsed:.1f} s"
-    assert "Traceback" not in err, err
-    if rc == 0:
-        return rc, err
-    assert rc == 2, (rc, err)
-    assert err.endswith("\n") and err.count("\n") == 1, err
-    assert not out.exists(), f"{out} was created: {_listing(out)}"
-    assert _listing(workdir) == before, "files appeared beside the input"
-    return rc, err
 
 
 # -- properties --------------------------------------------------------------------------------------------------

@@ -18,7 +18,7 @@ from generator.rng import stream
 from generator.spec import load_spec, parse_spec
 from generator.spec.towns import spec_for_record, town_of, town_record, town_spec
 from generator.world.rig import Rig
-from tests.test_hostile_specs import run_cli
+from kits.cli_run import run_cli
 
 #: spec_hash of the shipped specs before the option existed (main at 37f56ea): a spec that does not
 #: set it must keep its hash, or every dataset made before would refuse to resume
