@@ -11,8 +11,8 @@ import pytest
 
 from generator.errors import SpecError
 from generator.spec.load import parse_spec
-from generator.weather import (DEFAULT_TIMES, KINDS, TIMES, draw_lighting, global_irradiance, is_overcast, light_level,
-                               render_key)
+from generator.weather import (DEFAULT_TIMES, KINDS, LIT_TIMES, TIMES, draw_lighting, global_irradiance, is_overcast,
+                               light_level, render_key)
 
 
 def test_lighting_is_deterministic_per_seed_and_frame(test_spec):
@@ -55,12 +55,23 @@ def test_sun_positions_are_those_drawn_before_clouds(test_spec):
 
 
 def test_dusk_is_a_low_sun_with_the_lights_on(test_spec):
-    lo, hi = test_spec.weather.dusk_sun_elevation_deg
-    for k in range(20):
-        dusk = draw_lighting(test_spec, k, "dusk")
-        assert lo <= dusk.sun_elevation_deg <= hi and dusk.lit_windows is not None
+    """Dusk: the sun low (in the spec's dusk range) at an azimuth of the spec's range, a share of the
+    windows lit drawn per frame within the spec's range, and the street lamps on (the renderer and the
+    post fx light lamps at the times in LIT_TIMES; the scene gets at least the lamps' light, as at
+    night). Night: no sun, windows lit as at dusk; day: no window lit."""
+    w = test_spec.weather
+    lo, hi = w.dusk_sun_elevation_deg
+    dusks = [draw_lighting(test_spec, k, "dusk") for k in range(20)]
+    for dusk in dusks:
+        assert lo <= dusk.sun_elevation_deg <= hi
+        assert w.sun_azimuth_deg[0] <= dusk.sun_azimuth_deg <= w.sun_azimuth_deg[1]
+        assert w.lit_windows[0] <= dusk.lit_windows <= w.lit_windows[1]
+    assert len({d.lit_windows for d in dusks}) == len(dusks)          # a new draw every frame
+    assert "dusk" in LIT_TIMES and "night" in LIT_TIMES and "day" not in LIT_TIMES
     night = draw_lighting(test_spec, 0, "night")
-    assert night.sun_elevation_deg is None and night.lit_windows is not None
+    assert night.sun_elevation_deg is None and w.lit_windows[0] <= night.lit_windows <= w.lit_windows[1]
+    assert min(light_level(d) for d in dusks) >= light_level(night) > 0     # at least the lamps' light
+    assert draw_lighting(test_spec, 0, "day").lit_windows is None
 
 
 def test_light_levels_order_day_overcast_dusk_night(test_spec):

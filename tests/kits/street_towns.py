@@ -31,3 +31,20 @@ def full_spec(seed: int, traffic: dict | None = None, one_way: float = 3):
     if traffic is not None:
         doc["traffic"] = traffic
     return parse_spec(doc, "full_mix_town.json")
+
+
+def skewed_spec(angle=(65.0, 65.0), seed: int = 4, traffic: dict | None = None, speed_mps: float | None = None,
+                **streets):
+    """A 2 x 2 town whose streets cross at an angle drawn from ``angle`` (degrees), with every street
+    type and the things that stand by streets; ``streets``: more ``streets`` fields."""
+    doc = {"name": "skewed_town", "seed": seed,
+           "town": {"blocks_x": 2, "blocks_y": 2, "block_size_m": 50, "block_size_jitter_m": 6, "margin_m": 10},
+           "streets": {"intersection_angle_deg": list(angle),
+                       "types": {"plain": 2, "residential": 1, "boulevard": 1, "arterial": 1}, **streets},
+           "density": {"bike_racks_per_block": 2, "street_objects_per_100m": 4, "riders_per_km": 20,
+                       "bus_stops_per_km": 4, "walls": 0.5, "driveways": 0.5, "gravel": 0.5, "trams": 1}}
+    if traffic is not None:
+        doc["traffic"] = traffic
+    if speed_mps is not None:
+        doc["paths"] = {"speed_mps": speed_mps}
+    return parse_spec(doc, "skewed_town.json")

@@ -24,7 +24,6 @@ from generator.layout.network.draw import make_grid
 from generator.materials import material_table
 from generator.spec import parse_spec
 from generator.traffic.build import build_world
-from kits.blender_scene import blender_matches_scene
 from kits.town_checks import GROUND_KINDS, ON_LANES, no_collisions, rests_on_ground
 from kits.traffic_contacts import assert_vehicles_miss_people
 
@@ -213,19 +212,3 @@ def test_bad_shared_weight_is_one_line(streets, expected):
         parse_spec({"name": "x", "seed": 1, "streets": streets}, "scenes/x.json")
     msg = str(e.value)
     assert msg.startswith("scenes/x.json: " + expected) and "\n" not in msg
-
-
-@pytest.mark.blender
-def test_blender_builds_one_way_and_shared_streets_as_the_scene_model(tmp_path):
-    """Paved shared carriageways, bollards, one-way arrows and dividers reach Blender triangle for triangle."""
-    spec = parse_spec({"name": "oneway_shared_tiny", "seed": 5,
-                       "town": {"blocks_x": 2, "blocks_y": 2, "block_size_m": 30, "block_size_jitter_m": 0,
-                                "margin_m": 8},
-                       "density": {"trees_per_100m": 0, "people_per_100m": 2},
-                       "streets": {"types": {"one_way": 2, "shared": 1}}}, "oneway_shared_tiny.json")
-    grid = make_grid(spec)
-    kinds = {grid.section(s).kind for s in grid.segments}
-    assert {"one_way", "shared"} <= kinds
-    scene = build_scene(spec)
-    assert any(o.kind == "bollard" for o in scene.objects)
-    blender_matches_scene(spec, scene, tmp_path)

@@ -24,7 +24,6 @@ from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
 from generator.traffic.lanes.graph import LaneGraph
 from generator.traffic.vehicles.sim import conflict_key
-from kits.blender_scene import blender_matches_scene
 from kits.street_towns import MIX_TRAFFIC, full_spec
 from kits.town_checks import check_lane_graph, forward, no_collisions, on_carriageway, radii, rests_on_ground
 from kits.traffic_contacts import assert_no_contact
@@ -202,22 +201,6 @@ def test_a_bus_leaving_a_roundabout_keeps_off_a_bus_waiting_at_its_exit_arm():
     world = build_world(spec, scene, 6.0)
     for t in np.arange(3.0, 6.0, 0.2):
         assert_no_contact(world, t, ego=False)
-
-
-@pytest.mark.blender
-def test_blender_builds_a_town_with_every_street_kind_as_the_scene_model(tmp_path):
-    """One-way arrows, shared paving, roundabout islands and pocket parks in one town reach Blender
-    triangle for triangle."""
-    spec = parse_spec({"name": "full_mix_tiny", "seed": 11,
-                       "town": {"blocks_x": 3, "blocks_y": 3, "block_size_m": 30, "block_size_jitter_m": 0,
-                                "margin_m": 8},
-                       "density": {"trees_per_100m": 0, "people_per_100m": 2},
-                       "streets": {"types": {"one_way": 3, "shared": 1}, "roundabouts": 0.5,
-                                   "closed_streets": 0.4}}, "full_mix_tiny.json")
-    grid = make_grid(spec)
-    assert _one_way(grid) and grid.roundabouts and grid.closed
-    scene = build_scene(spec)
-    blender_matches_scene(spec, scene, tmp_path)
 
 
 @pytest.mark.parametrize("kind", ["residential", "boulevard", "arterial", "one_way", "shared"])

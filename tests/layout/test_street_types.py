@@ -26,7 +26,6 @@ from generator.geometry.boxes import point_box_distance
 from generator.layout.network.grid import segment_frame_points
 from generator.layout.network.draw import make_grid
 from generator.spec import load_spec, parse_spec
-from kits.blender_scene import blender_matches_scene
 from kits.town_checks import GROUND_KINDS, check_vehicles, no_collisions, rests_on_ground
 
 @pytest.fixture(scope="module")
@@ -216,20 +215,6 @@ def test_street_geometry_faces_up_and_curbs_face_the_lane(kitti):
     uv = segment_frame_points(seg, v[:, :2])
     on_edge = np.isclose(np.abs(uv[curb][:, :, 1]), grid.lane_half, atol=1e-6).all(1)
     assert on_edge.any() and (np.sign(uv[curb][on_edge][:, 0, 1]) == side).any()
-
-
-@pytest.mark.blender
-def test_blender_builds_the_street_types_as_the_scene_model(tmp_path):
-    """Verges, median islands, verge hedges and district lots reach Blender triangle for triangle."""
-    spec = parse_spec({"name": "streets_tiny", "seed": 2,
-                       "town": {"blocks_x": 1, "blocks_y": 1, "block_size_m": 40, "block_size_jitter_m": 0,
-                                "margin_m": 12},
-                       "streets": {"types": {"residential": 1, "boulevard": 1, "arterial": 1},
-                                   "districts": {"detached": 1, "light_industry": 1}}}, "streets_tiny.json")
-    scene = build_scene(spec)
-    grid = make_grid(spec)
-    assert {k for _, k, _ in grid.raised_rects()} == {"verge", "median"}
-    blender_matches_scene(spec, scene, tmp_path)
 
 
 def _furnished(seed: int):

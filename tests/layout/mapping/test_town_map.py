@@ -14,29 +14,10 @@ from scipy.spatial import ConvexHull
 from generator.geometry import apply, pose
 from generator.labels import class_table
 from generator.layout import build_scene
-from generator.geometry.boxes import world_boxes
 from generator.layout.network.draw import make_grid
 from generator.layout.mapping.town_map import TownMap, draw_town_map
-from generator.spec import parse_spec
-from generator.traffic.build import build_world
+from kits.street_towns import skewed_spec as spec_with
 from kits.town_checks import GROUND_KINDS, RIDERS
-from kits.traffic_contacts import assert_no_contact, assert_vehicles_miss_people, static_quads
-
-
-
-def spec_with(angle=(65.0, 65.0), seed: int = 4, traffic: dict | None = None, speed_mps: float | None = None,
-              **streets):
-    doc = {"name": "skewed_town", "seed": seed,
-           "town": {"blocks_x": 2, "blocks_y": 2, "block_size_m": 50, "block_size_jitter_m": 6, "margin_m": 10},
-           "streets": {"intersection_angle_deg": list(angle),
-                       "types": {"plain": 2, "residential": 1, "boulevard": 1, "arterial": 1}, **streets},
-           "density": {"bike_racks_per_block": 2, "street_objects_per_100m": 4, "riders_per_km": 20,
-                       "bus_stops_per_km": 4, "walls": 0.5, "driveways": 0.5, "gravel": 0.5, "trams": 1}}
-    if traffic is not None:
-        doc["traffic"] = traffic
-    if speed_mps is not None:
-        doc["paths"] = {"speed_mps": speed_mps}
-    return parse_spec(doc, "skewed_town.json")
 
 
 @pytest.fixture(scope="module")
@@ -248,67 +229,40 @@ def test_same_spec_same_world():
     assert build_scene(spec).digest() == build_scene(spec).digest()
 
 
-# -- traffic -----------------------------------------------------------------------------------------------------
-TRAFFIC = {"cars_per_km": 20, "pedestrians_per_100m": 2, "cyclists_per_km": 4}
+def _route_directions(scene) -> np.ndarray:
+    """Directions (degrees in [0, 180)) of the straight stretches of route 0 in the world."""
+    d = np.diff(scene.paths[0].points[:, :2], axis=0)
+    d = d[np.linalg.norm(d, axis=1) > 0.5]
+    ang = np.degrees(np.arctan2(d[:, 1], d[:, 0])) % 180.0
+    ang = ang[(np.abs(np.diff(ang, prepend=ang[0])) < 1e-6)]          # straight stretches (direction constant)
+    return np.unique(np.round(ang, 3))
 
 
-@pytest.mark.parametrize("seed, angle, roundabouts", [(3, 70.0, 0.5), (4, 60.0, 0.0)])
-def test_traffic_touches_nothing_and_heads_where_it_goes(seed, angle, roundabouts):
-    spec = spec_with((angle, angle), seed=seed, traffic=TRAFFIC, roundabouts=roundabouts)
-    scene = build_scene(spec)
-    world = build_world(spec, scene, 12.0)
-    parked = static_quads(scene)
-    vehicles = [a for a in world.actors if a.cls != "person"]
-    people = [a for a in world.actors if a.cls == "person"]
-    assert len(vehicles) > 5 and people
-    for t in np.arange(0.0, 12.0, 0.2):
-        assert_no_contact(world, t, parked)
-        assert_vehicles_miss_people(world, t, vehicles, people)
-    for a in vehicles:          # no crabbing: a moving vehicle's heading is its direction of travel
-        t = np.arange(0.0, 12.0, 0.1)
-        p = a.track.position(t)[:, :2]
-        v = np.diff(p, axis=0)
-        fast = np.linalg.norm(v, axis=1) > 0.1       # > 1 m/s
-        if not fast.any():
-            continue
-        h = a.track.heading(t[:-1] + 0.05)
-        err = np.angle(np.exp(1j * (np.arctan2(v[:, 1], v[:, 0]) - h)))[fast]
-        assert np.abs(err).max() < np.radians(8), a.name
-    E = world.ego.T_world_ego(np.array([0.0, 6.0, 12.0]))
-    assert np.ptp(E[:, 0, 3]) + np.ptp(E[:, 1, 3]) > 5.0    # the ego drives
+def test_metadata_records_the_angle_the_town_was_built_with(skewed, tmp_path):
+    """The angle and lean a LiDAR sequence's ``lidar_meta.json`` and an image's JSON record are the
+    ones the streets of the scanned town cross at: x-streets run along 0 degrees, y-streets along the
+    angle (lean +1, towards +x going north) or 180 degrees less it (lean -1)."""
+    import json
 
-
-@pytest.mark.blender
-def test_blender_builds_the_skewed_town_triangle_for_triangle(tmp_path):
-    """Baked shaped objects and turned rigid ones reach Blender as the LiDAR sees them."""
-    from kits.blender_scene import blender_matches_scene
-
-    doc = {"name": "skewed_small", "seed": 5, "town": {"blocks_x": 1, "blocks_y": 1, "block_size_m": 40, "margin_m": 5},
-           "streets": {"intersection_angle_deg": [62, 62]}}
-    spec = parse_spec(doc, "skewed_small.json")
-    scene = build_scene(spec)
-    assert scene.town_map is not None
-    blender_matches_scene(spec, scene, tmp_path)
-
-
-def test_metadata_records_the_angle_the_town_was_built_with(skewed):
-    from generator.spec.towns import angle_record as _angle_record
+    from generator.jobs.lidar_sequence import SequenceOptions, write_sequence
+    from generator.jobs.variants import render_frame
+    from generator.lidar.sensors import load_preset
+    from generator.spec.render import load_render_config
+    from generator.spec.towns import angle_record
+    from generator.world.rig import Rig
+    from kits.fake_renderer import FakeRenderer
 
     spec, scene = skewed
-    assert _angle_record(spec) == {"intersection_angle": {"angle_deg": scene.town_map.angle_deg,
-                                                          "lean": scene.town_map.lean}}
-    assert _angle_record(spec_with((90, 90))) == {}
-
-
-def test_speeds_in_the_world_are_the_simulated_ones():
-    """The map stretches lengths by 1/sin(angle); the tracks are slowed to match, so no vehicle
-    passes the speed limit in the world and the ego keeps its speed (at 60 degrees the unslowed
-    tracks ran 15 % faster)."""
-    spec = spec_with((60.0, 60.0), seed=4, traffic={"cars_per_km": 20}, speed_mps=3.0)
-    world = build_world(spec, build_scene(spec), 20.0)
-    t = np.arange(0.0, 20.0, 0.1)
-    fastest = max(np.linalg.norm(np.diff(a.track.position(t)[:, :2], axis=0), axis=1).max() / 0.1
-                  for a in world.actors)
-    assert fastest <= spec.traffic.speed_limit_mps * 1.02
-    ego = np.linalg.norm(np.diff(world.ego.T_world_ego(t)[:, :2, 3], axis=0), axis=1) / 0.1
-    assert 0.9 * spec.paths.speed_mps < ego.max() <= spec.paths.speed_mps * 1.02     # it reaches its speed, no more
+    write_sequence(scene, spec, tmp_path / "lidar", SequenceOptions(frames=1, sequence="00", threads=1),
+                   sensor=load_preset("vlp16"), progress=False)
+    lidar = json.loads((tmp_path / "lidar" / "sequences" / "00" / "lidar_meta.json").read_text())
+    frame = Rig.from_spec(spec, scene).frame(0)
+    render_frame(FakeRenderer(24, 32), spec, load_render_config("test"), frame, tmp_path / "cam", [("day", "clear")])
+    image = json.loads(next((tmp_path / "cam" / "images").glob("*.json")).read_text())
+    dirs = _route_directions(scene)
+    assert dirs[0] == pytest.approx(0.0, abs=1e-3) and len(dirs) == 2
+    for written in (lidar["scene"]["intersection_angle"], image["intersection_angle"]):
+        angle, lean = written["angle_deg"], written["lean"]
+        assert 0.0 < angle < 90.0 and lean in (-1, 1)
+        assert dirs[1] == pytest.approx(angle if lean > 0 else 180.0 - angle, abs=1e-3)
+    assert angle_record(spec_with((90, 90))) == {}     # right-angle towns write no record

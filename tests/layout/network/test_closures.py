@@ -23,7 +23,6 @@ from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
 from generator.traffic.lanes.graph import LaneGraph
 from kits.traffic_contacts import assert_no_contact, static_quads
-from kits.blender_scene import blender_matches_scene
 
 TRAFFIC = {"cars_per_km": 25, "trucks_per_km": 2, "buses_per_km": 1, "cyclists_per_km": 3, "motorcyclists_per_km": 2,
            "other_vehicles_per_km": 1, "pedestrians_per_100m": 1.5, "standing_pedestrians_per_100m": 0.5}
@@ -211,15 +210,3 @@ def test_feet_on_the_ground_under_them(seed):
     road = z < 1e-6
     assert road.any() and (np.abs(z - grid.curb_h) < 1e-6).any()    # some cross, most walk the pavement
     assert _on_crossing(grid, xy[road]).all()
-
-
-@pytest.mark.blender
-def test_blender_builds_the_pocket_parks_as_the_scene_model(tmp_path):
-    """The parks (grass, footpath, kept sidewalks) and the T-junction caps reach Blender triangle for triangle."""
-    spec = parse_spec({"name": "closed_tiny", "seed": 2,
-                       "town": {"blocks_x": 2, "blocks_y": 2, "block_size_m": 30, "block_size_jitter_m": 0,
-                                "margin_m": 8},
-                       "streets": {"closed_streets": 1}}, "closed_tiny.json")
-    scene = build_scene(spec)
-    assert make_grid(spec).closed
-    blender_matches_scene(spec, scene, tmp_path)

@@ -31,7 +31,6 @@ from generator.traffic.lanes.signals import Signals
 from generator.traffic.vehicles.sim import Vehicle, VehicleSim
 from generator.world.scene import OrientedBox
 from kits.traffic_contacts import assert_no_contact, assert_vehicles_miss_people, static_quads
-from kits.blender_scene import blender_matches_scene
 from kits.town_checks import radii
 
 TRAFFIC = {"cars_per_km": 25, "trucks_per_km": 2, "buses_per_km": 1, "cyclists_per_km": 3, "motorcyclists_per_km": 2,
@@ -352,19 +351,6 @@ def test_lidar_rays_see_the_apron_and_the_raised_grass_at_their_heights(town):
         else:
             np.testing.assert_allclose(z, heights[cls], atol=1e-3)
             assert {table.names[i] for i in scene.face_class[prim]} == {cls}
-
-
-@pytest.mark.blender
-def test_blender_builds_the_roundabout_as_the_scene_model(tmp_path):
-    """The island (apron, raised centre, grass), give-way lines and approach signs reach Blender
-    triangle for triangle."""
-    spec = parse_spec({"name": "roundabout_tiny", "seed": 2,
-                       "town": {"blocks_x": 2, "blocks_y": 2, "block_size_m": 30, "block_size_jitter_m": 0,
-                                "margin_m": 8},
-                       "streets": {"roundabouts": 1}}, "roundabout_tiny.json")
-    scene = build_scene(spec)
-    assert make_grid(spec).roundabouts == {(1, 1)}
-    blender_matches_scene(spec, scene, tmp_path)
 
 
 def test_a_vehicle_at_its_setback_keeps_clear_of_a_bus_swinging_out_over_its_give_way_line():
