@@ -20,7 +20,7 @@ from generator.formats.label_config import label_config, merge_split
 from generator.formats.ply import read_ply, write_ply
 from generator.labels import class_table
 from generator.jobs.lidar_sequence import SequenceOptions, write_sequence
-from kits.lidar_helpers import scene_of, straight_path
+from kits.scene_kit import scene_of, straight_path
 
 HEADING = 0.7  # a diagonal route, so the pose chain is tested with a rotation
 

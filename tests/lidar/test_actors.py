@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from kits.lidar_helpers import scene_of
+from kits.scene_kit import scene_of
 
 from generator.formats import semantickitti as sk
 from generator.geometry import box, icosphere, rect

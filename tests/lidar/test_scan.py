@@ -15,7 +15,7 @@ from generator.lidar.scan import POINT_DTYPE, Scanner
 from generator.world.rig import Rig
 from generator.lidar.sensors import load_preset
 from generator.materials import material_table
-from kits.lidar_helpers import scene_of, straight_path
+from kits.scene_kit import scene_of, straight_path
 
 H = 1.73  # KITTI mount height
 

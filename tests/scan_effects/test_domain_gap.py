@@ -15,7 +15,7 @@ from generator.scan_effects.domain_gap import DomainGap, PRESETS, apply_domain_g
 from generator.lidar.scan import POINT_DTYPE
 from generator.jobs.lidar_sequence import SequenceOptions, write_sequence
 from generator.rng import stream
-from kits.lidar_helpers import scene_of
+from kits.scene_kit import scene_of
 
 
 def cloud(n=20_000, seed=0):

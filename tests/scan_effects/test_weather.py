@@ -19,7 +19,7 @@ from generator.scan_effects.weather import (LidarWeatherParams, apply_lidar_weat
                                      weather_config)
 from generator.materials import material_table
 from generator.weather import KOSCHMIEDER, Weather, draw_weather, lidar_combination
-from kits.lidar_helpers import scene_of
+from kits.scene_kit import scene_of
 
 PARAMS = LidarWeatherParams(1e-5, 0.9)
 

@@ -29,8 +29,7 @@ from generator.traffic.lanes.graph import LaneGraph
 from generator.geometry.boxes import quads_overlap
 from generator.traffic.lanes.signals import Signals
 from generator.traffic.vehicles.sim import Vehicle, VehicleSim
-from generator.world.scene import OrientedBox
-from kits.traffic_contacts import assert_no_contact, assert_vehicles_miss_people, static_quads
+from kits.traffic_contacts import Box, assert_no_contact, assert_vehicles_miss_people, footprint, footprints, static_quads, touching
 from kits.town_checks import radii
 
 TRAFFIC = {"cars_per_km": 25, "trucks_per_km": 2, "buses_per_km": 1, "cyclists_per_km": 3, "motorcyclists_per_km": 2,
@@ -195,9 +194,9 @@ def test_an_entering_vehicle_waits_while_a_vehicle_on_the_ring_holds_a_conflicti
             granted = t
         pa, ha = sim.pose(a)
         pb, hb = sim.pose(b)
-        qa = OrientedBox((*pa, 0.7), (4.5, 1.9, 1.5), ha).corners_xy()[None]
-        qb = OrientedBox((*pb, 0.7), (4.5, 1.9, 1.5), hb).corners_xy()[None]
-        assert not quads_overlap(qa, qb).any(), t
+        qa = footprint(Box((*pa, 0.7), (4.5, 1.9, 1.5), ha))[None]
+        qb = footprint(Box((*pb, 0.7), (4.5, 1.9, 1.5), hb))[None]
+        assert not touching(qa, qb).any(), t
     assert released is not None and granted is not None and granted >= released
 
 
@@ -370,11 +369,10 @@ def test_a_vehicle_at_its_setback_keeps_clear_of_a_bus_swinging_out_over_its_giv
             sb = setbacks(graph, (x, y, 0), bus, wait[1])
             assert set(sb) == {(y, 0)} and sb[(y, 0)] > 1.0, sb
             p = ring_path(graph.grid.ring, np.zeros(2), x, y, 0)
-            swept = np.stack([OrientedBox((*q[:2], 1.5), (*bus, 3.0), float(h)).corners_xy()
-                              for q, h in zip(p.points, p.headings)])
+            swept = footprints([Box((*q[:2], 1.5), (*bus, 3.0), float(h)) for q, h in zip(p.points, p.headings)])
             a = -np.asarray(ARM_DIRS[y])
             right = np.array([a[1], -a[0]])
             for back, clear in ((sb[(y, 0)], True), (0.0, False)):
                 centre = -a * (graph.stop_m + back + wait[0] / 2) + right * graph.grid.lane_w / 2
-                box = OrientedBox((*centre, 1.5), (*wait, 3.0), float(np.arctan2(a[1], a[0]))).corners_xy()
-                assert quads_overlap(box[None], swept).any() != clear, (x, y, back)
+                box = footprint(Box((*centre, 1.5), (*wait, 3.0), float(np.arctan2(a[1], a[0]))))
+                assert touching(box[None], swept).any() != clear, (x, y, back)

@@ -187,13 +187,12 @@ def test_no_moving_actor_touches_a_one_way_sign():
     """With traffic and pedestrians (20 s, every 0.2 s), no vehicle, rider or pedestrian box
     overlaps the footprint of a one-way or no-entry sign (pedestrians walk round them)."""
     from generator.traffic.build import build_world
-    from generator.geometry.boxes import quads_overlap
+    from kits.traffic_contacts import footprints, touching
 
     spec = full_spec(3, traffic={**MIX_TRAFFIC, "pedestrians_per_100m": 3.0})
     scene = build_scene(spec)
     world = build_world(spec, scene, 20.0)
-    signs = np.stack([o.box.corners_xy() for o in scene.objects if _face_kind(scene, o)])
+    signs = footprints([o.box for o in scene.objects if _face_kind(scene, o)])
     assert len(signs) >= 10 and sum(a.kind == "person" for a in world.actors) >= 20
     for t in np.arange(0.0, 20.0, 0.2):
-        q = np.stack([a.box(t).corners_xy() for a in world.actors])
-        assert not quads_overlap(q, signs).any(), f"an actor touches a sign at t = {t:.1f} s"
+        assert not touching(footprints([a.box(t) for a in world.actors]), signs).any(), f"an actor touches a sign at t = {t:.1f} s"

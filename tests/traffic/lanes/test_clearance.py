@@ -15,8 +15,7 @@ from generator.traffic.build import build_world
 from generator.layout.network.design_vehicle import EGO_SIZE_M
 from generator.traffic.vehicles.fleet import KINDS
 from generator.traffic.vehicles.fleet import widest_half_width
-from generator.geometry.boxes import quads_overlap
-from kits.traffic_contacts import static_quads
+from kits.traffic_contacts import footprints, static_quads, touching
 from kits.paths import ROOT
 
 BUSES = {"cars_per_km": 10, "trucks_per_km": 1, "buses_per_km": 4, "other_vehicles_per_km": 1, "cyclists_per_km": 1}
@@ -55,6 +54,5 @@ def test_no_moving_vehicle_box_ever_overlaps_a_static_object(scene, seed):
     assert sum(a.kind == "bus" for a in vehicles) >= 3
     static = static_quads(town)
     for t in np.arange(0.0, 20.0, 0.1):
-        q = np.stack([a.box(t).corners_xy() for a in vehicles])
-        hit = quads_overlap(q, static)
+        hit = touching(footprints([a.box(t) for a in vehicles]), static)
         assert not hit.any(), f"{vehicles[np.argwhere(hit)[0][0]].name} touches a static object at t={t:.1f}"

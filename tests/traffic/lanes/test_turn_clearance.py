@@ -22,10 +22,8 @@ from generator.traffic.build import build_world
 from generator.traffic.lanes.clearance import MARGIN_M, blocked_turns, too_narrow
 from generator.layout.network.measures import ARM_DIRS
 from generator.traffic.lanes.graph import LaneGraph
-from generator.geometry.boxes import quads_overlap
 from generator.traffic.lanes.turn_clearance import node_setbacks
-from generator.world.scene import OrientedBox
-from kits.traffic_contacts import assert_no_contact, assert_vehicles_miss_people, static_quads
+from kits.traffic_contacts import Box, assert_no_contact, assert_vehicles_miss_people, footprint, footprints, static_quads, touching
 from kits.paths import ROOT
 
 BUS = (12.13, 3.0)        #: the longest bus variant's box, mirrors included, metres
@@ -74,7 +72,7 @@ def _opposite_waiting_box(graph, arm: int, back: float, size) -> np.ndarray:
     a = -np.asarray(ARM_DIRS[arm])
     right = np.array([a[1], -a[0]])
     centre = -a * (graph.stop_m + back + size[0] / 2) + right * graph.grid.lane_w / 2
-    return OrientedBox((*centre, 1.5), (*size, 3.0), float(np.arctan2(a[1], a[0]))).corners_xy()
+    return footprint(Box((*centre, 1.5), (*size, 3.0), float(np.arctan2(a[1], a[0]))))
 
 
 @pytest.mark.parametrize("town, seed", [("mixed", 1), ("kitti", 4)])
@@ -100,11 +98,10 @@ def test_a_vehicle_at_its_setback_keeps_clear_of_a_bus_turning_right_into_its_st
         sb = node_setbacks(graph, conn, BUS, wait[1])
         assert sb.get((y, 0), 0.0) > 1.0, (x, y, sb)
         rel = conn.path.points[:, :2] - c0
-        swept = np.stack([OrientedBox((*q, 1.5), (*BUS, 3.0), float(h)).corners_xy()
-                          for q, h in zip(rel, conn.path.headings)])
+        swept = footprints([Box((*q, 1.5), (*BUS, 3.0), float(h)) for q, h in zip(rel, conn.path.headings)])
         for back, clear in ((sb[(y, 0)], True), (0.0, False)):
             box = _opposite_waiting_box(graph, y, back, wait)
-            assert quads_overlap(box[None], swept).any() != clear, (x, y, back)
+            assert touching(box[None], swept).any() != clear, (x, y, back)
     assert right_turns == 4
 
 
@@ -120,8 +117,7 @@ def test_turns_whose_sweep_reaches_a_parked_object_are_avoided_by_buses_only():
     size = (BUS[0] + 2 * MARGIN_M, BUS[1] + 2 * MARGIN_M)
     for c in blocked:   # each one really does touch a placed object
         e = graph.edges[c]
-        swept = np.stack([OrientedBox((*q[:2], 1.5), (*size, 3.0), float(h)).corners_xy()
-                          for q, h in zip(e.path.points, e.path.headings)])
-        assert quads_overlap(swept, parked).any()
+        swept = footprints([Box((*q[:2], 1.5), (*size, 3.0), float(h)) for q, h in zip(e.path.points, e.path.headings)])
+        assert touching(swept, parked).any()
     assert blocked <= too_narrow(graph, scene, BUS[1] / 2, set(), BUS[0])
     assert not too_narrow(graph, scene, 1.9 / 2, set(), 4.6) & blocked

@@ -12,10 +12,10 @@ from generator.layout.network.draw import make_grid
 from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
 from generator.traffic.lanes.graph import LaneGraph
-from generator.geometry.boxes import quads_overlap
 from generator.world.actors import MOVING_THRESHOLD_MPS, Track
 from generator.world.rig import SWEEP_PERIOD_S, Rig
-from kits.traffic_contacts import assert_no_contact, assert_vehicles_miss_people, ego_box, static_quads
+from kits.traffic_contacts import (assert_no_contact, assert_vehicles_miss_people, ego_box, footprints, static_quads,
+                                   touching)
 from kits.paths import ROOT
 
 TRAFFIC = {"cars_per_km": 25, "trucks_per_km": 2, "buses_per_km": 1, "cyclists_per_km": 3, "motorcyclists_per_km": 2,
@@ -275,8 +275,7 @@ def test_no_moving_actor_ever_touches_a_static_object(seed, roundabouts, dense):
     assert bool(make_grid(spec).roundabouts) == (roundabouts > 0)
     static = static_quads(scene)
     for t in np.arange(0.0, 20.0, 0.1):
-        q = np.stack([b.corners_xy() for b in world.boxes(t)])
-        hit = quads_overlap(q, static)
+        hit = touching(footprints(world.boxes(t)), static)
         assert not hit.any(), f"{world.actors[np.argwhere(hit)[0][0]].name} touches a static object at t={t:.1f}"
 
 
@@ -292,8 +291,8 @@ def test_no_vehicle_touches_a_person_in_roundabout_towns_with_excavators(seed):
     people = [a for a in world.actors if a.kind == "person"]
     vehicles = [a for a in world.actors if a.kind != "person"]
     assert "construction_vehicle" in {a.kind for a in vehicles} and len(people) > 20
-    static_people = np.stack([o.box.corners_xy() for o in scene.objects if o.instance_id > 0 and o.cls == "person"])
+    static_people = footprints([o.box for o in scene.objects if o.instance_id > 0 and o.cls == "person"])
     for t in np.arange(0.0, 30.0, 0.1):
         assert_vehicles_miss_people(world, t, vehicles, people)
-        q = np.stack([a.box(t).corners_xy() for a in vehicles] + [ego_box(world, t).corners_xy()])
-        assert not quads_overlap(q, static_people).any(), f"a vehicle touches a person of the static town at t={t:.1f}"
+        q = footprints([a.box(t) for a in vehicles] + [ego_box(world, t)])
+        assert not touching(q, static_people).any(), f"a vehicle touches a person of the static town at t={t:.1f}"
