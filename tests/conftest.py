@@ -1,4 +1,5 @@
-"""Shared fixtures: a seeded rng, the test and default specs, a cached test-town scene."""
+"""Shared fixtures: a seeded rng, the test and default specs, a cached test-town scene; the
+grouping that keeps a module's shared build on one worker under ``pytest -n 2 --dist loadgroup``."""
 
 from __future__ import annotations
 
@@ -48,6 +49,22 @@ def default_scene(default_spec):
     from generator.layout import build_scene
 
     return build_scene(default_spec)
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_collection_modifyitems(config, items):
+    """Under ``--dist loadgroup`` (pytest-xdist) every test that uses a module- or class-scoped
+    fixture joins its module's group, so the module's shared build (a rendered dataset, a town with
+    traffic) is made once, on one worker; the other tests go to whichever worker is free. Session
+    fixtures are built once per worker. Without xdist the mark does nothing."""
+    for item in items:
+        info = getattr(item, "_fixtureinfo", None)
+        if info is None:
+            continue
+        shared = any(d.scope in ("module", "class", "package")
+                     for name in info.names_closure for d in info.name2fixturedefs.get(name, ()))
+        if shared and not any(True for _ in item.iter_markers("xdist_group")):
+            item.add_marker(pytest.mark.xdist_group(item.nodeid.split("::")[0]))
 
 
 # Hypothesis profiles for the property tests: ``dev`` (default, 100 examples), ``ci`` (25

@@ -258,7 +258,7 @@ def test_metadata_records_the_angle_the_town_was_built_with(skewed, tmp_path):
     lidar = json.loads((tmp_path / "lidar" / "sequences" / "00" / "lidar_meta.json").read_text())
     frame = Rig.from_spec(spec, scene).frame(0)
     render_frame(FakeRenderer(24, 32), spec, load_render_config("test"), frame, tmp_path / "cam", [("day", "clear")])
-    image = json.loads(next((tmp_path / "cam" / "images").glob("*.json")).read_text())
+    image = json.loads(next((tmp_path / "cam").rglob("*.json")).read_text())
     dirs = _route_directions(scene)
     assert dirs[0] == pytest.approx(0.0, abs=1e-3) and len(dirs) == 2
     for written in (lidar["scene"]["intersection_angle"], image["intersection_angle"]):
