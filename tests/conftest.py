@@ -7,8 +7,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from kits.paths import ROOT
 
+from kits.paths import ROOT
 
 
 @pytest.fixture

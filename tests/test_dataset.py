@@ -5,11 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from kits.fusion_kit import write_raycast_images
 from generator.dataset import Dataset
 from generator.errors import UserError
 from generator.formats import semantickitti as sk
 from generator.labels import class_table
+from kits.fusion_kit import write_raycast_images
 
 
 @pytest.fixture(scope="module")
@@ -19,7 +19,8 @@ def dataset(tmp_path_factory, test_spec, test_scene):
 
     root = tmp_path_factory.mktemp("reader")
     write_raycast_images(root, test_scene, test_spec, 2)
-    write_sequence(test_scene, test_spec, root / "lidar", SequenceOptions(frames=2, threads=2, bev=False), progress=False)
+    write_sequence(test_scene, test_spec, root / "lidar", SequenceOptions(frames=2, threads=2, bev=False),
+                   progress=False)
     write_sequence_openlabel(test_spec, root, scene=test_scene)
     return root
 

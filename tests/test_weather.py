@@ -11,8 +11,17 @@ import pytest
 
 from generator.errors import SpecError
 from generator.spec.load import parse_spec
-from generator.weather import (DEFAULT_TIMES, KINDS, LIT_TIMES, TIMES, draw_lighting, global_irradiance, is_overcast,
-                               light_level, render_key)
+from generator.weather import (
+    DEFAULT_TIMES,
+    KINDS,
+    LIT_TIMES,
+    TIMES,
+    draw_lighting,
+    global_irradiance,
+    is_overcast,
+    light_level,
+    render_key,
+)
 
 
 def test_lighting_is_deterministic_per_seed_and_frame(test_spec):

@@ -400,7 +400,8 @@ def test_bike_rack_and_bench_have_gaps():
 
 # -- riders sit on their vehicles ---------------------------------------------------------------------
 
-RIDES = [(k, s, seed) for k, styles in (("bicyclist", ("city", "sport", "mtb")), ("motorcyclist", ("naked", "sport", "scooter")))
+RIDES = [(k, s, seed) for k, styles in (("bicyclist", ("city", "sport", "mtb")), ("motorcyclist", ("naked", "sport",
+                                                                                                   "scooter")))
          for s in styles for seed in range(3)]
 
 

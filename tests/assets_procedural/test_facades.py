@@ -56,7 +56,7 @@ def test_window_layouts_vary_between_buildings():
     assert len(layouts) >= 10, layouts
     widths = sorted({w for _, w, _ in layouts})
     assert widths[-1] - widths[0] > 0.4, "window widths should range over several tens of centimetres"
-    shops, awnings, proud = (np.array(c) for c in zip(*details))
+    shops, awnings, proud = (np.array(c) for c in zip(*details, strict=False))
     assert 0 < shops.sum() < len(shops) and 0 < awnings.sum() <= shops.sum()
     assert 0 < proud.sum() < len(proud), "balconies or awnings on some buildings, flat fronts on others"
 

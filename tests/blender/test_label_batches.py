@@ -12,8 +12,8 @@ import dataclasses
 import numpy as np
 import pytest
 
-from kits.actor_world import FRAME, car_world
 from generator.world.rig import Rig
+from kits.actor_world import FRAME, car_world
 
 RES = (96, 54)
 STEPS = (0.0, 0.1, 0.2)
@@ -67,7 +67,7 @@ def renders(tmp_path_factory, test_spec, test_scene):
 @pytest.mark.blender
 def test_batched_labels_equal_each_image_rendered_alone(renders):
     batched, alone, world = renders
-    for b, a in zip(batched["labels"], alone["labels"]):
+    for b, a in zip(batched["labels"], alone["labels"], strict=False):
         for name in FIELDS:
             np.testing.assert_array_equal(getattr(b, name), getattr(a, name), err_msg=name)
     cars = {act.instance_id for act in world.actors}
@@ -80,7 +80,7 @@ def test_batched_labels_equal_each_image_rendered_alone(renders):
 @pytest.mark.blender
 def test_rgb_does_not_depend_on_the_renders_before_it(renders):
     batched, alone, _ = renders
-    for b, a in zip(batched["rgb"], alone["rgb"]):
+    for b, a in zip(batched["rgb"], alone["rgb"], strict=False):
         np.testing.assert_array_equal(b, a)
 
 

@@ -7,9 +7,9 @@ import dataclasses
 import numpy as np
 import pytest
 
-from generator.world import rig
 from generator.labels import class_table
 from generator.weather import Lighting
+from generator.world import rig
 from kits.scene_kit import fence_scene
 
 pytestmark = pytest.mark.blender

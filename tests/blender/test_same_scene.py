@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from generator.lidar.caster import EmbreeCaster
-from generator.world.rig import Rig
 from generator.lidar.sensors import sensor_for_spec
+from generator.world.rig import Rig
 
 pytestmark = pytest.mark.blender
 
@@ -50,7 +50,7 @@ def test_embree_distances_equal_blender_ray_cast(town, test_spec):
     depsgraph = bpy.context.evaluated_depsgraph_get()
     depsgraph.update()
     blender = np.full(len(o), np.inf)
-    for i, (oi, di) in enumerate(zip(o, d)):
+    for i, (oi, di) in enumerate(zip(o, d, strict=False)):
         hit, loc, *_ = bscene.ray_cast(depsgraph, mathutils.Vector(oi), mathutils.Vector(di), distance=120.0)
         if hit:
             blender[i] = (loc - mathutils.Vector(oi)).length

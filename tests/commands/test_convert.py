@@ -35,7 +35,7 @@ def test_native_to_raw_to_unified_is_the_composition_for_every_class():
                 "other_vehicle": "vehicle", "bicyclist": "person", "motorcyclist": "person", "wall": "fence",
                 "other_ground": "other-ground", "street_object": "unlabeled", "rail_track": "other-ground",
                 "shelter": "unlabeled", "ridden_bicycle": "person", "ridden_motorcycle": "person"}
-    assert {n: table.unified_names[int(u)] for n, u in zip(table.names, uni)} == expected
+    assert {n: table.unified_names[int(u)] for n, u in zip(table.names, uni, strict=False)} == expected
 
 
 def test_raw_unified_canonical_raw_round_trip_is_identity_on_unified():

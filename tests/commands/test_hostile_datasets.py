@@ -12,8 +12,9 @@ corruption:
 
 * exit 2 with exactly one line on stderr (``validate``, ``stats --verify``: 1 with one line
   per finding), or 0 when the corruption is harmless to that command;
-* no traceback and no warning (Python would print it as more lines), and neither the marker planted in the corrupted file nor the secret a link
-  points at appears on stdout or stderr (captured at the file descriptors: C libraries too);
+* no traceback and no warning (Python would print it as more lines), and neither the marker planted in the
+  corrupted file nor the secret a link points at appears on stdout or stderr (captured at the file
+  descriptors: C libraries too);
 * on failure nothing is written: the dataset copy and the output folder are as before;
 * every run ends within :data:`TIME_LIMIT_S`.
 
@@ -43,12 +44,12 @@ import numpy as np
 import pytest
 
 hypothesis = pytest.importorskip("hypothesis")
-from hypothesis import HealthCheck, given, settings
-from hypothesis import strategies as st
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
 
-from generator import cli
-from kits.json_kit import value_paths
-from kits.paths import ROOT
+from generator import cli  # noqa: E402
+from kits.json_kit import value_paths  # noqa: E402
+from kits.paths import ROOT  # noqa: E402
 
 MARKER = "HOSTILE-MARKER-7f3a"
 SECRET = "hunter2-SECRET-7f3a"
@@ -70,20 +71,20 @@ class Kit:
 
 
 def _write_images(root: Path, scene, spec, n: int, width: int = 96, height: int = 64) -> None:
-    from kits.fusion_kit import raycast_image
-
     from generator.imaging.exr import LabelledImage, write_exr
     from generator.imaging.metadata import image_metadata
     from generator.lidar.caster import EmbreeCaster
     from generator.spec.render import load_render_config
     from generator.world import rig
+    from kits.fusion_kit import raycast_image
 
     caster, cfg = EmbreeCaster.from_scene(scene), load_render_config("test")
     K = rig.intrinsics(spec.sensors.camera.hfov_deg, width, height)
     for f in rig.Rig.from_spec(spec, scene).frames(n):
         cls, inst, depth = raycast_image(caster, scene, f.T_world_camera, K, width, height)
         name = f"{f.index:06d}_day_clear"
-        write_exr(root / "images" / f"{name}.exr", LabelledImage(np.zeros((height, width, 3), np.float32), cls, inst, depth))
+        write_exr(root / "images" / f"{name}.exr", LabelledImage(np.zeros((height, width, 3), np.float32), cls, inst,
+                                                                 depth))
         rec = image_metadata(image=name, files={"exr": f"{name}.exr"}, frame=f, k=K, width=width, height=height,
                              hfov_deg=spec.sensors.camera.hfov_deg, class_id=cls, time_of_day="day",
                              weather={"kind": "clear"}, lighting={}, spec=spec, render_cfg=cfg, device="cpu",
@@ -652,7 +653,8 @@ def test_intensity_profiles_stay_in_the_spec_folder_unless_given_on_the_command_
     def lidar(profile_in_spec, *extra):
         spec = specs / "spec.json"
         spec.write_text(json.dumps({"name": "t", "seed": 1, "town": {"blocks_x": 1, "blocks_y": 1},
-                                    "lidar": {"intensity_model": "class_normal", "intensity_profile": profile_in_spec}}))
+                                    "lidar": {"intensity_model": "class_normal",
+                                              "intensity_profile": profile_in_spec}}))
         blocker = tmp_path / "out_is_a_file"  # every check on the inputs runs first, then --out stops the run
         blocker.write_text("x")
         argv = ["lidar", str(spec), "--out", str(blocker), *extra]

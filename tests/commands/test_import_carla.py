@@ -9,10 +9,10 @@ import pytest
 import yaml
 
 import generator.cli as cli
-from generator.world import rig
 from generator.formats import carla_ply
 from generator.formats import semantickitti as sk
 from generator.labels import class_table
+from generator.world import rig
 from kits.carla_town import DT, PACKETS, make_town, write_ply
 
 
@@ -41,7 +41,7 @@ def test_import_maps_every_tag_and_keeps_geometry_poses_instances(tmp_path, caps
     assert len(seq) == 3
     table = class_table()
     seen_instances = set()
-    for rec, v in zip(seq, frames):
+    for rec, v in zip(seq, frames, strict=False):
         assert np.array_equal(rec.points[:, :3], np.stack([v["x"], v["y"], v["z"]], -1))
         expected = np.array([doc[int(t)]["semantickitti"] for t in v["semantic"]])
         assert np.array_equal(rec.semantic, expected)
@@ -93,7 +93,8 @@ def test_physical_uses_the_ply_cos_and_domain_gap_applies(tmp_path, capsys):
     xyz = rec.points[b, :3]
     r = np.linalg.norm(xyz, axis=1)
     meta = json.loads((out / "sequences" / "24" / "lidar_meta.json").read_text())
-    assert meta["processing"]["domain_gap"]["dropout"] == 0.1 and meta["scans"][0]["domain_gap"]["removed"] == round(0.1 * len(v))
+    assert meta["processing"]["domain_gap"]["dropout"] == 0.1
+    assert meta["scans"][0]["domain_gap"]["removed"] == round(0.1 * len(v))
     assert rec.points[:, 3].max() <= 1 and rec.points[:, 3].min() >= 0
     # I * R^2 / rho grows with the incidence cosine the PLY gave (match points to the PLY by nearest xyz)
     src = np.stack([v["x"], v["y"], v["z"]], -1)

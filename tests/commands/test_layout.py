@@ -20,12 +20,12 @@ from generator.spec import load_spec
 from kits.paths import ROOT
 
 
-
 def test_layout_writes_map_glb_and_summary(tmp_path, capsys):
     out = tmp_path / "out"
     assert main(["-q", "layout", str(ROOT / "scenes" / "test_town.json"), "--out", str(out)]) == 0
     assert sorted(p.name for p in out.iterdir()) == ["test_town.glb", "test_town_map.png", "test_town_summary.json"]
-    assert capsys.readouterr().out.split() == [str(out / n) for n in ("test_town_map.png", "test_town.glb", "test_town_summary.json")]
+    assert capsys.readouterr().out.split() == [str(out / n) for n in ("test_town_map.png", "test_town.glb",
+                                                                      "test_town_summary.json")]
 
     summary = json.loads((out / "test_town_summary.json").read_text())
     classes = summary["classes"]

@@ -31,7 +31,8 @@ def test_lidar_command_writes_a_sequence(root, tmp_path, capsys):
         for sub, ext in (("velodyne", "bin"), ("labels", "label"), ("bev", "png"), ("range", "npy")):
             assert (seq / sub / f"{k:06d}.{ext}").is_file()
         rng_img = np.load(seq / "range" / f"{k:06d}.npy")
-        assert rng_img.shape == (64, 2083) and np.count_nonzero(rng_img) == len(sk.read_scan(seq / "velodyne" / f"{k:06d}.bin"))
+        assert rng_img.shape == (64, 2083)
+        assert np.count_nonzero(rng_img) == len(sk.read_scan(seq / "velodyne" / f"{k:06d}.bin"))
     meta = json.loads((seq / "lidar_meta.json").read_text())
     assert meta["remission"]["model"] == "class_normal" and not meta["remission"].get("placeholder")
     assert (out / "semantic-kitti.yaml").is_file()

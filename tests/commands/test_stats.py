@@ -74,7 +74,8 @@ def test_table1_equals_counts_computed_from_the_arrays(dataset, tmp_path):
     totals = [int(r["total_pixels"]) for r in rows]
     assert totals == sorted(totals, reverse=True)
     names = {r["class"] for r in rows}
-    assert names == set(table.seed003_names()) | {n for n, s in zip(table.names, table.to_seed003()) if s is None}
+    assert names == set(table.seed003_names()) | {n for n, s in zip(table.names, table.to_seed003(), strict=False)
+                                                  if s is None}
 
 
 def test_table2_counts_images_per_weather_and_time(dataset, tmp_path):

@@ -10,16 +10,16 @@ import numpy as np
 import pytest
 import yaml
 
-from generator.geometry import box, rect
-from generator.world import rig
-from generator.world.rig import Rig
 from generator.errors import UserError
 from generator.formats import kitti_calib
 from generator.formats import semantickitti as sk
 from generator.formats.label_config import label_config, merge_split
 from generator.formats.ply import read_ply, write_ply
-from generator.labels import class_table
+from generator.geometry import box, rect
 from generator.jobs.lidar_sequence import SequenceOptions, write_sequence
+from generator.labels import class_table
+from generator.world import rig
+from generator.world.rig import Rig
 from kits.scene_kit import scene_of, straight_path
 
 HEADING = 0.7  # a diagonal route, so the pose chain is tested with a rotation
@@ -155,10 +155,12 @@ def test_written_sequence_sizes_and_static_objects_stay_put(test_spec, tmp_path)
     assert len(seq) == 4 and seq.frames == [0, 1, 2, 3]
     np.testing.assert_allclose(seq.times, [0.0, 0.1, 0.2, 0.3])  # a 10 Hz stream, as KITTI's
     # lidar pose of scan 0 in the world, from the route and the mount
-    t_world_velo0 = rig.ego_pose(scene.paths[0].points[0], HEADING) @ rig.mount(spec.sensors.lidar.xyz_m, spec.sensors.lidar.rpy_deg)
-    boxes = {50: (scene.objects[1].box.center, scene.objects[1].box.size), 10: (scene.objects[2].box.center, scene.objects[2].box.size)}
+    t_world_velo0 = rig.ego_pose(scene.paths[0].points[0], HEADING) @ rig.mount(spec.sensors.lidar.xyz_m,
+                                                                                spec.sensors.lidar.rpy_deg)
+    boxes = {50: (scene.objects[1].box.center, scene.objects[1].box.size), 10: (scene.objects[2].box.center,
+                                                                                scene.objects[2].box.size)}
     seen = {50: 0, 10: 0}
-    for rec, n in zip(seq, meta["points_per_scan"]):
+    for rec, n in zip(seq, meta["points_per_scan"], strict=False):
         assert rec.points.shape == (n, 4) and len(rec.semantic) == n
         assert seq.scan_path(rec.index).stat().st_size // 16 == seq.label_path(rec.index).stat().st_size // 4
         assert (rec.points[:, 3] >= 0).all() and (rec.points[:, 3] <= 1).all()  # class_normal, clipped to [0, 1]
@@ -191,8 +193,10 @@ def test_same_seed_gives_identical_bytes(test_spec, tmp_path):
 
 
 def test_rerun_with_fewer_frames_removes_stale_scans(test_spec, tmp_path):
-    write_sequence(_static_scene(), test_spec, tmp_path, SequenceOptions(frames=3, threads=1, bev=False), progress=False)
-    write_sequence(_static_scene(), test_spec, tmp_path, SequenceOptions(frames=2, threads=1, bev=False), progress=False)
+    write_sequence(_static_scene(), test_spec, tmp_path, SequenceOptions(frames=3, threads=1, bev=False),
+                   progress=False)
+    write_sequence(_static_scene(), test_spec, tmp_path, SequenceOptions(frames=2, threads=1, bev=False),
+                   progress=False)
     seq = sk.Sequence(tmp_path, 0)
     assert seq.frames == [0, 1] and len(seq.cam_poses) == 2
     assert not any(Path(tmp_path).rglob(".tmp-*"))

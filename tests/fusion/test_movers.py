@@ -92,7 +92,8 @@ def test_actor_points_land_on_the_car_at_the_image_time(world, j):
     ground = scan["instance"] == 0
     np.testing.assert_array_equal(both[ground], sensor_only[ground])
     # sensor de-skew alone is exact for static points
-    np.testing.assert_allclose(transform(scan["T_world_lidar_start"], both[ground]), scan["world_xyz"][ground], atol=1e-9)
+    np.testing.assert_allclose(transform(scan["T_world_lidar_start"], both[ground]), scan["world_xyz"][ground],
+                               atol=1e-9)
 
 
 def test_without_times_every_point_fired_at_the_sweep_start(world):

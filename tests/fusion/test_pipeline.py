@@ -8,13 +8,13 @@ import numpy as np
 import pytest
 
 from generator import geometry as M
-from generator.world import rig
 from generator.cli import main
 from generator.fusion import projection as P
 from generator.fusion.agreement import HEADLINE, Agreement, FusedFrame, variant_key
 from generator.fusion.semantic_map import VoxelMap, top_down_image
 from generator.labels import class_table
 from generator.lidar.caster import EmbreeCaster
+from generator.world import rig
 from kits.fusion_kit import raycast_image, write_raycast_images
 from kits.scene_kit import fence_scene, make_scene
 
@@ -92,7 +92,8 @@ def test_subpixel_prediction_follows_slanted_ground():
     point = ray * (1.5 / ray[1])  # on the road plane y_cam = 1.5 (optical y points down)
     proj = P.project(point[None], K, 96, 64)
     d_centre = depth[proj.row[0], proj.col[0]]
-    assert abs(proj.distance[0] - d_centre) > max(P.ABS_TOL_M, P.REL_TOL * proj.distance[0])  # beyond the plain tolerance
+    assert abs(proj.distance[0] - d_centre) > max(P.ABS_TOL_M,
+                                                  P.REL_TOL * proj.distance[0])  # beyond the plain tolerance
     assert P.visible(proj, depth, K).tolist() == [True]
     assert P.visible(proj, depth, K, subpixel=False).tolist() == [False]
 
@@ -124,8 +125,8 @@ def test_boundary_mask_marks_pixels_next_to_another_class():
 # -- de-skew ------------------------------------------------------------------------------------------
 def test_deskew_with_the_recorded_sweep_poses_is_exact_through_a_turn(test_spec):
     from generator.lidar.scan import Scanner
-    from generator.world.rig import Rig
     from generator.lidar.sensors import sensor_for_spec
+    from generator.world.rig import Rig
     from generator.world.scene import Path
 
     # a straight that turns into an arc (0.1 rad per metre) at s = 10 m: the yaw rate jumps mid-sweep
@@ -195,7 +196,7 @@ def test_voxel_map_keeps_the_majority_label_and_the_centroid():
     two = VoxelMap(0.2)
     two.add(pts[:2], labels[:2])
     two.add(pts[2:], labels[2:])
-    for a, b in zip(two.voxels(), one.voxels()):
+    for a, b in zip(two.voxels(), one.voxels(), strict=False):
         assert np.allclose(a[np.argsort(two.voxels()[0][:, 0])], b[order])
     img = top_down_image(xyz, lab)
     assert img.width > 100 and img.height > 100
@@ -204,8 +205,8 @@ def test_voxel_map_keeps_the_majority_label_and_the_centroid():
 # -- the fuse command on a ray-cast dataset (no Blender) ---------------------------------------------------
 @pytest.fixture(scope="module")
 def raycast_dataset(tmp_path_factory, test_spec):
-    from generator.layout.assemble import build_scene
     from generator.jobs.lidar_sequence import SequenceOptions, write_sequence
+    from generator.layout.assemble import build_scene
 
     root = tmp_path_factory.mktemp("fuse")
     scene = build_scene(test_spec)
@@ -240,8 +241,8 @@ def test_fuse_refuses_a_folder_without_images(tmp_path, capsys):
 # -- on real renders (Blender) -----------------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def rendered_dataset(tmp_path_factory, test_spec):
-    from generator.layout.assemble import build_scene
     from generator.jobs.lidar_sequence import SequenceOptions, write_sequence
+    from generator.layout.assemble import build_scene
 
     root = tmp_path_factory.mktemp("rendered")
     assert main(["render", test_spec.source, "--config", "test", "--out", str(root), "--frames", "2"]) == 0

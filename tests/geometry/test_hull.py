@@ -23,7 +23,7 @@ def _trimesh(points):
 
 
 def _same(a, b) -> bool:
-    return all(x.dtype == y.dtype and x.shape == y.shape and np.array_equal(x, y) for x, y in zip(a, b))
+    return all(x.dtype == y.dtype and x.shape == y.shape and np.array_equal(x, y) for x, y in zip(a, b, strict=False))
 
 
 def _asset_clouds():

@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from generator.geometry.boxes import boxes_overlap
 from generator.geometry.overlap_kernel import any_overlap
 from generator.layout.placement.placer import Occupancy
-from generator.geometry.boxes import boxes_overlap
 
 
 def _kernel(a, b):

@@ -9,8 +9,8 @@ import pytest
 from generator.errors import UserError
 from generator.imaging.exr import LabelledImage, mask_channel, read_exr, write_exr
 from generator.imaging.metadata import camera_angles, class_pixels
-from generator.previews.preview import tonemap, write_preview
 from generator.labels import class_table
+from generator.previews.preview import tonemap, write_preview
 
 
 @pytest.fixture

@@ -44,7 +44,7 @@ def no_collisions(scene) -> None:
     b = np.array(boxes)
     hit = boxes_overlap(b, b)
     np.fill_diagonal(hit, False)
-    pairs = [(names[i], names[j]) for i, j in zip(*np.nonzero(np.triu(hit)))
+    pairs = [(names[i], names[j]) for i, j in zip(*np.nonzero(np.triu(hit)), strict=False)
              if riding[i] != names[j] and riding[j] != names[i]]
     assert not pairs
 
@@ -55,7 +55,7 @@ def rests_on_ground(spec, grid, scene) -> None:
     things = [o for o in scene.objects if o.instance_id > 0 and o.cls not in RIDERS]
     ground = grid.ground_height(np.array([o.transform[:2, 3] for o in things]))
     low = np.array([apply(o.transform, scene.prototypes[o.prototype].vertices)[:, 2].min() for o in things])
-    bad = [(o.name, float(z), float(g)) for o, z, g in zip(things, low, ground) if abs(z - g) > 0.01]
+    bad = [(o.name, float(z), float(g)) for o, z, g in zip(things, low, ground, strict=False) if abs(z - g) > 0.01]
     assert not bad
 
 
@@ -67,7 +67,8 @@ def check_vehicles(spec, scene) -> list:
     for o in vehicles:
         corners = o.box.corners_xy()
         inside = ((corners[:, None, 0] >= rects[None, :, 0] - 0.01) & (corners[:, None, 0] <= rects[None, :, 2] + 0.01)
-                  & (corners[:, None, 1] >= rects[None, :, 1] - 0.01) & (corners[:, None, 1] <= rects[None, :, 3] + 0.01))
+                  & (corners[:, None, 1] >= rects[None, :, 1] - 0.01) & (corners[:, None, 1] <= rects[None, :, 3]
+                                                                         + 0.01))
         assert inside.any(1).all(), f"{o.name} ({o.attrs.get('placement')}) leaves the parking strips and lanes"
     return vehicles
 

@@ -9,21 +9,21 @@ import pytest
 from scipy.spatial import ConvexHull
 
 from generator.geometry import apply
+from generator.geometry.boxes import boxes_overlap, point_box_distance
 from generator.labels import class_table
 from generator.layout import build_scene
-from generator.world.rig import Rig
-from generator.layout.network.design_vehicle import EGO_HALF_WIDTH_M
-from generator.geometry.boxes import boxes_overlap, point_box_distance
-from generator.previews.layout_map import rasterize
-from generator.layout.lots.lot import make_lots
 from generator.layout.ground.terrain import HORIZON_M
+from generator.layout.lots.lot import make_lots
+from generator.layout.network.design_vehicle import EGO_HALF_WIDTH_M
+from generator.layout.network.draw import make_grid
 from generator.layout.network.grid import segment_frame_points
 from generator.layout.network.measures import MARK_Z_M
-from generator.layout.network.draw import make_grid
 from generator.materials import material_table
-from kits.town_checks import check_vehicles
-from generator.world.scene import OrientedBox
+from generator.previews.layout_map import rasterize
 from generator.spec import parse_spec
+from generator.world.rig import Rig
+from generator.world.scene import OrientedBox
+from kits.town_checks import check_vehicles
 
 
 def _rect_boxes(rects) -> np.ndarray:
@@ -90,7 +90,8 @@ def test_default_town_is_reproducible(root):
     env = reference_env()
     if env is None:
         pytest.skip(why_not())
-    code = ("import json, pathlib; from generator.spec.load import parse_spec; from generator.layout import build_scene; "
+    code = ("import json, pathlib; from generator.spec.load import parse_spec; "
+            "from generator.layout import build_scene; "
             "doc = json.loads(pathlib.Path('scenes/default_town.json').read_text()); doc.pop('traffic', None); "
             "print(build_scene(parse_spec(doc, 'default_town.json')).digest())")
     run = subprocess.run([sys.executable, "-c", code], cwd=root, env=env, capture_output=True, text=True, check=True)
@@ -210,7 +211,7 @@ def _check_rest(spec, scene) -> np.ndarray:
     things = [o for o in scene.objects if o.instance_id > 0]
     ground = grid.ground_height(np.array([o.transform[:2, 3] for o in things]))    # where it stands
     low = np.array([_world_vertices(scene, o)[:, 2].min() for o in things])
-    bad = [(o.name, float(z), float(g)) for o, z, g in zip(things, low, ground) if abs(z - g) > 0.01]
+    bad = [(o.name, float(z), float(g)) for o, z, g in zip(things, low, ground, strict=False) if abs(z - g) > 0.01]
     assert not bad
     return ground
 
@@ -261,7 +262,7 @@ def test_nothing_collides_at_street_level(default_scene):
     b = np.array(boxes)
     hit = boxes_overlap(b, b)
     np.fill_diagonal(hit, False)
-    pairs = [(names[i], names[j]) for i, j in zip(*np.nonzero(np.triu(hit)))]
+    pairs = [(names[i], names[j]) for i, j in zip(*np.nonzero(np.triu(hit)), strict=False)]
     assert not pairs
 
 
@@ -460,7 +461,8 @@ def test_ground_has_no_holes_out_to_the_horizon(default_spec, default_scene):
     (a camera 1.65 m up sees ground to within 0.05 degrees of the horizon)."""
     s = default_scene
     cls = s.face_class.astype(np.int64)
-    ground = [class_table().id(c) for c in ("road", "road_marking", "crosswalk", "curb", "sidewalk", "parking", "terrain")]
+    ground = [class_table().id(c) for c in ("road", "road_marking", "crosswalk", "curb", "sidewalk", "parking",
+                                            "terrain")]
     stuff = np.isin(cls, ground)
     grid = make_grid(default_spec)
     top, z = rasterize(s.vertices, s.faces[stuff], cls[stuff], np.asarray(grid.bounds), 2.0)
@@ -524,7 +526,7 @@ def test_route_zero_keeps_right(default_spec, default_scene):
     p = default_scene.paths[0]
     left = np.stack([-np.sin(p.headings), np.cos(p.headings)], 1)
     on_street = 0
-    for xy, n in zip(p.points[:, :2], left):
+    for xy, n in zip(p.points[:, :2], left, strict=False):
         dx, dy = grid.xs - xy[0], grid.ys - xy[1]
         i, j = np.argmin(np.abs(dx)), np.argmin(np.abs(dy))
         if abs(dx[i]) < grid.lane_half and abs(dy[j]) > grid.road_half:      # on a north-south street
@@ -540,7 +542,8 @@ def test_frames_follow_route_zero(default_spec, default_scene):
     """Frame 0 starts on a straight leg, and every frame sits on route 0 facing along it."""
     path = default_scene.paths[0]
     frames = Rig.from_spec(default_spec, default_scene).frames(4)
-    steps = [np.linalg.norm(b.T_world_ego[:2, 3] - a.T_world_ego[:2, 3]) for a, b in zip(frames, frames[1:])]
+    steps = [np.linalg.norm(b.T_world_ego[:2, 3] - a.T_world_ego[:2, 3]) for a, b in zip(frames, frames[1:],
+                                                                                         strict=False)]
     assert np.allclose(steps, default_spec.paths.spacing_m, rtol=1e-3)
     for f in Rig.from_spec(default_spec, default_scene).frames(30, first=5):
         pos, hd = path.at(f.s)
@@ -576,7 +579,8 @@ def test_oriented_boxes_enclose_object_vertices(default_scene):
 
 def test_box_helper_sanity():
     box = OrientedBox((0.0, 0.0, 0.5), (4.0, 2.0, 1.0), np.pi / 2)
-    assert point_box_distance(np.array([[0.0, 3.0], [2.0, 0.0], [0.0, 0.0]]), box).tolist() == pytest.approx([1.0, 1.0, 0.0])
+    assert point_box_distance(np.array([[0.0, 3.0], [2.0, 0.0], [0.0, 0.0]]), box).tolist() == pytest.approx([1.0,
+                                                                                                              1.0, 0.0])
 
 
 def test_instance_ids_go_to_things_only(default_scene):

@@ -15,12 +15,12 @@ from generator.errors import SpecError
 from generator.geometry import apply
 from generator.labels import class_table
 from generator.layout import build_scene
-from generator.layout.placement.shared_streets import BOLLARD_SPACING_M
-from generator.layout.network.cross_sections import SHARED_SPEED_MPS
 from generator.layout.ground.roads import SURFACE
+from generator.layout.network.cross_sections import SHARED_SPEED_MPS
+from generator.layout.network.draw import make_grid
 from generator.layout.network.grid import segment_frame_points
 from generator.layout.network.measures import PARKING_START_U, STOP_U
-from generator.layout.network.draw import make_grid
+from generator.layout.placement.shared_streets import BOLLARD_SPACING_M
 from generator.materials import material_table
 from generator.spec import parse_spec
 from generator.traffic.build import build_world

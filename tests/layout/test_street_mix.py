@@ -15,11 +15,11 @@ import numpy as np
 import pytest
 
 from generator.layout.assemble import build_scene
-from generator.layout.network.one_way import driven_directions
 from generator.layout.network.design_vehicle import MIN_RADIUS_M
-from generator.layout.network.routes import make_routes
-from generator.layout.network.measures import STOP_U
 from generator.layout.network.draw import make_grid
+from generator.layout.network.measures import STOP_U
+from generator.layout.network.one_way import driven_directions
+from generator.layout.network.routes import make_routes
 from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
 from generator.traffic.lanes.graph import LaneGraph
@@ -110,7 +110,7 @@ def test_layout_summary_rows_name_each_open_segment_with_its_own_section():
     grid = make_grid(full_spec(5))
     rows = sections_record(grid)
     assert grid.closed and len(rows) == len(grid.segments)
-    for row, seg in zip(rows, grid.segments):
+    for row, seg in zip(rows, grid.segments, strict=False):
         sec = grid.section(seg)
         assert (row["segment"], tuple(row["a"]), tuple(row["b"])) == (seg.index, seg.a, seg.b)
         assert (row["kind"], row["one_way"]) == (sec.kind, sec.one_way)
@@ -131,7 +131,7 @@ def test_routes_in_a_full_mix_town_are_smooth_on_the_lanes_and_one_way_forwards(
         assert inside.all(), route.name
         for node in grid.roundabouts:
             assert np.hypot(*(xy - grid.node_xy(node)).T).min() > grid.ring.island_r
-        for p, hd in zip(xy, h):
+        for p, hd in zip(xy, h, strict=False):
             hit = on_carriageway(grid, p[None])
             if hit is None or not 1.0 < hit[1] < hit[0].length - 1.0:
                 continue

@@ -16,17 +16,18 @@ import pytest
 
 from generator.errors import SpecError
 from generator.geometry import apply
+from generator.geometry.boxes import point_box_distance
 from generator.labels import class_table
 from generator.layout import build_scene
-from generator.layout.network.cross_sections import MEDIAN_W_M
 from generator.layout.lots.districts import DISTRICTS
 from generator.layout.lots.lot import make_lots
+from generator.layout.network.cross_sections import MEDIAN_W_M
 from generator.layout.network.design_vehicle import EGO_HALF_WIDTH_M
-from generator.geometry.boxes import point_box_distance
-from generator.layout.network.grid import segment_frame_points
 from generator.layout.network.draw import make_grid
+from generator.layout.network.grid import segment_frame_points
 from generator.spec import load_spec, parse_spec
 from kits.town_checks import GROUND_KINDS, check_vehicles, no_collisions, rests_on_ground
+
 
 @pytest.fixture(scope="module")
 def kitti(root):
@@ -171,7 +172,8 @@ def test_presets_are_reproducible(root, kitti):
 
 
 BAD = [
-    ({"types": {}}, "streets.types: must name at least one of arterial, boulevard, one_way, plain, residential, shared, got {}"),
+    ({"types": {}},
+     "streets.types: must name at least one of arterial, boulevard, one_way, plain, residential, shared, got {}"),
     ({"types": {"plain": 0}}, 'streets.types: needs a weight > 0, got {"plain": 0}'),
     ({"types": {"cul_de_sac": 1}}, "streets.types.cul_de_sac: unknown key"),
     ({"types": {"plain": -1}}, "streets.types.plain: must be a number in [0, 100], got -1"),

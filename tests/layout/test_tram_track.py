@@ -57,7 +57,8 @@ def test_a_ballast_track_lines_the_tram_street(tram_town):
     faces = scene.face_class == RAIL
     assert faces.sum() > 100
     z = scene.vertices[scene.faces[faces]][..., 2]
-    assert z.min() == pytest.approx(grid.curb_h, abs=1e-6) and 0.4 < z.max() - grid.curb_h < 0.8   # bed + rails on the lot
+    assert z.min() == pytest.approx(grid.curb_h,
+                                    abs=1e-6) and 0.4 < z.max() - grid.curb_h < 0.8   # bed + rails on the lot
 
 
 def test_town_without_trams_gets_no_track(test_spec):
@@ -69,7 +70,8 @@ def test_rail_track_maps_in_every_label_set():
     t = class_table()
     sets = label_sets()
     assert sets["native"].names[sets["native"].from_native[RAIL]] == "rail_track"
-    assert int(t.to_semantickitti[RAIL]) == 49 and sets["semantickitti"].names[sets["semantickitti"].from_native[RAIL]] == "other-ground"
+    assert int(t.to_semantickitti[RAIL]) == 49
+    assert sets["semantickitti"].names[sets["semantickitti"].from_native[RAIL]] == "other-ground"
     assert sets["unified11"].names[sets["unified11"].from_native[RAIL]] == "other-ground"
     assert int(t.to_cityscapes[RAIL]) == 10           # Cityscapes "rail track"
 

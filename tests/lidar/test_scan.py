@@ -8,13 +8,13 @@ import numpy as np
 import pytest
 
 from generator.geometry import box, convex_hull, rect
-from generator.world import rig
 from generator.labels import class_table
 from generator.lidar.caster import EmbreeCaster
 from generator.lidar.scan import POINT_DTYPE, Scanner
-from generator.world.rig import Rig
 from generator.lidar.sensors import load_preset
 from generator.materials import material_table
+from generator.world import rig
+from generator.world.rig import Rig
 from kits.scene_kit import scene_of, straight_path
 
 H = 1.73  # KITTI mount height
@@ -92,11 +92,13 @@ def test_points_only_within_the_sensor_range(hdl64e):
 def test_casts_real_geometry_not_label_proxies(hdl64e):
     crown = box((1.0, 1.0, 1.0), "tree_crown", "leaves", center=(8.0, 0.0, 2.0))
     scene = scene_of([("crown", crown, 5)])
-    scene.proxies["crown_hull"] = convex_hull(box((6.0, 6.0, 6.0), "tree_crown", "leaves", center=(8.0, 0.0, 2.0)), "tree_crown")
+    scene.proxies["crown_hull"] = convex_hull(box((6.0, 6.0, 6.0), "tree_crown", "leaves", center=(8.0, 0.0, 2.0)),
+                                              "tree_crown")
     scene.objects[0].proxy = "crown_hull"
     with Scanner(scene, hdl64e, threads=1) as sc:
         p = sc.scan(rig.mount((0, 0, H), (0, 0, 0))).points
-    assert len(p) and p["x"].min() > 7.5 - 1e-3  # the small real crown (front at 7.5 m), not the 6 m hull (front at 5 m)
+    # the small real crown (front at 7.5 m), not the 6 m hull (front at 5 m)
+    assert len(p) and p["x"].min() > 7.5 - 1e-3
 
 
 def test_threads_give_identical_points(hdl64e):
@@ -105,7 +107,8 @@ def test_threads_give_identical_points(hdl64e):
                       ("wall", box((1.0, 30.0, 8.0), "building", "facade_brick", center=(-15.0, 0.0, 4.0)), 2)])
     caster = EmbreeCaster.from_scene(scene)
     pose = rig.mount((0, 0, H), (0, 0, 0))
-    with Scanner(scene, hdl64e, threads=1, caster=caster) as one, Scanner(scene, hdl64e, threads=2, caster=caster) as two:
+    with Scanner(scene, hdl64e, threads=1, caster=caster) as one, Scanner(scene, hdl64e, threads=2,
+                                                                          caster=caster) as two:
         a, b = one.scan(pose).points, two.scan(pose).points
     assert a.dtype == POINT_DTYPE and a.tobytes() == b.tobytes()
 

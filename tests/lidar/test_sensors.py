@@ -95,11 +95,15 @@ def _write(tmp_path: Path, name: str, text: str) -> Path:
 
 
 @pytest.mark.parametrize("text, field", [
-    ("name: x\nrotation_hz: 10\nazimuth_steps: 100\nrange_m: [1, 50]\nlasers:\n  - {laser_id: 0}\n", "lasers[0].vert_correction"),
-    ("name: x\nrotation_hz: 0\nazimuth_steps: 100\nrange_m: [1, 50]\nuniform: {beams: 4, elevation_deg: [-5, 5]}\n", "rotation_hz"),
-    ("name: x\nrotation_hz: 10\nazimuth_steps: 100\nrange_m: [50, 1]\nuniform: {beams: 4, elevation_deg: [-5, 5]}\n", "range_m"),
+    ("name: x\nrotation_hz: 10\nazimuth_steps: 100\nrange_m: [1, 50]\nlasers:\n  - {laser_id: 0}\n",
+     "lasers[0].vert_correction"),
+    ("name: x\nrotation_hz: 0\nazimuth_steps: 100\nrange_m: [1, 50]\nuniform: {beams: 4, elevation_deg: [-5, 5]}\n",
+     "rotation_hz"),
+    ("name: x\nrotation_hz: 10\nazimuth_steps: 100\nrange_m: [50, 1]\nuniform: {beams: 4, elevation_deg: [-5, 5]}\n",
+     "range_m"),
     ("name: x\nrotation_hz: 10\nazimuth_steps: 100\nrange_m: [1, 50]\n", "lasers"),
-    ("name: x\nrotation_hz: 10\nazimuth_steps: 100\nrange_m: [1, 50]\nuniform: {beams: 4, elevation_deg: [-5, 5]}\nlaser_count: 3\n", "laser_count"),
+    ("name: x\nrotation_hz: 10\nazimuth_steps: 100\nrange_m: [1, 50]\nuniform: {beams: 4, elevation_deg: [-5, 5]}\n"
+     "laser_count: 3\n", "laser_count"),
 ])
 def test_bad_sensor_file_is_one_line_naming_file_and_field(tmp_path, text, field):
     p = _write(tmp_path, "bad.yaml", text)
@@ -112,20 +116,23 @@ def test_bad_sensor_file_is_one_line_naming_file_and_field(tmp_path, text, field
 def test_user_sensor_file_relative_to_spec(tmp_path):
     _write(tmp_path, "my_lidar.yaml", "name: mine\nrotation_hz: 20\nazimuth_steps: 360\nrange_m: [0.5, 60]\n"
                                        "uniform: {beams: 8, elevation_deg: [-10, 4]}\n")
-    spec_path = _write(tmp_path, "spec.json", json.dumps({"name": "t", "seed": 1, "sensors": {"lidar": {"sensor_file": "my_lidar.yaml"}}}))
+    spec_path = _write(tmp_path, "spec.json", json.dumps({"name": "t", "seed": 1,
+                                                          "sensors": {"lidar": {"sensor_file": "my_lidar.yaml"}}}))
     s = sensor_for_spec(load_spec(spec_path))
     assert s.name == "mine" and s.n_lasers == 8 and s.period_s == 0.05
     np.testing.assert_allclose(np.degrees(s.elevation[s.by_ring][[0, -1]]), [4, -10])
 
 
 def test_missing_user_sensor_file_names_it(tmp_path):
-    spec_path = _write(tmp_path, "spec.json", json.dumps({"name": "t", "seed": 1, "sensors": {"lidar": {"sensor_file": "nope.yaml"}}}))
+    spec_path = _write(tmp_path, "spec.json", json.dumps({"name": "t", "seed": 1,
+                                                          "sensors": {"lidar": {"sensor_file": "nope.yaml"}}}))
     with pytest.raises(SpecError, match="nope.yaml: file not found"):
         sensor_for_spec(load_spec(spec_path))
 
 
 def test_unknown_preset_names_the_spec_field(tmp_path):
-    spec_path = _write(tmp_path, "spec.json", json.dumps({"name": "t", "seed": 1, "sensors": {"lidar": {"preset": "hdl128"}}}))
+    spec_path = _write(tmp_path, "spec.json", json.dumps({"name": "t", "seed": 1,
+                                                          "sensors": {"lidar": {"preset": "hdl128"}}}))
     with pytest.raises(SpecError) as e:
         sensor_for_spec(load_spec(spec_path))
     assert e.value.field == "sensors.lidar.preset" and "hdl64e" in str(e.value) and str(spec_path) in str(e.value)

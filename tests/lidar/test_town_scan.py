@@ -7,8 +7,8 @@ import pytest
 
 from generator.labels import class_table
 from generator.lidar.scan import Scanner
-from generator.world.rig import Rig
 from generator.lidar.sensors import sensor_for_spec
+from generator.world.rig import Rig
 
 assemble = pytest.importorskip("generator.layout.assemble")
 

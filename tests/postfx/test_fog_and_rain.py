@@ -62,7 +62,7 @@ def rms_contrast(rgb: np.ndarray) -> float:
 def test_denser_fog_means_less_contrast():
     rgb, depth = street_like("day")
     c = [rms_contrast(fog_image(rgb, depth, v, "day")[0]) for v in (1000.0, 250.0, 80.0, 30.0)]
-    assert c[0] < rms_contrast(rgb) and all(a > b for a, b in zip(c, c[1:])), c
+    assert c[0] < rms_contrast(rgb) and all(a > b for a, b in zip(c, c[1:], strict=False)), c
 
 
 def test_night_airlight_darker_than_day():

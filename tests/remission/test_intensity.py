@@ -13,11 +13,12 @@ import generator.cli as cli
 from generator.errors import SpecError, UserError
 from generator.formats import semantickitti as sk
 from generator.labels import class_table
-from generator.remission import class_profiles, models as intensity
-from generator.remission.fit import ClassMoments, fit_dataset
-from generator.remission.models import intensity_fn_for_spec, intensity_model
 from generator.lidar.scan import POINT_DTYPE
 from generator.materials import material_table
+from generator.remission import class_profiles
+from generator.remission import models as intensity
+from generator.remission.fit import ClassMoments, fit_dataset
+from generator.remission.models import intensity_fn_for_spec, intensity_model
 
 SEM_DTYPE = np.dtype([("range", "<f4"), ("cos_incidence", "<f4"), ("semantic", "<u2")])
 
@@ -70,7 +71,8 @@ def test_class_normal_samples_have_profile_moments_and_stay_in_unit_interval():
         assert abs(x.mean() - m) < 6 * s / np.sqrt(n), (name, x.mean(), m)
         assert abs(x.std() - s) < 6 * s / np.sqrt(2 * n), (name, x.std(), s)
         if stats.norm.cdf(0, st.mean, st.std) + stats.norm.sf(1, st.mean, st.std) < 1e-4:  # clipping negligible
-            assert abs(x.mean() - st.mean) < 6 * st.std / np.sqrt(n) and abs(x.std() - st.std) < 6 * st.std / np.sqrt(2 * n)
+            assert abs(x.mean() - st.mean) < 6 * st.std / np.sqrt(n)
+            assert abs(x.std() - st.std) < 6 * st.std / np.sqrt(2 * n)
 
 
 def test_native_points_use_raw_then_unified_class():
@@ -88,7 +90,8 @@ def test_native_points_use_raw_then_unified_class():
 
 
 def test_raw_entry_takes_precedence_over_unified():
-    prof = class_profiles.parse_profile({"unified": {"unlabeled": {"mean": 0.1, "std": 0.0}, "road": {"mean": 0.3, "std": 0.0}},
+    prof = class_profiles.parse_profile({"unified": {"unlabeled": {"mean": 0.1, "std": 0.0}, "road": {"mean": 0.3,
+                                                                                                      "std": 0.0}},
                                     "semantickitti": {60: {"mean": 0.9, "std": 0.0}}}, "p.yaml")
     x = intensity.class_normal(prof)(semantic_points(np.array([40, 60, 48, 10], np.uint16)), np.random.default_rng(0))
     # 40 road -> unified road, 60 raw entry, 48 sidewalk and 10 car fall back to unlabeled
@@ -150,7 +153,8 @@ def test_physical_is_monotone_in_range_and_incidence_and_in_unit_interval():
         pts["range"], pts["cos_incidence"] = 10.0, c
         by_cos.append(fn(pts, np.random.default_rng(0)).mean())
     assert np.all(np.diff(by_cos) > 0)
-    pts["range"], pts["cos_incidence"] = np.random.default_rng(1).uniform(0.9, 120, n), np.random.default_rng(2).uniform(0, 1, n)
+    pts["range"], pts["cos_incidence"] = np.random.default_rng(1).uniform(0.9, 120,
+                                                                          n), np.random.default_rng(2).uniform(0, 1, n)
     pts["material"] = np.random.default_rng(3).integers(0, len(mats), n)
     x = fn(pts, np.random.default_rng(0))
     assert x.dtype == np.float32 and x.min() >= 0 and x.max() <= 1
@@ -162,7 +166,8 @@ def test_physical_is_monotone_in_range_and_incidence_and_in_unit_interval():
 
 
 def test_physical_without_materials_uses_class_reflectivity():
-    road, sign = semantic_points(np.array([40], np.uint16), 10.0, 1.0), semantic_points(np.array([81], np.uint16), 10.0, 1.0)
+    road, sign = semantic_points(np.array([40], np.uint16), 10.0, 1.0), semantic_points(np.array([81], np.uint16),
+                                                                                        10.0, 1.0)
     assert intensity.received_power(road)[0] == pytest.approx(material_table()["asphalt"].reflectivity)
     assert intensity.received_power(sign)[0] > 10 * intensity.received_power(road)[0]
 
@@ -186,13 +191,15 @@ def test_spec_profile_path_is_relative_to_the_spec(tmp_path, test_spec):
                                                                   "intensity_profile": "prof.yaml"}}))
     fn = intensity_fn_for_spec(load_spec(spec))
     assert np.allclose(fn(semantic_points(np.array([40, 10], np.uint16)), np.random.default_rng(0)), 0.7)
-    spec.write_text(json.dumps({"name": "t", "seed": 1, "lidar": {"intensity_model": "hybrid", "intensity_profile": "nope.yaml"}}))
+    spec.write_text(json.dumps({"name": "t", "seed": 1, "lidar": {"intensity_model": "hybrid",
+                                                                  "intensity_profile": "nope.yaml"}}))
     with pytest.raises(SpecError, match="lidar.intensity_profile: nope.yaml: intensity profile not found"):
         intensity_fn_for_spec(load_spec(spec))
 
 
 def test_intensity_model_by_name():
-    assert intensity_model("constant", constant_value=0.25)(semantic_points(np.zeros(3, np.uint16)), None).tolist() == [0.25] * 3
+    assert intensity_model("constant", constant_value=0.25)(semantic_points(np.zeros(3, np.uint16)),
+                                                            None).tolist() == [0.25] * 3
     with pytest.raises(UserError, match="unknown intensity model"):
         intensity_model("laser")
 
@@ -221,7 +228,7 @@ def welford(root, sequences):
     n, mean, m2 = {}, {}, {}
     for s in sequences:
         for rec in sk.Sequence(root, s):
-            for key, x in zip(rec.semantic.tolist(), rec.points[:, 3].astype(np.float64).tolist()):
+            for key, x in zip(rec.semantic.tolist(), rec.points[:, 3].astype(np.float64).tolist(), strict=False):
                 n[key] = n.get(key, 0) + 1
                 d = x - mean.get(key, 0.0)
                 mean[key] = mean.get(key, 0.0) + d / n[key]
@@ -242,9 +249,10 @@ def test_fit_recovers_known_parameters_and_equals_welford(tmp_path):
         assert abs(st.mean - m) < 6 * sd / np.sqrt(st.count) and abs(st.std - sd) < 6 * sd / np.sqrt(2 * st.count)
     # unified 'road' pools raw road (40) and lane-marking (60): equal to Welford over both
     pooled = [(rec.points[:, 3], rec.semantic) for s in ("00", "01") for rec in sk.Sequence(tmp_path, s)]
-    road = np.concatenate([p[np.isin(l, [40, 60])] for p, l in pooled]).astype(np.float64)
+    road = np.concatenate([p[np.isin(lab, [40, 60])] for p, lab in pooled]).astype(np.float64)
     assert prof.unified["road"].count == len(road)
-    assert abs(prof.unified["road"].mean - road.mean()) < 1e-6 and abs(prof.unified["road"].std - road.std(ddof=1)) < 1e-6
+    assert abs(prof.unified["road"].mean - road.mean()) < 1e-6
+    assert abs(prof.unified["road"].std - road.std(ddof=1)) < 1e-6
     assert set(prof.unified) == {"road", "vehicle", "vegetation"}
     everything = np.concatenate([p for p, _ in pooled]).astype(np.float64)
     assert prof.pooled.count == len(everything) and abs(prof.pooled.mean - everything.mean()) < 1e-6

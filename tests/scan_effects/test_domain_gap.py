@@ -1,4 +1,5 @@
-"""Seed 002 domain-gap processing: exact removal fraction, jitter bounds, constant intensity, switches, seeds, metadata."""
+"""Seed 002 domain-gap processing: exact removal fraction, jitter bounds, constant intensity, switches, seeds,
+metadata."""
 
 from __future__ import annotations
 
@@ -8,13 +9,13 @@ import json
 import numpy as np
 import pytest
 
-from generator.geometry import box, rect
 from generator.errors import UserError
 from generator.formats import semantickitti as sk
-from generator.scan_effects.domain_gap import DomainGap, PRESETS, apply_domain_gap, apply_to_points, preset
-from generator.lidar.scan import POINT_DTYPE
+from generator.geometry import box, rect
 from generator.jobs.lidar_sequence import SequenceOptions, write_sequence
+from generator.lidar.scan import POINT_DTYPE
 from generator.rng import stream
+from generator.scan_effects.domain_gap import PRESETS, DomainGap, apply_domain_gap, apply_to_points, preset
 from kits.scene_kit import scene_of
 
 
@@ -100,7 +101,7 @@ def test_sequence_applies_the_gap_and_records_it(test_spec, tmp_path):
     meta = write_sequence(scene, spec, tmp_path,
                           SequenceOptions(frames=2, threads=1, bev=False), progress=False)
     assert meta["processing"]["domain_gap"]["dropout"] == 0.1 and meta["processing"]["domain_gap"]["jitter_m"] == 0.05
-    for rec, scan_meta in zip(sk.Sequence(tmp_path, 0), meta["scans"]):
+    for rec, scan_meta in zip(sk.Sequence(tmp_path, 0), meta["scans"], strict=False):
         cast = scan_meta["points_cast"]
         assert scan_meta["domain_gap"]["removed"] == round(0.1 * cast)
         assert len(rec.points) == cast - round(0.1 * cast) == scan_meta["points"]
@@ -128,6 +129,7 @@ def test_lidar_command_processing_options_errors(root, tmp_path, capsys, monkeyp
 
 def test_command_line_options_reach_the_spec(test_spec):
     import argparse
+
     from generator.commands.intensity import add_processing_args, spec_with_processing_args
     p = argparse.ArgumentParser()
     add_processing_args(p, weather=True)

@@ -1,4 +1,5 @@
-"""LiDAR weather: fog thins far points and dims intensity, soft returns, rain noise, wet ground, tied to the frame draw."""
+"""LiDAR weather: fog thins far points and dims intensity, soft returns, rain noise, wet ground, tied to the
+frame draw."""
 
 from __future__ import annotations
 
@@ -8,16 +9,21 @@ import json
 import numpy as np
 import pytest
 
-from generator.geometry import box, rect
 from generator.formats import semantickitti as sk
-from generator.labels import class_table
-from generator.scan_effects.pipeline import ScanProcessing, process_scan, processing_for_spec
-from generator.remission.models import constant
-from generator.lidar.scan import POINT_DTYPE
+from generator.geometry import box, rect
 from generator.jobs.lidar_sequence import SequenceOptions, write_sequence
-from generator.scan_effects.weather import (LidarWeatherParams, apply_lidar_weather, extinction_per_m, frame_weather,
-                                     weather_config)
+from generator.labels import class_table
+from generator.lidar.scan import POINT_DTYPE
 from generator.materials import material_table
+from generator.remission.models import constant
+from generator.scan_effects.pipeline import ScanProcessing, process_scan, processing_for_spec
+from generator.scan_effects.weather import (
+    LidarWeatherParams,
+    apply_lidar_weather,
+    extinction_per_m,
+    frame_weather,
+    weather_config,
+)
 from generator.weather import KOSCHMIEDER, Weather, draw_weather, lidar_combination
 from kits.scene_kit import scene_of
 
@@ -57,8 +63,8 @@ def test_more_fog_fewer_far_points_and_lower_intensity():
         mean_i.append(float(r[hard].mean()))
         assert r.min() >= 0 and r.max() <= 1
     assert far[0] == int((pts["range"] > 40).sum())  # clear air keeps these (threshold 1e-5)
-    assert all(a > b for a, b in zip(far, far[1:])), far
-    assert all(a > b for a, b in zip(mean_i, mean_i[1:])), mean_i
+    assert all(a > b for a, b in zip(far, far[1:], strict=False)), far
+    assert all(a > b for a, b in zip(mean_i, mean_i[1:], strict=False)), mean_i
     assert far[-1] < 0.02 * far[0]  # 40 m visibility: almost nothing beyond 40 m
 
 
@@ -164,7 +170,7 @@ def test_sequence_with_weather_records_it_per_scan(test_spec, tmp_path):
     on_disk = json.loads((tmp_path / "sequences" / "00" / "lidar_meta.json").read_text())
     assert on_disk["processing"]["weather"]["detection_threshold"] == 1e-5
     assert on_disk["processing"]["intensity"]["model"] == "physical"
-    for rec, s in zip(sk.Sequence(tmp_path, 0), meta["scans"]):
+    for rec, s in zip(sk.Sequence(tmp_path, 0), meta["scans"], strict=False):
         assert len(rec.points) == s["points"] == s["weather"]["points_out"]
         soft = s["weather"]["fog_soft_returns"]
         assert (rec.semantic == 0).sum() == soft and (soft > 0) == (s["weather"]["kind"] == "fog")

@@ -31,13 +31,13 @@ import pytest
 import yaml
 
 hypothesis = pytest.importorskip("hypothesis")
-from hypothesis import HealthCheck, given, settings
-from hypothesis import strategies as st
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
 
-from kits.json_kit import value_paths
-from generator.spec import load_spec
-from kits.cli_run import TIME_LIMIT_S, run_cli
-from kits.paths import ROOT
+from generator.spec import load_spec  # noqa: E402
+from kits.cli_run import TIME_LIMIT_S, run_cli  # noqa: E402
+from kits.json_kit import value_paths  # noqa: E402
+from kits.paths import ROOT  # noqa: E402
 
 BASE_SPEC = load_spec(ROOT / "scenes" / "test_town.json").to_dict()  # every field, defaults filled in
 BASE_CONFIG = yaml.safe_load((ROOT / "render_configs" / "test.yaml").read_text())

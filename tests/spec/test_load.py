@@ -13,7 +13,6 @@ from generator.spec.validate import load_schema
 from kits.paths import ROOT
 
 
-
 @pytest.mark.parametrize("path", sorted((ROOT / "scenes").glob("*.json")), ids=lambda p: p.name)
 def test_every_shipped_scene_loads(path):
     spec = load_spec(path)

@@ -33,7 +33,8 @@ def test_scans_drawn_from_the_reference_mix_are_close_to_it(tmp_path, rng):
     seq = tmp_path / "sequences" / "00"
     for k in range(3):
         sem = rng.choice(raw, size=40_000, p=share / share.sum()).astype(np.uint16)
-        sk.write_scan(seq / "velodyne" / f"{k:06d}.bin", np.zeros((len(sem), 3), np.float32), np.zeros(len(sem), np.float32))
+        sk.write_scan(seq / "velodyne" / f"{k:06d}.bin", np.zeros((len(sem), 3), np.float32), np.zeros(len(sem),
+                                                                                                       np.float32))
         sk.write_labels(seq / "labels" / f"{k:06d}.label", sem, np.zeros(len(sem), np.uint16))
     counts, scans = count_points(tmp_path)
     assert scans == 3 and counts.sum() == 120_000

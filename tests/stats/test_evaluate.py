@@ -88,7 +88,7 @@ def test_iou_matches_the_definition_on_random_labels(rng):
     gt, pred = rng.integers(0, n, 2000), rng.integers(0, n, 2000)
     c = confusion(pred, gt, n)
     loop = np.zeros((n, n), np.int64)
-    for g, p in zip(gt, pred):
+    for g, p in zip(gt, pred, strict=False):
         loop[p, g] += 1
     assert np.array_equal(c, loop)
     res = iou_from_confusion(c, mean_over="all")

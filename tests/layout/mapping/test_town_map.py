@@ -14,8 +14,8 @@ from scipy.spatial import ConvexHull
 from generator.geometry import apply, pose
 from generator.labels import class_table
 from generator.layout import build_scene
-from generator.layout.network.draw import make_grid
 from generator.layout.mapping.town_map import TownMap, draw_town_map
+from generator.layout.network.draw import make_grid
 from kits.street_towns import skewed_spec as spec_with
 from kits.town_checks import GROUND_KINDS, RIDERS
 
@@ -62,7 +62,8 @@ def test_things_beside_a_street_keep_their_angle_to_its_kerb():
         for yaw in (0.0, np.pi / 2, np.pi, -np.pi / 2, 0.3):
             R = tm.rigid(pose(x, y, 0.0, yaw))
             world = np.arctan2(R[1, 0], R[0, 0])
-            assert np.angle(np.exp(1j * ((world - street[which]) - (yaw - grid_street)))) == pytest.approx(0.0, abs=1e-9)
+            assert np.angle(np.exp(1j * ((world - street[which]) - (yaw - grid_street)))) == pytest.approx(0.0,
+                                                                                                           abs=1e-9)
     R = tm.rigid(pose(58.0, 48.0, 0.0, np.pi / 2))          # in an intersection
     assert np.arctan2(R[1, 0], R[0, 0]) == pytest.approx(street["ns"])
 
@@ -73,7 +74,7 @@ def test_preimage_boxes_contain_the_preimage_of_the_world_box():
     world = np.c_[rng.uniform(-50, 50, (200, 2)), rng.uniform(0.1, 6, (200, 2)), rng.uniform(-4, 4, 200), np.zeros(200),
                   np.ones(200)]
     grid = tm.preimage_boxes(world, 0.7)
-    for w, g in zip(world, grid):
+    for w, g in zip(world, grid, strict=False):
         c, s = np.cos(w[4]), np.sin(w[4])
         corners = w[:2] + np.array([[a * w[2] * c - b * w[3] * s, a * w[2] * s + b * w[3] * c]
                                     for a in (-1, 1) for b in (-1, 1)])
@@ -211,8 +212,8 @@ def test_vehicles_stand_in_the_mapped_lanes_and_strips(skewed):
 
 def test_routes_keep_clear_in_the_world(skewed):
     _, scene = skewed
-    from generator.layout.network.design_vehicle import EGO_HALF_WIDTH_M
     from generator.geometry.boxes import point_box_distance
+    from generator.layout.network.design_vehicle import EGO_HALF_WIDTH_M
 
     spec = skewed[0]
     limit = spec.paths.clearance_m + EGO_HALF_WIDTH_M

@@ -16,9 +16,9 @@ from generator.errors import SpecError
 from generator.labels import class_table
 from generator.layout.assemble import build_scene
 from generator.layout.network.cycles import route_pairs
-from generator.layout.network.routes import make_routes
-from generator.layout.network.measures import CROSSWALK_U
 from generator.layout.network.draw import make_grid
+from generator.layout.network.measures import CROSSWALK_U
+from generator.layout.network.routes import make_routes
 from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
 from generator.traffic.lanes.graph import LaneGraph
@@ -99,7 +99,8 @@ def test_zero_leaves_the_spec_hash_and_bad_values_are_one_line():
         with pytest.raises(SpecError) as e:
             parse_spec({"name": "x", "seed": 1, "streets": {"closed_streets": value}}, "scenes/x.json")
         msg = str(e.value)
-        assert msg.startswith("scenes/x.json: streets.closed_streets: must be a number in [0, 1], got ") and "\n" not in msg
+        assert msg.startswith("scenes/x.json: streets.closed_streets: must be a number in [0, 1], got ")
+        assert "\n" not in msg
 
 
 def test_bad_closed_streets_through_the_cli_exits_2_writes_nothing(tmp_path, capsys):
@@ -137,7 +138,8 @@ def test_the_park_is_grass_and_a_path_with_trees_and_nothing_else(town):
     for seg in grid.closed:
         inner = _in_corridor(grid, seg, centre[:, :2], grid.road_half - 0.05) & is_ground
         u = (centre[:, :2] - np.asarray(seg.origin)) @ np.array([np.cos(seg.yaw), np.sin(seg.yaw)])
-        inner &= (u > grid.corridor_half - grid.road_half + 0.05) & (u < seg.length - grid.corridor_half + grid.road_half - 0.05)
+        inner &= (u > grid.corridor_half - grid.road_half + 0.05) & (u < seg.length - grid.corridor_half
+                                                                     + grid.road_half - 0.05)
         flat = inner & (np.abs(tri[:, :, 2] - grid.curb_h).max(1) < 1e-3)     # the ground at kerb height
         assert {table.names[i] for i in np.unique(scene.face_class[flat])} == {"terrain", "sidewalk"}
         below = inner & (tri[:, :, 2].min(1) < grid.curb_h - 1e-3)
@@ -201,7 +203,8 @@ def test_feet_on_the_ground_under_them(seed):
         xyz = a.track.xyz
         ground = grid.ground_height(xyz[:, :2])
         bad = np.flatnonzero(np.abs(xyz[:, 2] - ground) > 1e-6)
-        assert not len(bad), f"{a.name} sample {bad[0]}: feet at {xyz[bad[0], 2]:.4f} m on ground at {ground[bad[0]]:.4f} m"
+        assert not len(bad), (f"{a.name} sample {bad[0]}: feet at {xyz[bad[0], 2]:.4f} m "
+                              f"on ground at {ground[bad[0]]:.4f} m")
         for seg in grid.closed:
             inside = _in_corridor(grid, seg, xyz[:, :2], grid.corridor_half)
             assert np.all(np.abs(xyz[inside, 2] - grid.curb_h) < 1e-6), a.name

@@ -18,11 +18,11 @@ from generator.cli import main
 from generator.errors import SpecError
 from generator.labels import class_table
 from generator.layout import build_scene
-from generator.layout.network.one_way import driven_directions, strongly_connected
-from generator.layout.network.routes import make_routes
+from generator.layout.network.draw import make_grid
 from generator.layout.network.grid import segment_frame_points
 from generator.layout.network.measures import STOP_U
-from generator.layout.network.draw import make_grid
+from generator.layout.network.one_way import driven_directions, strongly_connected
+from generator.layout.network.routes import make_routes
 from generator.spec import load_spec, parse_spec
 from generator.traffic.build import build_world
 from generator.traffic.lanes.graph import LaneGraph
@@ -71,7 +71,7 @@ def test_routes_drive_one_way_streets_forwards_only(seed):
         if d:
             assert driven.get(s.index, {d}) == {d}
     for path in make_routes(grid):
-        for p, h in zip(path.points[:, :2], path.headings):
+        for p, h in zip(path.points[:, :2], path.headings, strict=False):
             hit = on_carriageway(grid, p[None])
             if hit is None or not 1.0 < hit[1] < hit[0].length - 1.0:
                 continue
@@ -215,6 +215,7 @@ def test_layout_summary_records_each_streets_draw():
 hypothesis = pytest.importorskip("hypothesis")
 from hypothesis import HealthCheck, given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
+
 from kits.hostile_values import HOSTILE  # noqa: E402
 
 

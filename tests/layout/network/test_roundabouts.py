@@ -13,24 +13,29 @@ import numpy as np
 import pytest
 
 from generator.errors import SpecError
+from generator.geometry.boxes import quads_overlap
 from generator.labels import class_table
 from generator.layout.assemble import build_scene
-from generator.layout.network.design_vehicle import EGO_HALF_WIDTH_M
-from generator.layout.network.measures import ARM_DIRS
-from generator.layout.network.design_vehicle import DESIGN_VEHICLES_M, STANDARD_CAR_M
-from generator.layout.network.rings import _closest, ring_geometry, ring_path
-from generator.layout.network.design_vehicle import MIN_RADIUS_M
-from generator.layout.network.routes import make_routes
-from generator.layout.network.measures import APRON_H_M
+from generator.layout.network.design_vehicle import DESIGN_VEHICLES_M, EGO_HALF_WIDTH_M, MIN_RADIUS_M, STANDARD_CAR_M
 from generator.layout.network.draw import make_grid
+from generator.layout.network.measures import APRON_H_M, ARM_DIRS
+from generator.layout.network.rings import _closest, ring_geometry, ring_path
+from generator.layout.network.routes import make_routes
 from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
 from generator.traffic.lanes.graph import LaneGraph
-from generator.geometry.boxes import quads_overlap
 from generator.traffic.lanes.signals import Signals
 from generator.traffic.vehicles.sim import Vehicle, VehicleSim
-from kits.traffic_contacts import Box, assert_no_contact, assert_vehicles_miss_people, footprint, footprints, static_quads, touching
 from kits.town_checks import radii
+from kits.traffic_contacts import (
+    Box,
+    assert_no_contact,
+    assert_vehicles_miss_people,
+    footprint,
+    footprints,
+    static_quads,
+    touching,
+)
 
 TRAFFIC = {"cars_per_km": 25, "trucks_per_km": 2, "buses_per_km": 1, "cyclists_per_km": 3, "motorcyclists_per_km": 2,
            "other_vehicles_per_km": 1, "pedestrians_per_100m": 1.0, "standing_pedestrians_per_100m": 0.5}
@@ -115,7 +120,7 @@ def test_the_field_at_zero_changes_neither_the_hash_nor_the_routes(default_spec)
     a, b = parse_spec(base, "a.json"), parse_spec(zero, "a.json")
     assert a.spec_hash == b.spec_hash
     assert parse_spec({**zero, "streets": {**zero["streets"], "roundabouts": 0.3}}, "a.json").spec_hash != a.spec_hash
-    for ra, rb in zip(make_routes(make_grid(a)), make_routes(make_grid(b))):
+    for ra, rb in zip(make_routes(make_grid(a)), make_routes(make_grid(b)), strict=False):
         np.testing.assert_array_equal(ra.points, rb.points)
 
 
@@ -248,7 +253,8 @@ def test_the_island_is_raised_other_ground_with_grass_and_nothing_but_vehicles_o
     assert 0 < ring.core_r < ring.island_r
     top = scene.face_class[(r < ring.core_r - 0.05) & (np.abs(centre[:, 2] - grid.curb_h) < 0.01)]
     assert {table.names[i] for i in np.unique(top)} == {"other_ground", "terrain"}      # kerb band, grass
-    apron = scene.face_class[(r > ring.core_r + 0.05) & (r < ring.island_r - 0.05) & (np.abs(centre[:, 2] - APRON_H_M) < 0.01)]
+    on_apron = (r > ring.core_r + 0.05) & (r < ring.island_r - 0.05) & (np.abs(centre[:, 2] - APRON_H_M) < 0.01)
+    apron = scene.face_class[on_apron]
     assert {table.names[i] for i in np.unique(apron)} == {"other_ground"}
     assert grid.ground_height(c[None])[0] == grid.curb_h
     assert grid.ground_height(c[None] + [(ring.core_r + ring.island_r) / 2, 0])[0] == APRON_H_M
@@ -308,7 +314,8 @@ def test_a_minute_of_traffic_through_a_roundabout_never_touches(town):
             box = a.box(t)
             corners = box.corners_xy() - c
             # the box edges' closest point to the centre: sample the edges
-            edges = corners[:, None] + (np.roll(corners, -1, 0) - corners)[:, None] * np.linspace(0, 1, 41)[None, :, None]
+            edges = corners[:, None] + (np.roll(corners, -1, 0) - corners)[:, None] * np.linspace(0, 1, 41)[None, :,
+                                                                                                            None]
             r = np.hypot(*edges.reshape(-1, 2).T).min()
             assert r > ring.core_r, f"{a.name} drives over the raised island at t={t:.1f}"
             if box.size[0] <= STANDARD_CAR_M[0] and box.size[1] <= 2 * EGO_HALF_WIDTH_M:
@@ -369,7 +376,8 @@ def test_a_vehicle_at_its_setback_keeps_clear_of_a_bus_swinging_out_over_its_giv
             sb = setbacks(graph, (x, y, 0), bus, wait[1])
             assert set(sb) == {(y, 0)} and sb[(y, 0)] > 1.0, sb
             p = ring_path(graph.grid.ring, np.zeros(2), x, y, 0)
-            swept = footprints([Box((*q[:2], 1.5), (*bus, 3.0), float(h)) for q, h in zip(p.points, p.headings)])
+            swept = footprints([Box((*q[:2], 1.5), (*bus, 3.0), float(h)) for q, h in zip(p.points, p.headings,
+                                                                                          strict=False)])
             a = -np.asarray(ARM_DIRS[y])
             right = np.array([a[1], -a[0]])
             for back, clear in ((sb[(y, 0)], True), (0.0, False)):

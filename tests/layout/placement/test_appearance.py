@@ -35,7 +35,7 @@ def test_fleet_colour_frequencies_match_the_configured_distribution():
     assert _chi2_p(counts, fleet.p) > 1e-3
     assert np.abs(counts / N_DRAWS - fleet.p).max() < 0.01
     # the shares the issue asks for: mostly white, black, grey and silver
-    share = dict(zip(fleet.names, fleet.p))
+    share = dict(zip(fleet.names, fleet.p, strict=False))
     assert share["white"] == pytest.approx(0.25, abs=0.01) and share["black"] == pytest.approx(0.20, abs=0.01)
     assert share["grey"] + share["silver"] == pytest.approx(0.33, abs=0.01)
     assert share["blue"] == pytest.approx(0.09, abs=0.01) and share["red"] == pytest.approx(0.08, abs=0.01)
@@ -123,7 +123,8 @@ def test_every_body_type_rests_on_its_four_wheels(body, seed):
     assert len(wheels) == 4
     xs = np.unique(wheels[:, 0])
     assert len(xs) == 2                                                 # two axles ...
-    assert np.allclose(np.sort(contacts[contacts[:, 1] > 0, 1]), np.sort(-contacts[contacts[:, 1] < 0, 1]))  # ... a symmetric track
+    assert np.allclose(np.sort(contacts[contacts[:, 1] > 0, 1]), np.sort(-contacts[contacts[:, 1] < 0,
+                                                                                   1]))  # ... a symmetric track
     assert np.ptp(contacts[contacts[:, 1] > 0, 1]) > 0.1                # a tyre's width on the road
     lo, hi = m.bounds()
     wheelbase = xs[1] - xs[0]

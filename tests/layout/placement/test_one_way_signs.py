@@ -14,13 +14,13 @@ import pytest
 
 from assets_procedural.catalog import build
 from generator.geometry import face_normals
+from generator.geometry.boxes import point_box_distance
 from generator.labels import class_table
 from generator.layout import build_scene
 from generator.layout.network.design_vehicle import EGO_HALF_WIDTH_M
-from generator.geometry.boxes import point_box_distance
-from generator.layout.placement.street_frame import Street
-from generator.layout.network.grid import segment_frame_points
 from generator.layout.network.draw import make_grid
+from generator.layout.network.grid import segment_frame_points
+from generator.layout.placement.street_frame import Street
 from generator.materials import material_table
 from generator.traffic.lanes.graph import LaneGraph
 from kits.street_towns import MIX_TRAFFIC, full_spec, one_way_spec
@@ -195,4 +195,5 @@ def test_no_moving_actor_touches_a_one_way_sign():
     signs = footprints([o.box for o in scene.objects if _face_kind(scene, o)])
     assert len(signs) >= 10 and sum(a.kind == "person" for a in world.actors) >= 20
     for t in np.arange(0.0, 20.0, 0.2):
-        assert not touching(footprints([a.box(t) for a in world.actors]), signs).any(), f"an actor touches a sign at t = {t:.1f} s"
+        assert not touching(footprints([a.box(t) for a in world.actors]),
+                            signs).any(), f"an actor touches a sign at t = {t:.1f} s"

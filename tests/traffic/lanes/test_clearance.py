@@ -9,14 +9,13 @@ import numpy as np
 import pytest
 
 from generator.layout.assemble import build_scene
+from generator.layout.network.design_vehicle import EGO_SIZE_M
 from generator.layout.placement.prototypes import Library
 from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
-from generator.layout.network.design_vehicle import EGO_SIZE_M
-from generator.traffic.vehicles.fleet import KINDS
-from generator.traffic.vehicles.fleet import widest_half_width
-from kits.traffic_contacts import footprints, static_quads, touching
+from generator.traffic.vehicles.fleet import KINDS, widest_half_width
 from kits.paths import ROOT
+from kits.traffic_contacts import footprints, static_quads, touching
 
 BUSES = {"cars_per_km": 10, "trucks_per_km": 1, "buses_per_km": 4, "other_vehicles_per_km": 1, "cyclists_per_km": 1}
 

@@ -17,14 +17,22 @@ import pytest
 
 from generator.layout.assemble import build_scene
 from generator.layout.network.draw import make_grid
+from generator.layout.network.measures import ARM_DIRS
 from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
 from generator.traffic.lanes.clearance import MARGIN_M, blocked_turns, too_narrow
-from generator.layout.network.measures import ARM_DIRS
 from generator.traffic.lanes.graph import LaneGraph
 from generator.traffic.lanes.turn_clearance import node_setbacks
-from kits.traffic_contacts import Box, assert_no_contact, assert_vehicles_miss_people, footprint, footprints, static_quads, touching
 from kits.paths import ROOT
+from kits.traffic_contacts import (
+    Box,
+    assert_no_contact,
+    assert_vehicles_miss_people,
+    footprint,
+    footprints,
+    static_quads,
+    touching,
+)
 
 BUS = (12.13, 3.0)        #: the longest bus variant's box, mirrors included, metres
 
@@ -86,7 +94,7 @@ def test_a_vehicle_at_its_setback_keeps_clear_of_a_bus_turning_right_into_its_st
     c0 = graph.grid.node_xy(node)
     wait = (12.0, 2.55)
     right_turns = 0
-    for (n, x, y, k), ci in graph.connector.items():
+    for (n, x, y, _k), ci in graph.connector.items():
         conn = graph.edges[ci]
         if n != node:
             continue
@@ -98,7 +106,8 @@ def test_a_vehicle_at_its_setback_keeps_clear_of_a_bus_turning_right_into_its_st
         sb = node_setbacks(graph, conn, BUS, wait[1])
         assert sb.get((y, 0), 0.0) > 1.0, (x, y, sb)
         rel = conn.path.points[:, :2] - c0
-        swept = footprints([Box((*q, 1.5), (*BUS, 3.0), float(h)) for q, h in zip(rel, conn.path.headings)])
+        swept = footprints([Box((*q, 1.5), (*BUS, 3.0), float(h)) for q, h in zip(rel, conn.path.headings,
+                                                                                  strict=False)])
         for back, clear in ((sb[(y, 0)], True), (0.0, False)):
             box = _opposite_waiting_box(graph, y, back, wait)
             assert touching(box[None], swept).any() != clear, (x, y, back)
@@ -117,7 +126,8 @@ def test_turns_whose_sweep_reaches_a_parked_object_are_avoided_by_buses_only():
     size = (BUS[0] + 2 * MARGIN_M, BUS[1] + 2 * MARGIN_M)
     for c in blocked:   # each one really does touch a placed object
         e = graph.edges[c]
-        swept = footprints([Box((*q[:2], 1.5), (*size, 3.0), float(h)) for q, h in zip(e.path.points, e.path.headings)])
+        swept = footprints([Box((*q[:2], 1.5), (*size, 3.0), float(h)) for q, h in zip(e.path.points, e.path.headings,
+                                                                                       strict=False)])
         assert touching(swept, parked).any()
     assert blocked <= too_narrow(graph, scene, BUS[1] / 2, set(), BUS[0])
     assert not too_narrow(graph, scene, 1.9 / 2, set(), 4.6) & blocked

@@ -16,15 +16,21 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-from generator.layout.placement.prototypes import Library, WHOLE_BOX_KINDS, collision_boxes
 from generator.geometry.boxes import world_boxes
-from generator.layout.network.measures import CROSSWALK_U
 from generator.layout.network.draw import make_grid
-from generator.traffic.pedestrians import clear as walk_clear, net as walk_net
+from generator.layout.network.measures import CROSSWALK_U
+from generator.layout.placement.prototypes import WHOLE_BOX_KINDS, Library, collision_boxes
+from generator.traffic.lanes.signals import CYCLE_S, WALK_S, Signals
 from generator.traffic.movers import DT_S
-from generator.traffic.pedestrians.simulate import (MARGIN_M, max_speed, person_protos, sidewalk_length,
-                                                    simulate_pedestrians)
-from generator.traffic.lanes.signals import CYCLE_S, Signals, WALK_S
+from generator.traffic.pedestrians import clear as walk_clear
+from generator.traffic.pedestrians import net as walk_net
+from generator.traffic.pedestrians.simulate import (
+    MARGIN_M,
+    max_speed,
+    person_protos,
+    sidewalk_length,
+    simulate_pedestrians,
+)
 from generator.traffic.pedestrians.walkways import build_walkways, obstacles_of
 
 N_STEPS = int(CYCLE_S / DT_S)          # one whole signal cycle: every node has a walk phase
@@ -251,7 +257,8 @@ def test_density_scales_the_counts(test_spec, test_scene):
     counts = {}
     for d in (2.0, 4.0):
         movers = _simulate(_with_traffic(test_spec, d, d / 2), test_scene, 2)
-        counts[d] = (sum(m.attrs["role"] == "walking" for m in movers), sum(m.attrs["role"] == "standing" for m in movers))
+        counts[d] = (sum(m.attrs["role"] == "walking" for m in movers), sum(m.attrs["role"] == "standing"
+                                                                            for m in movers))
     length = sidewalk_length(make_grid(test_spec))
     for d, (walk, stand) in counts.items():
         assert (walk, stand) == (round(d * length / 100), round(d / 2 * length / 100))

@@ -14,9 +14,15 @@ from generator.traffic.build import build_world
 from generator.traffic.lanes.graph import LaneGraph
 from generator.world.actors import MOVING_THRESHOLD_MPS, Track
 from generator.world.rig import SWEEP_PERIOD_S, Rig
-from kits.traffic_contacts import (assert_no_contact, assert_vehicles_miss_people, ego_box, footprints, static_quads,
-                                   touching)
 from kits.paths import ROOT
+from kits.traffic_contacts import (
+    assert_no_contact,
+    assert_vehicles_miss_people,
+    ego_box,
+    footprints,
+    static_quads,
+    touching,
+)
 
 TRAFFIC = {"cars_per_km": 25, "trucks_per_km": 2, "buses_per_km": 1, "cyclists_per_km": 3, "motorcyclists_per_km": 2,
            "other_vehicles_per_km": 1}
@@ -77,7 +83,8 @@ def test_vehicles_stay_on_the_driving_lanes(town):
     for t in _times()[::5]:
         for a in world.actors:
             c = np.asarray(a.box(t).center[:2])
-            inside = ((c[0] >= drive[:, 0]) & (c[0] <= drive[:, 2]) & (c[1] >= drive[:, 1]) & (c[1] <= drive[:, 3])).any()
+            inside = ((c[0] >= drive[:, 0]) & (c[0] <= drive[:, 2]) & (c[1] >= drive[:, 1]) & (c[1] <= drive[:,
+                                                                                                             3])).any()
             assert inside, f"{a.name} off the lanes at t={t:.1f}: {c}"
 
 
@@ -121,7 +128,7 @@ def test_same_seed_same_world_and_a_longer_run_is_a_prefix(town):
     spec, scene, world = town
     short = build_world(spec, scene, 10.0)
     n = len(short.actors[0].track.yaw) - 30
-    for a, b in zip(world.actors, short.actors):
+    for a, b in zip(world.actors, short.actors, strict=False):
         assert np.array_equal(a.track.xyz[:n], b.track.xyz[:n]) and np.array_equal(a.track.yaw[:n], b.track.yaw[:n])
 
 
@@ -213,7 +220,8 @@ def test_lidar_sequence_through_traffic_labels_movers_and_repeats_byte_for_byte(
     assert seen_moving > 300
     to_static = {252: 10, 253: 31, 254: 30, 255: 32, 256: 16, 257: 13, 258: 18, 259: 20}
     for i, ids in class_of.items():  # an instance is one actor all sequence: its class, moving or not (a rider's bike)
-        assert {to_static.get(x, x) for x in ids} <= {int(class_table()[by_instance[i].cls].semantickitti), 11, 15}, (i, ids)
+        assert {to_static.get(x, x) for x in ids} <= {int(class_table()[by_instance[i].cls].semantickitti), 11,
+                                                      15}, (i, ids)
 
 
 def test_a_rebuilt_world_is_checked_against_the_recorded_digest(town):
@@ -252,8 +260,7 @@ def test_every_moving_vehicle_fits_inside_its_lane():
     parking strip (parked cars) or the opposite lane. Excavators drive with the house straight
     (generator/traffic/fleet.py): slewed, their boxes were 3-6 m wide."""
     from generator.layout.placement.prototypes import Library
-    from generator.traffic.vehicles.fleet import KINDS
-    from generator.traffic.vehicles.fleet import fleet_proto
+    from generator.traffic.vehicles.fleet import KINDS, fleet_proto
 
     for seed in (1, 2, 3, 11):
         grid, lib = make_grid(_sweep_town(seed, 0.0)), Library(seed)
