@@ -48,3 +48,14 @@ def skewed_spec(angle=(65.0, 65.0), seed: int = 4, traffic: dict | None = None, 
     if speed_mps is not None:
         doc["paths"] = {"speed_mps": speed_mps}
     return parse_spec(doc, "skewed_town.json")
+
+
+def roundabout_spec(blocks: int = 2, share: float = 1.0, seed: int = 11, traffic: dict | None = None, **town):
+    """A ``blocks`` x ``blocks`` town, ``share`` of its interior nodes roundabouts; ``town``: more town fields."""
+    doc = {"name": "roundabout_town", "seed": seed,
+           "town": {"blocks_x": blocks, "blocks_y": blocks, "block_size_m": 45, "block_size_jitter_m": 6,
+                    "margin_m": 10, **town},
+           "density": {"moving_cars_per_100m": 0}, "streets": {"roundabouts": share}}
+    if traffic is not None:
+        doc["traffic"] = traffic
+    return parse_spec(doc, "roundabout_town.json")
