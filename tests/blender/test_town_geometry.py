@@ -7,12 +7,23 @@ one-way and shared streets, all of them together, and a skewed town.
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from generator.layout import build_scene
 from generator.layout.network.draw import make_grid
 from generator.spec import parse_spec
-from kits.blender_scene import blender_matches_scene
+
+
+def blender_matches_scene(spec, scene, tmp_path) -> None:
+    """Blender's evaluated geometry of ``scene`` has its triangle count and bounds."""
+    from generator.blender.renderer import Renderer
+    from generator.spec.render import load_render_config
+
+    n, bounds = Renderer(scene, spec, load_render_config("test"), tmp_path).evaluated_geometry()
+    assert n == len(scene.faces)
+    v = scene.vertices.astype(np.float64)
+    assert np.allclose(bounds, [v.min(0), v.max(0)], atol=1e-3)
 
 
 @pytest.mark.blender

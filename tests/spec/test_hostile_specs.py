@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import copy
 import json
-import math
 import os
 import tempfile
 import time
@@ -36,6 +35,7 @@ from hypothesis import strategies as st  # noqa: E402
 
 from generator.spec import load_spec  # noqa: E402
 from kits.cli_run import TIME_LIMIT_S, run_cli  # noqa: E402
+from kits.hostile_values import HOSTILE  # noqa: E402
 from kits.json_kit import value_paths  # noqa: E402
 from kits.paths import ROOT  # noqa: E402
 
@@ -90,13 +90,6 @@ _scalars = st.one_of(
 #: Random JSON-like trees (YAML gets the same trees).
 TREES = st.recursive(_scalars, lambda c: st.lists(c, max_size=4) | st.dictionaries(st.text(max_size=12), c, max_size=4),
                      max_leaves=16)
-#: Values that are wrong for almost every field, never an in-range number (so a valid run stays the test town).
-HOSTILE = st.one_of(
-    st.sampled_from([math.nan, math.inf, -math.inf, 10**400, -(10**400), 1e308, "", "x" * 10_000, [], {}, None,
-                     True, [[[[]]]], {"": None}]),
-    st.text(max_size=20), st.lists(st.text(max_size=4), max_size=5),
-    st.dictionaries(st.text(max_size=8), st.text(max_size=8), max_size=3),
-)
 
 
 class Doc:
