@@ -1,5 +1,5 @@
 """Shared fixtures: a seeded rng, the test and default specs, a cached test-town scene; the
-grouping that keeps a module's shared build on one worker under ``pytest -n 2 --dist loadgroup``."""
+scheduling that keeps a module's shared build on one worker under ``pytest -n 2 --dist loadgroup``."""
 
 from __future__ import annotations
 
@@ -51,20 +51,27 @@ def default_scene(default_spec):
     return build_scene(default_spec)
 
 
-@pytest.hookimpl(tryfirst=True)
-def pytest_collection_modifyitems(config, items):
-    """Under ``--dist loadgroup`` (pytest-xdist) every test that uses a module- or class-scoped
-    fixture joins its module's group, so the module's shared build (a rendered dataset, a town with
-    traffic) is made once, on one worker; the other tests go to whichever worker is free. Session
-    fixtures are built once per worker. Without xdist the mark does nothing."""
-    for item in items:
-        info = getattr(item, "_fixtureinfo", None)
-        if info is None:
-            continue
-        shared = any(d.scope in ("module", "class", "package")
-                     for name in info.names_closure for d in info.name2fixturedefs.get(name, ()))
-        if shared and not any(True for _ in item.iter_markers("xdist_group")):
-            item.add_marker(pytest.mark.xdist_group(item.nodeid.split("::")[0]))
+try:
+    from xdist.scheduler import LoadGroupScheduling
+except ImportError:  # pytest-xdist is in the test extra; without it the suite runs in one process
+    LoadGroupScheduling = None
+if LoadGroupScheduling is not None:
+
+    class _SharedBuildScheduling(LoadGroupScheduling):
+        """``--dist loadgroup``: the tests of a module that use its module-scoped build run on one
+        worker, every other test wherever a worker is free (:mod:`kits.xdist_groups`)."""
+
+        def _split_scope(self, nodeid: str) -> str:
+            if nodeid.rfind("@") > nodeid.rfind("]"):       # an xdist_group mark xdist could apply
+                return super()._split_scope(nodeid)
+            from kits.xdist_groups import scope_of
+
+            return scope_of(nodeid, self.config.rootpath)
+
+    def pytest_xdist_make_scheduler(config, log):
+        if config.getvalue("dist") == "loadgroup":
+            return _SharedBuildScheduling(config, log)
+        return None
 
 
 # Hypothesis profiles for the property tests: ``dev`` (default, 100 examples), ``ci`` (25

@@ -72,3 +72,37 @@ def test_no_test_locates_the_checkout_from_its_own_path():
            if str(p.relative_to(TESTS)) not in LOCATES_ITSELF and _uses_file(p.read_text(encoding="utf-8"))]
     assert not bad, f"use kits.paths.ROOT / SHARED or the root fixture instead of __file__: {bad}"
     assert _uses_file("from pathlib import Path\nROOT = Path(__file__).parents[1]\n")
+
+
+def test_tests_that_share_a_module_build_share_a_worker(request):
+    """What the xdist scheduler reads from the files (kits.xdist_groups) covers every collected test
+    that pytest itself resolves to a module-, class- or package-scoped fixture: those tests form one
+    unit of work per module, so the module's build is made once under ``-n 2``."""
+    from kits.xdist_groups import scope_of
+
+    missed = []
+    for item in request.session.items:
+        info = getattr(item, "_fixtureinfo", None)
+        if info is None:
+            continue
+        shared = any(d.scope in ("module", "class", "package")
+                     for name in info.names_closure for d in info.name2fixturedefs.get(name, ()))
+        module = item.nodeid.split("::")[0]
+        if shared and scope_of(item.nodeid, ROOT) != module:
+            missed.append(item.nodeid)
+    assert not missed, f"the scheduler would split these from their module's build: {missed[:5]}"
+
+
+def test_the_scheduler_reads_module_fixtures_through_other_fixtures(tmp_path):
+    from kits.xdist_groups import scope_of
+
+    (tmp_path / "test_x.py").write_text(
+        "import pytest\n"
+        "@pytest.fixture(scope='module')\ndef town(): ...\n"
+        "@pytest.fixture\ndef world(town): ...\n"
+        "def test_a(world): ...\n"
+        "def test_b(tmp_path): ...\n"
+        "class TestC:\n    def test_c(self, town): ...\n")
+    assert scope_of("test_x.py::test_a[1-2]", tmp_path) == "test_x.py"
+    assert scope_of("test_x.py::TestC::test_c", tmp_path) == "test_x.py"
+    assert scope_of("test_x.py::test_b", tmp_path) == "test_x.py::test_b"
