@@ -110,8 +110,7 @@ def test_generate_refuses_an_absurd_plan_at_once(tmp_path, capsys, extra, messag
 
 def test_render_frame_numbers_stay_six_digits(tmp_path, capsys):
     out = tmp_path / "ds"
-    err = _refused(capsys, ["render", SPEC, "--config", "test", "--out", str(out), "--first", "999999", "--frames",
-                            "2"],
+    err = _refused(capsys, ["render", SPEC, "--config", "test", "--out", str(out), "--first", "999999", "--frames", "2"],
                    out)
     assert "frame 1000000 planned" in err
 
@@ -143,15 +142,13 @@ def test_a_resumed_plan_is_checked_merged(tmp_path, capsys):
 
     out = tmp_path / "ds"
     out.mkdir()
-    manifest = {"spec_hash": load_spec(SPEC).spec_hash,
-                "render_config": {"config_hash": load_render_config("test").config_hash},
+    manifest = {"spec_hash": load_spec(SPEC).spec_hash, "render_config": {"config_hash": load_render_config("test").config_hash},
                 "plan": {"frames": list(range(40_000)), "combos": [["day", "clear"], ["day", "fog"]], "sequence": "00"},
                 "finished": {"images": []}, "runs": []}
     (out / "manifest.json").write_text(json.dumps(manifest))
     before = sorted(p.name for p in out.iterdir())
     capsys.readouterr()
-    rc = cli.main(["generate", SPEC, "--config", "test", "--out", str(out), "--frames", "1", "--variants",
-                   "night:rain"])
+    rc = cli.main(["generate", SPEC, "--config", "test", "--out", str(out), "--frames", "1", "--variants", "night:rain"])
     err = capsys.readouterr().err
     assert rc == 2 and "40000 frames x 3 variants = 120000 images planned" in err, err
     assert sorted(p.name for p in out.iterdir()) == before
