@@ -1,4 +1,5 @@
-"""Shared fixtures: a seeded rng, the test and default specs, a cached test-town scene."""
+"""Shared fixtures: a seeded rng, the test and default specs, a cached test-town scene; the
+scheduling that keeps a module's shared build on one worker under ``pytest -n 2 --dist loadgroup``."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+from kits.paths import ROOT
 
 
 @pytest.fixture
@@ -48,6 +49,29 @@ def default_scene(default_spec):
     from generator.layout import build_scene
 
     return build_scene(default_spec)
+
+
+try:
+    from xdist.scheduler import LoadGroupScheduling
+except ImportError:  # pytest-xdist is in the test extra; without it the suite runs in one process
+    LoadGroupScheduling = None
+if LoadGroupScheduling is not None:
+
+    class _SharedBuildScheduling(LoadGroupScheduling):
+        """``--dist loadgroup``: the tests of a module that use its module-scoped build run on one
+        worker, every other test wherever a worker is free (:mod:`kits.xdist_groups`)."""
+
+        def _split_scope(self, nodeid: str) -> str:
+            if nodeid.rfind("@") > nodeid.rfind("]"):       # an xdist_group mark xdist could apply
+                return super()._split_scope(nodeid)
+            from kits.xdist_groups import scope_of
+
+            return scope_of(nodeid, self.config.rootpath)
+
+    def pytest_xdist_make_scheduler(config, log):
+        if config.getvalue("dist") == "loadgroup":
+            return _SharedBuildScheduling(config, log)
+        return None
 
 
 # Hypothesis profiles for the property tests: ``dev`` (default, 100 examples), ``ci`` (25

@@ -1,43 +1,81 @@
 """Contact checks shared by the traffic tests: the ego's box, actor-actor / actor-ego /
-actor-static overlaps and vehicle-person overlaps at one instant (world frame, metres)."""
+actor-static overlaps and vehicle-person overlaps at one instant (world frame, metres).
+
+The kit judges contact with its own geometry, not production's: footprints are computed here from
+each box's centre, size and yaw, and two footprints touch when shapely's polygons intersect
+(touching edges count, as production's separating-axis test counts them). A wrong overlap test in
+:mod:`generator.geometry.boxes` therefore cannot pass the simulation's tests;
+``tests/geometry/test_boxes.py`` checks that both agree on many random boxes.
+"""
 
 from __future__ import annotations
 
 import numpy as np
-
-from generator.geometry.boxes import quads_overlap
-from generator.world.scene import OrientedBox
+import shapely
 
 EGO_SIZE_M = (4.6, 1.9, 1.5)
 
 
-def ego_box(world, t: float) -> OrientedBox:
+class Box:
+    """An upright box by centre (x, y, z), size (length, width, height) and yaw (radians)."""
+
+    def __init__(self, center, size, yaw: float):
+        self.center, self.size, self.yaw = tuple(center), tuple(size), float(yaw)
+
+
+def footprint(box) -> np.ndarray:
+    """(4, 2) corners of ``box``'s footprint (anything with ``center``, ``size`` and ``yaw``)."""
+    c, s = np.cos(box.yaw), np.sin(box.yaw)
+    hl, hw = box.size[0] / 2.0, box.size[1] / 2.0
+    local = np.array([[-hl, -hw], [hl, -hw], [hl, hw], [-hl, hw]])
+    return local @ np.array([[c, s], [-s, c]]) + np.asarray(box.center[:2], np.float64)
+
+
+def footprints(boxes) -> np.ndarray:
+    """(n, 4, 2) corners of the footprints of ``boxes``."""
+    return np.stack([footprint(b) for b in boxes]) if len(boxes) else np.zeros((0, 4, 2))
+
+
+def _polygons(quads: np.ndarray) -> np.ndarray:
+    return shapely.polygons(np.asarray(quads, np.float64))
+
+
+def touching(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(n, m) bool: which of the (n, 4, 2) footprints ``a`` touch or overlap which of ``b`` (m, 4, 2)."""
+    out = np.zeros((len(a), len(b)), bool)
+    if len(a) and len(b):
+        i, j = shapely.STRtree(_polygons(b)).query(_polygons(a), predicate="intersects")
+        out[i, j] = True
+    return out
+
+
+def ego_box(world, t: float) -> Box:
     """The ego vehicle's box at time ``t`` (s)."""
     E = world.ego.T_world_ego(t)[0]
-    return OrientedBox((E[0, 3], E[1, 3], 0.7), EGO_SIZE_M, float(np.arctan2(E[1, 0], E[0, 0])))
+    return Box((E[0, 3], E[1, 3], 0.7), EGO_SIZE_M, float(np.arctan2(E[1, 0], E[0, 0])))
 
 
 def static_quads(scene) -> np.ndarray:
     """(n, 4, 2) footprints of the placed things (instance id > 0) of ``scene``."""
-    return np.stack([o.box.corners_xy() for o in scene.objects if o.instance_id > 0])
+    return footprints([o.box for o in scene.objects if o.instance_id > 0])
 
 
 def assert_no_contact(world, t: float, parked: np.ndarray | None = None, ego: bool = True) -> np.ndarray:
     """No two actors overlap at ``t``, none touches the ego (unless ``ego`` is False), and none a
     ``parked`` footprint. Returns the (n, 4, 2) actor footprints at ``t``."""
-    q = np.stack([b.corners_xy() for b in world.boxes(t)])
-    ov = quads_overlap(q, q)
+    q = footprints(world.boxes(t))
+    ov = touching(q, q)
     np.fill_diagonal(ov, False)
     assert not ov.any(), f"actors {np.argwhere(ov)[0]} overlap at t={t:.1f}"
     if ego:
-        assert not quads_overlap(ego_box(world, t).corners_xy()[None], q).any(), f"an actor touches the ego at t={t:.1f}"
+        assert not touching(footprint(ego_box(world, t))[None], q).any(), f"an actor touches the ego at t={t:.1f}"
     if parked is not None:
-        assert not quads_overlap(q, parked).any(), f"an actor touches a static object at t={t:.1f}"
+        assert not touching(q, parked).any(), f"an actor touches a static object at t={t:.1f}"
     return q
 
 
 def assert_vehicles_miss_people(world, t: float, vehicles: list, people: list) -> None:
     """No vehicle (nor the ego) touches a person at ``t``."""
-    p = np.stack([a.box(t).corners_xy() for a in people])
-    hit = quads_overlap(np.stack([a.box(t).corners_xy() for a in vehicles] + [ego_box(world, t).corners_xy()]), p)
+    p = footprints([a.box(t) for a in people])
+    hit = touching(footprints([a.box(t) for a in vehicles] + [ego_box(world, t)]), p)
     assert not hit.any(), (t, np.argwhere(hit)[:3])

@@ -3,16 +3,16 @@
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
-from kits.kitti_kit import as_predictions, synthetic
 
 from generator.formats.kitti_object import KittiObject
 from generator.stats.detection_kitti import DIFFICULTIES, Frame, evaluate, thresholds
+from kits.kitti_kit import as_predictions, synthetic
+from kits.paths import ROOT
 
-FIXTURE = Path(__file__).parent / "fixtures" / "kitti_reference_r40.json"
+FIXTURE = ROOT / "tests" / "stats" / "fixtures" / "kitti_reference_r40.json"
 
 
 @pytest.fixture(scope="module")
