@@ -45,6 +45,7 @@ from generator.formats import semantickitti as sk
 from generator.formats.point_sidecars import NATIVE_DIR, read_sidecar
 from generator.imaging import meta_fields as md
 from generator.imaging.exr import read_exr
+from generator.imaging.paths import find_image, frame_of, image_files
 from generator.labels import class_table
 from generator.labels.sets import label_sets
 from generator.safeload import printable
@@ -142,12 +143,14 @@ class Dataset:
     # -- images ------------------------------------------------------------------------------
     def image_names(self, frame: int | None = None) -> list[str]:
         """Image stems (``NNNNNN_<time>_<weather>``), sorted; only those of ``frame`` if given."""
-        names = sorted(p.stem for p in (self.root / "images").glob("[0-9][0-9][0-9][0-9][0-9][0-9]*.json"))
-        return [n for n in names if frame is None or int(n[:6]) == frame]
+        files = image_files(self.root, "[0-9][0-9][0-9][0-9][0-9][0-9]_*.json", None if frame is None else [frame])
+        return sorted({p.stem for p in files})
 
     def image(self, name: str) -> ImageSample:
         """The image ``name`` with its masks, instances, depth and metadata."""
-        exr, meta = self.root / "images" / f"{name}.exr", self.root / "images" / f"{name}.json"
+        if frame_of(name) is None:
+            raise UserError(f"{printable(name, 60)}: not an image name (NNNNNN_<time>_<weather>)")
+        exr, meta = find_image(self.root, name, ".exr"), find_image(self.root, name, ".json")
         if not os.path.lexists(exr) or not os.path.lexists(meta):
             raise UserError(f"{exr}: no such image (with its .json)")
         img = read_exr(exr)

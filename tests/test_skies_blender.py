@@ -14,6 +14,7 @@ import pytest
 
 from generator.cli import main
 from generator.imaging.exr import read_exr
+from generator.imaging.paths import image_dir
 from generator.labels import class_table
 from generator.postfx.filters import luminance
 
@@ -29,7 +30,7 @@ SKY = class_table().id("sky")
 def _render(out, root, variants=VARIANTS):
     assert main(["-q", "render", str(root / "scenes/test_town.json"), "--config", "test", "--out", str(out),
                  "--frames", "1", "--first", str(FRAME), "--variants", variants]) == 0
-    return out / "images"
+    return image_dir(out, FRAME)
 
 
 @pytest.fixture(scope="module")
@@ -97,7 +98,8 @@ def test_same_seed_same_image(rendered, tmp_path, root):
 def test_moving_cars_burn_tail_lights_at_night_parked_ones_do_not(tmp_path, test_spec, test_scene):
     """A car driving ahead of the camera shows red emitters at night (tail lights: red radiance some
     20x a lamp-lit white wall); the town's parked cars stay dark."""
-    from test_render_actors import FRAME as ACTOR_FRAME, car_world
+    from test_render_actors import FRAME as ACTOR_FRAME
+    from test_render_actors import car_world
 
     from generator.blender.renderer import Renderer
     from generator.jobs.exposure import expose

@@ -21,6 +21,7 @@ from generator.formats import semantickitti as sk
 from generator.formats.point_sidecars import NATIVE_DIR, TIMES_DIR, read_sidecar
 from generator.imaging import meta_fields as md
 from generator.imaging.exr import read_exr
+from generator.imaging.paths import image_files, images_root
 from generator.labels import class_table
 
 log = logging.getLogger(__name__)
@@ -97,11 +98,11 @@ def native_from_raw(raw: np.ndarray) -> np.ndarray:
 
 def frame_images(root: Path) -> dict[int, Path]:
     """Frame index -> metadata JSON of one image variant per frame (``day_clear`` preferred)."""
-    folder = root / "images"
+    folder = images_root(root)
     if not folder.is_dir():
         raise UserError(f"{folder}: missing (render images first: urbangen render SPEC --out {root})")
     out: dict[int, Path] = {}
-    for p in sorted(folder.glob("*.json")):
+    for p in image_files(root, "*.json"):
         stem = p.stem.split("_", 1)[0]
         if not (stem.isascii() and stem.isdigit() and len(stem) <= 9):
             continue

@@ -35,6 +35,7 @@ from pathlib import Path
 
 from generator.atomic import clean_temporaries
 from generator.errors import SpecError, UserError
+from generator.imaging.paths import find_image
 from generator.jobs import manifest as mf
 from generator.jobs.executors import make_jobs, run_jobs
 from generator.jobs.plan import MAX_FRAME_INDEX, MAX_IMAGES, Plan, check_free_space, check_plan, image_bytes, scan_bytes
@@ -77,8 +78,7 @@ def lidar_done(out: Path, plan: Plan, spec) -> bool:
 
 def images_done(out: Path, plan: Plan) -> list[int]:
     """Frames whose every planned image is complete on disk."""
-    images = out / "images"
-    return [k for k in plan.frames if all((images / f"{n}.json").exists() for n in plan.images_of(k))]
+    return [k for k in plan.frames if all(find_image(out, n, ".json").exists() for n in plan.images_of(k))]
 
 
 def write_lidar(spec, cfg, out: Path, plan: Plan, scene=None, drive=None, first: int = 0) -> dict:

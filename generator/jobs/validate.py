@@ -31,6 +31,7 @@ from generator.errors import UserError
 from generator.imaging import meta_fields as md
 from generator.imaging.exr import read_exr
 from generator.imaging.metadata import class_pixels, validate_metadata
+from generator.imaging.paths import find_image, frame_of, image_files, images_root, shard_name
 from generator.jobs.validate_lidar import check_lidar, reason, rel
 from generator.labels import class_table
 
@@ -111,13 +112,20 @@ def _image_meta(meta: dict, meta_path: Path, root: Path, img) -> list[str]:
 
 
 def check_images(root: Path) -> tuple[list[str], int]:
-    """Problems of ``root/images`` and the number of images checked."""
-    folder = root / "images"
+    """Problems of ``root/images`` (its shard folders, :mod:`generator.imaging.paths`, or the flat layout of
+    older datasets) and the number of images checked."""
     problems: list[str] = []
-    exrs = sorted(folder.glob("*.exr"))
-    jsons = sorted(p for p in folder.glob("*.json"))
-    for stem in sorted({p.stem for p in jsons} - {p.stem for p in exrs}):
-        problems.append(f"{rel(folder / stem, root)}.json: metadata without its EXR")
+    exrs = image_files(root, "*.exr")
+    jsons = image_files(root, "*.json")
+    for stem in sorted({p.with_suffix("") for p in jsons} - {p.with_suffix("") for p in exrs}):
+        problems.append(f"{rel(stem, root)}.json: metadata without its EXR")
+    base = images_root(root)
+    for p in exrs + jsons:
+        k = frame_of(p.name)
+        if k is None:
+            problems.append(f"{rel(p, root)}: not an image name (NNNNNN_<time>_<weather>)")
+        elif p.parent != base and p.parent.name != shard_name(k):
+            problems.append(f"{rel(p, root)}: in the wrong shard folder (frame {k} belongs in images/{shard_name(k)}/)")
     names = class_table().names
     for exr in exrs:
         r = rel(exr, root)
@@ -179,7 +187,7 @@ def check_manifest(root: Path) -> list[str]:
     if len(frames) * len(combos) > MAX_PLAN_ITEMS:
         return [f"manifest.json: plan: more than {MAX_PLAN_ITEMS} planned images"]
     missing = [f"{k:06d}_{t}_{w}" for k in frames for t, w in combos
-               if not (root / "images" / f"{k:06d}_{t}_{w}.json").exists()]
+               if not find_image(root, f"{k:06d}_{t}_{w}", ".json").exists()]
     return [f"manifest.json: planned image {n} is missing" for n in missing]
 
 
