@@ -62,7 +62,7 @@ def _sequence(dataset: Path) -> int:
     manifest = load_json(path, max_bytes=MAX_METADATA_BYTES, max_nodes=10_000_000) if os.path.lexists(path) else {}
     plan = manifest.get("plan", {}) if isinstance(manifest, dict) else {}
     seq = str(plan.get("sequence", "0") if isinstance(plan, dict) else "?")
-    if not (seq.isascii() and seq.isdigit() and len(seq) <= 4):
+    if not (seq.isascii() and seq.isdigit() and len(seq) <= 6):
         raise UserError(f"{path}: plan.sequence must be a number, got {printable(seq, 40)!r}")
     return int(seq)
 

@@ -33,7 +33,7 @@ def register(sub) -> None:
                        description=__doc__.split("\n\n")[1])
     p.add_argument("spec", type=text_path, help="scene spec JSON the sequence was cast from")
     p.add_argument("dataset", type=path, help="dataset folder (reads lidar/sequences/NN, writes openlabel/NN.json)")
-    p.add_argument("--sequence", type=sequence_id, default="00", help="sequence, 00..99 (default 00)")
+    p.add_argument("--sequence", type=sequence_id, default="00", help="sequence, 00..999999 (default 00)")
     p.add_argument("--classes", nargs="+", default=list(DEFAULT_CLASSES),
                    help=f"object classes (thing classes of the class table; default {' '.join(DEFAULT_CLASSES)})")
     p.add_argument("--min-points", type=Integer(0, MAX_MIN_POINTS), default=None,
