@@ -61,7 +61,7 @@ def _same_images(a: Path, b: Path) -> None:
 def test_dataset_is_complete_balanced_and_valid(reference, capsys):
     m = json.loads((reference / "manifest.json").read_text())
     assert m["finished"] == {**m["finished"], "lidar": True, "openlabel": True, "stats": True}
-    assert len(m["finished"]["images"]) == 3 * 3 == len(image_files(reference, "*.exr"))
+    assert m["finished"]["images"] == 3 * 3 == len(image_files(reference, "*.exr"))
     counts = {}
     for p in image_files(reference, "*.json"):
         meta = json.loads(p.read_text())

@@ -82,6 +82,9 @@ class SequenceOptions:
     weather : bool
         LiDAR weather when ``spec.lidar.weather.enabled`` is null (auto): ``generate`` sets
         True (its images carry the weather), the ``lidar`` command leaves it False.
+    dataset_label_config : bool
+        Rewrite ``out``'s label config (content summed over every sequence) after the sequence;
+        ``generate`` writes it once at the end instead (towns are cast at the same time).
     """
 
     frames: int
@@ -95,6 +98,7 @@ class SequenceOptions:
     route: int = 0
     weather: bool = False
     image_frames: tuple = ()
+    dataset_label_config: bool = True
 
 
 def _check_route(scene, spec, n: int, route: int) -> None:
@@ -209,7 +213,8 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
     meta["processing"], meta["scans"] = processing.describe(), records
     meta["sweep_poses_world"] = {"period_s": sensor.period_s, "frames": sweeps}
     write_json(seq / META_NAME, meta)
-    write_dataset_label_config(out)
+    if options.dataset_label_config:
+        write_dataset_label_config(out)
     return meta
 
 
