@@ -120,9 +120,24 @@ class FrameSet:
     def union(self, other: Iterable[int]) -> FrameSet:
         return FrameSet(self.ranges + FrameSet.of(other).ranges)
 
+    @classmethod
+    def _raw(cls, starts: list[int], stops: list[int]) -> FrameSet:
+        """From ranges already sorted, disjoint and non-adjacent (no checks)."""
+        out = cls.__new__(cls)
+        out._starts, out._stops = starts, stops
+        cum = [0]
+        for a, b in zip(starts, stops, strict=True):
+            cum.append(cum[-1] + b - a)
+        out._cum = cum
+        return out
+
     def intersection(self, lo: int, hi: int) -> FrameSet:
-        """The frames in ``[lo, hi)``."""
-        return FrameSet((max(a, lo), min(b, hi)) for a, b in self.ranges if a < hi and b > lo)
+        """The frames in ``[lo, hi)`` (O(log n + ranges inside))."""
+        i = max(bisect.bisect_right(self._stops, lo), 0)
+        j = bisect.bisect_left(self._starts, hi)
+        starts = [max(a, lo) for a in self._starts[i:j]]
+        stops = [min(b, hi) for b in self._stops[i:j]]
+        return FrameSet._raw(starts, stops)
 
     def without(self, mask: np.ndarray) -> FrameSet:
         """The frames ``k`` of this set whose ``mask[k]`` is false (``mask`` indexed by frame number;

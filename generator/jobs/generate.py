@@ -204,7 +204,7 @@ def run_generate(spec, cfg, opts: GenerateOptions) -> dict:
 
     source = RunSource(setup, checkpoint)
     _clean(out, pre, [pre.towns.sequence(i) for i in source.pending])
-    journal.compact()  # the state so far in one file (and the journal of a dataset from before it)
+    journal.settle()  # a dataset from before the journal gets one now
     checkpoint(source)
     try:
         figures = run_tasks(make_executor(opts.executor, opts.workers, opts.ray_address), source, desc="generate")

@@ -38,9 +38,20 @@ import re
 import zlib
 from pathlib import Path
 
+import numpy as np
+
 from generator.atomic import TMP_PREFIX, atomic_path
 from generator.jobs.frameset import FrameSet
-from generator.jobs.ledger import COMBOS, Ledger, combo_mask, combos_of, combos_text, frames_text, parse_frames_text
+from generator.jobs.ledger import (
+    COMBOS,
+    Ledger,
+    combo_mask,
+    combos_of,
+    combos_text,
+    frames_text,
+    parse_combos,
+    parse_frames_text,
+)
 
 __all__ = ["COMBOS", "Journal", "Ledger", "combo_mask", "combos_of", "frames_text", "line", "parse_frames_text",
            "parse_line"]
@@ -86,6 +97,7 @@ class Journal:
         self.damaged = 0
         #: whether ``merged.log`` alone no longer says everything (records, run segments, a ledger set from outside)
         self.dirty = True
+        self.loaded = False  # the ledger was read from the journal's files (not set from outside)
 
     # -- reading --
     def segments(self) -> list[Path]:
@@ -100,26 +112,50 @@ class Journal:
         return bool(self.segments())
 
     def load(self) -> Ledger:
-        """Read every segment into :attr:`ledger` (damaged lines are skipped and counted)."""
+        """Read every segment into :attr:`ledger` (damaged lines are skipped and counted).
+
+        Single-frame lines, the bulk of a killed run's segment, take a fast path: parsed as bytes and
+        applied to the ledger in one vectorised step per segment (a million lines in a few seconds).
+        """
         self.ledger, self.damaged = Ledger(), 0
+        masks: dict[bytes, int] = {}
         for seg in self.segments():
-            with open(seg, "rb") as f:
-                for n, raw in enumerate(f):
-                    rec = parse_line(raw)
-                    if rec is None:
-                        self.damaged += 1
+            ks, ms = [], []
+            pieces = seg.read_bytes().split(b"\n")
+            if pieces[-1]:  # a torn last line (no newline)
+                self.damaged += 1
+            for raw in pieces[:-1]:
+                body, sep, crc = raw.rpartition(b"\t")
+                try:
+                    if not sep or len(crc) != 8 or int(crc, 16) != zlib.crc32(body):
+                        raise ValueError
+                    if body.startswith(b"frame "):
+                        _, k, combos = body.split(b" ")
+                        mask = masks.get(combos)
+                        if mask is None:
+                            mask = masks[combos] = parse_combos(combos.decode("ascii"))
+                        ks.append(int(k))
+                        ms.append(mask)
                         continue
-                    if rec == HEADER or (n == 0 and rec.startswith("urbangen-journal ")):
-                        continue
-                    try:
+                    rec = body.decode("utf-8")
+                    if not rec.startswith("urbangen-journal "):
                         self.ledger.apply(rec)
-                    except (ValueError, KeyError, IndexError):
-                        self.damaged += 1
+                except (ValueError, KeyError, IndexError, UnicodeDecodeError):
+                    self.damaged += 1
+            self.ledger.or_frames(np.asarray(ks, np.int64), np.asarray(ms, np.uint32))
         if self.damaged:
             log.warning("%s: %d damaged journal line(s) (a killed run's last line): their items are made again",
                         self.dir, self.damaged)
         self.dirty = self.damaged > 0 or [p.name for p in self.segments()] != [MERGED]
+        self.loaded = True
         return self.ledger
+
+    def settle(self, max_runs: int = 8) -> None:
+        """At the start of a run: write the state when no file holds it (a ledger looked up file by file), or
+        compact when many killed runs left segments; otherwise leave the files (a resume stays quick)."""
+        runs = [p for p in self.segments() if p.name != MERGED]
+        if (not self.loaded and not self.ledger.empty) or len(runs) >= max_runs:
+            self.compact()
 
     # -- writing --
     def compact(self) -> Path:

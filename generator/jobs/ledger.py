@@ -67,6 +67,10 @@ class Ledger:
     towns: dict = field(default_factory=dict)
     dataset: dict = field(default_factory=dict)
 
+    @property
+    def empty(self) -> bool:
+        return not (self.frame_bits.any() or self.stereo or self.towns or self.dataset)
+
     def _grow(self, k: int) -> None:
         if k >= len(self.frame_bits):
             grown = np.zeros(max(k + 1, 2 * len(self.frame_bits), 1024), np.uint32)
@@ -81,6 +85,14 @@ class Ledger:
             return False
         self.frame_bits[k] = old | mask
         return True
+
+    def or_frames(self, ks: np.ndarray, masks: np.ndarray) -> None:
+        """Mark variants ``masks[i]`` of frame ``ks[i]`` finished, for many frames at once."""
+        if len(ks):
+            if ks.min() < 0:
+                raise ValueError("frame numbers are >= 0")
+            self._grow(int(ks.max()))
+            np.bitwise_or.at(self.frame_bits, ks, masks)
 
     def add_frames(self, frames: FrameSet, mask: int) -> None:
         if frames:
@@ -151,10 +163,10 @@ class Ledger:
         parts = record.split(" ")
         kind = parts[0]
         if kind == "frame":
-            self.add_frame(int(parts[1]), _parse_combos(parts[2]))
+            self.add_frame(int(parts[1]), parse_combos(parts[2]))
         elif kind == "frames":
             a, b = parts[1].split("-")
-            self.add_frames(FrameSet([(int(a), int(b) + 1)]), _parse_combos(parts[2]))
+            self.add_frames(FrameSet([(int(a), int(b) + 1)]), parse_combos(parts[2]))
         elif kind == "stereo":
             self.add_stereo(parts[1], int(parts[2]))
         elif kind == "town":
@@ -194,5 +206,5 @@ def combos_text(mask: int) -> str:
     return ",".join(f"{t}:{w}" for t, w in combos_of(mask))
 
 
-def _parse_combos(text: str) -> int:
+def parse_combos(text: str) -> int:
     return combo_mask(tuple(c.split(":")) for c in text.split(","))

@@ -107,6 +107,8 @@ class RunSource:
                         "products": {}, "cycles_rgb_s": 0.0}
         self.done_products = {p: 0 for stage in STAGES for p in products(stage)}
         self._pending = self._survey()
+        if self._pending:  # any town work makes the dataset products again (they read every town's output)
+            self.dataset_todo = DATASET_PRODUCTS
         self._total = self._count_total()
 
     # -- what is left --
