@@ -143,7 +143,7 @@ def products(stage: str) -> tuple[str, ...]:
 
 def run(job: TownJob, report) -> None:
     """Make ``job.products`` of one town and report each (``("item", ("town", NN, name), payload)``)."""
-    t0 = time.perf_counter()
+    t0, cpu0 = time.perf_counter(), time.process_time()
     table = {p.name: p for p in TOWN_PRODUCTS}
     ctx = TownContext(job)
     report.put(("ready", {"pid": os.getpid(), "town": job.spec.town_index, "sequence": job.plan.sequence}))
@@ -158,4 +158,5 @@ def run(job: TownJob, report) -> None:
         report.put(("user_error", str(e)))
         return
     report.put(("done", {"pid": os.getpid(), "seconds": seconds, "wall_s": time.perf_counter() - t0,
+                         "cpu_s": time.process_time() - cpu0, "start": t0,
                          "max_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))

@@ -113,6 +113,14 @@ def test_a_dataset_from_before_the_journal_resumes_from_its_files(reference, tmp
     assert json.loads((out / "manifest.json").read_text())["finished"] == _manifest(reference)["finished"]
 
 
+def test_a_journal_left_without_its_manifest_is_not_trusted(reference, tmp_path):
+    """A folder with a journal but no manifest is a new dataset: its journal (of another run) is dropped."""
+    out = tmp_path / "orphan"
+    shutil.copytree(reference / "journal", out / "journal")
+    assert _kit(out).returncode == 0
+    assert _files(out) == _files(reference)
+
+
 def _killed_then_resumed(reference: Path, tmp_path: Path, point: str) -> None:
     out = tmp_path / "killed"
     first = _kit(out, "--kill-at", point)
