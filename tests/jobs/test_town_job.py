@@ -29,6 +29,7 @@ def _tree(root: Path) -> dict[str, bytes]:
     return {str(p.relative_to(root)): p.read_bytes() for p in sorted(root.rglob("*")) if p.is_file()}
 
 
+@pytest.mark.slow
 def test_a_towns_lidar_cast_by_a_worker_is_the_parent_side_cast(traffic_spec, tmp_path):
     from generator.jobs.dispatch import FixedSource, run_tasks
     from generator.jobs.drive import plan_drive
