@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from generator.imaging.exr import read_exr
+from generator.imaging.paths import image_files
 from generator.postfx import camera as cm
 from generator.postfx.camera_crf import crf_8bit
 from generator.postfx.fog import fog_image
@@ -68,14 +69,14 @@ def dataset_info(roots: list[Path]) -> tuple[tuple[np.ndarray, np.ndarray] | Non
     """The first day image (rgb, depth) of the datasets and the median rgb_pass per resolution."""
     image, passes = None, {}
     for root in roots:
-        for js in sorted((root / "images").glob("*.json")):
+        for js in image_files(root, "*.json"):
             rec = json.loads(js.read_text())
             res = tuple(rec.get("render", {}).get("resolution", ()))
             secs = (rec.get("timings_s") or {}).get("rgb_pass")
             if secs is not None and len(res) == 2:
                 passes.setdefault(res, []).append(float(secs))
             if image is None and rec.get("time_of_day") == "day":
-                im = read_exr(root / "images" / rec["files"]["exr"])
+                im = read_exr(js.parent / rec["files"]["exr"])
                 image = (im.rgb.astype(np.float32), im.depth)
     return image, {r: statistics.median(v) for r, v in passes.items()}
 

@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from generator.imaging.exr import read_exr
+from generator.imaging.paths import image_files
 from generator.postfx.camera import vignetting_map
 from generator.postfx.filters import luminance
 from generator.weather import KINDS, TIMES
@@ -50,7 +51,7 @@ def scene_radiance(rgb: np.ndarray, meta: dict) -> np.ndarray:
 def measure(folder: Path, frames: set[int] | None) -> dict:
     """{(frame, time, weather): {"mean": float, "metered": float or None, "rgb_s": float}}."""
     out = {}
-    for exr in sorted((folder / "images").glob("*.exr")):
+    for exr in image_files(folder, "*.exr"):
         meta = json.loads(exr.with_suffix(".json").read_text())
         if frames and meta["frame"] not in frames:
             continue
@@ -74,7 +75,7 @@ def contact_sheet(folders: list[Path], frames: set[int] | None, out: Path, tile_
 
     found = {}
     for i, folder in enumerate(folders):
-        for exr in sorted((folder / "images").glob("*.exr")):
+        for exr in image_files(folder, "*.exr"):
             meta = json.loads(exr.with_suffix(".json").read_text())
             if frames and meta["frame"] not in frames:
                 continue

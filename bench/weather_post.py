@@ -27,6 +27,7 @@ import numpy as np
 from PIL import Image, ImageDraw
 
 from generator.imaging.exr import LabelledImage, read_exr, write_exr
+from generator.imaging.paths import image_files
 from generator.postfx.fog import fog_image
 from generator.previews.preview import tonemap
 from generator.postfx.rain import rain_image
@@ -133,12 +134,12 @@ def street(h: int, w: int, time_of_day: str, seed: int = 0) -> tuple[np.ndarray,
 def dataset_images(root: Path) -> dict[str, tuple[np.ndarray, np.ndarray, float | None]]:
     """First dry or wet image by day and by night: time -> (rgb, depth, rgb_pass seconds or None)."""
     out = {}
-    for js in sorted((root / "images").glob("*.json")):
+    for js in image_files(root, "*.json"):
         rec = json.loads(js.read_text())
         tod = rec.get("time_of_day")
         if tod in out or rec.get("weather", {}).get("kind") not in ("clear", "wet"):
             continue
-        im = read_exr(root / "images" / rec["files"]["exr"])
+        im = read_exr(js.parent / rec["files"]["exr"])
         secs = (rec.get("timings_s") or {}).get("rgb_pass")
         out[tod] = (im.rgb, im.depth, None if secs is None else float(secs))
     return out

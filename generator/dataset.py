@@ -65,6 +65,7 @@ from generator.formats.scene_flow import ego_flow, read_scene_flow
 from generator.imaging import meta_fields as md
 from generator.imaging.exr import read_exr
 from generator.imaging.motion_exr import DisparityMap, FlowMaps, read_disparity_exr, read_flow_exr
+from generator.imaging.paths import find_image, frame_of, image_files
 from generator.labels import class_table
 from generator.labels.sets import label_sets
 from generator.safeload import printable
@@ -154,12 +155,14 @@ class Dataset:
     # -- images ------------------------------------------------------------------------------
     def image_names(self, frame: int | None = None) -> list[str]:
         """Image stems (``NNNNNN_<time>_<weather>``), sorted; only those of ``frame`` if given."""
-        names = sorted(p.stem for p in (self.root / "images").glob("[0-9][0-9][0-9][0-9][0-9][0-9]*.json"))
-        return [n for n in names if frame is None or int(n[:6]) == frame]
+        files = image_files(self.root, "[0-9][0-9][0-9][0-9][0-9][0-9]_*.json", None if frame is None else [frame])
+        return sorted({p.stem for p in files})
 
     def image_files(self, name: str) -> tuple[Path, Path]:
-        """(EXR, metadata JSON) of image ``name``: the one place that says where an image lives."""
-        return self.root / "images" / f"{name}.exr", self.root / "images" / f"{name}.json"
+        """(EXR, metadata JSON) of image ``name``, sharded or flat (:mod:`generator.imaging.paths`)."""
+        if frame_of(name) is None:
+            raise UserError(f"{printable(name, 60)}: not an image name (NNNNNN_<time>_<weather>)")
+        return find_image(self.root, name, ".exr"), find_image(self.root, name, ".json")
 
     def image(self, name: str) -> ImageSample:
         """The image ``name`` with its masks, instances, depth and metadata."""

@@ -51,7 +51,7 @@ def register(sub) -> None:
                    help="label set: unified11, semantickitti or native (default unified11; native needs "
                         "native_labels/ in both trees)")
     p.add_argument("--sequences", nargs="+", type=sequence_id, default=None,
-                   help="sequences to evaluate, 00..99 (default: all of --gt)")
+                   help="sequences to evaluate, 00..999999 (default: all of --gt)")
     p.add_argument("--mean-over", default="all", choices=MEAN_OVER,
                    help="classes the means average: all (every class but 0, absent ones as 0; the reference, "
                         "default) or present (only classes in prediction or ground truth)")

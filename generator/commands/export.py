@@ -30,6 +30,7 @@ from typing import Iterator
 from generator.commands.options import Integer, Number, path, sequence_id, text_path
 from generator.commands.preflight import input_dir, output_dir
 from generator.errors import UserError
+from generator.imaging.paths import image_files, images_root
 from generator.jobs.plan import MAX_FRAME_INDEX, check_free_space
 from generator.safeload import MAX_METADATA_BYTES, load_json, printable
 from generator.weather import TIMES, combinations
@@ -84,7 +85,7 @@ def _sequence(dataset: Path) -> int:
     manifest = load_json(path, max_bytes=MAX_METADATA_BYTES, max_nodes=10_000_000) if os.path.lexists(path) else {}
     plan = manifest.get("plan", {}) if isinstance(manifest, dict) else {}
     seq = str(plan.get("sequence", "0") if isinstance(plan, dict) else "?")
-    if not (seq.isascii() and seq.isdigit() and len(seq) <= 4):
+    if not (seq.isascii() and seq.isdigit() and len(seq) <= 6):
         raise UserError(f"{path}: plan.sequence must be a number, got {printable(seq, 40)!r}")
     return int(seq)
 
@@ -102,9 +103,9 @@ def run(args) -> int:
 
     input_dir(args.dataset, what="dataset folder")
     output_dir(args.out, "OUT")
-    exrs = sorted((args.dataset / "images").glob("*.exr"))
+    exrs = image_files(args.dataset, "*.exr")
     if not exrs:
-        raise UserError(f"{args.dataset / 'images'}: no .exr images to export")
+        raise UserError(f"{images_root(args.dataset)}: no .exr images to export")
     if args.out.resolve() == args.dataset.resolve():
         raise UserError(f"{args.out}: output must differ from the dataset folder")
     # five PNGs per image: about half the size of its EXR (RGB 8-bit, label ids compress well)

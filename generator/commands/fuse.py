@@ -37,7 +37,7 @@ def register(sub) -> None:
     p = sub.add_parser("fuse", help="project LiDAR into the images: label agreement report and 3D semantic map",
                        description=__doc__.split("\n\n")[1])
     p.add_argument("dataset", type=path, help="dataset folder with images/ and lidar/sequences/NN/")
-    p.add_argument("--sequence", type=sequence_id, default="00", help="LiDAR sequence, 00..99 (default 00)")
+    p.add_argument("--sequence", type=sequence_id, default="00", help="LiDAR sequence, 00..999999 (default 00)")
     p.add_argument("--abs-tol", type=Number(0, 10), default=None,
                    help="occlusion tolerance floor, metres, in [0, 10] (default 0.1)")
     p.add_argument("--rel-tol", type=Number(0, 1), default=None,

@@ -44,7 +44,7 @@ def register(sub) -> None:
                        description=__doc__.split("\n\n")[1])
     p.add_argument("town", type=path, help="KITTI-CARLA town folder (TownNN with generated/frames/*.ply)")
     p.add_argument("output", type=path, help="dataset root; the sequence goes to OUT/sequences/NN")
-    p.add_argument("--sequence", required=True, type=sequence_id, help="sequence number 00..99, e.g. 22")
+    p.add_argument("--sequence", required=True, type=sequence_id, help="sequence number 00..999999, e.g. 22")
     p.add_argument("--seed", type=Integer(0, 2**63 - 1), default=0,
                    help="seed of the intensity and domain-gap draws, >= 0 (default 0)")
     p.add_argument("--frames", type=Integer(1, MAX_FRAMES), default=None,

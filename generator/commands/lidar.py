@@ -42,7 +42,7 @@ def register(sub) -> None:
     p.add_argument("--frames", type=Integer(1, MAX_FRAMES), default=10,
                    help=f"number of consecutive 10 Hz sweeps (times.txt steps 0.1 s), 1..{MAX_FRAMES} "
                         "(default 10: one second of driving)")
-    p.add_argument("--sequence", type=sequence_id, default="00", help="sequence number, 00..99 (default 00)")
+    p.add_argument("--sequence", type=sequence_id, default="00", help="sequence number, 00..999999 (default 00)")
     p.add_argument("--threads", type=Integer(1, 256), default=None, help="casting threads, 1..256 (default: all cores)")
     p.add_argument("--range-image", action="store_true", help="also save range/NNNNNN.npy (rings x columns, 0 = no return)")
     p.add_argument("--ply", action="store_true", help="also save ply/NNNNNN.ply per scan")

@@ -34,7 +34,7 @@ def register(sub) -> None:
                        description=__doc__.split("\n\n")[1])
     p.add_argument("spec", type=text_path, help="scene spec JSON the sequence was cast from")
     p.add_argument("dataset", type=path, help="dataset folder (reads lidar/sequences/NN, writes openlabel/NN.json)")
-    p.add_argument("--sequence", type=sequence_id, default="00", help="sequence, 00..99 (default 00)")
+    p.add_argument("--sequence", type=sequence_id, default="00", help="sequence, 00..999999 (default 00)")
     boxes = list(detection_classes().boxes)
     p.add_argument("--classes", nargs="+", default=boxes,
                    help=f"box classes (generator/labels/detection.yaml; default all: {' '.join(boxes)})")

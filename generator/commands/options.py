@@ -107,9 +107,10 @@ class Number:
 
 
 def sequence_id(text: str) -> str:
-    """A SemanticKITTI sequence number ``0``..``99`` -> its folder name ``NN``."""
-    if not re.fullmatch(r"[0-9]{1,2}", text):
-        raise argparse.ArgumentTypeError(f"must be a sequence number 00..99, got {shown(text)}")
+    """A SemanticKITTI sequence number ``0``..``999999`` -> its folder name (``7`` -> ``07``, ``123`` -> ``123``;
+    :data:`generator.formats.semantickitti.MAX_SEQUENCE`, the naming semantic-kitti-api reads)."""
+    if not re.fullmatch(r"[0-9]{1,6}", text):
+        raise argparse.ArgumentTypeError(f"must be a sequence number 00..999999, got {shown(text)}")
     return f"{int(text):02d}"
 
 

@@ -24,6 +24,7 @@ from generator.previews.preview import camera_model_of, colorize, display_rgb, s
 from generator.labels import class_table
 from generator.fusion.movers import is_moving_label
 from generator.imaging import meta_fields as md
+from generator.imaging.paths import image_files, images_root
 
 PREFERRED = ("day_clear", "night_clear")
 MIN_HEIGHT = 360
@@ -47,7 +48,7 @@ def register(sub) -> None:
 
 def _frames(root: Path) -> dict[int, list[Path]]:
     out: dict[int, list[Path]] = {}
-    for p in sorted((root / "images").glob("*.exr")):
+    for p in image_files(root, "*.exr"):
         m = re.match(r"^(\d{6})_", p.name)
         if m:
             out.setdefault(int(m.group(1)), []).append(p)
@@ -97,17 +98,17 @@ def _bev(sequences: list[tuple[Path, dict[int, int]]], frame: int, size: int) ->
 
 def run(args) -> int:
     root: Path = input_dir(args.dataset, what="dataset folder")
-    if not (root / "images").is_dir():
+    if not images_root(root).is_dir():
         raise UserError(f"{root}: no images/ folder (is it a dataset from urbangen generate?)")
     frames = _frames(root)
     if args.frames is not None:
         missing = [k for k in args.frames if k not in frames]
         if missing:
             raise UserError(f"--frames: no images of frame(s) {', '.join(map(str, missing[:10]))}"
-                            f"{' ...' if len(missing) > 10 else ''} in {root / 'images'}")
+                            f"{' ...' if len(missing) > 10 else ''} in {images_root(root)}")
         frames = {k: frames[k] for k in args.frames}
     if not frames:
-        raise UserError(f"{root / 'images'}: no images")
+        raise UserError(f"{images_root(root)}: no images")
     out = output_dir(root / "preview", "")
     # Every sheet is made in a stage and moved into preview/ at the end: a bad EXR in the
     # last frame leaves no sheets of the first ones behind.
@@ -133,4 +134,4 @@ def _sheets(root: Path, sequences: list, k: int, paths: list[Path], out: Path) -
     with atomic_path(out / f"{k:06d}.png", suffix=".png") as tmp:
         Image.fromarray(side_by_side(panels)).save(tmp, format="PNG")
     if len(paths) > 1:
-        variants_sheet(root / "images", k, out / f"{k:06d}_variants.png", scale=1.0 if img.rgb.shape[1] <= 320 else 0.5)
+        variants_sheet(pick.parent, k, out / f"{k:06d}_variants.png", scale=1.0 if img.rgb.shape[1] <= 320 else 0.5)

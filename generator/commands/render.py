@@ -24,6 +24,7 @@ from generator.atomic import TMP_PREFIX
 from generator.commands.options import Integer, path, shown, text_path
 from generator.commands.preflight import os_reason, output_dir
 from generator.errors import UserError
+from generator.imaging.paths import find_image, has_images, image_dir, image_path, images_root
 from generator.jobs.executors import EXECUTORS, make_jobs, run_jobs
 from generator.jobs.plan import (MAX_FRAME_INDEX, MAX_FRAMES, MAX_WORKERS, check_free_space, check_plan, check_workers,
                                  image_bytes, make_plan)
@@ -119,7 +120,7 @@ def run(args) -> int:
     out, combos, cfg = r.out, r.combos, r.cfg
     plan = make_plan(args.frames, args.first, combos)
     check_plan(plan)
-    todo = [k for k in plan.frames if not all((out / "images" / f"{n}.json").exists() for n in plan.images_of(k))]
+    todo = [k for k in plan.frames if not all(find_image(out, n, ".json").exists() for n in plan.images_of(k))]
     if not todo:
         log.info("all %d frames already rendered in %s", args.frames, out)
         return 0
@@ -140,7 +141,7 @@ def run(args) -> int:
     finally:
         shutil.rmtree(out / ".scratch", ignore_errors=True)
     n = sum(len(msg["images"]) for msg in done.values())
-    print(f"rendered {n} images of {len(done)} frames into {out / 'images'} in {wall:.1f} s")
+    print(f"rendered {n} images of {len(done)} frames into {images_root(out)} in {wall:.1f} s")
     return 0
 
 
@@ -157,15 +158,15 @@ def towns_of(spec, frames: list[int]) -> list[tuple[object, int, list[int]]]:
 def _remove_unfinished(out: Path, plan, created: bool) -> None:
     """After a failed run: drop the files of images without metadata (an image is done when its JSON
     exists) and temporaries; a folder this run created and that holds no finished image goes too."""
-    images = out / "images"
     try:
         for name in plan.images():
-            if not (images / f"{name}.json").exists():
+            if not image_path(out, name, ".json").exists():
                 for suffix in (".exr", "_preview.png"):
-                    (images / f"{name}{suffix}").unlink(missing_ok=True)
-        for tmp in images.glob(f"{TMP_PREFIX}*") if images.is_dir() else ():
-            tmp.unlink(missing_ok=True)
-        if created and not any(images.glob("*.json")):
+                    image_path(out, name, suffix).unlink(missing_ok=True)
+        for folder in sorted({image_dir(out, k) for k in plan.frames}):
+            for tmp in folder.glob(f"{TMP_PREFIX}*") if folder.is_dir() else ():
+                tmp.unlink(missing_ok=True)
+        if created and not has_images(out, "*.json"):
             shutil.rmtree(out, ignore_errors=True)
     except OSError as e:  # the failure being reported matters more than this cleanup
         log.warning("could not remove the unfinished images of the failed run: %s", e)

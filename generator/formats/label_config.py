@@ -27,6 +27,7 @@ import numpy as np
 from generator import safeload
 from generator.atomic import write_text
 from generator.errors import SpecError, UserError
+from generator.formats.semantickitti import MAX_SEQUENCE
 from generator.labels import class_table
 
 log = logging.getLogger(__name__)
@@ -73,8 +74,8 @@ def read_split(path: str | Path) -> dict[str, list[int]]:
         for part in SPLITS:
             seqs = split.get(part) or []
             if not isinstance(seqs, list) or not all(isinstance(s, int) and not isinstance(s, bool)
-                                                     and 0 <= s <= 9999 for s in seqs):
-                raise SpecError(str(path), f"split.{part}", "must be a list of sequence numbers 0..9999")
+                                                     and 0 <= s <= MAX_SEQUENCE for s in seqs):
+                raise SpecError(str(path), f"split.{part}", f"must be a list of sequence numbers 0..{MAX_SEQUENCE}")
             out[part] = list(seqs)
         return out
     except UserError as e:

@@ -166,11 +166,20 @@ def _present(path: Path) -> bool:
 
 
 # -- sequences ---------------------------------------------------------------------------------
+#: Largest sequence number urbangen writes or reads. SemanticKITTI names sequence folders by the number
+#: zero-padded to two digits, and semantic-kitti-api builds every path as ``'{0:02d}'.format(int(seq))``
+#: from the integers of the label config's ``split`` (``evaluate_semantics.py``, ``evaluate_panoptic.py``,
+#: ``evaluate_mos.py``, ``remap_semantic_labels.py``, ``visualize.py``, ``content.py``): sequence 100 is
+#: folder ``100``, read like ``00``. The format sets no upper bound; six digits (like frame numbers) are ours.
+MAX_SEQUENCE = 999_999
+
+
 def sequence_name(sequence: int | str) -> str:
-    """Two-digit (or longer, zero-padded) sequence folder name; rejects anything but digits."""
+    """Sequence folder name: the number zero-padded to two digits (``7`` -> ``07``, ``123`` -> ``123``),
+    as semantic-kitti-api spells it; rejects anything but digits and numbers beyond :data:`MAX_SEQUENCE`."""
     s = str(sequence)
-    if not s.isdigit() or len(s) > 4:
-        raise UserError(f"sequence must be a number like 00..99, got {sequence!r}")
+    if not (s.isascii() and s.isdigit()) or len(s) > 7 or int(s) > MAX_SEQUENCE:
+        raise UserError(f"sequence must be a number in 00..{MAX_SEQUENCE}, got {str(sequence)[:20]!r}")
     return f"{int(s):02d}"
 
 
@@ -180,11 +189,12 @@ def sequence_dir(root: str | Path, sequence: int | str) -> Path:
 
 
 def list_sequences(root: str | Path) -> list[str]:
-    """Sequence folder names under ``root/sequences`` (digits only), sorted."""
+    """Sequence folder names under ``root/sequences`` (digits only), in numeric order (``99`` before ``100``)."""
     base = Path(root) / "sequences"
     if not base.is_dir():
         raise UserError(f"{base}: not a SemanticKITTI dataset (no sequences/ folder)")
-    return sorted(p.name for p in base.iterdir() if p.is_dir() and p.name.isdigit())
+    return sorted((p.name for p in base.iterdir() if p.is_dir() and p.name.isascii() and p.name.isdigit()),
+                  key=lambda n: (int(n), n))
 
 
 @dataclass

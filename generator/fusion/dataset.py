@@ -20,6 +20,8 @@ from generator.formats import semantickitti as sk
 from generator.formats.point_sidecars import NATIVE_DIR, TIMES_DIR, read_sidecar
 from generator.imaging import meta_fields as md
 from generator.imaging.exr import read_exr
+from generator.imaging.paths import frame_images as frame_images_of
+from generator.imaging.paths import images_root
 from generator.labels import class_table
 from generator.world import rig
 
@@ -97,16 +99,10 @@ def native_from_raw(raw: np.ndarray) -> np.ndarray:
 
 def frame_variants(root: Path) -> dict[int, list[Path]]:
     """Frame index -> metadata JSON of every image variant of the frame (weather x time), sorted by name."""
-    folder = root / "images"
+    folder = images_root(root)
     if not folder.is_dir():
         raise UserError(f"{folder}: missing (render images first: urbangen render SPEC --out {root})")
-    out: dict[int, list[Path]] = {}
-    for p in sorted(folder.glob("*.json")):
-        stem = p.stem.split("_", 1)[0]
-        if not (stem.isascii() and stem.isdigit() and len(stem) <= 9):
-            continue
-        out.setdefault(int(stem), []).append(p)
-    return out
+    return frame_images_of(root)
 
 
 def frame_images(root: Path) -> dict[int, Path]:
@@ -158,7 +154,7 @@ class FusionDataset:
 
     def __init__(self, root: str | Path, sequence: str = "00", images: bool = True):
         self.root = Path(root)
-        self.images = frame_images(self.root) if images or (self.root / "images").is_dir() else {}
+        self.images = frame_images(self.root) if images or images_root(self.root).is_dir() else {}
         self.seq = sk.Sequence(self.root / "lidar", sequence)
         self.meta, self.sweeps = self._lidar_meta()
         #: (n, 4, 4) LiDAR poses in the first LiDAR frame (poses.txt + calib.txt)

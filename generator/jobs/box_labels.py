@@ -28,7 +28,7 @@ from generator.errors import SpecError, UserError
 from generator.formats.box_file import ImageEntry, write_box_file
 from generator.imaging import meta_fields as md
 from generator.imaging.exr import read_exr
-from generator.imaging.locate import frame_images
+from generator.imaging.paths import frame_images
 from generator.jobs.boxes import SequenceWorld, open_sequence
 
 log = logging.getLogger(__name__)
@@ -63,7 +63,7 @@ def _image_sources(sw: SequenceWorld, supersample: int) -> list[tuple[str, int |
     out = []
     if sw.stream:
         sweeps = md.image_sweeps(sw.meta, sw.src)
-        for k, paths in sorted(frame_images(sw.root, "json").items()):
+        for k, paths in sorted(frame_images(sw.root).items()):
             if k in sweeps and sweeps[k] in sw.seq.frames:
                 meta = md.load_metadata(paths[0])
                 exr = md.exr_path(meta, paths[0])

@@ -24,7 +24,7 @@ from generator.errors import SpecError, UserError
 from generator.formats import semantickitti as sk
 from generator.formats.openlabel import build_openlabel, write_openlabel
 from generator.imaging import meta_fields as md
-from generator.imaging.locate import image_files
+from generator.imaging.paths import image_files, image_relpath, iter_image_files
 from generator.labels.detection import detection_classes
 from generator.safeload import printable
 from generator.spec.towns import spec_for_record
@@ -103,7 +103,7 @@ def sweep_frames(rig: Rig, meta: dict, frames: list[int], times: np.ndarray, sou
 
 def _camera(root: Path, seq, meta: dict, meta_source: str) -> tuple[np.ndarray, int, int, str]:
     """Intrinsics from the first image's metadata, else from calib.txt and the sequence metadata."""
-    for p in image_files(root, "json"):
+    for p in iter_image_files(root, "[0-9]*_*.json"):
         try:
             K, w, h = md.intrinsics(md.load_metadata(p), str(p))
         except UserError as e:  # another JSON in images/, or a damaged one: the next may do
@@ -271,11 +271,13 @@ def write_sequence_openlabel(spec, root: Path, sequence: str = "00", classes=Non
     }
     info = {"scene": spec.name, "seed": spec.seed, "spec_hash": spec.spec_hash, "sequence": name,
             "route": md.integer(meta, "scene.route", src, 0, 10**6, default=0), "classes": list(classes)}
-    exr = {int(p.name[:6]): p.name for p in sorted(image_files(sw.root, "exr"), reverse=True)}
+    shown = [f.image if stream else f.index for f in frames]
+    exr = {int(p.name[:6]): p
+           for p in reversed(image_files(sw.root, "[0-9]*_*.exr", [k for k in shown if k is not None]))}
     frame_uris = []
-    for f in frames:
-        k = f.image if stream else f.index
-        uris = {"camera": f"images/{exr.get(k, f'{k:06d}_day_clear.exr')}"} if k is not None else {}
+    for f, k in zip(frames, shown, strict=True):
+        uris = {} if k is None else {"camera": exr[k].relative_to(sw.root).as_posix() if k in exr
+                                     else image_relpath(f"{k:06d}_day_clear")}
         frame_uris.append({**uris, "lidar": f"lidar/sequences/{name}/velodyne/{f.index:06d}.bin"})
     doc = build_openlabel(subjects=subs, frames=frames, times=[seq.times[k] for k in seq.frames], counts=counts,
                           min_points=min_points, T_ego_lidar=rig.T_ego_lidar,

@@ -1,28 +1,27 @@
-"""Executors: where the render jobs of a plan run.
+"""Executors: where the tasks of a plan run, and the render job.
 
-* ``local`` (default): one spawned process per worker on this machine
-  (:func:`generator.jobs.pool.run_workers`).
-* ``ray``: the same jobs as Ray tasks, on a local Ray instance or a cluster
-  (``--ray-address``); the output folder must be on storage every node can write.
+* ``local`` (default): a pool of spawned processes on this machine (:mod:`generator.jobs.pool`).
+* ``ray``: the same tasks as Ray tasks, on a local Ray instance or a cluster (``--ray-address``;
+  :mod:`generator.jobs.ray_executor`); the output folder must be on storage every node can write.
 
-Both run :func:`generator.jobs.worker.run` per :class:`RenderJob` (one Blender and one scene build
-per job, many frames) and report through a queue, so the parent's progress bar,
-manifest updates and error handling are the same.
+Both run the same task functions (a render job: :func:`generator.jobs.worker.run`, one Blender and
+one scene build per job, many frames) and report through a queue, so the parent's progress bar,
+bookkeeping and error handling are the same (:mod:`generator.jobs.dispatch`).
 """
 
 from __future__ import annotations
 
 import dataclasses
-import logging
+import itertools
 import os
-import time
 from dataclasses import dataclass
 from pathlib import Path
 
 from generator.errors import UserError
-from generator.jobs.pool import PoolResult, deal, follow, run_workers, scratch_dir
+from generator.jobs.frameset import FrameSet, count_frames, iter_frames
+from generator.jobs.pool import PoolResult, scratch_dir
+from generator.jobs.tasks import Task
 
-log = logging.getLogger(__name__)
 WORKER = "generator.jobs.worker:run"
 EXECUTORS = ("local", "ray")
 
@@ -36,9 +35,10 @@ class RenderJob:
     spec : generator.spec.SceneSpec
     config : generator.spec.render.RenderConfig
     out : str
-        Dataset folder; images go to ``out/images``.
-    frames : tuple of int
-        Frame indices this worker renders.
+        Dataset folder; images go to ``out/images/SSSS`` (:mod:`generator.imaging.paths`).
+    frames : tuple of int or range
+        Frame indices this worker renders (a ``range`` stands for its frames: a million-frame job
+        is a few ranges; :func:`generator.jobs.frameset.iter_frames`).
     combos : tuple of (str, str)
         (time_of_day, weather) variants of every frame.
     scratch : str
@@ -49,7 +49,7 @@ class RenderJob:
     sequence_dir : str
         The LiDAR sequence folder the stereo pairs belong to.
     parent_pid : int
-        Set by the local pool: the worker exits when its parent dies.
+        When set, the worker exits when that process dies (the local pool watches its parent itself).
     first : int
         Frame number at the start of the town's drive (``spec`` is that town's spec;
         :mod:`generator.jobs.towns`); 0 for the one town.
@@ -58,7 +58,7 @@ class RenderJob:
     spec: object
     config: object
     out: str
-    frames: tuple[int, ...]
+    frames: tuple
     combos: tuple[tuple[str, str], ...]
     scratch: str
     stereo: tuple[int, ...] = ()
@@ -66,69 +66,119 @@ class RenderJob:
     parent_pid: int = 0
     first: int = 0
 
-
-def make_jobs(spec, cfg, out: Path, frames: list[int], combos, workers: int, stereo: list[int] = (),
-              sequence_dir: Path | None = None, first: int = 0) -> list[RenderJob]:
-    """Deal the frames to render (``frames``: image variants, ``stereo``: stereo pairs) round-robin
-    to ``workers`` jobs (fewer when there is less work).
-
-    With a render config that asks for all cores (``threads: 0``) and several local
-    workers, each job gets its share of the machine's cores.
-    """
-    frames, stereo = set(frames), set(stereo)
-    parts = deal(sorted(frames | stereo), workers)
-    if cfg.threads == 0 and len(parts) > 1:
-        cfg = dataclasses.replace(cfg, threads=max(1, (os.cpu_count() or 1) // len(parts)))
-    return [RenderJob(spec, cfg, str(out), tuple(k for k in part if k in frames), tuple(tuple(c) for c in combos),
-                      str(scratch_dir(out, i)), tuple(k for k in part if k in stereo), str(sequence_dir or ""),
-                      first=first)
-            for i, part in enumerate(parts)]
+    @property
+    def n_items(self) -> int:
+        return count_frames(self.frames) + len(self.stereo)
 
 
-def run_jobs(executor: str, jobs: list[RenderJob], total: int, on_frame=None, ray_address: str | None = None) -> PoolResult:
-    """Run render ``jobs`` on ``executor``; see :func:`generator.jobs.pool.run_workers`."""
+def render_threads(cfg, parts: int, executor: str = "local"):
+    """The render config of one of ``parts`` local render jobs: with ``threads: 0`` (all cores) and several
+    jobs, each gets its share of the machine's cores."""
+    if executor == "local" and cfg.threads == 0 and parts > 1:
+        return dataclasses.replace(cfg, threads=max(1, (os.cpu_count() or 1) // parts))
+    return cfg
+
+
+def deal_render(spec, cfg, out: Path, frames: FrameSet, combos, workers: int, stereo=(),
+                sequence_dir: Path | None = None, first: int = 0, scratch_ids=None,
+                executor: str = "local") -> list[RenderJob]:
+    """Deal ``frames`` (image variants) and ``stereo`` (stereo pairs) round-robin to ``workers`` jobs (fewer
+    when there is less work); the frames stay ranges."""
+    stereo = sorted(set(stereo))
+    parts = max(1, min(workers, len(frames) + len(stereo)))
+    frame_parts = frames.deal(parts) if frames else []
+    frame_parts += [()] * (parts - len(frame_parts))
+    # the stereo pairs go first to the parts with fewer frames
+    order = sorted(range(parts), key=lambda i: (count_frames(frame_parts[i]), i))
+    stereo_parts = [[] for _ in range(parts)]
+    for n, j in enumerate(stereo):
+        stereo_parts[order[n % parts]].append(j)
+    cfg = render_threads(cfg, parts, executor)
+    ids = scratch_ids if scratch_ids is not None else itertools.count()
+    jobs = []
+    for fp, sp in zip(frame_parts, stereo_parts, strict=True):
+        if fp or sp:
+            jobs.append(RenderJob(spec, cfg, str(out), tuple(fp), tuple(tuple(c) for c in combos),
+                                  str(scratch_dir(out, next(ids))), tuple(sp), str(sequence_dir or ""), first=first))
+    return jobs
+
+
+def make_jobs(spec, cfg, out: Path, frames, combos, workers: int, stereo=(), sequence_dir: Path | None = None,
+              first: int = 0) -> list[RenderJob]:
+    """Render jobs of ``frames`` (any iterable of frame numbers) and ``stereo`` pairs (``render``)."""
+    return deal_render(spec, cfg, out, FrameSet.of(frames), combos, workers, stereo, sequence_dir, first)
+
+
+def make_executor(executor: str, slots: int, ray_address: str | None = None):
+    """The executor named ``executor`` with ``slots`` tasks at once."""
     if executor == "local":
-        return run_workers(WORKER, jobs, total, "render", on_frame)
+        from generator.jobs.pool import LocalExecutor
+
+        return LocalExecutor(slots)
     if executor == "ray":
-        return _run_ray(jobs, total, on_frame, ray_address)
+        from generator.jobs.ray_executor import RayExecutor
+
+        return RayExecutor(slots, ray_address)
     raise UserError(f"--executor: must be one of {', '.join(EXECUTORS)}, got {executor!r}")
 
 
-def _ray_worker(job: RenderJob, queue) -> None:
-    from generator.jobs.worker import run
+class _JobsSource:
+    """A fixed list of render jobs (``render``): every one runnable at once; a lost one is re-dealt."""
 
-    run(job, queue)
+    def __init__(self, jobs: list[RenderJob], target: str, on_frame):
+        self.ids = itertools.count()
+        self.todo = [Task(next(self.ids), "render", target, job, fresh=True) for job in jobs]
+        self.on_frame, self.target = on_frame, target
+        self.result = PoolResult()
+        self.done_frames: set = set()
+        self.n = sum(job.n_items for job in jobs)
+
+    def ready(self):
+        out, self.todo = self.todo, []
+        return out
+
+    def on_message(self, task, msg) -> None:
+        kind = msg[0]
+        if kind == "frame" and msg[1] not in self.done_frames:
+            self.done_frames.add(msg[1])
+            self.result.frame_seconds[msg[1]] = msg[2]
+            if self.on_frame is not None:
+                self.on_frame(msg[1], msg[2])
+        elif kind == "ready":
+            self.result.ready.append(msg[1])
+        elif kind == "done":
+            self.result.done.append(msg[1])
+
+    def on_end(self, task) -> None:
+        pass
+
+    def on_lost(self, task, reason):
+        job = task.job
+        frames = tuple(k for k in iter_frames(job.frames) if k not in self.done_frames)
+        stereo = tuple(j for j in job.stereo if ("stereo", j) not in self.done_frames)
+        if not frames and not stereo:
+            return []
+        again = dataclasses.replace(job, frames=frames, stereo=stereo)
+        return [dataclasses.replace(task, id=next(self.ids), job=again, attempt=task.attempt + 1)]
+
+    def finished(self) -> bool:
+        return True
+
+    def total(self) -> int:
+        return self.n
+
+    def tick(self) -> None:
+        pass
 
 
-def _run_ray(jobs: list[RenderJob], total: int, on_frame, address: str | None) -> PoolResult:
-    try:
-        import ray
-        from ray.util.queue import Queue
-    except ImportError:
-        raise UserError("--executor ray needs Ray: pip install 'urbangen[ray]' (or pip install 'ray>=2.9,<3')") from None
-    started_here = not ray.is_initialized()
-    if started_here:
-        kwargs = {"address": address} if address else {"num_cpus": max(len(jobs), 1)}
-        ray.init(include_dashboard=False, log_to_driver=False, logging_level=logging.WARNING, **kwargs)
-    t0 = time.perf_counter()
-    try:
-        q = Queue()
-        task = ray.remote(num_cpus=1, max_retries=0)(_ray_worker)
-        refs = [task.remote(job, q) for job in jobs]
+def run_jobs(executor: str, jobs: list[RenderJob], total: int, on_frame=None, ray_address: str | None = None,
+             target: str = WORKER) -> PoolResult:
+    """Run render ``jobs`` on ``executor`` (one task each, all at once); ``on_frame(index, payload)`` per
+    finished frame."""
+    from generator.jobs.dispatch import run_tasks
 
-        def failed() -> str | None:
-            ready, _ = ray.wait(refs, num_returns=len(refs), timeout=0)
-            for r in ready:
-                try:
-                    ray.get(r)
-                except Exception as e:  # noqa: BLE001 - report the remote failure
-                    return f"ray render task failed: {e}"
-            return None
-
-        res = follow(q.get, len(jobs), total, "render (ray)", on_frame, failed)
-        ray.get(refs)
-    finally:
-        if started_here:
-            ray.shutdown()
-    res.wall_s = time.perf_counter() - t0
-    return res
+    source = _JobsSource(jobs, target, on_frame)
+    figures = run_tasks(make_executor(executor, max(1, len(jobs)), ray_address), source, desc=f"render ({executor})",
+                        unit="frame")
+    source.result.wall_s = figures["wall_s"]
+    return source.result

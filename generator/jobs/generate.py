@@ -1,164 +1,132 @@
-"""``urbangen generate``: the whole dataset of a spec, resumable.
+"""``urbangen generate``: the whole dataset of a spec, resumable, at any scale.
 
-Stages, each skipped when its output is already complete:
+The parent plans, dispatches and records; tasks on the executor (local processes or Ray nodes) do
+the work (:mod:`generator.jobs.schedule`): per town a scan task (scene, drive, LiDAR sequence:
+:mod:`generator.jobs.town_job`), its render tasks (images in every weather x time combination and
+the KITTI stereo pairs, :mod:`generator.jobs.stereo`), a finishing task (OpenLABEL ...); then one
+dataset task (label config, statistics). One town unless ``town.redraw_every_frames`` is set, then
+town ``i`` (its own seed, its own drive from t = 0) makes sequence ``NN + i``
+(:mod:`generator.jobs.towns`).
 
-1. LiDAR: one SemanticKITTI sequence (``lidar/sequences/NN``), every scan sharing its
-   frame's weather draw (:func:`generator.weather.lidar_combination`). Cheap and
-   byte-deterministic, so it is rewritten whole unless ``lidar_meta.json`` matches the plan.
-2. Images: every frame in every planned weather x time combination, and the KITTI stereo
-   pair of every ``sensors.stereo.every``-th scan (:mod:`generator.jobs.stereo`), on an
-   executor (local spawned processes or Ray); a frame is done when all its metadata JSONs
-   exist, a pair when its ``image_3`` PNG does.
-3. OpenLABEL per sequence, then statistics.
+Bookkeeping: every finished item is one line appended to the journal (:mod:`generator.jobs.journal`),
+O(1) per item; ``manifest.json`` (:mod:`generator.jobs.manifest`) is the summary, written at the
+start, every few seconds' checkpoint and the end. A rerun reads the journal, not the files, and does
+what is left; everything is written atomically, so a run killed at any moment resumes to exactly the
+files of an uninterrupted run.
 
-The stages run town by town: one town unless ``town.redraw_every_frames`` is set, then town ``i``
-(its own seed, its own drive from t = 0) makes sequence ``NN + i`` (:mod:`generator.jobs.towns`).
-
-Before the first write, :func:`preflight` checks the whole run: the manifest of a folder
-being resumed (readable, same spec, config and sequence, the merged plan), the plan's
-size (:func:`generator.jobs.plan.check_plan`), the scene, sensor and intensity files the
-LiDAR stage reads, the route's room for the frames, and the disk the run will write against
-the free space at the output. A bad input therefore leaves no folder behind.
-
-The manifest is rewritten after every frame. Everything is written atomically, so a run
-killed at any moment resumes to exactly the files of an uninterrupted run.
+Before the first write, :func:`preflight` checks the whole run: the manifest of a folder being
+resumed (readable, same spec, config and sequence, the merged plan), the plan against what the
+file names allow (:func:`generator.jobs.plan.check_plan`, sequence numbers in
+:class:`generator.jobs.towns.TownPlan`), the scene, sensor and intensity files the LiDAR reads, the
+route's room for the frames of the first town with work left (the other towns' routes are checked
+by their own tasks), and the disk the run will write against the free space at the output. A bad
+input therefore leaves no folder behind; ``--plan-only`` stops there.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import logging
-import os
 import shutil
 import time
 from pathlib import Path
 
-from generator.atomic import clean_temporaries
-from generator.errors import SpecError, UserError
+from generator.atomic import TMP_PREFIX, clean_temporaries
+from generator.imaging.paths import image_dir
 from generator.jobs import manifest as mf
-from generator.jobs.executors import make_jobs, run_jobs
-from generator.jobs.plan import (MAX_FRAME_INDEX, MAX_IMAGES, Plan, check_free_space, check_plan, image_bytes, motion_bytes,
-                                 scan_bytes)
-from generator.jobs.stereo import pair_done, stereo_frames
-from generator.jobs.towns import town_runs
-from generator.safeload import MAX_METADATA_BYTES, load_json
-from generator.weather import TIMES, combinations
+from generator.jobs.journal import Journal, Ledger
+from generator.jobs.plan import Plan, check_free_space, check_plan, human, image_bytes, motion_bytes, scan_bytes
+from generator.jobs.resume import read_journal, read_manifest
+from generator.jobs.stereo import stereo_frames
+from generator.jobs.towns import TownPlan
 
 log = logging.getLogger(__name__)
 
 
 @dataclasses.dataclass
 class GenerateOptions:
-    """Options of one ``generate`` run (validated by the command)."""
+    """Options of one ``generate`` run (validated by the command).
+
+    ``stand_in``: every task is a stand-in (:mod:`generator.jobs.dry`; benches and tests of the
+    bookkeeping; no scene is built, no disk estimate made). ``plan_only``: check and summarise the
+    plan, write nothing.
+    """
 
     out: Path
     plan: Plan
     workers: int = 1
     executor: str = "local"
     ray_address: str | None = None
-
-
-def lidar_done(out: Path, plan: Plan, spec) -> bool:
-    """Whether ``lidar/sequences/NN`` is complete for this spec and plan (its metadata, read safely, says so)."""
-    meta = out / "lidar" / "sequences" / plan.sequence / "lidar_meta.json"
-    if not os.path.lexists(meta):
-        return False
-    n = 20 * len(plan.frames)  # the metadata grows with the scans (~2 KB and ~200 values each), ~15 sweeps a frame
-    try:
-        m = load_json(meta, max_bytes=MAX_METADATA_BYTES + n * 16 * 1024, max_nodes=100_000 + n * 2_000)
-    except UserError:  # damaged: it is cast again
-        return False
-    if not isinstance(m, dict) or not isinstance(m.get("image_frames"), list):
-        return False
-    scene = m.get("scene")
-    pairs = sorted(tuple(p) for p in m["image_frames"] if isinstance(p, list) and len(p) == 2)
-    return (isinstance(scene, dict) and scene.get("spec_hash") == spec.spec_hash and scene.get("seed") == spec.seed
-            and [k for k, _ in pairs] == sorted(plan.frames))
-
-
-def images_done(out: Path, plan: Plan) -> list[int]:
-    """Frames whose every planned image is complete on disk."""
-    images = out / "images"
-    return [k for k in plan.frames if all((images / f"{n}.json").exists() for n in plan.images_of(k))]
-
-
-def write_lidar(spec, cfg, out: Path, plan: Plan, scene=None, drive=None, first: int = 0) -> dict:
-    """The whole drive's 10 Hz sweeps (:mod:`generator.jobs.drive`) into ``out/lidar/sequences/NN``
-    (``spec``, ``plan``, ``first``: one town's, :class:`generator.jobs.towns.TownRun`)."""
-    from generator.jobs.drive import plan_drive
-    from generator.jobs.lidar_sequence import SequenceOptions, write_dataset_label_config, write_sequence
-    from generator.layout.assemble import build_scene
-
-    scene = build_scene(spec) if scene is None else scene
-    drive = plan_drive(spec, scene, plan.frames, first) if drive is None else drive
-    opts = SequenceOptions(frames=drive.sweeps, sequence=plan.sequence, resolution=cfg.resolution,
-                           render_config=cfg.name, weather=True, image_frames=tuple(drive.image_frames))
-    meta = write_sequence(scene, spec, out / "lidar", opts, world=drive.world)
-    write_dataset_label_config(out / "lidar")
-    return meta
+    split: str | None = None
+    plan_only: bool = False
+    stand_in: bool = False
+    stand_in_delay_s: float = 0.0
 
 
 @dataclasses.dataclass
 class Preflight:
-    """What :func:`preflight` found: the (merged) plan, the manifest to write, the towns, and the
-    built scene and drive of each town (kept for a one-town run only; many towns are rebuilt
-    one at a time, from the prototype cache, instead of all held in memory)."""
+    """What :func:`preflight` found: the (merged) plan, the manifest to write, the towns, what is done
+    (the journal, read), and the disk the run will write."""
 
     plan: Plan
     manifest: dict
-    towns: list
-    built: dict
-
-    def town(self, run):
-        """(scene, drive) of ``run`` (a :class:`generator.jobs.towns.TownRun`), built again if not kept."""
-        if run.index in self.built:
-            return self.built[run.index]
-        from generator.jobs.drive import plan_drive
-        from generator.layout.assemble import build_scene
-
-        scene = build_scene(run.spec)
-        return scene, plan_drive(run.spec, scene, run.plan.frames, run.first)
+    towns: TownPlan
+    journal: Journal
+    need_bytes: int
+    what: str
+    fresh: bool
 
 
-def read_manifest(out: Path) -> dict | None:
-    """The manifest of a folder being resumed, or None; a damaged one is a one-line error naming the field."""
-    path = out / mf.NAME
-    if not os.path.lexists(path):
-        return None
-    src = str(path)
-    doc = load_json(path, source=src, max_bytes=MAX_METADATA_BYTES, max_nodes=8 * MAX_IMAGES + 100_000)
+def _estimate(spec, cfg, out: Path, plan: Plan, towns: TownPlan, ledger: Ledger, stand_in: bool) -> tuple[int, str]:
+    """Bytes the run will write and what they hold. The first town with work left is built (its route
+    checked against its frames, its drive planned); other towns' scans and stereo pairs are estimated
+    from its sweeps per frame."""
+    from generator.jobs.journal import combo_mask
+    from generator.labels import class_table
+    from generator.lidar.sensors import sensor_for_spec
 
-    def need(obj, key, kind, where=""):
-        if not isinstance(obj, dict) or not isinstance(obj.get(key), kind):
-            what = {str: "text", dict: "a mapping", list: "a list"}[kind]
-            raise SpecError(src, where + key, f"must be {what} (not a manifest urbangen wrote; use another --out "
-                                              "or delete the folder)")
-        return obj[key]
+    mask = combo_mask(plan.combos)
+    left = ledger.frames_left(plan.frames, mask)
+    images = len(left) * len(plan.combos)
+    if stand_in:
+        return 0, f"{images} stand-in images"
+    sensor = sensor_for_spec(spec)
+    canary, scans, pairs = None, 0, 0  # canary: (sweeps, frames) of the one town built
+    for index in towns.indices:
+        seq, frames = towns.sequence(index), towns.frames(index)
+        lidar = ledger.town_done(seq, "lidar", frames)
+        if lidar is not None:
+            sweeps = int(lidar.get("sweeps", 0))
+        elif canary is None:
+            canary = _canary(towns.run(index))
+            sweeps = canary[0]
+        else:
+            sweeps = -(-canary[0] * len(frames) // canary[1])
+        scans += 0 if lidar is not None else sweeps
+        done = ledger.stereo.get(seq, ())
+        pairs += sum(j not in done for j in stereo_frames(spec, range(sweeps)))
+    per_image = image_bytes(cfg.width, cfg.height, cfg.exr_codec, len(class_table().names), cfg.preview)
+    need = (images + 2 * pairs) * per_image + scans * scan_bytes(sensor.rays_per_sweep)
+    need += (len(left) + 3 * pairs) * motion_bytes(cfg.width, cfg.height)  # flows (a frame; both cameras) + disparity
+    what = (f"{images} images and {pairs} stereo pairs at {cfg.width}x{cfg.height}, {scans} scans"
+            + (f" of {len(towns)} towns" if len(towns) > 1 else ""))
+    return need, what
 
-    need(doc, "spec_hash", str)
-    need(need(doc, "render_config", dict), "config_hash", str, "render_config.")
-    plan = need(doc, "plan", dict)
-    frames, combos = need(plan, "frames", list, "plan."), need(plan, "combos", list, "plan.")
-    need(plan, "sequence", str, "plan.")
-    if not all(type(k) is int and 0 <= k <= MAX_FRAME_INDEX for k in frames) or len(frames) > MAX_IMAGES:
-        raise SpecError(src, "plan.frames", f"must be at most {MAX_IMAGES} frame numbers in 0..{MAX_FRAME_INDEX}")
-    valid = {tuple(c) for c in combinations(TIMES)}
-    if not all(isinstance(c, list) and tuple(c) in valid for c in combos):
-        raise SpecError(src, "plan.combos", "must be [time_of_day, weather] pairs like [day, fog]")
-    finished = need(doc, "finished", dict)
-    if not isinstance(finished.get("images", []), list):
-        raise SpecError(src, "finished.images", "must be a list of image names")
-    if not isinstance(doc.get("runs", []), list):
-        raise SpecError(src, "runs", "must be a list")
-    return doc
+
+def _canary(run) -> tuple[int, int]:
+    """Build one town: its route must fit its frames; (sweeps, image frames) of its drive."""
+    from generator.jobs.drive import plan_drive
+    from generator.jobs.lidar_sequence import check_frames
+    from generator.layout import build_scene
+
+    scene = build_scene(run.spec)
+    check_frames(scene, run.spec, max(run.local_frames) + 1)
+    drive = plan_drive(run.spec, scene, run.plan.frames, run.first)
+    return drive.sweeps, len(run.plan.frames)
 
 
 def preflight(spec, cfg, opts: GenerateOptions) -> Preflight:
     """Check the whole run before anything is written (see the module docstring); a problem is one line."""
-    from generator.labels import class_table
-    from generator.layout.assemble import build_scene
-    from generator.jobs.drive import plan_drive
-    from generator.jobs.lidar_sequence import check_frames
     from generator.lidar.sensors import sensor_for_spec
     from generator.remission.models import intensity_fn_for_spec
     from generator.scan_effects.pipeline import processing_for_spec
@@ -172,130 +140,120 @@ def preflight(spec, cfg, opts: GenerateOptions) -> Preflight:
         manifest = mf.merge_plan(old, plan)
         plan = Plan.from_dict(manifest["plan"])
     check_plan(plan)
-    towns = town_runs(spec, plan)
-    sensor = sensor_for_spec(spec)  # every file the LiDAR stage reads, read now
-    processing_for_spec(spec, sensor, True, intensity_fn_for_spec(spec))
-    done = set(images_done(out, plan))
-    todo = [k for k in plan.frames if k not in done]
-    built, n_pairs, scans = {}, 0, 0
-    for run in towns:  # the expensive checks last: each town, then its traffic
-        scene = build_scene(run.spec)
-        check_frames(scene, run.spec, max(run.local_frames) + 1)
-        drive = plan_drive(run.spec, scene, run.plan.frames, run.first)
-        seq_dir = out / "lidar" / "sequences" / run.plan.sequence
-        n_pairs += sum(not pair_done(seq_dir, j) for j in stereo_frames(run.spec, range(drive.sweeps)))
-        scans += 0 if lidar_done(out, run.plan, run.spec) else drive.sweeps
-        if len(towns) == 1:
-            built[run.index] = (scene, drive)
-    per_image = image_bytes(cfg.width, cfg.height, cfg.exr_codec, len(class_table().names), cfg.preview)
-    need = (len(todo) * len(plan.combos) + 2 * n_pairs) * per_image
-    need += (len(todo) + 3 * n_pairs) * motion_bytes(cfg.width, cfg.height)  # flows (a frame; both cameras) + disparity
-    need += scans * scan_bytes(sensor.rays_per_sweep)
-    check_free_space(out, need, f"{len(todo) * len(plan.combos)} images and {n_pairs} stereo pairs at "
-                                f"{cfg.width}x{cfg.height}, {scans} scans" + (f" of {len(towns)} towns" if len(towns) > 1
-                                                                             else ""))
-    return Preflight(plan, manifest, towns, built)
+    towns = TownPlan(spec, plan)
+    if not opts.stand_in:
+        sensor = sensor_for_spec(spec)  # every file the LiDAR stage reads, read now
+        processing_for_spec(spec, sensor, True, intensity_fn_for_spec(spec))
+    journal = read_journal(out, old, plan, towns)
+    need, what = _estimate(spec, cfg, out, plan, towns, journal.ledger, opts.stand_in)
+    if not opts.stand_in:
+        check_free_space(out, need, what)
+    return Preflight(plan, manifest, towns, journal, need, what, old is None)
+
+
+def _clean(out: Path, pre: Preflight, sequences: list[str]) -> None:
+    """Temporaries of an interrupted run, only where unfinished items are (``sequences``: of the towns with
+    work left; never a walk over a million finished files)."""
+    from generator.jobs.journal import combo_mask
+
+    shutil.rmtree(out / ".scratch", ignore_errors=True)
+    removed = sum(p.unlink() is None for p in out.glob(TMP_PREFIX + "*") if p.is_file())
+    for sub in ("openlabel", "boxes", "flow", "stats", "stand-in"):
+        if (out / sub).is_dir():
+            removed += sum(p.unlink() is None for p in (out / sub).glob(TMP_PREFIX + "*"))
+    left = pre.journal.ledger.frames_left(pre.plan.frames, combo_mask(pre.plan.combos))
+    for a, b in left.ranges:
+        for shard in range(a // 100, (b - 1) // 100 + 1):
+            folder = image_dir(out, shard * 100)
+            if folder.is_dir():
+                removed += sum(p.unlink() is None for p in folder.glob(TMP_PREFIX + "*"))
+    for seq in sequences:
+        folder = out / "lidar" / "sequences" / seq
+        if folder.is_dir() and not folder.is_symlink():
+            removed += clean_temporaries(folder)
+    if removed:
+        log.info("removed %d unfinished temporary files of an interrupted run", removed)
 
 
 def run_generate(spec, cfg, opts: GenerateOptions) -> dict:
-    """Plan, render, scan and write a dataset into ``opts.out``; return the run record."""
+    """Plan, dispatch and record a dataset into ``opts.out``; return the run record (``--plan-only``: the plan)."""
+    from generator.jobs.dispatch import run_tasks
+    from generator.jobs.executors import make_executor
+    from generator.jobs.schedule import RunSetup, RunSource
+
     t0 = time.perf_counter()
     pre = preflight(spec, cfg, opts)
     out, plan, manifest = Path(opts.out), pre.plan, pre.manifest
+    if opts.plan_only:
+        return {"plan_only": True, "frames": len(plan.frames), "images": plan.n_images, "towns": len(pre.towns),
+                "sequences": [pre.towns.sequence(pre.towns.indices[0]), pre.towns.sequence(pre.towns.indices[-1])],
+                "disk": human(pre.need_bytes), "writes": pre.what}
     out.mkdir(parents=True, exist_ok=True)
-    removed = clean_temporaries(out)
-    shutil.rmtree(out / ".scratch", ignore_errors=True)
-    if removed:
-        log.info("removed %d unfinished temporary files of an interrupted run", removed)
+    journal = pre.journal
+    if pre.fresh and journal.exists():
+        journal.remove()  # left by a folder whose manifest is gone: not this dataset's
     run = {"started": time.strftime("%Y-%m-%dT%H:%M:%S%z"), "executor": opts.executor, "workers": opts.workers}
     if len(pre.towns) > 1:
-        run["towns"] = [{"town": r.index, "seed": r.spec.seed, "sequence": r.plan.sequence,
-                         "frames": [min(r.plan.frames), max(r.plan.frames)]} for r in pre.towns]
-    done = set(images_done(out, plan))
-    manifest["finished"]["images"] = [n for k in plan.frames if k in done for n in plan.images_of(k)]
-    manifest["finished"].setdefault("stereo", [])
-    results, n_todo, n_stereo = [], 0, 0
-    from generator.dataset import Dataset
-    from generator.jobs.finish import write_openlabel, write_stats
-    from generator.jobs.motion import motion_done, write_motion
+        run["towns"] = {"count": len(pre.towns), "sequences": [pre.towns.sequence(pre.towns.indices[0]),
+                                                                pre.towns.sequence(pre.towns.indices[-1])]}
+    setup = RunSetup(spec, cfg, out, plan, pre.towns, journal, opts.workers, opts.executor, opts.split,
+                     opts.stand_in, opts.stand_in_delay_s)
 
-    for town in pre.towns:
-        tplan, tspec = town.plan, town.spec
-        scene, drive = pre.town(town)
-        if not lidar_done(out, tplan, tspec):
-            t = time.perf_counter()
-            write_lidar(tspec, cfg, out, tplan, scene, drive, town.first)
-            run["lidar_s"] = round(run.get("lidar_s", 0.0) + time.perf_counter() - t, 2)
-        manifest["finished"]["lidar"] = town is pre.towns[-1]
+    def checkpoint(source) -> None:
+        manifest["finished"] = _summary(source)
         mf.save(out, manifest)
-        seq_dir = out / "lidar" / "sequences" / tplan.sequence
-        todo = [k for k in tplan.frames if k not in done]
-        pairs = stereo_frames(tspec, range(drive.sweeps))
-        stereo_done = [k for k in pairs if pair_done(seq_dir, k)]
-        stereo_todo = [k for k in pairs if k not in stereo_done]
-        # a one-town run keeps its old record: the sweeps of its one sequence
-        _set_stereo(manifest, tplan.sequence, stereo_done, len(pre.towns) > 1)
-        if todo or stereo_todo:
-            jobs = make_jobs(tspec, cfg, out, todo, plan.combos, opts.workers, stereo_todo, seq_dir, town.first)
 
-            def on_frame(index, payload: dict, seq=tplan.sequence) -> None:
-                manifest["finished"]["images"] += list(payload["images"])
-                if "stereo" in payload:
-                    _add_stereo(manifest, seq, payload["stereo"], len(pre.towns) > 1)
-                mf.save(out, manifest)
-
-            results.append(run_jobs(opts.executor, jobs, len(todo) + len(stereo_todo), on_frame, opts.ray_address))
-            shutil.rmtree(out / ".scratch", ignore_errors=True)
-            n_todo, n_stereo = n_todo + len(todo), n_stereo + len(stereo_todo)
-        if todo or stereo_todo or not motion_done(out, tplan, pairs):  # flow and disparity from the passes
-            t = time.perf_counter()
-            write_motion(Dataset(out, tplan.sequence), drive.world, tplan.frames, tplan.sequence, cfg.exr_codec)
-            run["motion_s"] = round(run.get("motion_s", 0.0) + time.perf_counter() - t, 2)
-        write_openlabel(tspec, out, tplan, scene, drive.world, cfg.label_supersample)  # the world it was cast in
-        mf.save(out, manifest)
-        del scene, drive
-    if results:
-        run.update(_render_figures(results, n_todo, len(plan.combos)))
-        run["stereo_pairs_rendered"] = n_stereo
-    manifest["finished"]["openlabel"] = True
-    write_stats(out)
-    manifest["finished"]["stats"] = True
+    source = RunSource(setup, checkpoint)
+    _clean(out, pre, [pre.towns.sequence(i) for i in source.pending])
+    journal.settle()  # a dataset from before the journal gets one now
+    checkpoint(source)
+    try:
+        figures = run_tasks(make_executor(opts.executor, opts.workers, opts.ray_address), source, desc="generate")
+    finally:
+        journal.close()
+        shutil.rmtree(out / ".scratch", ignore_errors=True)
+    for folder in sorted(source.dirty):  # where tasks lost on a dead node were writing
+        if folder.is_dir():
+            clean_temporaries(folder)
+    journal.compact()
+    run.update(_figures(source, figures, len(plan.combos)))
     run["wall_s"] = round(time.perf_counter() - t0, 2)
+    manifest["finished"] = _summary(source)
     manifest["runs"] = manifest.get("runs", []) + [run]
     mf.save(out, manifest)
     return run
 
 
-def _set_stereo(manifest: dict, sequence: str, done: list[int], many: bool) -> None:
-    """Record the finished stereo pairs of ``sequence`` (sweep numbers; ``"NN/j"`` when there are many towns)."""
-    if not many:
-        manifest["finished"]["stereo"] = list(done)
-        return
-    keep = [s for s in manifest["finished"]["stereo"] if not str(s).startswith(f"{sequence}/")]
-    manifest["finished"]["stereo"] = keep + [f"{sequence}/{j}" for j in done]
+def _summary(source) -> dict:
+    s = source.s
+    return mf.finished_summary(s.plan, source.ledger, len(s.towns), dict(source.done_products),
+                               source.ledger.dataset.get("stats") == source.fingerprint)
 
 
-def _add_stereo(manifest: dict, sequence: str, j: int, many: bool) -> None:
-    manifest["finished"]["stereo"].append(f"{sequence}/{j}" if many else j)
-
-
-def _render_figures(results, frames: int, per_frame: int) -> dict:
-    """Throughput and where the workers' time went (over every town's pool run)."""
-    workers = [w for res in results for w in res.done]
-    wall = sum(res.wall_s for res in results)
-    busy = sum(w["setup_s"] + w["frames_s"] for w in workers)
-    cycles = sum(w["cycles_rgb_s"] for w in workers)
-    rss = [(msg["frames_done"], msg["rss_mb"]) for res in results for msg in res.frame_seconds.values()]
-    return {
-        "render_wall_s": round(wall, 2),
-        "frames_rendered": frames,
-        "images_rendered": frames * per_frame,
-        "frames_per_hour": round(3600.0 * frames / wall, 2) if wall else None,
-        "images_per_hour": round(3600.0 * frames * per_frame / wall, 1) if wall else None,
-        "worker_setup_s": [round(w["setup_s"], 2) for w in workers],
-        "cycles_rgb_s": round(cycles, 2),
-        "share_outside_rgb_sampling": round(1.0 - cycles / busy, 4) if busy else None,
-        "worker_rss_mb": [round(w["rss_mb"], 1) for w in workers],
-        "worker_max_rss_mb": [round(w["max_rss_mb"], 1) for w in workers],
-        "rss_by_frames_done": sorted(rss),
-    }
+def _figures(source, figures: dict, per_frame: int) -> dict:
+    """Throughput, where the workers' time went and what the parent did (bookkeeping)."""
+    f = source.figures
+    render = [d for d in f["done"] if d["kind"] == "render"]
+    wall = figures["wall_s"]
+    busy = sum(d.get("setup_s", 0.0) + d.get("frames_s", 0.0) for d in render)
+    cycles = sum(d.get("cycles_rgb_s", 0.0) for d in render)
+    out = {"tasks": figures["tasks"], "tasks_lost": figures["tasks_lost"], "dispatch_wall_s": round(wall, 2),
+           "town_products_s": {k: round(v, 2) for k, v in f["products"].items()},
+           "stereo_pairs_rendered": f["stereo"]}
+    if figures["nodes"]:
+        out["ray_nodes"] = figures["nodes"]
+    if f["frames"]:
+        out.update({
+            "render_wall_s": round(wall, 2),
+            "frames_rendered": f["frames"],
+            "images_rendered": f["images"],
+            "frames_per_hour": round(3600.0 * f["frames"] / wall, 2) if wall else None,
+            "images_per_hour": round(3600.0 * f["images"] / wall, 1) if wall else None,
+            "worker_setup_s": [round(d.get("setup_s", 0.0), 2) for d in render],
+            "cycles_rgb_s": round(cycles, 2),
+            "share_outside_rgb_sampling": round(1.0 - cycles / busy, 4) if busy else None,
+            "worker_rss_mb": [round(d.get("rss_mb", 0.0), 1) for d in render],
+            "worker_max_rss_mb": [round(d.get("max_rss_mb", 0.0), 1) for d in render],
+            "rss_by_frames_done": sorted(f["rss"]),
+        })
+    return out

@@ -3,7 +3,8 @@
 Pure Python: the renderer is passed in (a :class:`generator.blender.renderer.Renderer`
 in production) only for its intrinsics, device and version, so this module never
 imports bpy. Every file is written atomically, the metadata last, so a metadata file
-present means the image is complete.
+present means the image is complete. Files go to the frame's shard folder,
+``images/SSSS/`` (:mod:`generator.imaging.paths`).
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from pathlib import Path
 from generator.atomic import inside, write_json
 from generator.imaging.exr import LabelledImage, write_exr
 from generator.imaging.metadata import image_metadata, validate_metadata
+from generator.imaging.paths import IMAGES_DIR, shard_name
 from generator.previews.preview import write_preview
 
 
@@ -40,7 +42,7 @@ def write_image(out: Path, frame, spec, cfg, renderer, rendered, time_of_day: st
     """
     secs = dict(rendered.seconds)
     name = name or image_name(frame.index, time_of_day, weather["kind"])
-    folder = inside(out, "images")
+    folder = inside(out, IMAGES_DIR, shard_name(frame.index))  # images/SSSS/ (generator.imaging.paths)
     lab = rendered.labels
     rgb = rendered.rgb if rgb is None else rgb
     files = {"exr": f"{name}.exr", **({"preview": f"{name}_preview.png"} if cfg.preview else {})}

@@ -94,6 +94,9 @@ class SequenceOptions:
     weather : bool
         LiDAR weather when ``spec.lidar.weather.enabled`` is null (auto): ``generate`` sets
         True (its images carry the weather), the ``lidar`` command leaves it False.
+    dataset_label_config : bool
+        Rewrite ``out``'s label config (content summed over every sequence) after the sequence;
+        ``generate`` writes it once at the end instead (towns are cast at the same time).
     """
 
     frames: int
@@ -107,6 +110,7 @@ class SequenceOptions:
     route: int = 0
     weather: bool = False
     image_frames: tuple = ()
+    dataset_label_config: bool = True
 
 
 def _check_route(scene, spec, n: int, route: int) -> None:
@@ -239,7 +243,8 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
     meta["sweep_poses_world"] = {"period_s": sensor.period_s, "frames": sweeps}
     meta["scene_flow"] = {**SCENE_FLOW, "dt_s": SWEEP_PERIOD_S}
     write_json(seq / META_NAME, meta)
-    write_dataset_label_config(out)
+    if options.dataset_label_config:
+        write_dataset_label_config(out)
     return meta
 
 

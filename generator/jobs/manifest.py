@@ -1,11 +1,15 @@
-"""``manifest.json``: what a dataset folder holds and how it was made.
+"""``manifest.json``: what a dataset folder holds and how it was made -- its summary.
 
-The manifest records the spec (and its hash), the render config, the software
-versions, the plan and the finished items. It is rewritten atomically after every
-finished frame. A rerun of the same command resumes: finished items are those whose
-files are complete on disk (an image's metadata JSON is written last), so a run killed
-at any instant loses at most the frames in flight. A folder made from another spec or
-config is refused rather than mixed.
+The manifest records the spec (and its hash), the render config, the software versions, the plan
+(frame ranges, not a list of frames) and a summary of what is finished (counts and the ranges of
+complete frames). The item-by-item record is the journal (:mod:`generator.jobs.journal`): the
+manifest is written when a run starts, every :data:`generator.jobs.schedule.CHECKPOINT_S` seconds
+and when it ends, never per item. A rerun of the same command resumes from the journal; a folder
+made from another spec or config is refused rather than mixed.
+
+Version 2 (this one) replaced version 1's ``plan.frames`` (every frame number) by
+``plan.frame_ranges`` (``[[start, stop], ...]``, half-open) and ``finished.images`` (every image
+name) by counts and ``finished.frame_ranges``; version 1 manifests are still read (and resumed).
 """
 
 from __future__ import annotations
@@ -17,10 +21,13 @@ from pathlib import Path
 from generator.atomic import write_json
 from generator.errors import UserError
 from generator.imaging.metadata import software_versions
+from generator.jobs.frameset import FrameSet
+from generator.jobs.journal import DIR as JOURNAL_DIR
+from generator.jobs.journal import combo_mask
 from generator.jobs.plan import Plan
 
 NAME = "manifest.json"
-VERSION = 1
+VERSION = 2
 
 
 def new_manifest(spec, cfg, plan: Plan, executor: str) -> dict:
@@ -35,7 +42,8 @@ def new_manifest(spec, cfg, plan: Plan, executor: str) -> dict:
         "plan": plan.to_dict(),
         "executor": executor,
         "created": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
-        "finished": {"images": [], "lidar": False, "openlabel": False, "stats": False},
+        "finished": {"images": 0, "frames": 0, "frame_ranges": [], "stereo": 0, "lidar": False, "openlabel": False,
+                     "stats": False, "journal": f"{JOURNAL_DIR}/"},
         "runs": [],
     }
 
@@ -64,12 +72,43 @@ def check_compatible(old: dict, new: dict, out: Path) -> None:
 
 
 def merge_plan(old: dict, plan: Plan) -> dict:
-    """A resumed run may extend the plan (more frames or variants); keep the union."""
-    frames = sorted(set(old["plan"]["frames"]) | set(plan.frames))
-    combos = [tuple(c) for c in old["plan"]["combos"]]
-    combos += [c for c in plan.combos if c not in combos]
-    merged = Plan(tuple(frames), tuple(combos), plan.sequence)
-    return {**old, "plan": merged.to_dict()}
+    """A resumed run may extend the plan (more frames or variants); keep the union (a version 2 manifest)."""
+    before = Plan.from_dict(old["plan"])
+    combos = list(before.combos) + [c for c in plan.combos if c not in before.combos]
+    merged = Plan(before.frames.union(plan.frames), tuple(combos), plan.sequence)
+    return {**old, "manifest_version": VERSION, "plan": merged.to_dict()}
+
+
+def finished_summary(plan: Plan, ledger, towns: int, products: dict, stats: bool) -> dict:
+    """The manifest's ``finished``: counts of what the journal holds (``ledger``) for ``plan``.
+
+    Parameters
+    ----------
+    towns : int
+        Towns of the plan.
+    products : dict of str -> int
+        Towns whose per-town product is made, by product (``lidar``, ``openlabel`` ...).
+    stats : bool
+        The dataset statistics are made for this plan.
+    """
+    complete = ledger.frames_done(plan.frames, combo_mask(plan.combos))
+    out = {"images": ledger.n_images(plan.frames, plan.combos), "frames": len(complete),
+           "frame_ranges": complete.to_json(), "stereo": sum(len(v) for v in ledger.stereo.values()),
+           "towns": {"count": towns, **products}}
+    out.update({p: n == towns for p, n in products.items()})
+    out.update(stats=stats, journal=f"{JOURNAL_DIR}/")
+    return out
+
+
+def complete_frames(doc: dict) -> FrameSet:
+    """The frames a manifest says are complete (version 2 ``finished.frame_ranges``; version 1: from the names
+    in ``finished.images`` whose frame has every planned variant)."""
+    finished = doc.get("finished", {})
+    if "frame_ranges" in finished:
+        return FrameSet.from_json(finished["frame_ranges"])
+    plan = Plan.from_dict(doc["plan"])
+    names = set(finished.get("images", []))
+    return FrameSet.of(k for k in plan.frames if all(n in names for n in plan.images_of(k)))
 
 
 def save(out: Path, manifest: dict) -> None:

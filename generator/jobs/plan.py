@@ -4,10 +4,14 @@ Every frame is rendered in every planned combination (masks and depth are shared
 frame's variants), so each (time of day, weather) pair gets exactly one image per frame:
 equal counts by construction. Every frame also gets one LiDAR scan in sequence ``NN``.
 
-Before any work, a plan is checked against fixed limits (:func:`check_plan`: frame numbers
-fit the six digits of file names, images per dataset) and the disk it will write is
-estimated (:func:`image_bytes`, :func:`scan_bytes`) and compared with the free space at
-the output (:func:`check_free_space`), so an absurd ``--frames`` ends in one line at once
+A plan is compact: its frames are ranges (:class:`generator.jobs.frameset.FrameSet`), so a
+million-image plan is a few numbers in memory and in ``manifest.json``.
+
+Before any work, a plan is checked against what the formats allow (:func:`check_plan`: frame
+numbers fit the six digits of file names, ``NNNNNN_<time>_<weather>``, KITTI's and Cityscapes'
+frame ids; there is no cap on the number of images, which only the disk bounds) and the disk it
+will write is estimated (:func:`image_bytes`, :func:`scan_bytes`) and compared with the free space
+at the output (:func:`check_free_space`), so an absurd ``--frames`` ends in one line at once
 instead of running until killed or until the disk is full.
 """
 
@@ -16,21 +20,20 @@ from __future__ import annotations
 import os
 import shutil
 from collections import Counter
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from pathlib import Path
 
 from generator.errors import UserError
+from generator.jobs.frameset import FrameSet
 from generator.jobs.images import image_name
 from generator.safeload import printable
 from generator.weather import combinations
 
-#: Frames one run may plan (``--frames``).
-MAX_FRAMES = 100_000
-#: Largest frame number: file names hold six digits (``NNNNNN_day_clear.exr``).
+#: Largest frame number: file names hold six digits (``NNNNNN_day_clear.exr``, KITTI's ``NNNNNN.png``,
+#: Cityscapes' ``city_SSSSSS_NNNNNN``).
 MAX_FRAME_INDEX = 999_999
-#: Images (frames x weather/time variants) one dataset may plan; a run that would make more
-#: is refused before it starts (Cityscapes has 25 000 images, SemanticKITTI 43 552 scans).
-MAX_IMAGES = 100_000
+#: Frames one run may plan (``--frames``): every six-digit frame number.
+MAX_FRAMES = MAX_FRAME_INDEX + 1
 #: Parallel render workers (``--workers``); the local executor also stops at the machine's cores.
 MAX_WORKERS = 256
 
@@ -41,20 +44,28 @@ class Plan:
 
     Attributes
     ----------
-    frames : tuple of int
-        Frame indices along route 0 (``NNNNNN`` of file names).
+    frames : FrameSet
+        Frame indices along route 0 (``NNNNNN`` of file names), as ranges.
     combos : tuple of (str, str)
         (time_of_day, weather_kind) rendered for every frame.
     sequence : str
-        Two-digit SemanticKITTI sequence id of the LiDAR scans.
+        SemanticKITTI sequence id of the LiDAR scans (of the first town).
     """
 
-    frames: tuple[int, ...]
+    frames: FrameSet
     combos: tuple[tuple[str, str], ...]
     sequence: str = "00"
 
+    def __post_init__(self):
+        if not isinstance(self.frames, FrameSet):
+            object.__setattr__(self, "frames", FrameSet.of(self.frames))
+
+    @property
+    def n_images(self) -> int:
+        return len(self.frames) * len(self.combos)
+
     def images(self) -> list[str]:
-        """Every image name of the plan, frame-major."""
+        """Every image name of the plan, frame-major (a list as long as the plan: for small plans)."""
         return [image_name(k, t, w) for k in self.frames for t, w in self.combos]
 
     def images_of(self, frame: int) -> list[str]:
@@ -62,41 +73,36 @@ class Plan:
 
     def counts(self) -> Counter:
         """Images per (time_of_day, weather)."""
-        return Counter((t, w) for _ in self.frames for t, w in self.combos)
+        return Counter({c: len(self.frames) for c in self.combos})
 
     def is_balanced(self) -> bool:
         return len(set(self.counts().values())) <= 1
 
     def to_dict(self) -> dict:
-        d = asdict(self)
-        d["frames"] = list(self.frames)
-        d["combos"] = [list(c) for c in self.combos]
-        d["images"] = len(self.frames) * len(self.combos)
-        return d
+        """The manifest's ``plan``: ``frame_ranges`` (half-open ``[start, stop)``), counts, combos, sequence."""
+        return {"frame_ranges": self.frames.to_json(), "frame_count": len(self.frames),
+                "combos": [list(c) for c in self.combos], "sequence": self.sequence, "images": self.n_images}
 
     @classmethod
-    def from_dict(cls, d: dict) -> "Plan":
-        return cls(tuple(d["frames"]), tuple(tuple(c) for c in d["combos"]), d["sequence"])
+    def from_dict(cls, d: dict) -> Plan:
+        """From :meth:`to_dict`'s form, or the frame list of manifests before version 2 (``frames``)."""
+        frames = FrameSet.from_json(d["frame_ranges"]) if "frame_ranges" in d else FrameSet.of(d["frames"])
+        return cls(frames, tuple(tuple(c) for c in d["combos"]), d["sequence"])
 
 
 def make_plan(frames: int, first: int = 0, combos=None, sequence: str = "00") -> Plan:
     """Frames ``first .. first + frames - 1`` in ``combos`` (default: all 12 of Table II)."""
-    return Plan(tuple(range(first, first + frames)), tuple(combos or combinations()), sequence)
+    return Plan(FrameSet.span(first, frames), tuple(combos or combinations()), sequence)
 
 
 def check_plan(plan: Plan, flag: str = "--frames") -> None:
-    """Refuse a plan beyond :data:`MAX_FRAMES`, :data:`MAX_FRAME_INDEX` or :data:`MAX_IMAGES` (one line)."""
+    """Refuse a plan whose frame numbers leave ``0..MAX_FRAME_INDEX`` (one line). The number of images
+    is not capped: the disk estimate (:func:`check_free_space`) bounds it."""
     if not plan.frames:
         raise UserError(f"{flag}: the plan has no frames")
-    if len(plan.frames) > MAX_FRAMES:
-        raise UserError(f"{flag}: {len(plan.frames)} frames planned; at most {MAX_FRAMES} per dataset")
-    if min(plan.frames) < 0 or max(plan.frames) > MAX_FRAME_INDEX:
-        raise UserError(f"{flag}: frame {max(plan.frames)} planned; frame numbers must stay in 0..{MAX_FRAME_INDEX} "
+    if plan.frames.min() < 0 or plan.frames.max() > MAX_FRAME_INDEX:
+        raise UserError(f"{flag}: frame {plan.frames.max()} planned; frame numbers must stay in 0..{MAX_FRAME_INDEX} "
                         f"(six digits in file names)")
-    images = len(plan.frames) * len(plan.combos)
-    if images > MAX_IMAGES:
-        raise UserError(f"{flag}: {len(plan.frames)} frames x {len(plan.combos)} variants = {images} images planned; "
-                        f"at most {MAX_IMAGES} per dataset (fewer --frames or --variants, or several datasets)")
 
 
 def check_workers(workers: int, executor: str, flag: str = "--workers") -> None:

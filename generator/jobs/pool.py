@@ -1,116 +1,146 @@
-"""Run render workers in spawned processes and follow their progress.
+"""The local executor: a pool of spawned worker processes on this machine.
 
-Each worker is one process with one Blender and one scene build; frames are dealt
-round-robin. The parent never imports bpy, so spawning is always safe.
+Each of ``slots`` processes runs tasks one after another (:func:`serve`); a task that imported bpy
+(``Task.fresh``) ends its process, which is replaced for the next task (one Blender per process:
+its state cannot be reset). The parent never imports bpy, so spawning is always safe. Workers exit
+when the parent dies (SIGKILL included).
 """
 
 from __future__ import annotations
 
-import dataclasses
 import logging
 import multiprocessing as mp
 import os
 import queue as queue_mod
-import time
+import traceback
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from generator.progress import progress
-
+from generator.jobs.tasks import TaggedReport, Task, exit_with_parent, resolve
 
 log = logging.getLogger(__name__)
 
 
 @dataclass
 class PoolResult:
-    """What the workers reported."""
+    """What the workers of a ``render`` run reported (:func:`generator.jobs.executors.run_jobs`)."""
 
-    frame_seconds: dict[int, dict] = field(default_factory=dict)
+    frame_seconds: dict = field(default_factory=dict)
     ready: list[dict] = field(default_factory=list)
     done: list[dict] = field(default_factory=list)
     wall_s: float = 0.0
 
 
-def run_workers(target: str, jobs: list, total: int, desc: str = "render", on_frame=None) -> PoolResult:
-    """Start one spawned process per job running ``target`` (``"module:function"``) and wait.
+def serve(inbox, outbox, parent_pid: int) -> None:
+    """A worker process: run the tasks ``inbox`` hands it until it hands ``None``."""
+    exit_with_parent(parent_pid)
+    while True:
+        item = inbox.get()
+        if item is None:
+            return
+        task_id, target, job, fresh = item
+        try:
+            resolve(target)(job, TaggedReport(outbox, task_id))
+        except BaseException:  # report everything; the parent decides (a worker's own report came first)
+            outbox.put((task_id, ("error", traceback.format_exc())))
+            outbox.close()
+            outbox.join_thread()
+            os._exit(1)
+        outbox.put((task_id, ("_end",)))
+        if fresh:
+            return
 
-    Parameters
-    ----------
-    target : str
-        Worker entry, called as ``function(job, queue)``.
-    jobs : list of dataclass
-        One job per worker (picklable, with a ``parent_pid`` field).
-    total : int
-        Number of ``("frame", ...)`` reports expected, for the progress bar.
-    on_frame : callable, optional
-        Called in the parent as ``on_frame(index, payload)`` for every finished frame.
 
-    Raises
-    ------
-    RuntimeError
-        With the worker's traceback when a worker fails.
+@dataclass
+class _Worker:
+    process: object
+    inbox: object
+    task: int | None = None
+    retiring: bool = False
+
+
+class LocalExecutor:
+    """Up to ``slots`` tasks at once, each in a spawned process of this machine.
+
+    Events (:meth:`events`): ``("msg", task_id, message)``, ``("ended", task_id)`` and
+    ``("failed", task_id, reason)`` for a process that died without reporting.
     """
-    module, func = target.split(":")
-    ctx = mp.get_context("spawn")
-    q = ctx.Queue()
-    import importlib
 
-    fn = getattr(importlib.import_module(module), func)
-    jobs = [dataclasses.replace(job, parent_pid=os.getpid()) for job in jobs]
-    procs = [ctx.Process(target=fn, args=(job, q), daemon=False) for job in jobs]
-    t0 = time.perf_counter()
-    for p in procs:
-        p.start()
+    name = "local"
 
-    def failed() -> str | None:
-        dead = [p for p in procs if p.exitcode not in (None, 0)]
-        return f"render worker {dead[0].pid} exited with code {dead[0].exitcode}" if dead else None
+    def __init__(self, slots: int):
+        self.slots = max(1, int(slots))
+        self.ctx = mp.get_context("spawn")
+        self.outbox = self.ctx.Queue()
+        self.workers: list[_Worker] = []
 
-    ok = False
-    try:
-        res = follow(q.get, len(procs), total, desc, on_frame, failed)
-        ok = True
-    finally:
-        for p in procs:  # finished workers are still flushing their queue: let them exit on their own
-            p.join(timeout=60 if ok else 0)
-            if p.is_alive():
-                p.terminate()
-                p.join(timeout=30)
-        q.close()
-        q.join_thread()
-    res.wall_s = time.perf_counter() - t0
-    return res
+    # -- the executor protocol ---------------------------------------------------------------------------------------
+    def has_slot(self) -> bool:
+        return sum(w.task is not None for w in self.workers) < self.slots
 
+    def submit(self, task: Task) -> None:
+        w = next((w for w in self.workers if w.task is None and not w.retiring and w.process.is_alive()), None)
+        if w is None:
+            self._reap()
+            inbox = self.ctx.Queue()
+            proc = self.ctx.Process(target=serve, args=(inbox, self.outbox, os.getpid()), daemon=False)
+            proc.start()
+            w = _Worker(proc, inbox)
+            self.workers.append(w)
+        w.task = task.id
+        w.retiring = task.fresh
+        w.inbox.put((task.id, task.target, task.job, task.fresh))
 
-def follow(get, n_workers: int, total: int, desc: str, on_frame, failed) -> PoolResult:
-    """Read worker messages with ``get(timeout=...)`` until every worker is done; drive the progress bar.
+    def events(self, timeout: float) -> list[tuple]:
+        out, msgs = [], []
+        try:
+            msgs.append(self.outbox.get(timeout=timeout))
+            while len(msgs) < 10_000:  # the rest next time
+                msgs.append(self.outbox.get_nowait())
+        except queue_mod.Empty:
+            pass
+        for task_id, msg in msgs:
+            if msg[0] == "_end":
+                w = next((w for w in self.workers if w.task == task_id), None)
+                if w is not None:
+                    w.task = None
+                out.append(("ended", task_id))
+            else:
+                out.append(("msg", task_id, msg))
+        if not out:
+            for w in self.workers:
+                code = w.process.exitcode
+                if w.task is not None and code is not None:
+                    out.append(("failed", w.task, f"worker process {w.process.pid} exited with code {code}"))
+                    w.task = None
+        return out
 
-    ``failed()`` returns a message when a worker died without reporting (checked on timeouts).
-    Shared by the local pool and the Ray executor.
-    """
-    res = PoolResult()
-    with progress(total=total, desc=desc, unit="frame") as bar:
-        while len(res.done) < n_workers:
-            try:
-                msg = get(timeout=1.0)
-            except queue_mod.Empty:  # Ray's queue raises a subclass (wrapped in RayTaskError)
-                problem = failed()
-                if problem:
-                    raise RuntimeError(problem)
+    def close(self, ok: bool = True) -> None:
+        """Stop the workers: idle ones are asked to exit; the rest are terminated (a failed run)."""
+        for w in self.workers:
+            if w.process.is_alive() and w.task is None:
+                w.inbox.put(None)
+        for w in self.workers:  # finished workers are still flushing their queue: let them exit on their own
+            w.process.join(timeout=60 if ok and w.task is None else 0)
+            if w.process.is_alive():
+                w.process.terminate()
+                w.process.join(timeout=30)
+        for w in self.workers:
+            w.inbox.close()
+        self.outbox.close()
+        self.outbox.join_thread()
+        self.workers = []
+
+    def _reap(self) -> None:
+        """Forget processes that have exited (retired after a fresh task)."""
+        keep = []
+        for w in self.workers:
+            if w.task is None and not w.process.is_alive():
+                w.process.join()
+                w.inbox.close()
                 continue
-            kind = msg[0]
-            if kind == "frame":
-                res.frame_seconds[msg[1]] = msg[2]
-                if on_frame is not None:
-                    on_frame(msg[1], msg[2])
-                bar.update(1)
-            elif kind == "ready":
-                res.ready.append(msg[1])
-            elif kind == "done":
-                res.done.append(msg[1])
-            elif kind == "error":
-                raise RuntimeError("render worker failed:\n" + msg[1])
-    return res
+            keep.append(w)
+        self.workers = keep
 
 
 def deal(items: list, workers: int) -> list[list]:
@@ -120,5 +150,5 @@ def deal(items: list, workers: int) -> list[list]:
 
 
 def scratch_dir(out: Path, worker: int) -> Path:
-    """Per-worker scratch folder inside the output folder (removed at the end of a run)."""
+    """Per-task scratch folder inside the output folder (removed at the end of a run)."""
     return Path(out) / ".scratch" / f"worker{worker}"

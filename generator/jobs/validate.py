@@ -14,7 +14,8 @@ problem like any other, and no line quotes a file's content.
 * LiDAR (:mod:`generator.jobs.validate_lidar`): scans, labels (ids in the label table,
   one per point), side files, poses (finite, rigid, one per scan), times (finite,
   increasing), calib, ``lidar_meta.json``.
-* OpenLABEL: every file against the 1.0 schema. Manifest: every planned item present.
+* OpenLABEL: every file against the 1.0 schema. Manifest: every planned image present (the plan's frame
+  ranges, manifest version 2, or its frame list, version 1).
 """
 
 from __future__ import annotations
@@ -31,13 +32,14 @@ from generator.errors import UserError
 from generator.imaging import meta_fields as md
 from generator.imaging.exr import read_exr
 from generator.imaging.metadata import class_pixels, validate_metadata
+from generator.imaging.paths import find_image, frame_of, image_files, images_root, shard_name
 from generator.jobs.validate_lidar import check_lidar, reason, rel
 from generator.labels import class_table
 
 #: OpenLABEL schema problems listed per file at most.
 MAX_SCHEMA_PROBLEMS = 20
-#: Planned items a manifest may list (frames x variants).
-MAX_PLAN_ITEMS = 1_000_000
+#: Missing planned images listed one by one at most (the rest are counted).
+MAX_LISTED = 1_000
 _NAME = re.compile(r"[a-z][a-z_]{0,31}")
 
 
@@ -111,13 +113,20 @@ def _image_meta(meta: dict, meta_path: Path, root: Path, img) -> list[str]:
 
 
 def check_images(root: Path) -> tuple[list[str], int]:
-    """Problems of ``root/images`` and the number of images checked."""
-    folder = root / "images"
+    """Problems of ``root/images`` (its shard folders, :mod:`generator.imaging.paths`, or the flat layout of
+    older datasets) and the number of images checked."""
     problems: list[str] = []
-    exrs = sorted(folder.glob("*.exr"))
-    jsons = sorted(p for p in folder.glob("*.json"))
-    for stem in sorted({p.stem for p in jsons} - {p.stem for p in exrs}):
-        problems.append(f"{rel(folder / stem, root)}.json: metadata without its EXR")
+    exrs = image_files(root, "*.exr")
+    jsons = image_files(root, "*.json")
+    for stem in sorted({p.with_suffix("") for p in jsons} - {p.with_suffix("") for p in exrs}):
+        problems.append(f"{rel(stem, root)}.json: metadata without its EXR")
+    base = images_root(root)
+    for p in exrs + jsons:
+        k = frame_of(p.name)
+        if k is None:
+            problems.append(f"{rel(p, root)}: not an image name (NNNNNN_<time>_<weather>)")
+        elif p.parent != base and p.parent.name != shard_name(k):
+            problems.append(f"{rel(p, root)}: in the wrong shard folder (frame {k} belongs in images/{shard_name(k)}/)")
     names = class_table().names
     for exr in exrs:
         r = rel(exr, root)
@@ -176,6 +185,10 @@ def check_boxes(root: Path) -> tuple[list[str], int]:
 
 
 def check_manifest(root: Path) -> list[str]:
+    """Every image the manifest plans is present (its metadata JSON, written last). Reads a version 2 plan
+    (``plan.frame_ranges``) or a version 1 one (``plan.frames``, every frame number)."""
+    from generator.jobs.frameset import FrameSet
+
     p = root / "manifest.json"
     if not os.path.lexists(p):
         return []
@@ -184,18 +197,31 @@ def check_manifest(root: Path) -> list[str]:
     if m is None:
         return problems
     plan = m.get("plan") if isinstance(m.get("plan"), dict) else {}
-    frames, combos = plan.get("frames"), plan.get("combos")
-    if not (isinstance(frames, list) and all(isinstance(k, int) and not isinstance(k, bool) and 0 <= k < 10**6
-                                             for k in frames)):
-        return ["manifest.json: plan.frames: must be a list of frame numbers"]
+    combos = plan.get("combos")
+    if "frame_ranges" in plan:
+        try:
+            frames = FrameSet.from_json(plan["frame_ranges"], 0, 10**6)
+        except ValueError as e:
+            return [f"manifest.json: plan.frame_ranges: {e}"]
+    else:
+        frames = plan.get("frames")
+        if not (isinstance(frames, list) and all(isinstance(k, int) and not isinstance(k, bool) and 0 <= k < 10**6
+                                                 for k in frames)):
+            return ["manifest.json: plan.frames: must be a list of frame numbers"]
+        frames = FrameSet.of(frames)
     if not (isinstance(combos, list) and all(isinstance(c, list) and len(c) == 2 and all(
             isinstance(x, str) and _NAME.fullmatch(x) for x in c) for c in combos)):
         return ["manifest.json: plan.combos: must be a list of [time_of_day, weather] names"]
-    if len(frames) * len(combos) > MAX_PLAN_ITEMS:
-        return [f"manifest.json: plan: more than {MAX_PLAN_ITEMS} planned images"]
-    missing = [f"{k:06d}_{t}_{w}" for k in frames for t, w in combos
-               if not (root / "images" / f"{k:06d}_{t}_{w}.json").exists()]
-    return [f"manifest.json: planned image {n} is missing" for n in missing]
+    missing, n = [], 0
+    for k in frames:
+        for t, w in combos:
+            if not find_image(root, f"{k:06d}_{t}_{w}", ".json").exists():
+                n += 1
+                if n <= MAX_LISTED:
+                    missing.append(f"manifest.json: planned image {k:06d}_{t}_{w} is missing")
+    if n > MAX_LISTED:
+        missing.append(f"manifest.json: and {n - MAX_LISTED} more planned images are missing")
+    return missing
 
 
 def validate_dataset(root: Path) -> tuple[list[str], dict]:

@@ -23,6 +23,9 @@ import time
 import traceback
 from pathlib import Path
 
+from generator.jobs.frameset import iter_frames, last_frame
+from generator.jobs.tasks import exit_with_parent
+
 log = logging.getLogger(__name__)
 
 
@@ -40,27 +43,10 @@ def _stdout_to(path: Path):
         os.close(fd)
 
 
-def _exit_with_parent(parent: int, period_s: float = 0.5) -> None:
-    """Exit at once when the parent process dies (a SIGKILLed parent cannot stop its workers).
-
-    The parent's pid is passed in the job: comparing with the current parent pid also
-    catches a parent that died before this thread started.
-    """
-    import threading
-
-    def watch() -> None:
-        while True:
-            if os.getppid() != parent:
-                os._exit(1)
-            time.sleep(period_s)
-
-    threading.Thread(target=watch, name="parent-watchdog", daemon=True).start()
-
-
 def run(job, queue) -> None:
     """Render ``job.frames`` (a :class:`~generator.jobs.executors.RenderJob`) and report on ``queue``."""
     if job.parent_pid:
-        _exit_with_parent(job.parent_pid)
+        exit_with_parent(job.parent_pid)
     try:
         scratch = Path(job.scratch)
         scratch.mkdir(parents=True, exist_ok=True)
@@ -88,22 +74,23 @@ def _run(job, queue, scratch: Path) -> None:
     queue.put(("ready", {"layout_s": layout_s, "blender_build_s": renderer.build_seconds, "pid": os.getpid()}))
 
     t_start = time.perf_counter()
-    frames = [local_frame(rig, index, job.first) for index in job.frames]
-    for n, (index, (_, images)) in enumerate(zip(job.frames, render_frames(renderer, spec, cfg, frames, Path(job.out),
-                                                                            job.combos, rig)), 1):
+    indices = list(iter_frames(job.frames))
+    frames = [local_frame(rig, index, job.first) for index in indices]
+    for n, (index, (_, images)) in enumerate(zip(indices, render_frames(renderer, spec, cfg, frames, Path(job.out),
+                                                                         job.combos, rig), strict=True), 1):
         queue.put(("frame", index, {"images": images, "rss_mb": _rss_mb(), "frames_done": n}))
     if job.stereo:
         from generator.jobs.stereo import render_pair
         from generator.lidar.sensors import sensor_for_spec
 
         sensor = sensor_for_spec(spec)
-        for n, index in enumerate(job.stereo, len(job.frames) + 1):
+        for n, index in enumerate(job.stereo, len(indices) + 1):
             secs = render_pair(renderer, spec, cfg, rig, sensor, index, Path(job.sequence_dir))
             queue.put(("frame", ("stereo", index), {"images": {}, "stereo": index, "seconds": secs,
                                                     "rss_mb": _rss_mb(), "frames_done": n}))
     cycles = renderer.cycles_seconds
     queue.put(("done", {
-        "pid": os.getpid(), "frames": len(job.frames) + len(job.stereo), "max_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
+        "pid": os.getpid(), "frames": len(indices) + len(job.stereo), "max_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
         "rss_mb": _rss_mb(), "setup_s": layout_s + renderer.build_seconds, "frames_s": time.perf_counter() - t_start,
         "cycles_rgb_s": cycles["rgb"], "cycles_labels_s": cycles["labels"],
     }))
@@ -120,7 +107,7 @@ def _world(spec, scene, job):
     from generator.traffic.build import build_world
     from generator.world.rig import SWEEP_PERIOD_S
 
-    last = max(job.frames, default=job.first) - job.first
+    last = last_frame(job.frames, job.first) - job.first
     duration = (max(job.stereo) + 1) * SWEEP_PERIOD_S + 0.2 if job.stereo else 0.0
     return build_world(spec, scene, duration, last * spec.paths.spacing_m + MARGIN_M)
 

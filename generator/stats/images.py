@@ -22,6 +22,7 @@ import numpy as np
 
 from generator.errors import UserError
 from generator.imaging import meta_fields as md
+from generator.imaging.paths import image_files, images_root
 from generator.labels import class_table
 from generator.safeload import printable
 from generator.stats.chart import log_bar_chart
@@ -121,7 +122,8 @@ def parse_record(path: Path, rec: object) -> ImageRecord:
 
 
 def load(root: Path) -> ImageData | None:
-    """Read every ``root/images/*.json`` (through :mod:`generator.safeload`, the metadata limits).
+    """Read every image's metadata, ``root/images/SSSS/*.json`` (:mod:`generator.imaging.paths`), through
+    :mod:`generator.safeload` (the metadata limits).
 
     Returns
     -------
@@ -133,10 +135,10 @@ def load(root: Path) -> ImageData | None:
     UserError
         If ``images/`` holds no metadata, or a metadata file is unreadable or malformed.
     """
-    folder = root / "images"
+    folder = images_root(root)
     if not folder.is_dir():
         return None
-    paths = sorted(folder.glob("*.json"))
+    paths = image_files(root, "*.json")
     if not paths:
         raise UserError(f"{folder}: no image metadata (*.json) found")
     records = []
@@ -246,7 +248,7 @@ def section(data: ImageData) -> Section:
     """The images section of the report."""
     n = len(data.records)
     t1, t2 = table1(data), table2(data)
-    summary = [f"{n:,} image{'s' if n != 1 else ''} from `{data.root / 'images'}` (metadata)",
+    summary = [f"{n:,} image{'s' if n != 1 else ''} from `{images_root(data.root)}` (metadata)",
                f"{int(data.totals().sum()):,} annotated pixels"]
     sized = [r for r in data.records if r.size is not None]
     partial = [r.name for r in sized if int(r.pixels.sum()) != r.size]

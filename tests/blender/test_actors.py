@@ -12,9 +12,11 @@ import dataclasses
 import numpy as np
 import pytest
 
+from generator.imaging.paths import image_path
 from generator.world.actors import frozen_world
 from generator.world.rig import Rig
 from kits.actor_world import CARS, FRAME, LATER, RES, car_world
+
 
 def project(k: np.ndarray, T_world_camera: np.ndarray, points: np.ndarray) -> np.ndarray:
     """(n, 2) pixel coordinates of world points (in front of the camera)."""
@@ -228,7 +230,7 @@ def test_written_metadata_records_time_and_visible_actors(tmp_path, test_spec, t
                               motion_blur=MotionBlur(True, 0.01))
     r = Renderer(test_scene, test_spec, cfg, tmp_path / "scratch", world)
     render_frame(r, test_spec, cfg, rig.frame(FRAME), tmp_path, [("day", "clear")], rig)
-    meta = json.loads((tmp_path / "images" / f"{FRAME:06d}_day_clear.json").read_text())
+    meta = json.loads(image_path(tmp_path, f"{FRAME:06d}_day_clear", ".json").read_text())
     assert meta["time_s"] == t and meta["motion"]["motion_blur"] == {"enabled": True, "shutter_s": 0.01,
                                                                      "method": "cycles"}
     seen = {a["uid"]: a for a in meta["motion"]["actors"]}

@@ -14,6 +14,7 @@ import pytest
 
 from generator.cli import main
 from generator.imaging.exr import read_exr
+from generator.imaging.paths import image_dir
 from generator.labels import class_table
 from generator.postfx.filters import luminance
 
@@ -29,7 +30,7 @@ SKY = class_table().id("sky")
 def _render(out, root, variants=VARIANTS):
     assert main(["-q", "render", str(root / "scenes/test_town.json"), "--config", "test", "--out", str(out),
                  "--frames", "1", "--first", str(FRAME), "--variants", variants]) == 0
-    return out / "images"
+    return image_dir(out, FRAME)
 
 
 @pytest.fixture(scope="module")

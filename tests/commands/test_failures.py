@@ -146,6 +146,8 @@ def test_openlabel_refuses_a_target_that_is_not_a_file(tmp_path, capsys):
       '"sequence": "00"}, "finished": {}}'), "plan.frames"),
     (('{"spec_hash": "x", "render_config": {"config_hash": "y"}, "plan": {"frames": [0], "combos": [["day", "../x"]], '
       '"sequence": "00"}, "finished": {}}'), "plan.combos"),
+    (('{"spec_hash": "x", "render_config": {"config_hash": "y"}, "plan": {"frame_ranges": [[5, 2]], "combos": [], '
+      '"sequence": "00"}, "finished": {}}'), "plan.frame_ranges"),
     ('{"spec_hash": NaN}', "NaN"),
     ("FIFO", "named pipe"),
 ])

@@ -21,6 +21,7 @@ import pytest
 
 from generator.cli import main
 from generator.imaging.exr import read_exr
+from generator.imaging.paths import image_files, image_path
 
 pytestmark = [pytest.mark.blender, pytest.mark.slow]
 VARIANTS = "day:clear,night:rain,day:fog"
@@ -50,8 +51,8 @@ def _lidar_bytes(root: Path) -> dict[str, bytes]:
 
 
 def _same_images(a: Path, b: Path) -> None:
-    for exr in sorted((a / "images").glob("*.exr")):
-        x, y = read_exr(exr), read_exr(b / "images" / exr.name)
+    for exr in image_files(a, "*.exr"):
+        x, y = read_exr(exr), read_exr(image_path(b, exr.stem, ".exr"))
         assert np.array_equal(x.class_id, y.class_id), exr.name
         assert np.array_equal(x.depth, y.depth), exr.name
         assert np.allclose(x.rgb, y.rgb, atol=1e-3), exr.name
@@ -60,9 +61,9 @@ def _same_images(a: Path, b: Path) -> None:
 def test_dataset_is_complete_balanced_and_valid(reference, capsys):
     m = json.loads((reference / "manifest.json").read_text())
     assert m["finished"] == {**m["finished"], "lidar": True, "openlabel": True, "stats": True}
-    assert len(m["finished"]["images"]) == 3 * 3 == len(list((reference / "images").glob("*.exr")))
+    assert m["finished"]["images"] == 3 * 3 == len(image_files(reference, "*.exr"))
     counts = {}
-    for p in (reference / "images").glob("*.json"):
+    for p in image_files(reference, "*.json"):
         meta = json.loads(p.read_text())
         key = (meta["time_of_day"], meta["weather"]["kind"])
         counts[key] = counts.get(key, 0) + 1
@@ -76,10 +77,10 @@ def test_dataset_is_complete_balanced_and_valid(reference, capsys):
 
 
 def test_rerun_skips_finished_work(reference, root, capsys):
-    before = {p: p.stat().st_mtime_ns for p in (reference / "images").glob("*.exr")}
+    before = {p: p.stat().st_mtime_ns for p in image_files(reference, "*.exr")}
     assert main(["-q", *_args(root, reference, "--workers", "2")]) == 0
     assert "nothing left to render" in capsys.readouterr().out
-    assert before == {p: p.stat().st_mtime_ns for p in (reference / "images").glob("*.exr")}
+    assert before == {p: p.stat().st_mtime_ns for p in image_files(reference, "*.exr")}
 
 
 def test_preview_sheets(reference, tmp_path):
@@ -115,18 +116,18 @@ def _label_out_of_table(d):
 
 
 def _drop_metadata_field(d):
-    p = d / "images/000001_night_rain.json"
+    p = image_path(d, "000001_night_rain", ".json")
     meta = json.loads(p.read_text())
     del meta["camera"]
     p.write_text(json.dumps(meta))
 
 
 def _non_binary_mask(d):
-    _rewrite_exr(d / "images/000000_day_clear.exr", lambda ch: ch["mask.road.V"].__setitem__((0, 0), 0.5))
+    _rewrite_exr(image_path(d, "000000_day_clear", ".exr"), lambda ch: ch["mask.road.V"].__setitem__((0, 0), 0.5))
 
 
 def _missing_channel(d):
-    _rewrite_exr(d / "images/000002_day_fog.exr", lambda ch: ch.pop("mask.car.V"))
+    _rewrite_exr(image_path(d, "000002_day_fog", ".exr"), lambda ch: ch.pop("mask.car.V"))
 
 
 @pytest.mark.parametrize("fault,expected", [
@@ -152,14 +153,14 @@ def test_sigkill_then_resume_gives_the_uninterrupted_files(reference, root, tmp_
     cmd = [sys.executable, "-m", "generator.cli", "-q", *_args(root, out, "--workers", "2")]
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     deadline = time.time() + 300
-    while time.time() < deadline and not list((out / "images").glob("*.json")) if out.exists() else True:
+    while time.time() < deadline and not image_files(out, "*.json") if out.exists() else True:
         if proc.poll() is not None:
             pytest.fail("generate finished before it could be killed")
         time.sleep(0.05)
     os.kill(proc.pid, signal.SIGKILL)
     proc.wait()
     time.sleep(1.5)  # the workers' watchdog notices the dead parent and exits
-    done = len(list((out / "images").glob("*.json")))
+    done = len(image_files(out, "*.json"))
     assert 0 < done < 9, "the kill should land mid-run"
     assert main(["-q", *_args(root, out, "--workers", "2")]) == 0
     assert _files(out) == _files(reference)

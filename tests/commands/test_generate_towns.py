@@ -14,6 +14,7 @@ import pytest
 
 from generator.cli import main
 from generator.dataset import Dataset
+from generator.imaging.paths import image_files, image_path
 from generator.layout import build_scene
 from generator.spec import load_spec
 from generator.spec.towns import town_spec
@@ -56,7 +57,7 @@ def test_every_file_names_its_town_and_sequences_hold_one_town(towns):
         digests[seq] = meta["scene"]["scene_digest"]
         assert min(j for _, j in meta["image_frames"]) == 0  # every town drives from its own start
         for k in frames:
-            img = json.loads((out / "images" / f"{k:06d}_day_clear.json").read_text())
+            img = json.loads(image_path(out, f"{k:06d}_day_clear", ".json").read_text())
             assert img["town"]["index"] == town and img["seed"] == t.seed
     assert digests["00"] != digests["01"]
 
@@ -79,8 +80,8 @@ def test_reader_pairs_images_with_their_towns_scans(towns):
 
 def test_rerun_resumes_with_nothing_left(towns, capsys):
     _, out, argv = towns
-    before = {p: p.stat().st_mtime_ns for p in (out / "images").glob("*.exr")}
+    before = {p: p.stat().st_mtime_ns for p in image_files(out, "*.exr")}
     capsys.readouterr()
     assert main(argv[1:]) == 0
     assert "nothing left to render" in capsys.readouterr().out
-    assert {p: p.stat().st_mtime_ns for p in (out / "images").glob("*.exr")} == before
+    assert {p: p.stat().st_mtime_ns for p in image_files(out, "*.exr")} == before

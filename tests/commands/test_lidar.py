@@ -40,9 +40,9 @@ def test_lidar_command_writes_a_sequence(root, tmp_path, capsys):
 
 
 @pytest.mark.parametrize("extra, message", [
-    (["--frames", "0"], "--frames: must be an integer in 1..100000, got '0'"),
-    (["--sequence", "abc"], "--sequence: must be a sequence number 00..99, got 'abc'"),
-    (["--sequence", "123"], "--sequence: must be a sequence number 00..99, got '123'"),
+    (["--frames", "0"], "--frames: must be an integer in 1..1000000, got '0'"),
+    (["--sequence", "abc"], "--sequence: must be a sequence number 00..999999, got 'abc'"),
+    (["--sequence", "1234567"], "--sequence: must be a sequence number 00..999999, got '1234567'"),
     (["--threads", "0"], "--threads: must be an integer in 1..256, got '0'"),
     (["--render-config", "nope"], "nope.yaml: file not found"),
 ])

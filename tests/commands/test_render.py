@@ -10,6 +10,7 @@ import json
 import numpy as np
 import pytest
 
+from generator.imaging.paths import image_dir
 from generator.cli import main
 from generator.imaging.exr import read_exr
 from generator.previews.preview import tonemap
@@ -26,7 +27,7 @@ def rendered(tmp_path_factory, root):
     code = main(["-q", "render", str(root / "scenes/test_town.json"), "--config", "test", "--out", str(out),
                  "--frames", "1", "--first", str(FRAME), "--variants", "all"])
     assert code == 0
-    return out / "images"
+    return image_dir(out, FRAME)
 
 
 def _load(images, tod, kind):
@@ -104,5 +105,5 @@ def test_second_render_gives_identical_masks(rendered, tmp_path, root):
                  "--frames", "1", "--first", str(FRAME)])
     assert code == 0
     a, _ = _load(rendered, "day", "clear")
-    b, _ = _load(tmp_path / "images", "day", "clear")
+    b, _ = _load(image_dir(tmp_path, FRAME), "day", "clear")
     assert np.array_equal(a.class_id, b.class_id) and np.array_equal(a.depth, b.depth)

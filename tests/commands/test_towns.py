@@ -16,6 +16,7 @@ import pytest
 from generator.cli import main
 from generator.commands.render import towns_of
 from generator.formats import semantickitti as sk
+from generator.imaging.paths import image_path
 from generator.jobs.towns import local_frame
 from generator.layout import build_scene
 from generator.spec import load_spec, parse_spec
@@ -105,9 +106,9 @@ def test_render_shows_town_k_over_n(root, tmp_path):
     assert main(["-q", "render", str(path), "--config", "test", "--out", str(out), "--frames", "3",
                  "--variants", "day:clear"]) == 0
     for k, town in ((0, 0), (1, 0), (2, 1)):
-        img = json.loads((out / "images" / f"{k:06d}_day_clear.json").read_text())
+        img = json.loads(image_path(out, f"{k:06d}_day_clear", ".json").read_text())
         assert img["town"]["index"] == town and img["seed"] == town_spec(spec, town).seed
     t1 = town_spec(spec, 1)
     start = local_frame(Rig.from_spec(t1, build_scene(t1)), 2, 2)  # town 1's drive starts at frame 2
-    img = json.loads((out / "images" / "000002_day_clear.json").read_text())
+    img = json.loads(image_path(out, "000002_day_clear", ".json").read_text())
     assert np.allclose(img["camera"]["position_m"], start.T_world_camera[:3, 3], atol=1e-3)

@@ -26,13 +26,13 @@ SPEC = str(ROOT / "scenes" / "test_town.json")
 Usage = namedtuple("Usage", "total used free")
 
 
-def test_check_plan_limits():
+def test_check_plan_limits_are_the_file_names():
+    """No cap on images: a million images (and more) are planned; frame numbers stop at six digits."""
     P.check_plan(P.make_plan(2))
-    P.check_plan(P.make_plan(8333))  # 8333 x 12 = 99 996 images
-    with pytest.raises(UserError, match=r"--frames: 8334 frames x 12 variants = 100008 images planned; at most 100000"):
-        P.check_plan(P.make_plan(8334))
-    with pytest.raises(UserError, match="at most 100000 per dataset"):
-        P.check_plan(P.make_plan(P.MAX_FRAMES + 1, combos=[("day", "clear")]))
+    million = P.make_plan(83_334)  # 83 334 frames x 12 variants = 1 000 008 images
+    P.check_plan(million)
+    assert million.n_images == 1_000_008 and million.to_dict()["frame_ranges"] == [[0, 83_334]]
+    P.check_plan(P.make_plan(P.MAX_FRAMES, combos=[("day", "clear")]))  # every six-digit frame number
     with pytest.raises(UserError, match=r"frame 1000000 planned; frame numbers must stay in 0\.\.999999"):
         P.check_plan(P.make_plan(2, first=999_999, combos=[("day", "clear")]))
     P.check_plan(P.make_plan(1, first=999_999, combos=[("day", "clear")]))
@@ -84,7 +84,7 @@ def _refused(capsys, argv, out: Path, plan_needs_scene: bool = False) -> str:
     came only after it cannot pass."""
     capsys.readouterr()
     work = AssertionError("work was done before the plan was refused")
-    targets = (["generator.jobs.lidar_sequence.Scanner", "generator.jobs.generate.run_jobs"] if plan_needs_scene
+    targets = (["generator.jobs.lidar_sequence.Scanner", "generator.jobs.dispatch.run_tasks"] if plan_needs_scene
                else ["generator.layout.assemble.build_scene", "generator.layout.build_scene"])
     with contextlib.ExitStack() as stack:
         for target in targets:
@@ -97,9 +97,8 @@ def _refused(capsys, argv, out: Path, plan_needs_scene: bool = False) -> str:
 
 
 @pytest.mark.parametrize("extra, message", [
-    (["--frames", "100000"], "--frames: 100000 frames x 12 variants = 1200000 images planned"),
-    (["--frames", "100001"], "--frames: must be an integer in 1..100000, got '100001'"),
-    (["--frames", "99999999999999999999999"], "--frames: must be an integer in 1..100000"),
+    (["--frames", "1000001"], "--frames: must be an integer in 1..1000000, got '1000001'"),
+    (["--frames", "99999999999999999999999"], "--frames: must be an integer in 1..1000000"),
     (["--workers", "257"], "--workers: must be an integer in 1..256"),
 ])
 def test_generate_refuses_an_absurd_plan_at_once(tmp_path, capsys, extra, message):
@@ -136,21 +135,23 @@ def test_disk_too_small_is_refused_before_any_work(tmp_path, capsys, monkeypatch
 
 
 def test_a_resumed_plan_is_checked_merged(tmp_path, capsys):
-    """A rerun extends the plan (union of frames and variants): the union must fit the limits."""
+    """A rerun extends the plan (union of frames and variants): the union must fit the frame numbers."""
     from generator.spec import load_spec
     from generator.spec.render import load_render_config
 
     out = tmp_path / "ds"
     out.mkdir()
     manifest = {"spec_hash": load_spec(SPEC).spec_hash, "render_config": {"config_hash": load_render_config("test").config_hash},
-                "plan": {"frames": list(range(40_000)), "combos": [["day", "clear"], ["day", "fog"]], "sequence": "00"},
-                "finished": {"images": []}, "runs": []}
+                "plan": {"frame_ranges": [[999_998, 1_000_000]], "combos": [["day", "clear"]], "sequence": "00"},
+                "finished": {"images": 0}, "runs": []}
     (out / "manifest.json").write_text(json.dumps(manifest))
     before = sorted(p.name for p in out.iterdir())
     capsys.readouterr()
-    rc = cli.main(["generate", SPEC, "--config", "test", "--out", str(out), "--frames", "1", "--variants", "night:rain"])
+    rc = cli.main(["generate", SPEC, "--config", "test", "--out", str(out), "--frames", "1", "--variants", "night:rain",
+                   "--plan-only"])
     err = capsys.readouterr().err
-    assert rc == 2 and "40000 frames x 3 variants = 120000 images planned" in err, err
+    # the merged plan: frames 0, 999 998, 999 999 x (day clear, night rain), a drive far too long for the disk
+    assert rc == 2 and "--out: this run writes about" in err and "(6 images and" in err, err
     assert sorted(p.name for p in out.iterdir()) == before
 
 

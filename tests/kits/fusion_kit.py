@@ -14,6 +14,7 @@ import numpy as np
 
 from generator.world import rig
 from generator.imaging.exr import LabelledImage, write_exr
+from generator.imaging.paths import image_path
 from generator.labels import class_table
 
 SKY = class_table().id("sky")
@@ -34,7 +35,8 @@ def raycast_image(caster, scene, T_world_camera: np.ndarray, K: np.ndarray, widt
 
 
 def write_raycast_images(root: Path, scene, spec, n_frames: int, width: int = 160, height: int = 96) -> None:
-    """``root/images/NNNNNN_day_clear.{exr,json}`` for frames 0..n-1, ray-cast (metadata: the keys fusion reads)."""
+    """``root/images/SSSS/NNNNNN_day_clear.{exr,json}`` for frames 0..n-1 (the shard layout of
+    :mod:`generator.imaging.paths`), ray-cast (metadata: the keys fusion reads)."""
     from generator.world.rig import Rig
     from generator.lidar.caster import EmbreeCaster
 
@@ -43,12 +45,12 @@ def write_raycast_images(root: Path, scene, spec, n_frames: int, width: int = 16
     for f in Rig.from_spec(spec, scene).frames(n_frames):
         cls, inst, depth = raycast_image(caster, scene, f.T_world_camera, K, width, height)
         name = f"{f.index:06d}_day_clear"
-        write_exr(root / "images" / f"{name}.exr", LabelledImage(np.zeros((height, width, 3), np.float32), cls, inst, depth))
+        write_exr(image_path(root, name, ".exr"), LabelledImage(np.zeros((height, width, 3), np.float32), cls, inst, depth))
         meta = {"image": name, "files": {"exr": f"{name}.exr"}, "frame": f.index,
                 "camera": {"T_world_camera": f.T_world_camera.tolist(), "T_ego_camera": f.T_ego_camera.tolist(),
                            "intrinsics": {"width": width, "height": height, "K": K.tolist()}},
                 "ego": {"T_world_ego": f.T_world_ego.tolist()}}
-        (root / "images" / f"{name}.json").write_text(json.dumps(meta))
+        image_path(root, name, ".json").write_text(json.dumps(meta))
 
 
 def write_raycast_stream(seq_dir: Path, scene, spec, scans, width: int = 640, height: int = 360) -> None:

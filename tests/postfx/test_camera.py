@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
+from generator.imaging.paths import image_dir, image_path
 from generator.postfx import camera as cm
 from generator.postfx.camera_crf import crf_8bit, curve, srgb_encode
 from generator.postfx.filters import luminance
@@ -282,7 +283,7 @@ def _render(tmp_path, test_spec, on: bool, combos):
     frame = Frame(3, 0.0, 0.0, np.eye(4), (0.0, 0.0, 0.0), np.eye(4))
     out = tmp_path / ("on" if on else "off")
     render_frame(_FakeRenderer(96, 160), test_spec, cfg, frame, out, combos)
-    return out / "images"
+    return image_dir(out, frame.index)
 
 
 COMBOS = [("day", "clear"), ("night", "clear"), ("day", "fog"), ("night", "rain")]
@@ -395,8 +396,8 @@ def test_rendered_night_is_darker_than_day_and_labels_match_off(tmp_path, root):
         outs[name] = tmp_path / name
         assert main(["-q", "render", str(root / "scenes/test_town.json"), "--config", config, "--out", str(outs[name]),
                      "--frames", "1", "--first", "3", "--variants", "day:clear,night:clear"]) == 0
-    imgs = {(n, t): read_exr(outs[n] / "images" / f"000003_{t}_clear.exr") for n in outs for t in ("day", "night")}
-    pngs = {t: np.asarray(Image.open(outs["on"] / "images" / f"000003_{t}_clear_preview.png"))[:64, :96]
+    imgs = {(n, t): read_exr(image_path(outs[n], f"000003_{t}_clear", ".exr")) for n in outs for t in ("day", "night")}
+    pngs = {t: np.asarray(Image.open(image_path(outs["on"], f"000003_{t}_clear", "_preview.png")))[:64, :96]
             for t in ("day", "night")}
     # the render itself (camera off: the EXR is the scene radiance) is physically dim at night
     ratio = luminance(imgs["off", "night"].rgb).mean() / luminance(imgs["off", "day"].rgb).mean()

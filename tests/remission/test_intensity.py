@@ -284,7 +284,7 @@ def test_fit_command_writes_a_profile_class_normal_can_use(tmp_path, capsys):
 
 @pytest.mark.parametrize("extra, message", [
     (["--sequences", "07"], "sequence not found"),
-    (["--sequences", "x"], "--sequences: must be a sequence number 00..99, got 'x'"),
+    (["--sequences", "x"], "--sequences: must be a sequence number 00..999999, got 'x'"),
     (["--labels", "unified11"], "not unified-11 ids"),
 ])
 def test_fit_command_errors_one_line_nothing_written(tmp_path, capsys, extra, message):

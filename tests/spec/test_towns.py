@@ -69,7 +69,7 @@ def test_frames_go_to_towns_and_a_sequence_never_spans_two(redraw):
     runs = town_runs(redraw, plan)
     assert [r.index for r in runs] == [0, 1, 2, 3]
     assert [r.plan.sequence for r in runs] == ["03", "04", "05", "06"]
-    assert [r.plan.frames for r in runs] == [(0, 1), (2, 3), (4, 5), (6,)]
+    assert [list(r.plan.frames) for r in runs] == [[0, 1], [2, 3], [4, 5], [6]]
     for r in runs:
         assert {town_of(redraw, k) for k in r.plan.frames} == {r.index}
         assert r.spec.seed == town_spec(redraw, r.index).seed and r.local_frames[0] == 0
@@ -83,9 +83,11 @@ def test_option_off_is_one_town_as_before(root):
     assert town_record(spec) is None
 
 
-def test_too_many_towns_for_two_digit_sequences(redraw):
-    with pytest.raises(UserError, match=r"^--frames: .*sequences 98\.\.100; sequence folders stop at 99"):
-        town_runs(redraw, make_plan(5, sequence="98"))
+def test_sequences_go_past_99_as_semantic_kitti_api_names_them(redraw):
+    """Sequence 100 is folder "100" ('{0:02d}'.format(100) in semantic-kitti-api); numbers stop at six digits."""
+    assert [r.plan.sequence for r in town_runs(redraw, make_plan(5, sequence="98"))] == ["98", "99", "100"]
+    with pytest.raises(UserError, match=r"^--frames: .*sequences 999998\.\.1000000; sequence numbers stop at 999999"):
+        town_runs(redraw, make_plan(5, sequence="999998"))
 
 
 def test_each_town_drives_from_its_start(redraw):
@@ -191,12 +193,12 @@ def test_unhashable_parameters_bypass_the_cache():
     assert len(calls) == 2 and cache.bypassed == 2 and len(cache) == 0
 
 
-def test_generate_refuses_towns_past_sequence_99_and_writes_nothing(tmp_path, capsys, root):
+def test_generate_refuses_towns_past_the_last_sequence_number_and_writes_nothing(tmp_path, capsys, root):
     spec = tmp_path / "spec.json"
     spec.write_text(json.dumps(_doc(root, redraw_every_frames=1)))
     out = tmp_path / "out"
     rc, err = run_cli(capsys, ["generate", str(spec), "--config", "test", "--out", str(out), "--frames", "3",
-                               "--sequence", "98"], tmp_path, out)
+                               "--sequence", "999998"], tmp_path, out)
     assert rc == 2 and err.startswith("urbangen generate: --frames: frames up to 2 with town.redraw_every_frames = 1 "
-                                      "make towns up to 2, LiDAR sequences 98..100"), err
+                                      "make towns up to 2, LiDAR sequences 999998..1000000"), err
     assert not out.exists()
