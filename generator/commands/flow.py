@@ -18,6 +18,7 @@ from pathlib import Path
 from generator.commands.options import path
 from generator.commands.preflight import input_dir
 from generator.errors import SpecError, UserError
+from generator.imaging.paths import images_root
 from generator.safeload import printable
 
 log = logging.getLogger(__name__)
@@ -63,7 +64,7 @@ def _streams(root: Path, town):
     ds = Dataset(root, town.plan.sequence)
     images = images_stream(ds, set(town.plan.frames))
     check_passes(images)
-    _one_image(images, f"{root / 'images'} (frames {min(town.plan.frames)}..{max(town.plan.frames)})")
+    _one_image(images, f"{images_root(root)} (frames {min(town.plan.frames)}..{max(town.plan.frames)})")
     seq_dir = root / "lidar" / "sequences" / town.plan.sequence
     cams = stereo_images(seq_dir)
     for cam, stream in cams.items():

@@ -25,9 +25,12 @@ from PIL import Image
 from generator.atomic import staging
 from generator.errors import UserError
 from generator.formats import coco as C
+from generator.imaging.paths import images_root
 from generator.labels.coco import coco_categories
 
 DEFAULT_SPLIT = "val"
+#: The export's own image folder (COCO's layout: ``images/<split>/NAME.png``), not a dataset's images/.
+COCO_IMAGES = "images"
 
 
 def image_sources(root: Path) -> list[tuple[str, str, object]]:
@@ -35,7 +38,7 @@ def image_sources(root: Path) -> list[tuple[str, str, object]]:
     ``("stereo", (exr, png))`` of a sequence's stereo pair."""
     from generator.dataset import Dataset
 
-    out = [(name, "images", name) for name in Dataset(root).image_names()] if (root / "images").is_dir() else []
+    out = [(name, "images", name) for name in Dataset(root).image_names()] if images_root(root).is_dir() else []
     for seq in sorted((root / "lidar" / "sequences").glob("[0-9][0-9]")):
         for cam in (2, 3):
             for exr in sorted((seq / f"passes_{cam}").glob("[0-9]*.exr")):
@@ -80,7 +83,7 @@ def export_coco(root: Path, out: Path, split: str = DEFAULT_SPLIT, progress=None
     root, out = Path(root), Path(out)
     sources = image_sources(root)
     targets = [out / "annotations" / f"instances_{split}.json", out / "annotations" / f"panoptic_{split}.json",
-               out / "images" / split, out / "annotations" / f"panoptic_{split}"]
+               out / COCO_IMAGES / split, out / "annotations" / f"panoptic_{split}"]
     for t in targets:
         if os.path.lexists(t):
             raise UserError(f"{t}: exists; remove it or choose another output folder")
@@ -90,7 +93,7 @@ def export_coco(root: Path, out: Path, split: str = DEFAULT_SPLIT, progress=None
     ds = Dataset(root)
     images, anns, pan = [], [], []
     with staging(out, "coco") as stage:
-        img_dir, pan_dir = stage / "images" / split, stage / "annotations" / f"panoptic_{split}"
+        img_dir, pan_dir = stage / COCO_IMAGES / split, stage / "annotations" / f"panoptic_{split}"
         img_dir.mkdir(parents=True)
         pan_dir.mkdir(parents=True)
         for image_id, (stem, kind, where) in enumerate(progress(sources, desc="export coco", unit="image"), start=1):

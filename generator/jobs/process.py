@@ -42,6 +42,7 @@ from generator.formats import semantickitti as sk
 from generator.formats.label_config import count_raw_ids, merge_counts
 from generator.formats.point_sidecars import SIDECARS, read_sidecar
 from generator.imaging import meta_fields as md
+from generator.imaging.paths import images_root
 from generator.rng import stream
 from generator.scan_effects.domain_gap import SCALE_NOTE, DomainGap, apply_domain_gap
 
@@ -219,8 +220,8 @@ def process_dataset(root: Path, out: Path, gap: DomainGap, progress=None) -> dic
         if split_cfg.is_file():
             shutil.copy2(split_cfg, stage / "lidar" / "semantic-kitti.yaml")   # its split, then new content
         write_dataset_label_config(stage / "lidar")
-        if (root / "images").is_dir():
-            _link_or_copy(root / "images", stage / "images")
+        if images_root(root).is_dir():
+            _link_or_copy(images_root(root), images_root(stage))
         if (root / "manifest.json").is_file():
             shutil.copy2(root / "manifest.json", stage / "manifest.json")
         for top in sorted(stage.iterdir()):

@@ -30,6 +30,7 @@ from generator.formats import cityscapes as cs
 from generator.formats.cityscapes_stems import dataset_sequence, image_stem_of
 from generator.formats.label_png import read_label_png
 from generator.imaging.exr import read_exr
+from generator.imaging.paths import find_image, images_root
 from generator.safeload import printable
 
 GT_SUFFIX = "_gtFine_labelIds.png"
@@ -88,7 +89,7 @@ def dataset_images(root: Path, sequence: str) -> list[GroundTruthImage]:
             lab = cs.label_ids(img.class_id)
             return lab.astype(np.int64), cs.instance_ids(lab, img.instance).astype(np.int64)
 
-        out.append(GroundTruthImage(stem, "stem", str(root / "images" / f"{name}.exr"), load))
+        out.append(GroundTruthImage(stem, "stem", str(find_image(root, name, ".exr")), load))
     return out + kitti_stream(root / "lidar" / "sequences" / sequence)
 
 
@@ -120,7 +121,7 @@ def ground_truth(root: Path, split: str, sequence: str) -> list[GroundTruthImage
     if (root / "gtFine").is_dir():
         found = cityscapes_export(root, split)
         where = f"gtFine/{split}/*/*{GT_SUFFIX}"
-    elif (root / "images").is_dir() or (root / "lidar" / "sequences").is_dir():
+    elif images_root(root).is_dir() or (root / "lidar" / "sequences").is_dir():
         found = dataset_images(root, sequence)
         where = f"images/ or lidar/sequences/{sequence}/semantic_2/"
     else:

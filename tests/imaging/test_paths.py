@@ -7,8 +7,7 @@ import ast
 from pathlib import Path
 
 from generator.imaging import paths as P
-
-ROOT = Path(__file__).resolve().parents[2]
+from kits.paths import ROOT
 
 
 def _touch(path: Path) -> Path:

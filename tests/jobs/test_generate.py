@@ -16,14 +16,14 @@ from collections import namedtuple
 from pathlib import Path
 
 import pytest
-from kits.stand_in_run import COMBOS, spec_with_towns
 
 from generator.cli import main
 from generator.jobs.frameset import FrameSet
 from generator.jobs.journal import Journal, combo_mask
 from generator.jobs.plan import make_plan
+from kits.paths import ROOT
+from kits.stand_in_run import COMBOS, spec_with_towns
 
-ROOT = Path(__file__).resolve().parents[2]
 Usage = namedtuple("Usage", "total used free")
 FRAMES, EVERY = "6", "3"  # two towns of three frames
 

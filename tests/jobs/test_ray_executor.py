@@ -11,12 +11,12 @@ import time
 from pathlib import Path
 
 import pytest
-from kits.stand_in_run import COMBOS, spec_with_towns
 
 from generator.jobs.generate import GenerateOptions, run_generate
 from generator.jobs.plan import make_plan
+from kits.paths import ROOT
+from kits.stand_in_run import COMBOS, spec_with_towns
 
-ROOT = Path(__file__).resolve().parents[2]
 pytestmark = pytest.mark.slow
 FRAMES = 10
 

@@ -10,8 +10,7 @@ import pytest
 
 from generator.jobs.frameset import FrameSet
 from generator.jobs.plan import Plan
-
-ROOT = Path(__file__).resolve().parents[2]
+from kits.paths import ROOT
 
 
 @pytest.fixture(scope="module")

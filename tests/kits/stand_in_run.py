@@ -19,7 +19,8 @@ import os
 import signal
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[2]
+from kits.paths import ROOT
+
 COMBOS = (("day", "clear"), ("night", "rain"))
 
 
