@@ -35,7 +35,7 @@ BINS = 40
 
 def generate(dataset: Path, models: list[str], frames: int, spec: Path) -> None:
     for i, model in enumerate(models):
-        if (dataset / "sequences" / f"{i:02d}" / "poses.txt").is_file():
+        if (dataset / "lidar" / "sequences" / f"{i:02d}" / "poses.txt").is_file():
             continue
         cmd = [sys.executable, "-m", "generator.cli", "-q", "lidar", str(spec), "--out", str(dataset), "--frames",
                str(frames), "--sequence", f"{i:02d}", "--intensity", model, "--no-bev"]
@@ -46,7 +46,7 @@ def generate(dataset: Path, models: list[str], frames: int, spec: Path) -> None:
 def collect(dataset: Path, sequence: str) -> dict[int, np.ndarray]:
     """Remission per SemanticKITTI raw id over every scan of a sequence."""
     parts: dict[int, list[np.ndarray]] = {}
-    for rec in sk.Sequence(dataset, sequence):
+    for rec in sk.Sequence(dataset / "lidar", sequence):
         for raw in np.unique(rec.semantic):
             parts.setdefault(int(raw), []).append(rec.points[rec.semantic == raw, 3])
     return {k: np.concatenate(v) for k, v in parts.items()}

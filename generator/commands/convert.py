@@ -17,13 +17,14 @@ from generator.commands.options import path, sequence_list
 from generator.commands.preflight import input_dir, output_dir
 from generator.formats.label_config import SPLITS
 from generator.formats.relabel import TARGETS, convert_dataset
+from generator.formats.semantickitti import semantickitti_root
 from generator.jobs.plan import check_free_space
 
 
 def register(sub) -> None:
     p = sub.add_parser("convert", help="relabel a SemanticKITTI-layout dataset into the unified 11 classes",
                        description=__doc__.split("\n\n")[1])
-    p.add_argument("input", type=path, help="dataset root (holds sequences/NN)")
+    p.add_argument("input", type=path, help="SemanticKITTI root (holds sequences/NN) or a dataset folder (lidar/sequences/NN)")
     p.add_argument("output", type=path, help="output dataset root")
     p.add_argument("--labels", required=True, choices=tuple(TARGETS), help="target label set")
     p.add_argument("--sequences", type=sequence_list, default=None,
@@ -36,6 +37,7 @@ def register(sub) -> None:
 
 def run(args) -> int:
     input_dir(args.input, what="dataset folder")
+    args.input = semantickitti_root(args.input)  # a dataset folder's lidar/ or a SemanticKITTI root
     output_dir(args.output, "OUT")
     check_free_space(args.output, _input_bytes(args.input, args.sequences), "a copy of the scans and labels",
                      flag="OUT")

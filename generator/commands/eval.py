@@ -26,6 +26,7 @@ from generator.atomic import write_json
 from generator.commands.eval_images import add_image_args, run_images
 from generator.commands.options import Integer, path, sequence_id
 from generator.commands.preflight import input_dir, output_file
+from generator.formats.semantickitti import semantickitti_root
 
 #: Largest --min-points (a segment of more points than a scan holds never counts).
 MAX_MIN_POINTS = 10_000_000
@@ -86,6 +87,7 @@ def run(args) -> int:
 
     for flag, folder in (("--pred", args.pred), ("--gt", args.gt)):
         input_dir(folder, flag)
+    args.gt = semantickitti_root(args.gt)  # a dataset folder's lidar/ or a SemanticKITTI root
     out = output_file(args.json or args.pred / f"eval_{args.labels}.json", "--json")
     seqs = None if args.sequences is None else list(dict.fromkeys(args.sequences))
     result = evaluate_trees(args.pred, args.gt, args.labels, seqs, mean_over=args.mean_over,

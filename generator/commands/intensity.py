@@ -15,9 +15,10 @@ from pathlib import Path
 from generator.commands.options import Number, path, sequence_list, text_path
 from generator.commands.preflight import input_dir, output_file
 from generator.errors import UserError
-from generator.scan_effects.domain_gap import DomainGap, preset
+from generator.formats.semantickitti import semantickitti_root
 from generator.remission.class_profiles import LABEL_SPACES, resolve_profile
 from generator.remission.models import MODEL_NAMES, IntensityFn, intensity_model
+from generator.scan_effects.domain_gap import DomainGap, preset
 
 WEATHER_CHOICES = {"auto": None, "on": True, "off": False}
 
@@ -28,7 +29,7 @@ def register(sub) -> None:
     actions = p.add_subparsers(dest="intensity_command", metavar="ACTION", parser_class=type(p))
     actions.required = True
     f = actions.add_parser("fit", help="fit a per-class intensity profile from a SemanticKITTI-layout dataset")
-    f.add_argument("dataset", type=path, help="dataset root (holds sequences/NN/velodyne and labels)")
+    f.add_argument("dataset", type=path, help="SemanticKITTI root (sequences/NN/velodyne and labels) or a dataset folder (lidar/sequences/NN)")
     f.add_argument("--sequences", type=sequence_list, default=None,
                    help="comma-separated sequence numbers (default: every labelled sequence)")
     f.add_argument("--labels", choices=LABEL_SPACES, default="semantickitti",
@@ -41,6 +42,7 @@ def run_fit(args) -> int:
     from generator.remission.fit import fit_dataset, write_profile
 
     input_dir(args.dataset, what="dataset folder")
+    args.dataset = semantickitti_root(args.dataset)  # a dataset folder's lidar/ or a SemanticKITTI root
     output_file(args.output, "-o")
     profile, summary = fit_dataset(args.dataset, args.sequences, args.labels)
     write_profile(args.output, profile, summary)

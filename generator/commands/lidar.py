@@ -1,9 +1,9 @@
 """``urbangen lidar SPEC --out DIR [--frames N] [--sequence NN] [--threads N] [--range-image]``.
 
 Builds the scene of SPEC and casts the spec's LiDAR (default: the KITTI HDL-64E) along
-route 0, one sweep per frame, writing a SemanticKITTI sequence to ``DIR/sequences/NN/``
+route 0, one sweep per frame, writing a SemanticKITTI sequence to ``DIR/lidar/sequences/NN/``
 (velodyne/*.bin, labels/*.label, poses.txt, calib.txt, times.txt, lidar_meta.json), a
-bird's-eye PNG per scan in ``bev/``, and the dataset label config ``DIR/semantic-kitti.yaml``,
+bird's-eye PNG per scan in ``bev/``, and the dataset label config ``DIR/lidar/semantic-kitti.yaml``,
 whose split lists every sequence in DIR: --split puts this one under train, valid or test
 (default: the split it already has there, else valid, the split semantic-kitti-api evaluates
 without -s).
@@ -25,9 +25,10 @@ from generator.commands.layout import add_town_argument, spec_for_town
 from generator.commands.options import Integer, path, sequence_id, text_path
 from generator.commands.preflight import output_dir
 from generator.formats.label_config import SPLITS
+from generator.formats.semantickitti import LIDAR_DIR
 from generator.jobs.plan import MAX_FRAMES, check_free_space, scan_bytes
-from generator.remission.models import intensity_fn_for_spec
 from generator.lidar.sensors import sensor_for_spec
+from generator.remission.models import intensity_fn_for_spec
 from generator.spec import load_spec
 from generator.spec.render import load_render_config
 
@@ -38,7 +39,7 @@ def register(sub) -> None:
     p = sub.add_parser("lidar", help="cast the virtual LiDAR along the route and write a SemanticKITTI sequence",
                        description=__doc__.split("\n\n")[1])
     p.add_argument("spec", type=text_path, help="scene spec JSON (e.g. scenes/default_town.json)")
-    p.add_argument("--out", required=True, type=path, help="dataset folder (sequences/NN/ is written inside)")
+    p.add_argument("--out", required=True, type=path, help="dataset folder (lidar/sequences/NN/ is written inside, as generate does)")
     p.add_argument("--frames", type=Integer(1, MAX_FRAMES), default=10,
                    help=f"number of consecutive 10 Hz sweeps (times.txt steps 0.1 s), 1..{MAX_FRAMES} "
                         "(default 10: one second of driving)")
@@ -65,13 +66,18 @@ def run(args) -> int:
     sensor = sensor_for_spec(spec)
     intensity_fn = intensity_fn_for_spec(spec)
     name: str = args.sequence
-    out: Path = output_dir(args.out, "--out")
+    out: Path = output_dir(output_dir(args.out, "--out") / LIDAR_DIR, "--out")  # DIR/lidar, as generate writes it
     extras = {"range_image": args.range_image, "ply": args.ply, "bev": not args.no_bev}
     check_free_space(out, args.frames * scan_bytes(sensor.rays_per_sweep, **extras), f"{args.frames} scans")
 
+    from generator.jobs.lidar_sequence import (
+        SequenceOptions,
+        check_sweeps,
+        world_for,
+        write_dataset_label_config,
+        write_sequence,
+    )
     from generator.layout.assemble import build_scene
-    from generator.jobs.lidar_sequence import (SequenceOptions, check_sweeps, world_for, write_dataset_label_config,
-                                               write_sequence)
 
     scene = build_scene(spec)
     check_sweeps(scene, spec, args.frames)
@@ -80,6 +86,7 @@ def run(args) -> int:
                            ply=args.ply, bev=not args.no_bev, resolution=(cfg.width, cfg.height), render_config=cfg.name)
     # The sequence is cast into a stage inside DIR and moved into place when complete: a failure
     # (or Ctrl-C) while casting and writing leaves DIR as it was.
+    out.mkdir(parents=True, exist_ok=True)
     with staging(out, "lidar") as stage:
         meta = write_sequence(scene, spec, stage, opts, sensor=sensor, intensity_fn=intensity_fn, world=world)
         _move_in(stage / "sequences" / name, out / "sequences" / name, args.frames)

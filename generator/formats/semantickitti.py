@@ -188,6 +188,20 @@ def sequence_dir(root: str | Path, sequence: int | str) -> Path:
     return Path(root) / "sequences" / sequence_name(sequence)
 
 
+#: Where a dataset folder (``urbangen generate`` / ``lidar --out D``) keeps its SemanticKITTI tree.
+LIDAR_DIR = "lidar"
+
+
+def semantickitti_root(folder: str | Path) -> Path:
+    """The SemanticKITTI root (the folder holding ``sequences/``) a user means by ``folder``: ``folder``
+    itself (KITTI's layout, semantic-kitti-api's ``--dataset``), or ``folder/lidar`` of a dataset folder
+    (``folder/lidar/sequences``). A folder with neither is returned as given (its reader says what is missing)."""
+    folder = Path(folder)
+    if not (folder / "sequences").is_dir() and (folder / LIDAR_DIR / "sequences").is_dir():
+        return folder / LIDAR_DIR
+    return folder
+
+
 def list_sequences(root: str | Path) -> list[str]:
     """Sequence folder names under ``root/sequences`` (digits only), in numeric order (``99`` before ``100``)."""
     base = Path(root) / "sequences"

@@ -133,4 +133,4 @@ def open_source(root: str | Path, role: str, every: int = 1) -> SemanticKittiSou
         raise UserError(f"{role}: {printable(root)}: no such folder")
     if not any(root.iterdir()):
         raise UserError(f"{role}: {printable(root)}: the folder is empty")
-    return LAYOUTS["semantickitti"](root, role, every)
+    return LAYOUTS["semantickitti"](sk.semantickitti_root(root), role, every)

@@ -191,7 +191,7 @@ def test_lidar_failing_mid_sequence_leaves_the_older_run_as_it_was(tmp_path, cap
         return ["-q", "lidar", SPEC, "--out", str(out), "--frames", str(frames), "--no-bev", "--threads", "2"]
 
     assert _run(capsys, argv(2))[0] == 0
-    extra = out / "sequences" / "00" / "image_2" / "000000.png"  # a generate dataset's stereo image
+    extra = out / "lidar" / "sequences" / "00" / "image_2" / "000000.png"  # a generate dataset's stereo image
     extra.parent.mkdir()
     extra.write_bytes(b"png")
     before = _tree(out)
@@ -205,10 +205,10 @@ def test_lidar_failing_mid_sequence_leaves_the_older_run_as_it_was(tmp_path, cap
 
     monkeypatch.setattr(sk, "write_labels", full_disk)
     rc, err = _run(capsys, argv(3))
-    assert rc == 2 and err == f"urbangen lidar: {out}: no space left on device\n", err
+    assert rc == 2 and err == f"urbangen lidar: {out / 'lidar'}: no space left on device\n", err
     assert _tree(out) == before  # no stage, no half sequence, nothing replaced
     monkeypatch.setattr(sk, "write_labels", real)
     assert _run(capsys, argv(1))[0] == 0  # a shorter rerun
-    seq = out / "sequences" / "00"
+    seq = out / "lidar" / "sequences" / "00"
     assert sorted(p.name for p in (seq / "velodyne").iterdir()) == ["000000.bin"]
-    assert extra.read_bytes() == b"png" and not list(out.glob(".tmp-*"))
+    assert extra.read_bytes() == b"png" and not list(out.rglob(".tmp-*"))

@@ -62,7 +62,7 @@ def test_seed002_processing_shows_as_the_three_differences_it_adds(pair, tmp_pat
     # 2. rings: +-5 cm jitter moves points centimetres off their cone and along their ring
     assert d["ring_fit_vertical"] > 0.01 and d["ring_regularity"] > 0.005
     # 3. intensity: W1 to a point mass at c is the mean distance to c
-    rem = np.concatenate([sk.read_scan(p)[:, 3] for p in sorted((raw / "sequences/00/velodyne").glob("*.bin"))])
+    rem = np.concatenate([sk.read_scan(p)[:, 3] for p in sorted((raw / "lidar/sequences/00/velodyne").glob("*.bin"))])
     assert d["intensity"] == pytest.approx(np.abs(rem - SEED002_INTENSITY).mean(), abs=0.01)
     assert d["class_mix"] < 0.01  # a uniform dropout leaves the mix
 

@@ -24,7 +24,7 @@ def test_lidar_command_writes_a_sequence(root, tmp_path, capsys):
     rc = cli.main(["-q", "lidar", str(root / "scenes" / "test_town.json"), "--out", str(out), "--frames", "2",
                    "--sequence", "7", "--range-image", "--threads", "2"])
     assert rc == 0
-    seq = out / "sequences" / "07"
+    seq = out / "lidar" / "sequences" / "07"
     for name in ("calib.txt", "poses.txt", "times.txt", "lidar_meta.json"):
         assert (seq / name).is_file(), name
     for k in range(2):
@@ -35,7 +35,7 @@ def test_lidar_command_writes_a_sequence(root, tmp_path, capsys):
         assert np.count_nonzero(rng_img) == len(sk.read_scan(seq / "velodyne" / f"{k:06d}.bin"))
     meta = json.loads((seq / "lidar_meta.json").read_text())
     assert meta["remission"]["model"] == "class_normal" and not meta["remission"].get("placeholder")
-    assert (out / "semantic-kitti.yaml").is_file()
+    assert (out / "lidar" / "semantic-kitti.yaml").is_file()
     assert "wrote 2 scans" in capsys.readouterr().out
 
 

@@ -79,11 +79,11 @@ def test_lidar_casts_the_town_it_is_asked_for(root, tmp_path):
     for town in (0, 1):
         out = tmp_path / f"out{town}"
         assert main(["lidar", str(path), "--out", str(out), "--frames", "1", "--town", str(town), "--no-bev"]) == 0
-        meta = json.loads((out / "sequences" / "00" / "lidar_meta.json").read_text())
+        meta = json.loads((out / "lidar" / "sequences" / "00" / "lidar_meta.json").read_text())
         t = town_spec(spec, town)
         assert meta["scene"]["town"] == {"index": town, "seed": t.seed, "base_seed": spec.seed, "every_frames": 2}
         assert meta["scene"]["scene_digest"] == build_scene(t).digest()
-        scans[town] = sk.read_scan(out / "sequences" / "00" / "velodyne" / "000000.bin")
+        scans[town] = sk.read_scan(out / "lidar" / "sequences" / "00" / "velodyne" / "000000.bin")
     assert not np.array_equal(scans[0][:1000], scans[1][:1000])  # two towns, two scans
 
 

@@ -71,7 +71,7 @@ def test_lidar_command_split_option(root, tmp_path, monkeypatch):
     monkeypatch.setattr(cli, "COMMANDS", ["lidar"])
     spec, out = str(root / "scenes" / "test_town.json"), tmp_path / "ds"
     assert cli.main(["-q", "lidar", spec, "--out", str(out), "--frames", "1", "--no-bev", "--threads", "2"]) == 0
-    assert _split(out / "semantic-kitti.yaml") == {"train": [], "valid": [0], "test": []}
+    assert _split(out / "lidar" / "semantic-kitti.yaml") == {"train": [], "valid": [0], "test": []}
     assert cli.main(["-q", "lidar", spec, "--out", str(out), "--frames", "1", "--no-bev", "--threads", "2",
                      "--sequence", "01", "--split", "train"]) == 0
-    assert _split(out / "semantic-kitti.yaml") == {"train": [1], "valid": [0], "test": []}
+    assert _split(out / "lidar" / "semantic-kitti.yaml") == {"train": [1], "valid": [0], "test": []}

@@ -196,7 +196,7 @@ def test_lidar_sequence_through_traffic_labels_movers_and_repeats_byte_for_byte(
     outs = [tmp_path / "a", tmp_path / "b"]
     for out in outs:
         assert main(["lidar", str(spec), "--out", str(out), "--frames", str(n), "--no-bev", "--threads", "2"]) == 0
-    seq = outs[0] / "sequences" / "00"
+    seq = outs[0] / "lidar" / "sequences" / "00"
     for f in sorted(seq.rglob("*")):
         if f.is_file():
             assert f.read_bytes() == (outs[1] / f.relative_to(outs[0])).read_bytes(), f.name
