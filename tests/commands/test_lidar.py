@@ -64,3 +64,19 @@ def test_bad_sensor_file_in_spec(tmp_path, capsys):
     err = capsys.readouterr().err
     assert rc == 2 and "bad_sensor.yaml: uniform.beams: must be an integer in [1, 256], got 0" in err
     assert err.count("\n") == 1 and not out.exists()
+
+
+def test_a_lidar_dataset_folder_is_what_the_other_commands_read(root, tmp_path, monkeypatch):
+    """``lidar --out D`` is a dataset folder as ``generate`` writes one: ``openlabel SPEC D`` boxes it, and the
+    SemanticKITTI readers take D as well as its SemanticKITTI root ``D/lidar``."""
+    monkeypatch.setattr(cli, "COMMANDS", ["lidar", "openlabel", "convert", "intensity"])
+    spec, ds = str(root / "scenes" / "test_town.json"), tmp_path / "ds"
+    assert cli.main(["-q", "lidar", spec, "--out", str(ds), "--frames", "1", "--no-bev", "--threads", "2"]) == 0
+    assert cli.main(["-q", "openlabel", spec, str(ds)]) == 0
+    assert (ds / "openlabel" / "00.json").is_file()
+    for i, given in enumerate((ds, ds / "lidar")):
+        out = tmp_path / f"unified{i}"
+        assert cli.main(["-q", "convert", str(given), str(out), "--labels", "unified11"]) == 0
+        assert (out / "sequences" / "00" / "labels" / "000000.label").is_file()
+        assert cli.main(["-q", "intensity", "fit", str(given), "-o", str(tmp_path / f"p{i}.yaml")]) == 0
+    assert (tmp_path / "p0.yaml").read_bytes() == (tmp_path / "p1.yaml").read_bytes()
