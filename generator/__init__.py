@@ -1,11 +1,12 @@
 """urbangen: procedural urban scenes, rendered and scanned from one geometry.
 
-The package is layered (see ``DESIGN.md`` in the shared folder):
+The package is layered (the package map and its import table: ``docs/architecture.md``; the table is
+enforced by ``tests/test_architecture.py``):
 
-* a pure numpy core (``spec``, ``labels``, ``layout``, ``scene``, ``lidar``,
-  ``formats``, ``fusion``, ``stats``) that never imports Blender;
+* a pure numpy core (``spec``, ``labels``, ``geometry``, ``world``, ``layout``, ``traffic``,
+  ``lidar``, ``formats``, ``fusion``, ``stats``, ...) that never imports Blender;
 * one thin Blender edge, ``generator.blender``, the only place that imports bpy;
-* the command line, ``generator.cli``.
+* orchestration (``generator.jobs``) and the command line (``generator.commands``, ``generator.cli``).
 """
 
 __version__ = "0.1.0"
