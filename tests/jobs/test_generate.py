@@ -56,18 +56,21 @@ def test_a_stand_in_run_records_every_item_once(reference):
     files = _files(reference)
     assert sum(k.startswith("images/0000/") for k in files) == 6 * 2
     assert sorted(k for k in files if k.startswith("stand-in/")) == [
-        "stand-in/00.lidar", "stand-in/00.openlabel", "stand-in/01.lidar", "stand-in/01.openlabel",
+        "stand-in/00.lidar", "stand-in/00.motion", "stand-in/00.openlabel", "stand-in/01.lidar", "stand-in/01.motion",
+        "stand-in/01.openlabel",
         "stand-in/dataset.label_config", "stand-in/dataset.stats"]
     assert [k for k in files if k.startswith("journal/")] == ["journal/merged.log"]  # compacted at the end
     lines = files["journal/merged.log"].decode().splitlines()
     assert [ln.split("\t")[0] for ln in lines] == [
         "urbangen-journal 1", "frames 0-5 day:clear,night:rain", "stereo 00 0", "stereo 01 0",
-        "town 00 lidar 0-2 sweeps=7", "town 00 openlabel 0-2", "town 01 lidar 3-5 sweeps=7", "town 01 openlabel 3-5",
+        "town 00 lidar 0-2 sweeps=7", "town 00 motion 0-2", "town 00 openlabel 0-2", "town 01 lidar 3-5 sweeps=7",
+        "town 01 motion 3-5", "town 01 openlabel 3-5",
         *(f"dataset {p} {lines[-1].split()[2]}" for p in ("label_config", "stats"))]
     m = json.loads((reference / "manifest.json").read_text())
     assert m["manifest_version"] == 2 and m["plan"]["frame_ranges"] == [[0, 6]] and m["plan"]["images"] == 12
     assert m["finished"] == {"images": 12, "frames": 6, "frame_ranges": [[0, 6]], "stereo": 2,
-                             "towns": {"count": 2, "lidar": 2, "openlabel": 2}, "lidar": True, "openlabel": True,
+                             "towns": {"count": 2, "lidar": 2, "motion": 2, "openlabel": 2}, "lidar": True,
+                             "motion": True, "openlabel": True,
                              "stats": True, "journal": "journal/"}
 
 
@@ -198,7 +201,8 @@ def test_the_bookkeeping_of_a_million_image_plan(towns_spec, tmp_path):
     assert tasks[0].job.job.out == str(tmp_path) and source.total() == 1 + 2  # the frame, then the dataset's two
     summary = mf.finished_summary(plan, journal.ledger, len(towns), dict(source.done_products), False)
     assert summary["images"] == 1_000_008 - 12 and summary["frame_ranges"] == [[0, 4_321], [4_322, 83_334]]
-    assert summary["towns"] == {"count": 834, "lidar": 834, "openlabel": 834} and len(mask_frames) == 83_334
+    assert summary["towns"] == {"count": 834, "lidar": 834, "motion": 834, "openlabel": 834}
+    assert len(mask_frames) == 83_334
 
 
 def _text(frames):
