@@ -21,7 +21,8 @@ from assets_procedural.building_roof import flat_roof, pitched_roof, rectangle_o
 from assets_procedural.facade_details import balcony, shop_front
 from assets_procedural.facade_layout import Hole, Style, draw_style, holes, wall_rects
 from generator.geometry import Mesh, box, merge, quads, resolve_ids
-from generator.geometry.primitives import _UNIT_BOX_FACES, _UNIT_BOX_VERTICES as _UNIT_BOX
+from generator.geometry.primitives import _UNIT_BOX_FACES
+from generator.geometry.primitives import _UNIT_BOX_VERTICES as _UNIT_BOX
 
 log = logging.getLogger(__name__)
 

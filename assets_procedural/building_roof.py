@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from generator.geometry import Mesh, resolve_ids, triangulate, box, merge, polygon, pose
+from generator.geometry import Mesh, box, merge, polygon, pose, resolve_ids, triangulate
 
 CLS = "building"
 UP = np.array([0.0, 0.0, 1.0])

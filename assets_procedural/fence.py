@@ -9,8 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from generator.geometry import Mesh, merge, prism, pose
-from generator.geometry.primitives import _UNIT_BOX_FACES as _BOX_FACES, resolve_ids
+from generator.geometry import Mesh, merge, pose, prism
+from generator.geometry.primitives import _UNIT_BOX_FACES as _BOX_FACES
+from generator.geometry.primitives import resolve_ids
 
 CLS = "fence"
 

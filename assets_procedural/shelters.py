@@ -12,6 +12,7 @@ import numpy as np
 from assets_procedural.parts import centred
 from generator.geometry import Mesh, box, merge, polygon, pose
 
+
 def bus_shelter(rng: np.random.Generator, length: float | None = None) -> Mesh:
     """A bus shelter along y, open toward +x: steel posts, a flat roof, glass back wall and side
     panes, an illuminated advertising panel at one end and a bench inside.

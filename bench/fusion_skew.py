@@ -40,8 +40,8 @@ def _headline(root: Path, deskew: bool) -> tuple[float, int]:
 def main(spec_path: str, dataset: str) -> None:
     from generator.fusion import projection as P
     from generator.fusion.dataset import FusionDataset, frame_images
-    from generator.layout.assemble import build_scene
     from generator.jobs.lidar_sequence import SequenceOptions, write_sequence
+    from generator.layout.assemble import build_scene
     from generator.spec import load_spec
 
     images = frame_images(Path(dataset))

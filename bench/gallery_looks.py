@@ -27,14 +27,14 @@ import numpy as np
 from PIL import Image, ImageDraw
 
 from assets_procedural import catalog
-from generator.layout.placement.appearance import fleet_paint, outfit
 from assets_procedural.vehicle import CAR_VARIANTS
 from generator import geometry as M
 from generator.labels import class_table
+from generator.layout.placement.appearance import fleet_paint, outfit
 from generator.rng import stream
 from generator.world import rig
-from generator.world.scene import OrientedBox, Path as RoutePath, SceneModel, SceneObject
-
+from generator.world.scene import OrientedBox, SceneModel, SceneObject
+from generator.world.scene import Path as RoutePath
 
 CAR_GAP_M = 14.0
 

@@ -36,11 +36,11 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from generator.layout.assemble import build_scene  # noqa: E402
-from generator.world.rig import Rig  # noqa: E402
 from generator.lidar.caster import EmbreeCaster  # noqa: E402
 from generator.lidar.scan import Scanner  # noqa: E402
 from generator.lidar.sensors import sensor_for_spec  # noqa: E402
 from generator.spec import load_spec, parse_spec  # noqa: E402
+from generator.world.rig import Rig  # noqa: E402
 
 REAL_SENSOR_PPS = 1.33e6
 

@@ -47,9 +47,8 @@ sys.path.insert(0, str(ROOT))
 from generator.jobs.lidar_returns import return_model
 from generator.layout.assemble import build_scene
 from generator.lidar.caster import EmbreeCaster
-from generator.lidar.sensors import with_returns
 from generator.lidar.scan import Scanner
-from generator.lidar.sensors import sensor_for_spec
+from generator.lidar.sensors import sensor_for_spec, with_returns
 from generator.spec import parse_spec
 from generator.world.actors import Actor, Track, World
 from generator.world.rig import SWEEP_PERIOD_S, Rig

@@ -29,13 +29,13 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from generator.layout import build_scene
-from generator.layout.placement.prototypes import Library
 from generator.layout.network.draw import make_grid
+from generator.layout.placement.prototypes import Library
 from generator.spec import load_spec
-from generator.traffic.pedestrians import simulate as peds
-from generator.traffic.pedestrians import sim as walk_sim
-from generator.traffic.movers import DT_S
 from generator.traffic.lanes.signals import Signals
+from generator.traffic.movers import DT_S
+from generator.traffic.pedestrians import sim as walk_sim
+from generator.traffic.pedestrians import simulate as peds
 from generator.traffic.pedestrians.lines import street_distance
 
 

@@ -29,11 +29,9 @@ from PIL import Image, ImageDraw
 from generator.imaging.exr import LabelledImage, read_exr, write_exr
 from generator.imaging.paths import image_files
 from generator.postfx.fog import fog_image
-from generator.previews.preview import tonemap
 from generator.postfx.rain import rain_image
+from generator.previews.preview import tonemap
 from generator.rng import stream
-
-
 
 # -- synthetic street -------------------------------------------------------------------
 # Ray-cast analytically in the optical camera frame (x right, y down, z forward; camera 1.5 m

@@ -13,8 +13,8 @@ from collections import defaultdict
 from pathlib import Path
 
 import pytest
-from kits.paths import ROOT
 
+from kits.paths import ROOT
 
 #: Bottom of the house: imported by anything, import nothing of ours but each other.
 BASE = {"generator", "errors", "atomic", "rng", "safeload", "progress"}  # safeload is a package of its own

@@ -20,8 +20,8 @@ def _blender(T_world_camera: np.ndarray) -> mathutils.Matrix:
     return mathutils.Matrix(m.tolist())
 
 
-def place(scene: "bpy.types.Scene", T_world_camera: np.ndarray, hfov_deg: float,
-          shutter: np.ndarray | None = None) -> "bpy.types.Object":
+def place(scene: bpy.types.Scene, T_world_camera: np.ndarray, hfov_deg: float,
+          shutter: np.ndarray | None = None) -> bpy.types.Object:
     """Create (once) and place the scene camera.
 
     Parameters

@@ -25,19 +25,19 @@ Background mode has no pixels in "Render Result", so each render is saved with
 from __future__ import annotations
 
 import time
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Sequence
 
 import numpy as np
 import OpenEXR
 
-from generator.world import rig
 from generator.blender import geometry, session
 from generator.blender.bpy_guard import bpy
 from generator.blender.materials import label_material
 from generator.labels import class_table
 from generator.labels.supersample import majority_labels
+from generator.world import rig
 
 SKY_Z = 1e9
 #: Native class of pixels whose ray hits nothing.

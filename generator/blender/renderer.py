@@ -10,14 +10,14 @@ from pathlib import Path
 
 import numpy as np
 
-from generator.world import rig
 from generator.blender import actors, camera, controls, geometry, lighting, materials, motion, night, passes, session
 from generator.blender.bpy_guard import bpy
-from generator.weather import LIT_TIMES
-from generator.world.actors import World
-from generator.world.scene import SceneModel
 from generator.spec.model import SceneSpec
 from generator.spec.render import RenderConfig
+from generator.weather import LIT_TIMES
+from generator.world import rig
+from generator.world.actors import World
+from generator.world.scene import SceneModel
 
 log = logging.getLogger(__name__)
 

@@ -24,17 +24,17 @@ kitti-object, nuscenes and coco live in their own modules (:mod:`generator.comma
 from __future__ import annotations
 
 import os
+from collections.abc import Iterator
 from pathlib import Path
-from typing import Iterator
 
 from generator.commands.options import Integer, Number, path, sequence_id, text_path
 from generator.commands.preflight import input_dir, output_dir
 from generator.errors import UserError
+from generator.formats.cityscapes import DEFAULT_SPLIT, SPLITS, CityscapesImage, city_name, export, image_stem
 from generator.imaging.paths import image_files, images_root
 from generator.jobs.plan import MAX_FRAME_INDEX, check_free_space
 from generator.safeload import MAX_METADATA_BYTES, load_json, printable
 from generator.weather import TIMES, combinations
-from generator.formats.cityscapes import DEFAULT_SPLIT, SPLITS, CityscapesImage, city_name, export, image_stem
 
 #: format -> the module whose ``run(args)`` writes it (None: this module, cityscapes)
 FORMATS = {"cityscapes": None, "kitti-object": "generator.commands.export_kitti_object",
@@ -96,10 +96,9 @@ def run(args) -> int:
 
         return importlib.import_module(FORMATS[args.format]).run(args)
     args.split = args.split or DEFAULT_SPLIT
-    from generator.progress import progress
-
     from generator.imaging.exr import read_exr
     from generator.previews.preview import camera_model_of, display_rgb
+    from generator.progress import progress
 
     input_dir(args.dataset, what="dataset folder")
     output_dir(args.out, "OUT")

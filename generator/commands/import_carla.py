@@ -17,17 +17,18 @@ from pathlib import Path
 import numpy as np
 
 from generator import __version__
-from generator.world import rig
 from generator.atomic import staging, write_json
 from generator.commands.intensity import add_processing_args, gap_from_args, intensity_fn_from_args
 from generator.commands.options import Integer, path, sequence_id
 from generator.commands.preflight import input_dir, output_dir
 from generator.errors import UserError
-from generator.formats import carla_ply, kitti_calib, semantickitti as sk
+from generator.formats import carla_ply, kitti_calib
+from generator.formats import semantickitti as sk
 from generator.formats.label_config import count_raw_ids, merge_counts
 from generator.jobs.plan import MAX_FRAMES, check_free_space
-from generator.scan_effects.pipeline import ScanProcessing, process_scan
 from generator.progress import progress as progress_bar
+from generator.scan_effects.pipeline import ScanProcessing, process_scan
+from generator.world import rig
 
 log = logging.getLogger(__name__)
 

@@ -15,9 +15,9 @@ from pathlib import Path
 from generator.commands.options import Number, path, sequence_list, text_path
 from generator.commands.preflight import input_dir, output_file
 from generator.errors import UserError
-from generator.scan_effects.domain_gap import DomainGap, preset
 from generator.remission.class_profiles import LABEL_SPACES, resolve_profile
 from generator.remission.models import MODEL_NAMES, IntensityFn, intensity_model
+from generator.scan_effects.domain_gap import DomainGap, preset
 
 WEATHER_CHOICES = {"auto": None, "on": True, "off": False}
 

@@ -129,8 +129,8 @@ def _kinds(scene) -> dict[str, int]:
 
 def run(args: argparse.Namespace) -> int:
     from generator.formats.glb import scene_to_glb
-    from generator.previews.layout_map import render_map
     from generator.layout.assemble import build_scene
+    from generator.previews.layout_map import render_map
 
     spec = spec_for_town(load_spec(args.spec), args.town)
     out = output_dir(args.out, "--out")

@@ -26,8 +26,8 @@ from generator.commands.options import Integer, path, sequence_id, text_path
 from generator.commands.preflight import output_dir
 from generator.formats.label_config import SPLITS
 from generator.jobs.plan import MAX_FRAMES, check_free_space, scan_bytes
-from generator.remission.models import intensity_fn_for_spec
 from generator.lidar.sensors import sensor_for_spec
+from generator.remission.models import intensity_fn_for_spec
 from generator.spec import load_spec
 from generator.spec.render import load_render_config
 
@@ -69,9 +69,14 @@ def run(args) -> int:
     extras = {"range_image": args.range_image, "ply": args.ply, "bev": not args.no_bev}
     check_free_space(out, args.frames * scan_bytes(sensor.rays_per_sweep, **extras), f"{args.frames} scans")
 
+    from generator.jobs.lidar_sequence import (
+        SequenceOptions,
+        check_sweeps,
+        world_for,
+        write_dataset_label_config,
+        write_sequence,
+    )
     from generator.layout.assemble import build_scene
-    from generator.jobs.lidar_sequence import (SequenceOptions, check_sweeps, world_for, write_dataset_label_config,
-                                               write_sequence)
 
     scene = build_scene(spec)
     check_sweeps(scene, spec, args.frames)

@@ -17,14 +17,14 @@ from generator.atomic import atomic_path, staging
 from generator.commands.options import integer_list, path
 from generator.commands.preflight import input_dir, output_dir
 from generator.errors import UserError
-from generator.jobs.plan import MAX_FRAME_INDEX
-from generator.previews.contact_sheet import variants_sheet
-from generator.imaging.exr import read_exr
-from generator.previews.preview import camera_model_of, colorize, display_rgb, side_by_side
-from generator.labels import class_table
 from generator.fusion.movers import is_moving_label
 from generator.imaging import meta_fields as md
+from generator.imaging.exr import read_exr
 from generator.imaging.paths import image_files, images_root
+from generator.jobs.plan import MAX_FRAME_INDEX
+from generator.labels import class_table
+from generator.previews.contact_sheet import variants_sheet
+from generator.previews.preview import camera_model_of, colorize, display_rgb, side_by_side
 
 PREFERRED = ("day_clear", "night_clear")
 MIN_HEIGHT = 360

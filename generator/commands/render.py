@@ -26,8 +26,16 @@ from generator.commands.preflight import os_reason, output_dir
 from generator.errors import UserError
 from generator.imaging.paths import find_image, has_images, image_dir, image_path, images_root
 from generator.jobs.executors import EXECUTORS, make_jobs, run_jobs
-from generator.jobs.plan import (MAX_FRAME_INDEX, MAX_FRAMES, MAX_WORKERS, check_free_space, check_plan, check_workers,
-                                 image_bytes, make_plan)
+from generator.jobs.plan import (
+    MAX_FRAME_INDEX,
+    MAX_FRAMES,
+    MAX_WORKERS,
+    check_free_space,
+    check_plan,
+    check_workers,
+    image_bytes,
+    make_plan,
+)
 from generator.jobs.variants import parse_combos
 from generator.spec import load_spec
 from generator.spec.render import load_render_config

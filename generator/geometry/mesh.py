@@ -59,14 +59,14 @@ class Mesh:
             return np.zeros((2, 3))
         return np.stack([self.vertices.min(0), self.vertices.max(0)])
 
-    def transformed(self, matrix: np.ndarray) -> "Mesh":
+    def transformed(self, matrix: np.ndarray) -> Mesh:
         """A copy with vertices and anchors mapped by the 4x4 ``matrix``."""
         return Mesh(
             apply(matrix, self.vertices), self.faces, self.face_class, self.face_material,
             {k: apply(matrix, v) for k, v in self.anchors.items()},
         )
 
-    def select(self, face_mask: np.ndarray) -> "Mesh":
+    def select(self, face_mask: np.ndarray) -> Mesh:
         """The sub-mesh of the faces where ``face_mask`` is True (unused vertices dropped)."""
         faces = self.faces[face_mask]
         used, inverse = np.unique(faces, return_inverse=True)

@@ -12,19 +12,29 @@ II therefore cost 6 RGB renders, and a frame's variants differ only in RGB.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
+from generator.jobs.exposure import expose, motion_record
+from generator.jobs.images import write_image
 from generator.postfx.camera import apply_camera, draw_params
 from generator.postfx.fog import fog_image
 from generator.postfx.rain import rain_image
-from generator.jobs.exposure import expose, motion_record
-from generator.jobs.images import write_image
 from generator.rng import child_seed, stream
-from generator.weather import (DEFAULT_TIMES, TIMES, combinations, draw_lighting, draw_weather, frame_wetness, has_fog,
-                               has_rain, light_level, render_key)
+from generator.weather import (
+    DEFAULT_TIMES,
+    TIMES,
+    combinations,
+    draw_lighting,
+    draw_weather,
+    frame_wetness,
+    has_fog,
+    has_rain,
+    light_level,
+    render_key,
+)
 
 #: Memory a worker may hold in finished label arrays of a batch (see :func:`label_batch_size`).
 LABEL_BATCH_BYTES = 256 * 2**20

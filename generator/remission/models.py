@@ -34,8 +34,8 @@ from __future__ import annotations
 
 import functools
 import logging
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 import yaml
@@ -231,7 +231,7 @@ def intensity_fn_for_spec(spec, command_line_profile: str | None = None) -> Inte
 MODEL_NAMES = ("constant", "class_normal", "physical", "hybrid")
 
 
-def intensity_model(name: str, profile: "IntensityProfile | None" = None, constant_value: float = 0.5,
+def intensity_model(name: str, profile: IntensityProfile | None = None, constant_value: float = 0.5,
                     label_space: str = "semantickitti") -> IntensityFn:
     """An intensity function by model name, without a spec (importers, converters).
 

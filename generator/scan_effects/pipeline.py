@@ -32,11 +32,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from generator.scan_effects.domain_gap import DomainGap, apply_to_points, gap_for_spec
 from generator.remission.models import IntensityFn, intensity_fn_for_spec
-from generator.scan_effects.weather import (LidarWeatherParams, apply_lidar_weather, enabled_for_spec, frame_weather,
-                                     weather_config)
 from generator.rng import stream
+from generator.scan_effects.domain_gap import DomainGap, apply_to_points, gap_for_spec
+from generator.scan_effects.weather import (
+    LidarWeatherParams,
+    apply_lidar_weather,
+    enabled_for_spec,
+    frame_weather,
+    weather_config,
+)
 
 ORDER = "intensity model -> domain gap -> LiDAR weather"
 ORDER_GAINS = "intensity model -> laser gains (physical sensor) -> domain gap -> LiDAR weather"

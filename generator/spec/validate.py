@@ -26,7 +26,7 @@ SCHEMA_DIR = Path(__file__).resolve().parent / "schemas"
 @functools.cache
 def load_schema(name: str) -> dict:
     """The packaged JSON Schema ``schemas/<name>.schema.json``."""
-    with open(SCHEMA_DIR / f"{name}.schema.json", "r", encoding="utf-8") as f:
+    with open(SCHEMA_DIR / f"{name}.schema.json", encoding="utf-8") as f:
         return json.load(f)
 
 

@@ -27,18 +27,19 @@ Label sets (:data:`LABEL_SETS`): ``unified11`` (seed 000's 11 classes, from the 
 from __future__ import annotations
 
 import os
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Iterator
 
 import numpy as np
 
 from generator.errors import UserError
 from generator.formats import semantickitti as sk
 from generator.formats.point_sidecars import NATIVE_DIR, read_sidecar
-from generator.labels.sets import LABEL_SET_NAMES as LABEL_SETS, LabelSet, label_sets
-from generator.stats.panoptic import MIN_POINTS, PanopticAccumulator, panoptic_result
+from generator.labels.sets import LABEL_SET_NAMES as LABEL_SETS
+from generator.labels.sets import LabelSet, label_sets
 from generator.progress import progress as progress_bar
+from generator.stats.panoptic import MIN_POINTS, PanopticAccumulator, panoptic_result
 
 IGNORE = 0
 #: Which classes the means average: every non-ignored class (the reference) or those present.

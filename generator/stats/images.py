@@ -24,11 +24,11 @@ from generator.errors import UserError
 from generator.imaging import meta_fields as md
 from generator.imaging.paths import image_files, images_root
 from generator.labels import class_table
+from generator.progress import progress
 from generator.safeload import printable
 from generator.stats.chart import log_bar_chart
 from generator.stats.report import Figure, Section, Table
 from generator.weather import DEFAULT_TIMES, KINDS, TIMES
-from generator.progress import progress
 
 log = logging.getLogger(__name__)
 

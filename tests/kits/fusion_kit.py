@@ -12,10 +12,10 @@ from pathlib import Path
 
 import numpy as np
 
-from generator.world import rig
 from generator.imaging.exr import LabelledImage, write_exr
 from generator.imaging.paths import image_path
 from generator.labels import class_table
+from generator.world import rig
 
 SKY = class_table().id("sky")
 
@@ -37,8 +37,8 @@ def raycast_image(caster, scene, T_world_camera: np.ndarray, K: np.ndarray, widt
 def write_raycast_images(root: Path, scene, spec, n_frames: int, width: int = 160, height: int = 96) -> None:
     """``root/images/SSSS/NNNNNN_day_clear.{exr,json}`` for frames 0..n-1 (the shard layout of
     :mod:`generator.imaging.paths`), ray-cast (metadata: the keys fusion reads)."""
-    from generator.world.rig import Rig
     from generator.lidar.caster import EmbreeCaster
+    from generator.world.rig import Rig
 
     caster = EmbreeCaster.from_scene(scene)
     K = rig.intrinsics(spec.sensors.camera.hfov_deg, width, height)

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from kits.scene_kit import scene_of
 
 from generator.formats import semantickitti as sk
 from generator.geometry import box, icosphere, rect
@@ -21,6 +20,7 @@ from generator.lidar.tracks import TrackBank
 from generator.materials import material_table
 from generator.world import rig
 from generator.world.actors import MOVING_THRESHOLD_MPS, Actor, Track, World
+from kits.scene_kit import scene_of
 
 H = 1.73  # KITTI mount height
 DT = 0.05

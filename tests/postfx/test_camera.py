@@ -318,9 +318,7 @@ def test_off_is_bit_identical_to_no_camera_model(written, test_spec, tod, kind):
     """Off: the EXR RGB is fog/rain's output as it was, the preview the fixed tone map, no record."""
     from generator.jobs.variants import camera_post, weather_post
     from generator.spec.render import load_render_config
-    from generator.weather import draw_lighting
-
-    from generator.weather import light_level
+    from generator.weather import draw_lighting, light_level
 
     img, meta, png = _read(written[0], tod, kind)
     r = _FakeRenderer(96, 160)
