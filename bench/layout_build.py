@@ -168,8 +168,8 @@ def cache_table(spec_path: str, sizes: list[int], towns: int, baseline: str | No
             row = {"n": n, "code": code, "new_wall": statistics.median(t["wall"] for t in new),
                    "new_cpu": statistics.median(t["cpu"] for t in new)}
             for k in ("cold", "again"):
-                row[f"{k}_wall"] = _median(runs, lambda r: r[k]["wall"])
-                row[f"{k}_cpu"] = _median(runs, lambda r: r[k]["cpu"])
+                row[f"{k}_wall"] = _median(runs, lambda r, k=k: r[k]["wall"])
+                row[f"{k}_cpu"] = _median(runs, lambda r, k=k: r[k]["cpu"])
             results.append(row)
             print(f"{f'{n}x{n}':>5} {code:>9} {_median(runs, lambda r: r['cold']['wall']):>10.2f} "
                   f"{_median(runs, lambda r: r['cold']['cpu']):>6.2f} {_median(runs, lambda r: r['again']['wall']):>11.2f} "

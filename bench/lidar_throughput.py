@@ -152,7 +152,7 @@ def main(argv=None) -> int:
 
     for _ in range(args.rounds):
         for th, sc in scanners.items():
-            out = measure(th, lambda: [sc.scan(p) for p in poses])
+            out = measure(th, lambda sc=sc: [sc.scan(p) for p in poses])
             scans = out if th == args.threads else scans
         measure("raw", lambda: [caster.run_raw(o, d) for o, d in local])
         if args.threads > 1:  # how much parallelism the machine offers right now, cast only
@@ -253,7 +253,7 @@ def main(argv=None) -> int:
             ps = [rig_n.sweep_poses(f.t, sensor.column_time()) for f in rig_n.frames(5)]
             with Scanner(sc_n, sensor, threads=args.threads, caster=c) as sc:
                 sc.scan(ps[0])
-                secs, scans = timed(lambda: [sc.scan(p) for p in ps], repeat=2)
+                secs, scans = timed(lambda ps=ps: [sc.scan(p) for p in ps], repeat=2)
             npts = np.mean([len(x.points) for x in scans])
             print(f"{n}x{n:<4d} {len(sc_n.faces):11,d} {t_layout:9.1f} {t_bvh:7.2f} {secs / len(ps):13.4f} {npts:13,.0f}")
     return 0

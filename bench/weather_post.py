@@ -210,10 +210,10 @@ def bench(sources: dict, rgb_pass: dict[str, tuple[float, int]], repeat: int) ->
         for tod in ("day", "night"):
             rgb, depth = sources[tod](h, w)
             base = exr_read_time(rgb, depth, max(1, repeat // 2))
-            ops = [("fog V=60 m", lambda: fog_image(rgb, depth, 60.0, tod)),
-                   ("rain 20 mm/h", lambda: rain_image(rgb, depth, 20.0, np.random.default_rng(1), tod)),
-                   ("rain 40 mm/h", lambda: rain_image(rgb, depth, 40.0, np.random.default_rng(1), tod)),
-                   ("rain 20 mm/h + fog V=60 m", lambda: variant(rgb, depth, tod, 60.0, 20.0))]
+            ops = [("fog V=60 m", lambda rgb=rgb, depth=depth, tod=tod: fog_image(rgb, depth, 60.0, tod)),
+                   ("rain 20 mm/h", lambda rgb=rgb, depth=depth, tod=tod: rain_image(rgb, depth, 20.0, np.random.default_rng(1), tod)),
+                   ("rain 40 mm/h", lambda rgb=rgb, depth=depth, tod=tod: rain_image(rgb, depth, 40.0, np.random.default_rng(1), tod)),
+                   ("rain 20 mm/h + fog V=60 m", lambda rgb=rgb, depth=depth, tod=tod: variant(rgb, depth, tod, 60.0, 20.0))]
             for name, fn in ops:
                 t = timed(fn, repeat)
                 ref = rgb_pass.get(tod) or next(iter(rgb_pass.values()), None)

@@ -253,7 +253,7 @@ def test_no_import_circle_inside_a_package():
     packages = sorted({m for m, is_init, _ in _modules() if is_init})
     bad = []
     for pkg in packages:
-        def child(m: str) -> str | None:
+        def child(m: str, pkg: str = pkg) -> str | None:
             if m == pkg:
                 return pkg
             return pkg + "." + m[len(pkg) + 1:].split(".")[0] if m.startswith(pkg + ".") else None
