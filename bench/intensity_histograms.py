@@ -82,7 +82,7 @@ def draw(per_model: dict[str, dict[int, np.ndarray]], classes: list[int], out: P
         n = {m: len(v.get(raw, [])) for m, v in per_model.items()}
         d.text((x0, oy + 6), f"{raw} {table.sk_labels[raw]} -> {uni}  n={max(n.values()):,}", fill="black", font=font)
         bw = (x1 - x0) / BINS
-        for i, (m, h) in enumerate(hists.items()):
+        for i, h in enumerate(hists.values()):
             for b, v in enumerate(h):
                 if v <= 0:
                     continue

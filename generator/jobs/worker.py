@@ -54,7 +54,7 @@ def run(job, queue) -> None:
             _run(job, queue, scratch)
     except BaseException as e:  # report everything; the parent decides
         queue.put(("error", f"{type(e).__name__}: {e}\n{traceback.format_exc()}"))
-        raise SystemExit(1)
+        raise SystemExit(1) from e
 
 
 def _run(job, queue, scratch: Path) -> None:
