@@ -44,14 +44,14 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from generator.jobs.lidar_returns import return_model
-from generator.layout.assemble import build_scene
-from generator.lidar.caster import EmbreeCaster
-from generator.lidar.scan import Scanner
-from generator.lidar.sensors import sensor_for_spec, with_returns
-from generator.spec import parse_spec
-from generator.world.actors import Actor, Track, World
-from generator.world.rig import SWEEP_PERIOD_S, Rig
+from generator.jobs.lidar_returns import return_model  # noqa: E402
+from generator.layout.assemble import build_scene  # noqa: E402
+from generator.lidar.caster import EmbreeCaster  # noqa: E402
+from generator.lidar.scan import Scanner  # noqa: E402
+from generator.lidar.sensors import sensor_for_spec, with_returns  # noqa: E402
+from generator.spec import parse_spec  # noqa: E402
+from generator.world.actors import Actor, Track, World  # noqa: E402
+from generator.world.rig import SWEEP_PERIOD_S, Rig  # noqa: E402
 
 TRAFFIC_X3 = {"cars_per_km": 36, "trucks_per_km": 3, "buses_per_km": 1.5, "cyclists_per_km": 6, "motorcyclists_per_km": 3}
 

@@ -24,14 +24,14 @@ from pathlib import Path
 
 import pytest
 
-hypothesis = pytest.importorskip("hypothesis")
-from hypothesis import HealthCheck, assume, given, settings
-from hypothesis import strategies as st
-
 from generator import cli
 from generator.commands import options
 from generator.safeload import printable
 from kits.paths import ROOT
+
+hypothesis = pytest.importorskip("hypothesis")
+from hypothesis import HealthCheck, assume, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
 
 SPEC = str(ROOT / "scenes" / "test_town.json")
 #: Seconds one refused command may take (option errors take milliseconds; a spec load ~0.1 s).
