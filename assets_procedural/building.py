@@ -66,7 +66,7 @@ class _Facade:
         self.d = np.array([d[0], d[1], 0.0]) / self.length
         self.n = np.array([self.d[1], -self.d[0], 0.0])  # outward for a CCW footprint
         self.o = np.array([p0[0], p0[1], 0.0])
-        self._axes = [tuple(float(x) for x in c) for c in zip(self.o, self.d, (0.0, 0.0, 1.0), self.n)]
+        self._axes = [tuple(float(x) for x in c) for c in zip(self.o, self.d, (0.0, 0.0, 1.0), self.n, strict=False)]
         self._up, self._down, self._back = np.array([0, 0, 1.0]), -np.array([0, 0, 1.0]), -self.d
         # quads are collected as 12 facade coordinates each (4 corners of (u, v, w)), mapped in mesh();
         # the direction each faces is an index into _normals (one array per direction, not per quad)
@@ -161,7 +161,7 @@ class _Facade:
             fcls = np.stack([b[2] for b in built])[which].ravel()
             fmat = np.stack([b[3] for b in built])[which].ravel()
         else:
-            faces = np.concatenate([built[k][1] + o for k, o in zip(which, offsets)])
+            faces = np.concatenate([built[k][1] + o for k, o in zip(which, offsets, strict=False)])
             fcls = np.concatenate([built[k][2] for k in which])
             fmat = np.concatenate([built[k][3] for k in which])
         return [Mesh(verts.reshape(-1, 3), faces, fcls, fmat)]

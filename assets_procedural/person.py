@@ -135,7 +135,7 @@ def person(rng: np.random.Generator, height: float, pose: str = "standing") -> M
     parts = [_torso(girth, breadth, garment)] + _head(1.0, rng)
     thigh = "skin" if garment == "skirt" else "clothing_bottom"
     shin = "skin" if garment in ("skirt", "shorts") else "clothing_bottom"
-    for (side, phase), action in zip(((1.0, 1.0), (-1.0, -1.0)), arms):
+    for (side, phase), action in zip(((1.0, 1.0), (-1.0, -1.0)), arms, strict=False):
         # legs: the side with phase +1 steps forward, the other pushes off with a bent knee
         hip = np.array([0.0, side * 0.052 * girth, 0.53])
         leg = phase * swing

@@ -44,7 +44,7 @@ def _panes(x0: float, x1: float, z0: float, z1: float, y: float, pitch: float, c
             continue
         n = max(1, int(round((a1 - a0) / pitch)))
         edges = np.linspace(a0, a1, n + 1)
-        for a, b in zip(edges[:-1], edges[1:]):
+        for a, b in zip(edges[:-1], edges[1:], strict=False):
             a, b = a + gap / 2, b - gap / 2
             q = np.array([[a, y, z0], [b, y, z0], [b, y, z1], [a, y, z1]])
             out.append(polygon(q, cls, "car_glass", (0, side, 0)))
@@ -273,7 +273,7 @@ def tram(rng: np.random.Generator, sections: int | None = None, bend_deg: float 
     out, heading = [], 0.0
     front_end = np.zeros(2)
     anchors = {}
-    for k, (Lk, m) in enumerate(zip(lengths, sections_m)):
+    for k, (Lk, m) in enumerate(zip(lengths, sections_m, strict=False)):
         d = np.array([np.cos(heading), np.sin(heading)])
         centre = front_end - d * Lk / 2
         t = pose(centre[0], centre[1], 0.0, yaw=heading)

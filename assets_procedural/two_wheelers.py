@@ -62,7 +62,7 @@ def _saddle(top_centre: np.ndarray, cls: str, length: float = 0.27, width: float
     h = 0.05
     rings = []
     a = np.linspace(0, 2 * np.pi, 8, endpoint=False)
-    for x, w in zip(xs, half_w):
+    for x, w in zip(xs, half_w, strict=False):
         rings.append(np.stack([np.full(8, x), w * np.cos(a), -h / 2 + h / 2 * np.sin(a)], 1))
     m = loft(np.array(rings), cls, "rubber")
     return m.transformed(pose(*(top_centre + np.array([0.0, 0.0, 0.0]))))

@@ -84,7 +84,7 @@ def welford_lists(seq: sk.Sequence, frames: list[int]) -> dict:
     for i in frames:
         pts = sk.read_scan(seq.scan_path(i))
         sem, _ = sk.read_labels(seq.label_path(i))
-        for key, x in zip(sem.tolist(), pts[:, 3].astype(np.float64).tolist()):
+        for key, x in zip(sem.tolist(), pts[:, 3].astype(np.float64).tolist(), strict=False):
             c = n.get(key, 0) + 1
             n[key] = c
             mu = mean.get(key, 0.0)

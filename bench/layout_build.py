@@ -193,14 +193,14 @@ def plot(results: list[dict], path: str, title: str) -> None:
     fig, axes = plt.subplots(len(sizes), 2, figsize=(10, 3.8 * len(sizes)), squeeze=False)
     x = np.arange(3)
     width = 0.8 / len(codes)
-    for row, n in zip(axes, sizes):
-        for ax, clock in zip(row, ("cpu", "wall")):
+    for row, n in zip(axes, sizes, strict=False):
+        for ax, clock in zip(row, ("cpu", "wall"), strict=False):
             for k, code in enumerate(codes):
                 r = next(r for r in results if r["n"] == n and r["code"] == code)
                 v = [r[f"cold_{clock}"], r[f"again_{clock}"], r[f"new_{clock}"]]
                 pos = x + (k - (len(codes) - 1) / 2) * width
                 ax.bar(pos, v, width * 0.9, color=f"C{k}", label=code)
-                for px, val in zip(pos, v):
+                for px, val in zip(pos, v, strict=False):
                     ax.text(px, val, f"{val:.2f}", ha="center", va="bottom", fontsize=8)
             if clock == "cpu":
                 ax.axhline(1.5, color="k", lw=0.8, ls="--")

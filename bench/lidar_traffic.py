@@ -205,7 +205,7 @@ def main(argv=None) -> int:
                 wall, cpu = time.perf_counter() - w0, time.process_time() - c0
                 best[k][:, i] = np.minimum(best[k][:, i], (wall, cpu))
     best = {k: tuple(v.sum(1)) for k, v in best.items()}
-    scans = [scanners[(True, args.threads)].scan(p, t0=float(x)) for p, x in zip(poses, times)]
+    scans = [scanners[(True, args.threads)].scan(p, t0=float(x)) for p, x in zip(poses, times, strict=False)]
     kept = {k: np.mean([len(sc.scan(p, t0=float(x), noise_key=i).points)
                         for i, (p, x) in enumerate(zip(poses, times, strict=True))]) for k, sc in physical.items()}
     for sc in scanners.values():
@@ -232,7 +232,7 @@ def main(argv=None) -> int:
     on_actor = np.array([(s.points["instance"] >= 60000).sum() if args.traffic == "lanes" else
                          np.isin(s.points["instance"], [a.instance_id for a in world.actors]).sum() for s in scans])
     mov = np.array([s.points["moving"].sum() for s in scans])
-    plan = [scanners[(True, 1)].actors.plan(p, float(x), sensor.column_time()) for p, x in zip(poses, times)]
+    plan = [scanners[(True, 1)].actors.plan(p, float(x), sensor.column_time()) for p, x in zip(poses, times, strict=False)]
     cand = [0 if pl is None else int(np.clip(pl.ring1 - pl.ring0, 0, None).sum()) for pl in plan]
     seen = [0 if pl is None else len(np.unique(pl.actor)) for pl in plan]
     base = best[("ours: Scanner.scan, actors moving", args.threads)][0]

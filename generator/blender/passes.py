@@ -160,7 +160,7 @@ def render_label_batch(scene, bs: geometry.BlenderScene, k: np.ndarray, scratch:
     session.label_state(scene, label_material())
     geometry.set_proxies_visible(bs, False)
     reals, secs = [], [{} for _ in poses]
-    for place, sec in zip(poses, secs):
+    for place, sec in zip(poses, secs, strict=False):
         place()
         t = time.perf_counter()
         real = _render(scene, scratch / "real.exr")
@@ -174,7 +174,7 @@ def render_label_batch(scene, bs: geometry.BlenderScene, k: np.ndarray, scratch:
     geometry.set_proxies_visible(bs, True)
     out = []
     with session.supersampled(scene, supersample):
-        for place, sec, (real_class, real_instance, depth) in zip(poses, secs, reals):
+        for place, sec, (real_class, real_instance, depth) in zip(poses, secs, reals, strict=False):
             place()
             t = time.perf_counter()
             fine_class, fine_instance = label_samples(_render(scene, scratch / "label.exr"))

@@ -45,7 +45,7 @@ def _split(g: Nodes, vec):
 
 def _join(g: Nodes, x, y, z):
     n = g.node("ShaderNodeCombineXYZ")
-    for s, v in zip(n.inputs, (x, y, z)):
+    for s, v in zip(n.inputs, (x, y, z), strict=False):
         g.set(s, v)
     return n.outputs[0]
 

@@ -114,7 +114,7 @@ def run(args) -> int:
     planned = [(city_name(t, w), image_stem(city_name(t, w), seq, f)) for f, t, w in metas]
 
     def images() -> Iterator[CityscapesImage]:
-        for exr, (frame, time_of_day, weather) in progress(list(zip(exrs, metas)), desc="export cityscapes",
+        for exr, (frame, time_of_day, weather) in progress(list(zip(exrs, metas, strict=False)), desc="export cityscapes",
                                                            unit="image"):
             im = read_exr(exr)
             yield CityscapesImage(str(exr), city_name(time_of_day, weather), seq, frame,

@@ -105,7 +105,7 @@ def merge(meshes: list[Mesh]) -> Mesh:
             anchors.setdefault(k, []).append(v)
     return Mesh(
         np.concatenate([m.vertices for m in meshes]),
-        np.concatenate([m.faces + o for m, o in zip(meshes, offsets)]),
+        np.concatenate([m.faces + o for m, o in zip(meshes, offsets, strict=False)]),
         np.concatenate([m.face_class for m in meshes]),
         np.concatenate([m.face_material for m in meshes]),
         {k: np.concatenate(v) for k, v in anchors.items()},

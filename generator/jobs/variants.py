@@ -184,7 +184,7 @@ def render_frames(renderer, spec, cfg, frames, out: Path, combos: list[tuple[str
     for i in range(0, len(frames), n):
         batch = frames[i:i + n]
         labels = renderer.render_labels_batch([pose_for(renderer, f, rig) for f in batch])
-        for frame, lab in zip(batch, labels):
+        for frame, lab in zip(batch, labels, strict=False):
             yield frame, render_frame(renderer, spec, cfg, frame, out, combos, rig, lab)
 
 

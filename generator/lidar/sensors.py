@@ -189,7 +189,7 @@ def _laser_columns(doc: dict, source: str) -> dict[str, np.ndarray]:
             i = given.index(None)
             raise SpecError(source, f"lasers[{i}].ring", "is required when any laser gives a ring (or omit all rings)")
         expect = _rings(col["elevation"], ids)
-        for i, (g, e) in enumerate(zip(given, expect)):
+        for i, (g, e) in enumerate(zip(given, expect, strict=False)):
             if g != e:
                 raise SpecError(source, f"lasers[{i}].ring",
                                 f"must be the elevation rank (0 = highest beam), expected {int(e)}, got {g}")

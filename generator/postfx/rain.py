@@ -133,7 +133,7 @@ def streak_alpha(depth: np.ndarray, rate_mmh: float, rng: np.random.Generator, f
     layer = np.searchsorted(np.asarray(LAYER_EDGES_M), dist)[which]
     maps = _splat(x[visible], y[visible], wt[visible], layer[visible], len(LAYER_SIGMA_PX), h, w)
     keep = np.ones((h, w), np.float32)
-    for m, sigma in zip(maps, LAYER_SIGMA_PX):
+    for m, sigma in zip(maps, LAYER_SIGMA_PX, strict=False):
         keep *= 1.0 - np.clip(ndimage.gaussian_filter(m, sigma * scale, truncate=3.0), 0.0, 1.0)
     params = {"streaks": n, "wind_deg": round(wind, 3), "exposure_s": round(exposure_s, 6),
               "median_drop_mm": round(float(np.median(diam)), 3) if n else None}

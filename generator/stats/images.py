@@ -229,7 +229,7 @@ def table2(data: ImageData) -> Table:
     ids = [*KINDS, "total"]
     return Table("table2_conditions", "Table II. Distribution of images with respect to lighting and weather conditions",
                  ["Weather", *(TIME_TITLES[t] for t in times), "Total"],
-                 ["weather", *times, "total"], rows, csv_rows=[[k, *r[1:]] for k, r in zip(ids, rows)])
+                 ["weather", *times, "total"], rows, csv_rows=[[k, *r[1:]] for k, r in zip(ids, rows, strict=False)])
 
 
 def chart(t1: Table) -> Figure:

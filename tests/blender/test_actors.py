@@ -241,7 +241,7 @@ def test_written_metadata_records_time_and_visible_actors(tmp_path, test_spec, t
         assert a["speed_mps"] == pytest.approx(CARS[uid][3]) and a["instance_id"] == world.actors[uid].instance_id
     # (same Blender scene) each car's headlights drive with it: at its anchors, posed at the time set
     r.set_time(t + LATER)
-    for a, ob in zip(world.actors, r.actors.objects):
+    for a, ob in zip(world.actors, r.actors.objects, strict=False):
         lights = [np.array(x.matrix_world.translation) for x in r.night_lights.objects if x.parent == ob]
         anchors = world.prototypes[a.prototype].anchors["headlight"]
         pose = a.track.pose(t + LATER)[0]
