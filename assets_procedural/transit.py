@@ -254,7 +254,9 @@ def tram(rng: np.random.Generator, sections: int | None = None, bend_deg: float 
             zl = 0.75
             for s in (1.0, -1.0):
                 mat = "headlight" if sign > 0 else "taillight"
-                parts.append(box((0.05, 0.22, 0.12), cls, mat, (sign * (Lk / 2 - 0.005), s * (W / 2 * 0.78 - 0.25), zl)))
+                parts.append(
+                    box((0.05, 0.22, 0.12), cls, mat, (sign * (Lk / 2 - 0.005), s * (W / 2 * 0.78 - 0.25), zl))
+                )
                 anchors_local.setdefault("headlight" if sign > 0 else "taillight", []).append(
                     (k, np.array([sign * (Lk / 2 + 0.02), s * (W / 2 * 0.78 - 0.25), zl])))
         # bogies under the odd sections (1st, 3rd, 5th): two axles, wheels just inside the skirt

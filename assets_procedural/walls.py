@@ -51,7 +51,9 @@ def _retaining(rng: np.random.Generator, length: float, height: float) -> Mesh:
     # expansion joints every ~6 m: shallow dark vertical strips on the street face
     for x in _posts(length, 6.0, 0.02)[1:-1] if length > 6.5 else []:
         parts.append(box((0.02, 0.01, height - 0.1), CLS, "rubber", (x, -base_t / 2 - 0.005, height / 2 - 0.05)))
-    parts.append(box((length, top_t + 0.04, 0.05), CLS, "curb_concrete", (0.0, -base_t / 2 + top_t / 2, height + 0.025)))
+    parts.append(
+        box((length, top_t + 0.04, 0.05), CLS, "curb_concrete", (0.0, -base_t / 2 + top_t / 2, height + 0.025))
+    )
     # weep holes near the foot
     for x in np.arange(-length / 2 + 1.0, length / 2 - 0.5, 2.0):
         parts.append(box((0.08, 0.01, 0.08), CLS, "rubber", (x, -base_t / 2 - 0.005, 0.3)))

@@ -185,7 +185,9 @@ def main(argv: list[str] | None = None) -> int:
             draw_view(img, (vx, vy, vx + TILE, vy + TILE), mesh, view, pal, idx)
     args.out.parent.mkdir(parents=True, exist_ok=True)
     img.save(args.out)
-    print(f"{len(examples)} assets, {total} triangles, built and drawn in {time.perf_counter() - t0:.1f} s -> {args.out}")
+    print(
+        f"{len(examples)} assets, {total} triangles, built and drawn in {time.perf_counter() - t0:.1f} s -> {args.out}"
+    )
     return 0
 
 

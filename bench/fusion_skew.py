@@ -83,8 +83,10 @@ def main(spec_path: str, dataset: str) -> None:
             fuse_frame(f)
         full = (time.perf_counter() - t0) / len(frames)
         npts = int(np.mean([len(f.xyz) for f in frames]))
-        print(f"per frame ({npts} points, {frames[0].depth.shape[1]}x{frames[0].depth.shape[0]} px): "
-              f"Eq. 1 projection {1000 * base:.1f} ms (baseline), + de-skew, occlusion, boundaries {1000 * full:.1f} ms")
+        print(
+            f"per frame ({npts} points, {frames[0].depth.shape[1]}x{frames[0].depth.shape[0]} px): "
+            f"Eq. 1 projection {1000 * base:.1f} ms (baseline), + de-skew, occlusion, boundaries {1000 * full:.1f} ms"
+        )
 
 
 if __name__ == "__main__":

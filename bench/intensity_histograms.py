@@ -73,10 +73,17 @@ def draw(per_model: dict[str, dict[int, np.ndarray]], classes: list[int], out: P
     for j, raw in enumerate(classes):
         ox, oy = (j % cols) * pw, top + (j // cols) * ph
         x0, y0, x1, y1 = ox + pad, oy + 22, ox + pw - 10, oy + ph - 26
-        hists = {m: np.histogram(v.get(raw, np.zeros(0)), edges)[0] / max(len(v.get(raw, [])), 1) for m, v in per_model.items()}
+        hists = {
+            m: np.histogram(v.get(raw, np.zeros(0)), edges)[0] / max(len(v.get(raw, [])), 1)
+            for m, v in per_model.items()
+        }
         uni = table.unified_names[int(table.sk_to_unified[raw])]
         st = prof.unified[uni]
-        pdf = np.exp(-0.5 * ((edges[:-1] + 0.5 / BINS - st.mean) / st.std) ** 2) / (st.std * math.sqrt(2 * math.pi)) / BINS
+        pdf = (
+            np.exp(-0.5 * ((edges[:-1] + 0.5 / BINS - st.mean) / st.std) ** 2)
+            / (st.std * math.sqrt(2 * math.pi))
+            / BINS
+        )
         ymax = max(max(h.max() for h in hists.values()), pdf.max(), 1e-9) * 1.1
         d.rectangle([x0, y0, x1, y1], outline=(160, 160, 160))
         n = {m: len(v.get(raw, [])) for m, v in per_model.items()}
@@ -112,7 +119,11 @@ def main() -> None:
     generate(args.dataset, models, args.frames, args.spec)
     per_model = {m: collect(args.dataset, f"{i:02d}") for i, m in enumerate(models)}
     table = class_table()
-    classes = sorted(k for k in set().union(*per_model.values()) if max(len(v.get(k, [])) for v in per_model.values()) >= args.min_points)
+    classes = sorted(
+        k
+        for k in set().union(*per_model.values())
+        if max(len(v.get(k, [])) for v in per_model.values()) >= args.min_points
+    )
     print(f"{'class':<16}{'model':<14}{'points':>10}{'mean':>8}{'std':>8}{'=0':>8}{'=1':>8}")
     for raw in classes:
         for m, v in per_model.items():

@@ -171,12 +171,14 @@ def cache_table(spec_path: str, sizes: list[int], towns: int, baseline: str | No
                 row[f"{k}_wall"] = _median(runs, lambda r, k=k: r[k]["wall"])
                 row[f"{k}_cpu"] = _median(runs, lambda r, k=k: r[k]["cpu"])
             results.append(row)
-            print(f"{f'{n}x{n}':>5} {code:>9} {_median(runs, lambda r: r['cold']['wall']):>10.2f} "
-                  f"{_median(runs, lambda r: r['cold']['cpu']):>6.2f} {_median(runs, lambda r: r['again']['wall']):>11.2f} "
-                  f"{_median(runs, lambda r: r['again']['cpu']):>6.2f} {statistics.median(t['wall'] for t in new):>14.2f} "
-                  f"{statistics.median(t['cpu'] for t in new):>6.2f} "
-                  f"{rate:>6}  {same}",
-                  flush=True)
+            print(
+                f"{f'{n}x{n}':>5} {code:>9} {_median(runs, lambda r: r['cold']['wall']):>10.2f} "
+                f"{_median(runs, lambda r: r['cold']['cpu']):>6.2f} {_median(runs, lambda r: r['again']['wall']):>11.2f} "
+                f"{_median(runs, lambda r: r['again']['cpu']):>6.2f} {statistics.median(t['wall'] for t in new):>14.2f} "
+                f"{statistics.median(t['cpu'] for t in new):>6.2f} "
+                f"{rate:>6}  {same}",
+                flush=True,
+            )
     return results
 
 
@@ -247,7 +249,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--baseline", default=None, help="another checkout whose build is timed beside (see above)")
     ap.add_argument("--skip-breakdown", action="store_true", help="only the cache table")
     ap.add_argument("--png", default=None, help="also draw the cache table's bars to this PNG")
-    ap.add_argument("--profile", action="store_true", help="cProfile a new town of the first size and print the top costs")
+    ap.add_argument(
+        "--profile", action="store_true", help="cProfile a new town of the first size and print the top costs"
+    )
     args = ap.parse_args(argv)
     if args.profile:
         profile_new_town(args.spec, args.sizes[0])

@@ -132,7 +132,9 @@ def main(argv=None) -> int:
     # measured in interleaved rounds (best of each) so load from other processes hits all alike
     sensor_rays = sensor.local_rays()
     rays = [sweep_rays(sensor_rays, p) for p in poses]
-    local = [(np.ascontiguousarray(o - caster.center, np.float32), np.ascontiguousarray(d, np.float32)) for o, d in rays]
+    local = [
+        (np.ascontiguousarray(o - caster.center, np.float32), np.ascontiguousarray(d, np.float32)) for o, d in rays
+    ]
     thread_counts = sorted({args.threads, 1}, reverse=True)
     scanners = {th: Scanner(scene, sensor, threads=th, caster=caster) for th in thread_counts}
     best = {k: np.inf for k in [*thread_counts, "raw"]}
@@ -194,7 +196,9 @@ def main(argv=None) -> int:
         rt = ray_triangle.RayMeshIntersector(tm)
         rt.intersects_first(o_all[sample[:10]], d_all[sample[:10]])  # builds its r-tree
         secs, _ = timed(lambda: rt.intersects_first(o_all[sample], d_all[sample]))
-        rows.append(row("trimesh ray_triangle intersects_first", len(sample), secs, None, f"numpy, {len(sample)}-ray sample"))
+        rows.append(
+            row("trimesh ray_triangle intersects_first", len(sample), secs, None, f"numpy, {len(sample)}-ray sample")
+        )
     except ImportError as e:  # ray_triangle needs the optional rtree package
         print(f"trimesh ray_triangle unavailable: {e}")
 
@@ -237,7 +241,9 @@ def main(argv=None) -> int:
 
     if not args.no_towns:
         print()
-        print(f"{'town':6s} {'triangles':>11s} {'layout s':>9s} {'BVH s':>7s} {'scan s/sweep':>13s} {'points/sweep':>13s}")
+        print(
+            f"{'town':6s} {'triangles':>11s} {'layout s':>9s} {'BVH s':>7s} {'scan s/sweep':>13s} {'points/sweep':>13s}"
+        )
         base = json.loads(Path(args.spec).read_text())
         for n in (1, 2, 3, 4):
             doc = json.loads(json.dumps(base))
@@ -255,7 +261,9 @@ def main(argv=None) -> int:
                 sc.scan(ps[0])
                 secs, scans = timed(lambda ps=ps: [sc.scan(p) for p in ps], repeat=2)
             npts = np.mean([len(x.points) for x in scans])
-            print(f"{n}x{n:<4d} {len(sc_n.faces):11,d} {t_layout:9.1f} {t_bvh:7.2f} {secs / len(ps):13.4f} {npts:13,.0f}")
+            print(
+                f"{n}x{n:<4d} {len(sc_n.faces):11,d} {t_layout:9.1f} {t_bvh:7.2f} {secs / len(ps):13.4f} {npts:13,.0f}"
+            )
     return 0
 
 

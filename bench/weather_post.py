@@ -225,7 +225,9 @@ def bench(sources: dict, rgb_pass: dict[str, tuple[float, int]], repeat: int) ->
                     rp = f"{est:7.1f}{mark:>5}"
                 else:
                     share, rp = "n/a", "n/a"
-                print(f"{f'{w}x{h}':<10} {tod + ' ' + name:<32} {1000 * t:8.1f} {1000 * base:11.1f} {t / base:7.2f} {rp:>12} {share:>7}")
+                print(
+                    f"{f'{w}x{h}':<10} {tod + ' ' + name:<32} {1000 * t:8.1f} {1000 * base:11.1f} {t / base:7.2f} {rp:>12} {share:>7}"
+                )
 
 
 def main(argv=None) -> int:

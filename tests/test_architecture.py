@@ -97,7 +97,9 @@ def graph() -> dict[str, set[str]]:
     """Module -> the project modules and packages it imports."""
     g = {}
     for module, is_init, path in _modules():
-        g[module] = {m for m in _imports(module, is_init, path) if m.split(".")[0] in ("generator", "assets_procedural")}
+        g[module] = {
+            m for m in _imports(module, is_init, path) if m.split(".")[0] in ("generator", "assets_procedural")
+        }
     return g
 
 

@@ -76,7 +76,9 @@ class Renderer:
         self.k = rig.intrinsics(spec.sensors.camera.hfov_deg, cfg.width, cfg.height)
         controls.apply(self.bscene, controls.DAY_DEFAULTS)
         self.build_seconds = time.perf_counter() - t
-        log.info("Blender scene built in %.2f s (%d objects, device %s)", self.build_seconds, len(scene.objects), self.device)
+        log.info(
+            "Blender scene built in %.2f s (%d objects, device %s)", self.build_seconds, len(scene.objects), self.device
+        )
 
     @property
     def cycles_seconds(self) -> dict[str, float]:

@@ -279,7 +279,9 @@ class Sequence:
         pts = read_scan(self.scan_path(index))
         sem, inst = read_labels(self.label_path(index))
         if len(sem) != len(pts):
-            raise UserError(f"{self.label_path(index)}: {len(sem)} labels but {self.scan_path(index)} has {len(pts)} points")
+            raise UserError(
+                f"{self.label_path(index)}: {len(sem)} labels but {self.scan_path(index)} has {len(pts)} points"
+            )
         return pts, sem, inst
 
     def read(self, index: int, labels: bool = True, _poses: np.ndarray | None = None) -> ScanRecord:

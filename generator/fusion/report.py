@@ -20,7 +20,8 @@ def markdown(report: dict) -> str:
     s = report["settings"]
     hl = report["headline"]
     lines = [
-        "# Camera–LiDAR label agreement", "",
+        "# Camera–LiDAR label agreement",
+        "",
         f"Dataset `{s['dataset']}`, sequence {s['sequence']}, frames {', '.join(map(str, report['frames']))}.",
         "",
         f"* Projection: seed 001 Eq. 1, `d [u v 1]^T = K T X` with `T = inv(T_world_camera) @ T_world_lidar` "
@@ -34,8 +35,11 @@ def markdown(report: dict) -> str:
         "",
         f"**Agreement, non-proxy classes away from 1-px mask boundaries, occlusion test on: "
         f"{_pct(hl['agreement_native'])} % (native), {_pct(hl['agreement_unified11'])} % (unified 11).**",
-        "", "## Agreement per variant", "",
-        "Agreement = share of counted points whose mask class equals their ray-cast class.", "",
+        "",
+        "## Agreement per variant",
+        "",
+        "Agreement = share of counted points whose mask class equals their ray-cast class.",
+        "",
         "| occlusion | proxies | boundaries | points | agreement native % | mIoU native % | agreement unified11 % | mIoU unified11 % |",
         "|---|---|---|---:|---:|---:|---:|---:|",
     ]

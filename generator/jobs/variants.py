@@ -75,7 +75,9 @@ def renders_needed(combos: list[tuple[str, str]]) -> list[tuple[str, bool, bool]
 
 def cycles_seed(spec, frame_index: int, time_of_day: str, wet: bool, overcast: bool) -> int:
     """Cycles' seed of one RGB render (the sunny renders keep the seeds they had before skies were drawn)."""
-    return child_seed(spec.seed, "frame", frame_index, "cycles", time_of_day, int(wet), *(("overcast",) if overcast else ()))
+    return child_seed(
+        spec.seed, "frame", frame_index, "cycles", time_of_day, int(wet), *(("overcast",) if overcast else ())
+    )
 
 
 def weather_post(spec, frame_index: int, time_of_day: str, kind: str, rgb: np.ndarray, depth: np.ndarray,

@@ -253,7 +253,9 @@ def load_preset(name: str) -> Sensor:
     """
     path = PRESET_DIR / f"{name}.yaml"
     if not path.is_file():
-        raise SpecError("sensors.lidar.preset", "", f"unknown LiDAR preset {name!r}; known: {', '.join(preset_names())}")
+        raise SpecError(
+            "sensors.lidar.preset", "", f"unknown LiDAR preset {name!r}; known: {', '.join(preset_names())}"
+        )
     return load_sensor(path, f"generator/lidar/sensors/{name}.yaml")
 
 

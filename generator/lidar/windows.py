@@ -104,7 +104,9 @@ def sweep_windows(beams: BeamTable, radius: np.ndarray, lo: np.ndarray, hi: np.n
     az = np.arctan2(v[:, 1], v[:, 0])
     lo_psi, hi_psi = az - half - beams.rot.max(), az + half - beams.rot.min()
     k, start = s.azimuth_steps / (2 * np.pi), s.start_azimuth_rad
-    lo_c, hi_c = ((start - hi_psi) * k, (start - lo_psi) * k) if s.clockwise else ((lo_psi - start) * k, (hi_psi - start) * k)
+    lo_c, hi_c = (
+        ((start - hi_psi) * k, (start - lo_psi) * k) if s.clockwise else ((lo_psi - start) * k, (hi_psi - start) * k)
+    )
     ca = np.floor(lo_c).astype(np.int64) - 1
     width = np.floor(hi_c).astype(np.int64) + 2 - ca
     every = (d_xy <= r_tot) | (half >= np.pi) | (width >= s.azimuth_steps)

@@ -156,7 +156,9 @@ def streak_radiance(rgb: np.ndarray, time_of_day: str) -> np.ndarray:
     if time_of_day in LIT_TIMES:  # lamps are lit at dusk and night
         src += np.float32(LAMP_GLINT / STREAK_GAIN[time_of_day]) * block_mean(emitter_map(rgb), f)
     share = ENV_SHARE[time_of_day]
-    small = STREAK_GAIN[time_of_day] * ((1.0 - share) * gaussian(src, sigma / f) + share * src.mean((0, 1), keepdims=True))
+    small = STREAK_GAIN[time_of_day] * (
+        (1.0 - share) * gaussian(src, sigma / f) + share * src.mean((0, 1), keepdims=True)
+    )
     return upsample(small.astype(np.float32), f, h, w)
 
 

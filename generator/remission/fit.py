@@ -114,7 +114,9 @@ def _sequences(root: Path, sequences: list[str] | None) -> list[str]:
     for s in sequences:
         name = sk.sequence_name(s)
         if name not in present:
-            raise UserError(f"{root / 'sequences' / name}: sequence not found (present: {', '.join(present) or 'none'})")
+            raise UserError(
+                f"{root / 'sequences' / name}: sequence not found (present: {', '.join(present) or 'none'})"
+            )
         if not (root / "sequences" / name / "labels").is_dir():
             raise UserError(f"{root / 'sequences' / name / 'labels'}: missing; cannot fit intensities without labels")
         out.append(name)
@@ -136,7 +138,9 @@ def read_semantic_remission(scan_path: Path, label_path: Path) -> tuple[np.ndarr
     return labels.view("<u2")[::2], pts[:, 3]  # little-endian: the low 16 bits first
 
 
-def accumulate(root: str | Path, sequences: list[str] | None = None, progress: bool = True) -> tuple[ClassMoments, dict]:
+def accumulate(
+    root: str | Path, sequences: list[str] | None = None, progress: bool = True
+) -> tuple[ClassMoments, dict]:
     """Stream every labelled scan of the chosen sequences into per-label moments.
 
     Returns
@@ -183,7 +187,9 @@ def profile_from_moments(moments: ClassMoments, label_space: str, name: str, sou
     if label_space == "unified11":
         bad = [int(k) for k in present if k not in names]
         if bad:
-            raise UserError(f"{source}: labels {bad[:5]} are not unified-11 ids 0..{max(names)} (use --labels semantickitti?)")
+            raise UserError(
+                f"{source}: labels {bad[:5]} are not unified-11 ids 0..{max(names)} (use --labels semantickitti?)"
+            )
         return IntensityProfile(name, source, {names[k]: st for k, st in stats.items()}, {}, pooled)
     unknown = [int(k) for k in present if k not in table.sk_labels]
     if unknown:
@@ -215,7 +221,9 @@ def format_profile(profile: IntensityProfile, summary: dict | None = None) -> st
             "# classes absent from the data use 'unlabeled', else 'pooled' (all points together)."]
     if summary:
         head.append(f"# {summary['scans']} scans, {summary['points']} points.")
-    return "\n".join(head) + "\n" + yaml.safe_dump(profile.to_dict(), sort_keys=False, default_flow_style=None, width=120)
+    return (
+        "\n".join(head) + "\n" + yaml.safe_dump(profile.to_dict(), sort_keys=False, default_flow_style=None, width=120)
+    )
 
 
 def write_profile(path: str | Path, profile: IntensityProfile, summary: dict | None = None) -> None:

@@ -157,7 +157,7 @@ def physical() -> IntensityFn:
     fn.description = {
         "model": "physical",
         "formula": "clip(P * (1 + noise_relative N) + noise_absolute N, 0, 1); P = rho (cos + retro_gain cos^retro_exponent "
-                   "[retroreflective]) (R0 / max(R, min_range_m))^2 exp(-2 clear_alpha R)",
+        "[retroreflective]) (R0 / max(R, min_range_m))^2 exp(-2 clear_alpha R)",
         "normalisation": "P = 1 for a reflectivity-1 Lambertian target at R0 and normal incidence in clear air",
         "reflectivity": "generator/materials.yaml at 905 nm (per point material, else class_materials of reflectivity.yaml)",
         **{k: float(v) for k, v in p.items()},
@@ -174,13 +174,20 @@ def hybrid(profile: IntensityProfile, label_space: str = "semantickitti") -> Int
     def fn(points: np.ndarray, rng: np.random.Generator) -> np.ndarray:
         cos = np.clip(points["cos_incidence"].astype(np.float64), 0.0, 1.0)
         r = np.maximum(points["range"].astype(np.float64), h["min_range_m"])
-        w = ((1 - a) + a * cos) / ((1 - a) + a * h["reference_cos"]) * (h["reference_range_m"] / r) ** h["range_exponent"]
+        w = (
+            ((1 - a) + a * cos)
+            / ((1 - a) + a * h["reference_cos"])
+            * (h["reference_range_m"] / r) ** h["range_exponent"]
+        )
         return np.clip(draw(points, rng) * np.minimum(w, h["max_gain"]), 0.0, 1.0).astype(np.float32)
 
-    fn.description = {"model": "hybrid", **desc,
-                      "formula": "clip(N(mean_c, std_c) * min(max_gain, ((1-a) + a cos) / ((1-a) + a reference_cos) "
-                                 "* (reference_range_m / max(R, min_range_m))^range_exponent), 0, 1), a = incidence_weight",
-                      **{k: float(v) for k, v in h.items()}}
+    fn.description = {
+        "model": "hybrid",
+        **desc,
+        "formula": "clip(N(mean_c, std_c) * min(max_gain, ((1-a) + a cos) / ((1-a) + a reference_cos) "
+        "* (reference_range_m / max(R, min_range_m))^range_exponent), 0, 1), a = incidence_weight",
+        **{k: float(v) for k, v in h.items()},
+    }
     return fn
 
 

@@ -147,8 +147,9 @@ def process_scan(points: np.ndarray, processing: ScanProcessing, spec, frame_ind
     seed = spec.seed
     more = () if part is None else (part,)
     record = {"frame": int(frame_index), "points_cast": int(len(points)), "domain_gap": None, "weather": None}
-    remission = np.asarray(processing.intensity_fn(points, stream(seed, "frame", frame_index, "lidar_intensity", *more)),
-                           np.float32)
+    remission = np.asarray(
+        processing.intensity_fn(points, stream(seed, "frame", frame_index, "lidar_intensity", *more)), np.float32
+    )
     if processing.laser_gain is not None:
         remission = np.clip(remission * processing.laser_gain[points["laser"]], 0.0, 1.0).astype(np.float32)
     if processing.domain_gap is not None:

@@ -175,7 +175,9 @@ def verify(data: ImageData) -> list[str]:
         actual = np.bincount(class_id.ravel(), minlength=len(table)).astype(np.int64)
         diff = np.flatnonzero(actual != r.pixels)
         if diff.size:
-            what = ", ".join(f"{table.names[i]} {int(r.pixels[i])} in metadata vs {int(actual[i])} in EXR" for i in diff)
+            what = ", ".join(
+                f"{table.names[i]} {int(r.pixels[i])} in metadata vs {int(actual[i])} in EXR" for i in diff
+            )
             problems.append(f"{r.name}: {what}")
     return problems
 

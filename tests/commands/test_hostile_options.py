@@ -308,9 +308,13 @@ def test_number_accepts_exactly_finite_decimals_in_range(text, bounds):
 # -- whole command lines -----------------------------------------------------------------------------------------
 
 _FLAGS = sorted({o for n in COMMANDS for a in _parser_of(n)._actions for o in a.option_strings})
-_TOKENS = st.one_of(st.sampled_from(_FLAGS), st.sampled_from(_WORDS), st.sampled_from([c[0] for c in COMMANDS.values()]),
-                    st.sampled_from([".", "..", "-", "fit", "cityscapes", "all", "day:fog", "-q", "-v", "-vv"]),
-                    st.text(max_size=8))
+_TOKENS = st.one_of(
+    st.sampled_from(_FLAGS),
+    st.sampled_from(_WORDS),
+    st.sampled_from([c[0] for c in COMMANDS.values()]),
+    st.sampled_from([".", "..", "-", "fit", "cityscapes", "all", "day:fog", "-q", "-v", "-vv"]),
+    st.text(max_size=8),
+)
 
 
 @_cli_settings

@@ -45,7 +45,9 @@ def write_raycast_images(root: Path, scene, spec, n_frames: int, width: int = 16
     for f in Rig.from_spec(spec, scene).frames(n_frames):
         cls, inst, depth = raycast_image(caster, scene, f.T_world_camera, K, width, height)
         name = f"{f.index:06d}_day_clear"
-        write_exr(image_path(root, name, ".exr"), LabelledImage(np.zeros((height, width, 3), np.float32), cls, inst, depth))
+        write_exr(
+            image_path(root, name, ".exr"), LabelledImage(np.zeros((height, width, 3), np.float32), cls, inst, depth)
+        )
         meta = {"image": name, "files": {"exr": f"{name}.exr"}, "frame": f.index,
                 "camera": {"T_world_camera": f.T_world_camera.tolist(), "T_ego_camera": f.T_ego_camera.tolist(),
                            "intrinsics": {"width": width, "height": height, "K": K.tolist()}},
