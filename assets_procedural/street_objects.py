@@ -58,8 +58,8 @@ def bench(rng: np.random.Generator, length: float | None = None, backrest: bool 
         parts.append(box((depth, 0.05, 0.05), CLS, frame, (0.0, y, seat_z - slat_t - 0.025)))
         if backrest:
             top = np.array([-depth / 2 - 0.12, y, seat_z + 0.42])
-            parts.append(sweep(np.array([[-depth / 2 + 0.03, y, seat_z - slat_t - 0.03], top]), (0.025, 0.025), CLS, frame, 4,
-                               binormal=(0, 1, 0)))
+            parts.append(sweep(np.array([[-depth / 2 + 0.03, y, seat_z - slat_t - 0.03], top]), (0.025, 0.025), CLS,
+                               frame, 4, binormal=(0, 1, 0)))
         if y in (frames_y[0], frames_y[-1]):   # armrests at the ends
             parts.append(sweep(np.array([[depth / 2 - 0.06, y, seat_z - slat_t], [depth / 2 - 0.02, y, seat_z + 0.2],
                                          [-depth / 2 + 0.05, y, seat_z + 0.22]]), 0.018, CLS, frame, 5))
@@ -115,7 +115,8 @@ def bin(rng: np.random.Generator, style: str | None = None) -> Mesh:  # noqa: A0
         rings = np.array([np.c_[bot, np.full(4, 0.06)], np.c_[topo, np.full(4, h - 0.06)]])
         parts.append(loft(rings, CLS, "truck_paint"))
         parts.append(box((d + 0.04, w + 0.02, 0.05), CLS, "truck_paint", (0.02, 0.0, h - 0.035)))
-        parts.append(sweep(np.array([[-d / 2 - 0.06, -w / 2 + 0.08, h - 0.12], [-d / 2 - 0.06, w / 2 - 0.08, h - 0.12]]),
+        parts.append(sweep(np.array([[-d / 2 - 0.06, -w / 2 + 0.08, h - 0.12],
+                                     [-d / 2 - 0.06, w / 2 - 0.08, h - 0.12]]),
                            0.016, CLS, "rubber", 6))
         for s in (1.0, -1.0):
             wheel = cylinder(0.1, 0.05, CLS, "rubber", 12).transformed(pose(-d / 2 + 0.02, s * (w / 2 - 0.08), 0.1,
@@ -210,7 +211,8 @@ def bike_rack(rng: np.random.Generator, stands: int | None = None, style: str | 
             y = (k - (slots - 1) / 2) * pitch
             # a wheel slot: two bent bars, 5 cm apart, rising from the bottom rail over the top rail
             for dy in (-0.03, 0.03):
-                parts.append(sweep(np.array([[-0.35, y + dy, 0.03], [-0.25, y + dy, h], [0.25, y + dy, h], [0.35, y + dy, 0.03]]),
+                parts.append(sweep(np.array([[-0.35, y + dy, 0.03], [-0.25, y + dy, h], [0.25, y + dy, h],
+                                             [0.35, y + dy, 0.03]]),
                                    0.008, CLS, "pole_metal", 4, caps=False))
     return centred(merge(parts))
 

@@ -173,7 +173,8 @@ def _pantograph(x: float, z_roof: float, height: float, cls: str) -> list[Mesh]:
         bar = np.array([head + [dx, -0.62, 0.0], head + [dx, 0.62, 0.0]])
         parts.append(sweep(bar, (0.02, 0.03), cls, "chrome", 6))
     for s in (1.0, -1.0):
-        parts.append(sweep(np.array([head + [0.0, s * 0.6, 0.0], head + [0.0, s * 0.8, -0.05], head + [0.0, s * 0.9, -0.18]]),
+        parts.append(sweep(np.array([head + [0.0, s * 0.6, 0.0], head + [0.0, s * 0.8, -0.05],
+                                     head + [0.0, s * 0.9, -0.18]]),
                            0.015, cls, "pole_metal", 5))
     parts.append(box((0.3, 0.6, 0.04), cls, "pole_metal", tuple(head + [0.0, 0.0, -0.05])))
     return parts
@@ -287,7 +288,8 @@ def tram(rng: np.random.Generator, sections: int | None = None, bend_deg: float 
         if k < n - 1:
             pivot = centre - d * (Lk / 2 + gap / 2)
             mid_heading = heading + np.radians(bend_deg) / 2
-            bell = _body([(-gap / 2 - 0.05, W / 2 * 0.9, 0.45, H - 0.12, 0.6), (gap / 2 + 0.05, W / 2 * 0.9, 0.45, H - 0.12, 0.6)],
+            bell = _body([(-gap / 2 - 0.05, W / 2 * 0.9, 0.45, H - 0.12, 0.6),
+                          (gap / 2 + 0.05, W / 2 * 0.9, 0.45, H - 0.12, 0.6)],
                          cls, "rubber", r_top=0.3)
             out.append(bell.transformed(pose(pivot[0], pivot[1], 0.0, yaw=mid_heading)))
             heading += np.radians(bend_deg)

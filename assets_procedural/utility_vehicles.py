@@ -68,7 +68,8 @@ def trailer(rng: np.random.Generator, style: str | None = None) -> Mesh:
     # chassis rails under the deck, drawbar V to the coupling, jockey wheel
     for s in (1.0, -1.0):
         parts.append(box((bl, 0.06, 0.1), cls, "pole_metal", (0.0, s * bw * 0.3, deck - 0.05)))
-        parts.append(sweep(np.array([[bl / 2 - 0.2, s * bw * 0.3, deck - 0.05], [bl / 2 + draw - 0.25, s * 0.04, deck - 0.05]]),
+        parts.append(sweep(np.array([[bl / 2 - 0.2, s * bw * 0.3, deck - 0.05],
+                                     [bl / 2 + draw - 0.25, s * 0.04, deck - 0.05]]),
                            0.035, cls, "pole_metal", 6))
     hitch = np.array([bl / 2 + draw, 0.0, deck - 0.05])
     parts.append(box((0.3, 0.1, 0.09), cls, "chrome", tuple(hitch - [0.12, 0.0, 0.0])))
