@@ -62,13 +62,15 @@ def draw(per_model: dict[str, dict[int, np.ndarray]], classes: list[int], out: P
     d = ImageDraw.Draw(img)
     font = ImageFont.load_default()
     x = 10
-    d.text((10, 8), "urbangen: remission per SemanticKITTI class, default town, 5 scans (bars: share of the class's points per bin)", fill="black", font=font)
+    d.text((10, 8), "urbangen: remission per SemanticKITTI class, default town, 5 scans "
+           "(bars: share of the class's points per bin)", fill="black", font=font)
     for i, name in enumerate(per_model):
         d.rectangle([x, 30, x + 14, 42], fill=COLORS[i])
         d.text((x + 20, 30), name, fill="black", font=font)
         x += 20 + 8 * len(name) + 30
     d.line([x, 36, x + 20, 36], fill="black", width=2)
-    d.text((x + 26, 30), "Table III normal density (class_normal target, before clipping to [0, 1])", fill="black", font=font)
+    d.text((x + 26, 30), "Table III normal density (class_normal target, before clipping to [0, 1])", fill="black",
+           font=font)
     edges = np.linspace(0, 1, BINS + 1)
     for j, raw in enumerate(classes):
         ox, oy = (j % cols) * pw, top + (j // cols) * ph

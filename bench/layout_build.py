@@ -171,14 +171,14 @@ def cache_table(spec_path: str, sizes: list[int], towns: int, baseline: str | No
                 row[f"{k}_wall"] = _median(runs, lambda r, k=k: r[k]["wall"])
                 row[f"{k}_cpu"] = _median(runs, lambda r, k=k: r[k]["cpu"])
             results.append(row)
-            print(
-                f"{f'{n}x{n}':>5} {code:>9} {_median(runs, lambda r: r['cold']['wall']):>10.2f} "
-                f"{_median(runs, lambda r: r['cold']['cpu']):>6.2f} {_median(runs, lambda r: r['again']['wall']):>11.2f} "
-                f"{_median(runs, lambda r: r['again']['cpu']):>6.2f} {statistics.median(t['wall'] for t in new):>14.2f} "
-                f"{statistics.median(t['cpu'] for t in new):>6.2f} "
-                f"{rate:>6}  {same}",
-                flush=True,
-            )
+            print(f"{f'{n}x{n}':>5} {code:>9} {_median(runs, lambda r: r['cold']['wall']):>10.2f} "
+                  f"{_median(runs, lambda r: r['cold']['cpu']):>6.2f} "
+                  f"{_median(runs, lambda r: r['again']['wall']):>11.2f} "
+                  f"{_median(runs, lambda r: r['again']['cpu']):>6.2f} "
+                  f"{statistics.median(t['wall'] for t in new):>14.2f} "
+                  f"{statistics.median(t['cpu'] for t in new):>6.2f} "
+                  f"{rate:>6}  {same}",
+                  flush=True)
     return results
 
 

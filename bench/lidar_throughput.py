@@ -222,7 +222,8 @@ def main(argv=None) -> int:
                 rows.append(row("Blender scene.ray_cast per ray", info["n"], info["loop_s"], None,
                                 f"{info['n']}-ray sample; BVH {info['build_s']:.2f} s; process "
                                 f"{time.perf_counter() - t_spawn:.0f} s; |d_blender - d_embree| max "
-                                f"{agree.max() * 1000:.2f} mm, hit sets differ on {(np.isfinite(dist_b) != np.isfinite(dist_e)).sum()}"))
+                                f"{agree.max() * 1000:.2f} mm, hit sets differ on "
+                                f"{(np.isfinite(dist_b) != np.isfinite(dist_e)).sum()}"))
 
     print()
     print(f"{'method':44s} {'rays':>9s} {'seconds':>8s} {'rays/s':>12s} {'points/s':>12s}  note")

@@ -53,7 +53,8 @@ from generator.spec import parse_spec  # noqa: E402
 from generator.world.actors import Actor, Track, World  # noqa: E402
 from generator.world.rig import SWEEP_PERIOD_S, Rig  # noqa: E402
 
-TRAFFIC_X3 = {"cars_per_km": 36, "trucks_per_km": 3, "buses_per_km": 1.5, "cyclists_per_km": 6, "motorcyclists_per_km": 3}
+TRAFFIC_X3 = {"cars_per_km": 36, "trucks_per_km": 3, "buses_per_km": 1.5, "cyclists_per_km": 6,
+              "motorcyclists_per_km": 3}
 
 
 def lane_world(spec, scene, n: int, duration_s: float, ego_s: float) -> World:
@@ -213,9 +214,8 @@ def main(argv=None) -> int:
     pool.shutdown()
 
     n = args.sweeps
-    print(
-        f"\n{args.sweeps} sweeps of {sensor.rays_per_sweep:,} rays at 10 Hz from t = {args.t0} s, {args.rounds} rounds\n"
-    )
+    print(f"\n{args.sweeps} sweeps of {sensor.rays_per_sweep:,} rays at 10 Hz from t = {args.t0} s, "
+          f"{args.rounds} rounds\n")
     print(f"{'method':44s} {'thr':>3s} {'rays/s':>12s} {'sweeps/s':>9s} {'ms/sweep':>9s} {'CPU ms/sweep':>13s}")
     for (name, th), (wall, cpu) in best.items():
         print(f"{name:44s} {th:3d} {sensor.rays_per_sweep * n / wall:12,.0f} {n / wall:9.1f} {1000 * wall / n:9.2f} "
@@ -225,16 +225,15 @@ def main(argv=None) -> int:
     ours_a = best[("ours: Scanner.scan, actors moving", args.threads)]
     raw_f = best[("raw embreex, town + actors frozen", args.threads)]
     cpu = {k: v[1] for k, v in best.items()}
-    print(
-        f"\nstatic: ours / raw embreex, {args.threads} threads: {raw_s[0] / ours_s[0]:.2f}x (target >= 0.95x); "
-        f"CPU per sweep, raw / ours, 1 thread: {cpu[('raw embreex, static town', 1)] / cpu[('ours: Scanner.scan, static town', 1)]:.2f}x"
-    )
-    print(
-        f"moving actors: ours {n / ours_a[0]:.1f} sweeps/s = {sensor.rays_per_sweep * n / ours_a[0] / 1e6:.2f} M rays/s "
-        f"on {args.threads} threads (target >= 30 sweeps/s, 4 M rays/s); {raw_f[0] / ours_a[0]:.2f}x raw embreex on the "
-        f"town with the actors frozen; CPU over static-only: "
-        f"+{1000 * (cpu[('ours: Scanner.scan, actors moving', 1)] - cpu[('ours: Scanner.scan, static town', 1)]) / n:.2f} ms/sweep"
-    )
+    cpu_static, cpu_moving = cpu[("ours: Scanner.scan, static town", 1)], cpu[("ours: Scanner.scan, actors moving", 1)]
+    print(f"\nstatic: ours / raw embreex, {args.threads} threads: {raw_s[0] / ours_s[0]:.2f}x (target >= 0.95x); "
+          f"CPU per sweep, raw / ours, 1 thread: {cpu[('raw embreex, static town', 1)] / cpu_static:.2f}x")
+    print(f"moving actors: ours {n / ours_a[0]:.1f} sweeps/s = "
+          f"{sensor.rays_per_sweep * n / ours_a[0] / 1e6:.2f} M rays/s "
+          f"on {args.threads} threads (target >= 30 sweeps/s, 4 M rays/s); "
+          f"{raw_f[0] / ours_a[0]:.2f}x raw embreex on the "
+          f"town with the actors frozen; CPU over static-only: "
+          f"+{1000 * (cpu_moving - cpu_static) / n:.2f} ms/sweep")
     on_actor = np.array([(s.points["instance"] >= 60000).sum() if args.traffic == "lanes" else
                          np.isin(s.points["instance"], [a.instance_id for a in world.actors]).sum() for s in scans])
     mov = np.array([s.points["moving"].sum() for s in scans])

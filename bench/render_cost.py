@@ -122,9 +122,8 @@ def main() -> None:
     images: dict = {}
     res = {"before": _phase("before", legacy_wet_surface, scene, spec, cfg, poses, images, a.diagnose, a.time_of_day),
            "after": _phase("after", wet_surface, scene, spec, cfg, poses, images, a.diagnose, a.time_of_day)}
-    print(
-        f"{cfg.name} {cfg.width}x{cfg.height}, {cfg.samples} spp, {a.time_of_day}, {a.poses} poses x 2 renders each, medians (s)"
-    )
+    print(f"{cfg.name} {cfg.width}x{cfg.height}, {cfg.samples} spp, {a.time_of_day}, "
+          f"{a.poses} poses x 2 renders each, medians (s)")
     print(f"{'':<8}{'dry RGB':>9}{'wet RGB':>9}{'wet/dry':>9}"
           + (f"{'dry 0b':>9}{'wet 0b':>9}{'ratio':>7}" if a.diagnose else ""))
     for name, m in res.items():
