@@ -65,7 +65,8 @@ STREET_LUX = 60.0
 
 
 def global_irradiance(elevation_deg: float) -> float:
-    """Clear-sky global horizontal irradiance (render units) at a sun elevation (log-interpolated :data:`GLOBAL_LUX`)."""
+    """Clear-sky global horizontal irradiance (render units) at a sun elevation (log-interpolated
+    :data:`GLOBAL_LUX`)."""
     el, lux = np.array(GLOBAL_LUX).T
     return float(np.exp(np.interp(elevation_deg, el, np.log(lux)))) * UNITS_PER_LUX
 

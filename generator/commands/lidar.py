@@ -84,7 +84,8 @@ def run(args) -> int:
     check_sweeps(scene, spec, args.frames)
     world = world_for(spec, scene, args.frames)  # traffic problems are refused here, before any write
     opts = SequenceOptions(frames=args.frames, sequence=name, threads=args.threads, range_image=args.range_image,
-                           ply=args.ply, bev=not args.no_bev, resolution=(cfg.width, cfg.height), render_config=cfg.name)
+                           ply=args.ply, bev=not args.no_bev, resolution=(cfg.width, cfg.height),
+                           render_config=cfg.name)
     # The sequence is cast into a stage inside DIR and moved into place when complete: a failure
     # (or Ctrl-C) while casting and writing leaves DIR as it was.
     with staging(out, "lidar") as stage:

@@ -32,8 +32,8 @@ from generator.labels import class_table
 
 __all__ = [
     "encode_labels", "decode_labels", "write_scan", "write_labels", "write_poses", "write_times",
-    "read_scan", "read_labels", "read_poses", "read_times", "read_calib", "check_raw_ids", "sequence_name", "sequence_dir",
-    "list_sequences", "Sequence", "ScanRecord", "iter_sequence",
+    "read_scan", "read_labels", "read_poses", "read_times", "read_calib", "check_raw_ids", "sequence_name",
+    "sequence_dir", "list_sequences", "Sequence", "ScanRecord", "iter_sequence",
 ]
 
 

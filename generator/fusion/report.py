@@ -40,7 +40,8 @@ def markdown(report: dict) -> str:
         "",
         "Agreement = share of counted points whose mask class equals their ray-cast class.",
         "",
-        "| occlusion | proxies | boundaries | points | agreement native % | mIoU native % | agreement unified11 % | mIoU unified11 % |",
+        "| occlusion | proxies | boundaries | points | agreement native % | mIoU native % "
+        "| agreement unified11 % | mIoU unified11 % |",
         "|---|---|---|---:|---:|---:|---:|---:|",
     ]
     nat, uni = (report["label_sets"][k]["variants"] for k in ("native", "unified11"))
@@ -76,7 +77,8 @@ def _confusion_md(ls: dict, v: tuple[str, str, str]) -> list[str]:
     c = np.array(ls["variants"][variant_key(v)]["confusion_lidar_image"], np.int64)
     used = np.flatnonzero((c.sum(0) + c.sum(1)) > 0)
     names = ls["classes"]
-    out = ["", f"## Confusion, native ({variant_key(v)})", "", "Rows: ray-cast LiDAR class; columns: mask class at the point's pixel.", "",
+    out = ["", f"## Confusion, native ({variant_key(v)})", "",
+           "Rows: ray-cast LiDAR class; columns: mask class at the point's pixel.", "",
            "| LiDAR \\ image | " + " | ".join(names[j] for j in used) + " |", "|---|" + "---:|" * len(used)]
     for i in used:
         out.append(f"| {names[i]} | " + " | ".join(str(int(c[i, j])) for j in used) + " |")

@@ -28,5 +28,5 @@ from generator.geometry.primitives import (
 from generator.geometry.transforms import apply, invert, mount, pose
 
 __all__ = ["Mesh", "apply", "box", "convex_hull", "cylinder", "disc", "empty", "face_normals", "icosphere", "invert",
-           "loft", "merge", "mount", "on_ground", "polygon", "pose", "prism", "quad", "quads", "rect", "resolve_ids", "slab",
-           "triangulate", "tube"]
+           "loft", "merge", "mount", "on_ground", "polygon", "pose", "prism", "quad", "quads", "rect", "resolve_ids",
+           "slab", "triangulate", "tube"]

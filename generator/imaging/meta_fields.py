@@ -173,7 +173,8 @@ def schema_message(err) -> str:
         return f"{where}: must be of type {kinds}, got {kind_of(err.instance)}"
     if v in ("enum", "const"):
         allowed = want if v == "enum" else [want]
-        return f"{where}: must be {'one of ' if v == 'enum' else ''}{', '.join(safeload.printable(a, 40) for a in allowed[:12])}"
+        return (f"{where}: must be {'one of ' if v == 'enum' else ''}"
+                f"{', '.join(safeload.printable(a, 40) for a in allowed[:12])}")
     if v == "additionalProperties" and isinstance(err.instance, dict):
         extra = sorted(set(err.instance) - set(err.schema.get("properties", {})))
         return f"{where}: unknown key {safeload.printable(extra[0] if extra else '?', 64)!r}"

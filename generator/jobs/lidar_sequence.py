@@ -2,10 +2,11 @@
 
 A 10 Hz stream: sweep ``j`` starts at ``t_j = j * SWEEP_PERIOD_S`` (0.1 s) along the ego's drive
 through the world in time (:func:`generator.traffic.build.build_world`: the static town and the
-moving actors, each column of a sweep seeing them where they are at its firing time); files under ``out/sequences/NN/`` (see :mod:`generator.formats.semantickitti`)
-plus ``bev/NNNNNN.png`` (bird's-eye view), optionally ``range/NNNNNN.npy`` (range image,
-rings x columns float32, 0 = no return) and ``ply/NNNNNN.ply``; ``lidar_meta.json`` says
-how the data was made (sensor, conventions, remission placeholder, point counts); the
+moving actors, each column of a sweep seeing them where they are at its firing time); files under
+``out/sequences/NN/`` (see :mod:`generator.formats.semantickitti`) plus ``bev/NNNNNN.png``
+(bird's-eye view), optionally ``range/NNNNNN.npy`` (range image, rings x columns float32,
+0 = no return) and ``ply/NNNNNN.ply``; ``lidar_meta.json`` says how the data was made (sensor,
+conventions, remission placeholder, point counts); the
 dataset's ``semantic-kitti.yaml`` label config sits in ``out/``.
 Side files for fusion: ``point_times/`` and ``native_labels/`` per scan
 (:mod:`generator.formats.point_sidecars`), the scene flow of every scan but the last

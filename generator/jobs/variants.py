@@ -122,7 +122,8 @@ def weather_post(spec, frame_index: int, time_of_day: str, kind: str, rgb: np.nd
 
 
 def camera_post(spec, cfg, frame_index: int, time_of_day: str, kind: str, rgb: np.ndarray,
-                stream_tag: tuple = (), noise_tag: tuple = (), exposure: dict | None = None) -> tuple[np.ndarray, dict | None]:
+                stream_tag: tuple = (), noise_tag: tuple = (),
+                exposure: dict | None = None) -> tuple[np.ndarray, dict | None]:
     """The camera model (:mod:`generator.postfx.camera`) on one image after its fog and rain.
 
     Off (``cfg.camera_model`` false) it returns ``rgb`` itself and None: the image is written

@@ -13,8 +13,9 @@ ray that an actor would stop):
    actor's box (the prototype's bounding box under the actor's pose) seen from the sensor in its
    frame at that instant bounds the beam azimuth (the box's half-width across the line of sight
    over its nearest depth) and elevation (its height range over its horizontal distance range),
-   widened only by the emission-point offsets (across the beam only the 2.6 cm horizontal one). No motion margin is needed: both poses are exact
-   there. For a car 10 m ahead the beams kept are about a quarter of the sphere's.
+   widened only by the emission-point offsets (across the beam only the 2.6 cm horizontal one). No motion
+   margin is needed: both poses are exact there. For a car 10 m ahead the beams kept are about a quarter
+   of the sphere's.
 
 Frames: ``poses`` are ``T_world_sensor``; beam azimuths are CCW from the sensor's +x, elevations
 from its xy-plane; ring ``r`` is the ``r``-th highest beam.

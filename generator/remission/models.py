@@ -156,10 +156,12 @@ def physical() -> IntensityFn:
 
     fn.description = {
         "model": "physical",
-        "formula": "clip(P * (1 + noise_relative N) + noise_absolute N, 0, 1); P = rho (cos + retro_gain cos^retro_exponent "
-        "[retroreflective]) (R0 / max(R, min_range_m))^2 exp(-2 clear_alpha R)",
+        "formula": "clip(P * (1 + noise_relative N) + noise_absolute N, 0, 1); "
+                   "P = rho (cos + retro_gain cos^retro_exponent [retroreflective]) "
+                   "(R0 / max(R, min_range_m))^2 exp(-2 clear_alpha R)",
         "normalisation": "P = 1 for a reflectivity-1 Lambertian target at R0 and normal incidence in clear air",
-        "reflectivity": "generator/materials.yaml at 905 nm (per point material, else class_materials of reflectivity.yaml)",
+        "reflectivity": "generator/materials.yaml at 905 nm "
+                        "(per point material, else class_materials of reflectivity.yaml)",
         **{k: float(v) for k, v in p.items()},
     }
     return fn

@@ -76,8 +76,10 @@ class ScanProcessing:
                                       {"model": getattr(self.intensity_fn, "__name__", "custom")})),
             **({} if self.laser_gain is None else {"laser_gain": {
                 "by_laser_id": {str(i): round(float(self.laser_gain[i]), 5) for i in self.laser_ids},
-                "draw": "log-normal, mean 1, sigma = intensity_gain_spread; stream ('lidar_sensor', 'intensity_gain')"}}),
-            "domain_gap": None if self.domain_gap is None else {"source": "seed 002 sec. 3.2 / 4.1.2", **self.domain_gap.to_dict()},
+                "draw": "log-normal, mean 1, sigma = intensity_gain_spread; "
+                        "stream ('lidar_sensor', 'intensity_gain')"}}),
+            "domain_gap": None if self.domain_gap is None else {"source": "seed 002 sec. 3.2 / 4.1.2",
+                                                                **self.domain_gap.to_dict()},
             "weather": None if self.weather is None else {
                 "detection_threshold": self.weather.detection_threshold, "min_range_m": self.weather.min_range_m,
                 "frame_weather": "generator.weather.draw_weather(spec, k, lidar_combination(k)[1])",

@@ -171,7 +171,8 @@ def with_defaults(document: dict, schema: dict, root: dict | None = None) -> dic
 
 
 def check_ranges(document: Any, source: str, path: tuple = ()) -> None:
-    """Every ``[low, high]`` pair under a key ending in ``_m``/``_deg``/``_mmh`` or a known range must have low <= high."""
+    """Every ``[low, high]`` pair under a key ending in ``_m``/``_deg``/``_mmh`` or a known range must have
+    low <= high."""
     if isinstance(document, dict):
         for k, v in document.items():
             check_ranges(v, source, path + (k,))

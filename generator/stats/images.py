@@ -229,7 +229,8 @@ def table2(data: ImageData) -> Table:
     rows = [[KIND_TITLES[k], *map(int, counts[i]), int(counts[i].sum())] for i, k in enumerate(KINDS)]
     rows.append(["Total", *map(int, counts.sum(0)), int(counts.sum())])
     ids = [*KINDS, "total"]
-    return Table("table2_conditions", "Table II. Distribution of images with respect to lighting and weather conditions",
+    return Table("table2_conditions",
+                 "Table II. Distribution of images with respect to lighting and weather conditions",
                  ["Weather", *(TIME_TITLES[t] for t in times), "Total"],
                  ["weather", *times, "total"], rows, csv_rows=[[k, *r[1:]] for k, r in zip(ids, rows, strict=False)])
 

@@ -196,7 +196,8 @@ def test_motion_blur_leaves_labels_exact(renders, town):
         moving |= off["labels"].instance == a.instance_id
     near = moving.copy()
     for shift in range(1, 9):
-        near |= np.roll(moving, shift, 1) | np.roll(moving, -shift, 1) | np.roll(moving, shift, 0) | np.roll(moving, -shift, 0)
+        near |= (np.roll(moving, shift, 1) | np.roll(moving, -shift, 1)
+                 | np.roll(moving, shift, 0) | np.roll(moving, -shift, 0))
     diff = np.abs(renders["on"]["still_rgb"] - off["rgb"]).mean(-1)
     crossing = off["labels"].instance == world.actors[1].instance_id
     assert diff[crossing].mean() > 10 * diff[~near].mean(), (diff[crossing].mean(), diff[~near].mean())
