@@ -21,7 +21,8 @@ from assets_procedural.building_roof import flat_roof, pitched_roof, rectangle_o
 from assets_procedural.facade_details import balcony, shop_front
 from assets_procedural.facade_layout import Hole, Style, draw_style, holes, wall_rects
 from generator.geometry import Mesh, box, merge, quads, resolve_ids
-from generator.geometry.primitives import _UNIT_BOX_FACES, _UNIT_BOX_VERTICES as _UNIT_BOX
+from generator.geometry.primitives import _UNIT_BOX_FACES
+from generator.geometry.primitives import _UNIT_BOX_VERTICES as _UNIT_BOX
 
 log = logging.getLogger(__name__)
 
@@ -65,7 +66,7 @@ class _Facade:
         self.d = np.array([d[0], d[1], 0.0]) / self.length
         self.n = np.array([self.d[1], -self.d[0], 0.0])  # outward for a CCW footprint
         self.o = np.array([p0[0], p0[1], 0.0])
-        self._axes = [tuple(float(x) for x in c) for c in zip(self.o, self.d, (0.0, 0.0, 1.0), self.n)]
+        self._axes = [tuple(float(x) for x in c) for c in zip(self.o, self.d, (0.0, 0.0, 1.0), self.n, strict=False)]
         self._up, self._down, self._back = np.array([0, 0, 1.0]), -np.array([0, 0, 1.0]), -self.d
         # quads are collected as 12 facade coordinates each (4 corners of (u, v, w)), mapped in mesh();
         # the direction each faces is an index into _normals (one array per direction, not per quad)
@@ -160,7 +161,7 @@ class _Facade:
             fcls = np.stack([b[2] for b in built])[which].ravel()
             fmat = np.stack([b[3] for b in built])[which].ravel()
         else:
-            faces = np.concatenate([built[k][1] + o for k, o in zip(which, offsets)])
+            faces = np.concatenate([built[k][1] + o for k, o in zip(which, offsets, strict=False)])
             fcls = np.concatenate([built[k][2] for k in which])
             fmat = np.concatenate([built[k][3] for k in which])
         return [Mesh(verts.reshape(-1, 3), faces, fcls, fmat)]

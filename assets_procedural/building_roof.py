@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from generator.geometry import Mesh, resolve_ids, triangulate, box, merge, polygon, pose
+from generator.geometry import Mesh, box, merge, polygon, pose, resolve_ids, triangulate
 
 CLS = "building"
 UP = np.array([0.0, 0.0, 1.0])
@@ -122,7 +122,7 @@ def pitched_roof(rng: np.random.Generator, rect: tuple[float, float, float, floa
         s, n = [-A, -B, ze + dz], [-A, B, ze + dz]
         se, ne = [A, -B, ze + dz], [A, B, ze + dz]
         rw, re = [-r, 0, zr + dz], [r, 0, zr + dz]
-        hint = lambda v: np.array(v) if sgn > 0 else -UP  # noqa: E731 - undersides face down
+        hint = lambda v, sgn=sgn: np.array(v) if sgn > 0 else -UP  # noqa: E731 - undersides face down
         parts.append(_quad([s, se, re, rw], mat, hint([0, -1, 1])))
         parts.append(_quad([ne, n, rw, re], mat, hint([0, 1, 1])))
         if kind == "hip":

@@ -150,7 +150,7 @@ def stations(p: dict, k: dict, max_gap: float = 0.42) -> np.ndarray:
     xs = np.array(sorted(x for x in xs if -L / 2 <= x <= L / 2))
     xs = xs[np.concatenate([[True], np.diff(xs) > 0.03])]
     xs[-1] = L / 2
-    fill = [np.linspace(a, b, int(np.ceil((b - a) / max_gap)) + 1)[1:-1] for a, b in zip(xs[:-1], xs[1:])]
+    fill = [np.linspace(a, b, int(np.ceil((b - a) / max_gap)) + 1)[1:-1] for a, b in zip(xs[:-1], xs[1:], strict=False)]
     return np.sort(np.concatenate([xs, *fill]))
 
 
@@ -189,11 +189,11 @@ def body_shell(p: dict, body: str, cls: str = "car") -> tuple[Mesh, dict]:
         zb[inside] = np.maximum(zb[inside], r + np.sqrt(ar ** 2 - (xs[inside] - wx) ** 2))
     end_d = np.minimum(L / 2 - xs, xs + L / 2)
     zb = zb + np.interp(end_d, [0.0, 0.06, 0.2], [0.1, 0.04, 0.0])   # bumpers curve up underneath
-    half = W / 2 * np.interp(end_d, *zip(*_PLAN))
+    half = W / 2 * np.interp(end_d, *zip(*_PLAN, strict=False))
     g = np.clip((U - S) / max(p["H"] - belt, 1e-6), 0, 1)        # 0 on hood/deck, 1 under the roof
     w_top = half * (0.93 - 0.2 * g)
     rings = []
-    for x, b, s_, u, w, wt in zip(xs, zb, S, U, half, w_top):
+    for x, b, s_, u, w, wt in zip(xs, zb, S, U, half, w_top, strict=False):
         ws = 0.975 * w
         z4 = s_ + 0.55 * (u - s_)
         zr = u - min(0.05, 0.25 * (u - s_))

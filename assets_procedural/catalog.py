@@ -6,30 +6,31 @@ the native class that identifies the object (instance boxes, statistics).
 
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 
 from assets_procedural.building import building
-from assets_procedural.proto_cache import CACHE
 from assets_procedural.fence import fence
-from generator.geometry import Mesh
-from generator.labels import class_table
-from assets_procedural.person import person
-from assets_procedural.street_furniture import lamp_post, traffic_light, traffic_sign
 from assets_procedural.ground_pieces import driveway_apron, gravel_patch, median_strip, traffic_island
 from assets_procedural.motorcycles import motorcycle
+from assets_procedural.person import person
+from assets_procedural.proto_cache import CACHE
 from assets_procedural.riders import bicyclist, motorcyclist, ridden
 from assets_procedural.shelters import bus_shelter
+from assets_procedural.street_furniture import lamp_post, traffic_light, traffic_sign
 from assets_procedural.street_objects import advertising_column, bench, bike_rack, bollard, hydrant
 from assets_procedural.street_objects import bin as litter_bin
 from assets_procedural.tracks import rail_track, tram_rails
 from assets_procedural.transit import bus, tram
-from assets_procedural.utility_vehicles import box_van, construction_vehicle, trailer
 from assets_procedural.two_wheelers import bicycle
-from assets_procedural.walls import wall
+from assets_procedural.utility_vehicles import box_van, construction_vehicle, trailer
 from assets_procedural.vegetation import bush, hedge, tree
 from assets_procedural.vehicle import car, truck
+from assets_procedural.walls import wall
+from generator.geometry import Mesh
+from generator.labels import class_table
+
 
 def _ridden_vehicle(rider_kind: str, vehicle_class: str):
     """Builder of the two-wheeler a ``rider_kind`` rides: the vehicle of :func:`ridden` from the same

@@ -159,7 +159,7 @@ def wall_rects(length: float, height: float, hs: list[Hole]) -> list[tuple[float
     """Rectangles (u0, u1, v0, v1) covering [0, length] x [0, height] minus the holes."""
     vs = sorted({0.0, height, *[h.v0 for h in hs], *[h.v1 for h in hs]})
     rects = []
-    for va, vb in zip(vs[:-1], vs[1:]):
+    for va, vb in zip(vs[:-1], vs[1:], strict=False):
         if vb - va < 1e-6:
             continue
         cuts = sorted((h.u0, h.u1) for h in hs if h.v0 <= va + 1e-9 and h.v1 >= vb - 1e-9)

@@ -9,8 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from generator.geometry import Mesh, merge, prism, pose
-from generator.geometry.primitives import _UNIT_BOX_FACES as _BOX_FACES, resolve_ids
+from generator.geometry import Mesh, merge, pose, prism
+from generator.geometry.primitives import _UNIT_BOX_FACES as _BOX_FACES
+from generator.geometry.primitives import resolve_ids
 
 CLS = "fence"
 
@@ -96,7 +97,7 @@ def _bars(rng: np.random.Generator, length: float, height: float) -> Mesh:
     parts = _Parts(mat)
     for x in posts:
         parts.bar(x - pw / 2, x + pw / 2, -pw / 2, pw / 2, 0.0, height)
-    for xa, xb in zip(posts[:-1], posts[1:]):
+    for xa, xb in zip(posts[:-1], posts[1:], strict=False):
         for z in (0.12, height - 0.12):
             parts.bar(xa, xb, -0.02, 0.02, z - 0.02, z + 0.02, ends=False)
         for x in _bars_between(xa + pw / 2, xb - pw / 2, pitch, bw):
@@ -117,7 +118,7 @@ def _pickets(rng: np.random.Generator, length: float, height: float) -> Mesh:
                         [-kw / 2, height - 0.05 - tip]])
     # picket outline in the x-z plane, extruded along y (roll +90 deg: prism z -> -y)
     picket = prism(outline, -pw / 2 - 0.007 - kt, -pw / 2 - 0.007, CLS, mat, bottom=True)
-    for xa, xb in zip(posts[:-1], posts[1:]):
+    for xa, xb in zip(posts[:-1], posts[1:], strict=False):
         for z in (0.3, height - 0.35):
             parts.bar(xa, xb, pw / 2 - 0.035, pw / 2 + 0.005, z - 0.04, z + 0.04, ends=False)
         parts.moved(picket, [pose(x, 0.0, 0.05, roll=np.pi / 2) for x in _bars_between(xa + pw / 2, xb - pw / 2,
@@ -135,7 +136,7 @@ def _panels(rng: np.random.Generator, length: float, height: float) -> Mesh:
     for x in posts:
         parts.bar(x - pw / 2, x + pw / 2, -pw / 2, pw / 2, 0.0, height + 0.05)
     z0, z1 = 0.06, height
-    for xa, xb in zip(posts[:-1], posts[1:]):
+    for xa, xb in zip(posts[:-1], posts[1:], strict=False):
         xa, xb = xa + pw / 2, xb - pw / 2
         for x in _bars_between(xa, xb, cell_x, wire):
             parts.bar(x - wire / 2, x + wire / 2, -wire / 2, wire / 2, z0, z1, ends=False)

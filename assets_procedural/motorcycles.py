@@ -18,9 +18,12 @@ from generator.geometry import Mesh, box, loft, merge, polygon, pose, tube
 MOTO_STYLES = ("naked", "sport", "scooter")
 
 MOTO = {
-    "naked": dict(R=(0.30, 0.315), tyre=(0.055, 0.062), wb=(1.38, 1.48), seat=(0.78, 0.84), bar=(0.74, 0.82), rake=25.0),
-    "sport": dict(R=(0.30, 0.315), tyre=(0.058, 0.065), wb=(1.38, 1.44), seat=(0.80, 0.85), bar=(0.64, 0.70), rake=24.0),
-    "scooter": dict(R=(0.22, 0.25), tyre=(0.045, 0.05), wb=(1.28, 1.36), seat=(0.76, 0.80), bar=(0.66, 0.72), rake=27.0),
+    "naked": dict(R=(0.30, 0.315), tyre=(0.055, 0.062), wb=(1.38, 1.48), seat=(0.78, 0.84), bar=(0.74, 0.82),
+                  rake=25.0),
+    "sport": dict(R=(0.30, 0.315), tyre=(0.058, 0.065), wb=(1.38, 1.44), seat=(0.80, 0.85), bar=(0.64, 0.70),
+                  rake=24.0),
+    "scooter": dict(R=(0.22, 0.25), tyre=(0.045, 0.05), wb=(1.28, 1.36), seat=(0.76, 0.80), bar=(0.66, 0.72),
+                    rake=27.0),
 }
 
 
@@ -66,12 +69,17 @@ def _motorcycle_parts(rng: np.random.Generator, style: str | None) -> tuple[list
                                     ring(front[1], 0.17, floor_z + 0.05, head[2] - 0.02)]), cls, "car_paint"))
         parts.append(box((front[0] - seat_x, 0.34, 0.06), cls, "rubber", ((front[0] + seat_x) / 2, 0.0, floor_z)))
         body = []
-        for x, w, z0, z1 in ((seat_x + 0.16, 0.15, floor_z + 0.03, seat_z - 0.1), (seat_x, 0.19, R + 0.08, seat_z - 0.06),
-                             (-0.2, 0.16, R + 0.12, seat_z - 0.1), (-0.42, 0.08, R + 0.2, seat_z - 0.2)):
+        for x, w, z0, z1 in (
+            (seat_x + 0.16, 0.15, floor_z + 0.03, seat_z - 0.1),
+            (seat_x, 0.19, R + 0.08, seat_z - 0.06),
+            (-0.2, 0.16, R + 0.12, seat_z - 0.1),
+            (-0.42, 0.08, R + 0.2, seat_z - 0.2),
+        ):
             body.append(ring(x, w, z0, z1))
         parts.append(loft(np.array(body), cls, "car_paint"))
         parts.append(loft(np.array([ring(seat_x + 0.18, 0.13, seat_z - 0.1, seat_z - 0.02),
-                                    ring(seat_x, 0.17, seat_z - 0.1, seat_z), ring(-0.3, 0.12, seat_z - 0.1, seat_z - 0.03)]),
+                                    ring(seat_x, 0.17, seat_z - 0.1, seat_z),
+                                    ring(-0.3, 0.12, seat_z - 0.1, seat_z - 0.03)]),
                           cls, "rubber"))
         parts.append(box((0.25, 0.14, 0.1), cls, "pole_metal", (0.1, -0.12, R + 0.02)))
         parts.append(tube(np.array([0.15, -0.12, 0.2]), np.array([-0.3, -0.15, 0.25]), 0.04, cls, "chrome", sections=6))
@@ -89,14 +97,21 @@ def _motorcycle_parts(rng: np.random.Generator, style: str | None) -> tuple[list
             tank.append(np.stack([np.full(10, x), w * np.cos(a), (z0 + z1) / 2 + (z1 - z0) / 2 * np.sin(a)], 1))
         parts.append(loft(np.array(tank), cls, "car_paint"))
         seat = []
-        for x, w, zt in ((seat_x + 0.2, 0.12, seat_z - 0.01), (seat_x, 0.15, seat_z), (seat_x - 0.3, 0.13, seat_z + 0.03),
-                         (seat_x - 0.5, 0.09, seat_z + 0.06)):
+        for x, w, zt in (
+            (seat_x + 0.2, 0.12, seat_z - 0.01),
+            (seat_x, 0.15, seat_z),
+            (seat_x - 0.3, 0.13, seat_z + 0.03),
+            (seat_x - 0.5, 0.09, seat_z + 0.06),
+        ):
             a = np.linspace(0, 2 * np.pi, 8, endpoint=False)
             seat.append(np.stack([np.full(8, x), w * np.cos(a), zt - 0.05 + 0.05 * np.sin(a)], 1))
         parts.append(loft(np.array(seat), cls, "rubber"))
         tail = []
-        for x, w, z0, z1 in ((seat_x - 0.3, 0.12, seat_z - 0.2, seat_z - 0.02), (seat_x - 0.55, 0.09, seat_z - 0.1, seat_z + 0.03),
-                             (seat_x - 0.75, 0.05, seat_z - 0.02, seat_z + 0.05)):
+        for x, w, z0, z1 in (
+            (seat_x - 0.3, 0.12, seat_z - 0.2, seat_z - 0.02),
+            (seat_x - 0.55, 0.09, seat_z - 0.1, seat_z + 0.03),
+            (seat_x - 0.75, 0.05, seat_z - 0.02, seat_z + 0.05),
+        ):
             a = np.linspace(0, 2 * np.pi, 8, endpoint=False)
             tail.append(np.stack([np.full(8, x), w * np.cos(a), (z0 + z1) / 2 + (z1 - z0) / 2 * np.sin(a)], 1))
         parts.append(loft(np.array(tail), cls, "car_paint"))
@@ -104,18 +119,24 @@ def _motorcycle_parts(rng: np.random.Generator, style: str | None) -> tuple[list
         parts.append(box((0.42, 0.3, 0.36), cls, "pole_metal", tuple(eng_c)))
         parts.append(oriented_box(eng_c + np.array([0.12, 0.0, 0.26]), (0.16, 0.26, 0.22), cls, "chrome", pitch=-0.3))
         for s in (1.0, -1.0):
-            parts.append(tube(ra + s * 0.08 * y, eng_c + np.array([-0.2, s * 0.09, 0.0]), 0.03, cls, "pole_metal", sections=6))
-            parts.append(tube(head + s * 0.05 * y, eng_c + np.array([-0.15, s * 0.1, 0.15]), 0.025, cls, "pole_metal", sections=6))
-        parts.append(tube(np.array([0.12, 0.0, R + 0.12]), np.array([seat_x - 0.05, 0.0, seat_z - 0.12]), 0.03, cls, "chrome",
-                          sections=6))
+            parts.append(
+                tube(ra + s * 0.08 * y, eng_c + np.array([-0.2, s * 0.09, 0.0]), 0.03, cls, "pole_metal", sections=6)
+            )
+            parts.append(
+                tube(
+                    head + s * 0.05 * y, eng_c + np.array([-0.15, s * 0.1, 0.15]), 0.025, cls, "pole_metal", sections=6
+                )
+            )
+        parts.append(tube(np.array([0.12, 0.0, R + 0.12]), np.array([seat_x - 0.05, 0.0, seat_z - 0.12]), 0.03, cls,
+                          "chrome", sections=6))
         parts.append(sweep(np.array([eng_c + [0.15, -0.1, -0.15], eng_c + [-0.05, -0.17, -0.22], [0.2, -0.2, R - 0.08],
                                      [-0.25, -0.2, R + 0.12]]), 0.045, cls, "chrome", 8))
         parts.append(sweep(np.array([fa + [-0.2, 0, 0.18], fa + [0.0, 0, R - 0.03], fa + [0.18, 0, R - 0.12]]),
                            (0.008, 0.07), cls, "car_paint", 6, binormal=(0, 1, 0)))
         feet = [np.array([seat_x + 0.12, s * (0.2 if style == "naked" else 0.23), R + 0.06]) for s in (-1.0, 1.0)]
         for f in feet:
-            parts.append(tube(f - [0, np.sign(f[1]) * 0.1, 0], f + [0, np.sign(f[1]) * 0.04, 0], 0.012, cls, "pole_metal",
-                              sections=6))
+            parts.append(tube(f - [0, np.sign(f[1]) * 0.1, 0], f + [0, np.sign(f[1]) * 0.04, 0], 0.012, cls,
+                              "pole_metal", sections=6))
         light_f = head + np.array([0.14, 0.0, -0.08])
         light_r = np.array([seat_x - 0.78, 0.0, seat_z + 0.0])
         if style == "sport":

@@ -63,7 +63,9 @@ def sweep(path: np.ndarray, radius: float | tuple[float, float], cls: str | int,
         v = np.cross(t, u)
     ang = np.linspace(0, 2 * np.pi, sides, endpoint=False)
     ca, sa = np.cos(ang), np.sin(ang)
-    verts = (p[:, None, :] + a * ca[None, :, None] * u[:, None, :] + b * sa[None, :, None] * v[:, None, :]).reshape(-1, 3)
+    verts = (p[:, None, :] + a * ca[None, :, None] * u[:, None, :] + b * sa[None, :, None] * v[:, None, :]).reshape(
+        -1, 3
+    )
     k = np.arange(sides)
     k1 = (k + 1) % sides
     faces = []
@@ -86,7 +88,9 @@ def sweep(path: np.ndarray, radius: float | tuple[float, float], cls: str | int,
 def arc(center, u, v, radius: float, a0: float, a1: float, n: int) -> np.ndarray:
     """(n, 3) points of a circular arc ``center + r (cos a u + sin a v)`` from angle ``a0`` to ``a1``."""
     a = np.linspace(a0, a1, n)
-    return np.asarray(center, float) + radius * (np.cos(a)[:, None] * np.asarray(u, float) + np.sin(a)[:, None] * np.asarray(v, float))
+    return np.asarray(center, float) + radius * (
+        np.cos(a)[:, None] * np.asarray(u, float) + np.sin(a)[:, None] * np.asarray(v, float)
+    )
 
 
 def torus(center, axis, major: float, minor: float | tuple[float, float], cls: str | int, material: str | int,
@@ -163,7 +167,9 @@ def ring_plate(center, normal, r_in: float, r_out: float, cls: str | int, materi
     ring = np.cos(a)[:, None] * e1 + np.sin(a)[:, None] * e2
     c = np.asarray(center, float)
     h = thickness / 2
-    v = np.concatenate([c + r_out * ring + h * n, c + r_in * ring + h * n, c + r_out * ring - h * n, c + r_in * ring - h * n])
+    v = np.concatenate(
+        [c + r_out * ring + h * n, c + r_in * ring + h * n, c + r_out * ring - h * n, c + r_in * ring - h * n]
+    )
     k = np.arange(segments)
     k1 = (k + 1) % segments
     O1, I1, O0, I0 = 0, segments, 2 * segments, 3 * segments
@@ -245,7 +251,9 @@ def wheel_cylinder(x: float, y_centre: float, radius: float, width: float, cls: 
     return merge([tyre, hubd])
 
 
-def two_link(root: np.ndarray, target: np.ndarray, l1: float, l2: float, hint: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def two_link(
+    root: np.ndarray, target: np.ndarray, l1: float, l2: float, hint: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """(middle joint, end) of a two-segment limb from ``root`` reaching toward ``target``.
 
     The joint bends toward ``hint``; a target out of reach is approached along the line.

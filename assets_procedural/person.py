@@ -84,9 +84,13 @@ def _arm(side: float, shoulder: np.ndarray, action: str, swing: float, rng: np.r
     """Upper arm, forearm, hand (and a bag) of one arm, unit height."""
     l1, l2 = 0.175, 0.15
     if action == "phone":
-        elbow, wrist = two_link(shoulder, np.array([0.03, side * 0.075, 0.9]), l1, l2, np.array([0.35, side * 0.3, -1.0]))
+        elbow, wrist = two_link(
+            shoulder, np.array([0.03, side * 0.075, 0.9]), l1, l2, np.array([0.35, side * 0.3, -1.0])
+        )
     elif action == "pockets":
-        elbow, wrist = two_link(shoulder, np.array([0.03, side * 0.095, 0.5]), l1, l2, np.array([-1.0, side * 0.45, 0.0]))
+        elbow, wrist = two_link(
+            shoulder, np.array([0.03, side * 0.095, 0.5]), l1, l2, np.array([-1.0, side * 0.45, 0.0])
+        )
     else:                                                            # hanging (swinging when walking) or a bag
         elbow, wrist = _limb(shoulder, swing if action == "hanging" else 0.03, np.radians(rng.uniform(8, 25)), l1, l2)
         elbow[1] += side * 0.02
@@ -135,7 +139,7 @@ def person(rng: np.random.Generator, height: float, pose: str = "standing") -> M
     parts = [_torso(girth, breadth, garment)] + _head(1.0, rng)
     thigh = "skin" if garment == "skirt" else "clothing_bottom"
     shin = "skin" if garment in ("skirt", "shorts") else "clothing_bottom"
-    for (side, phase), action in zip(((1.0, 1.0), (-1.0, -1.0)), arms):
+    for (side, phase), action in zip(((1.0, 1.0), (-1.0, -1.0)), arms, strict=False):
         # legs: the side with phase +1 steps forward, the other pushes off with a bent knee
         hip = np.array([0.0, side * 0.052 * girth, 0.53])
         leg = phase * swing

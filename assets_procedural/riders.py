@@ -25,6 +25,7 @@ from assets_procedural.person import _head
 from assets_procedural.two_wheelers import _bicycle_parts, contact_anchors
 from generator.geometry import Mesh, box, icosphere, loft, merge, pose, resolve_ids, tube
 
+
 def _rot_to(d: np.ndarray) -> np.ndarray:
     """3x3 rotation taking +z to the unit vector ``d``."""
     d = d / np.linalg.norm(d)

@@ -12,6 +12,7 @@ import numpy as np
 from assets_procedural.parts import centred
 from generator.geometry import Mesh, box, merge, polygon, pose
 
+
 def bus_shelter(rng: np.random.Generator, length: float | None = None) -> Mesh:
     """A bus shelter along y, open toward +x: steel posts, a flat roof, glass back wall and side
     panes, an illuminated advertising panel at one end and a bench inside.
@@ -46,8 +47,10 @@ def bus_shelter(rng: np.random.Generator, length: float | None = None) -> Mesh:
     parts.append(roof.transformed(pose(0.1, 0.0, H + 0.06, pitch=-0.03)))
     # back wall glass between the posts (leaving a 10 cm gap at the bottom), a top rail
     pane_t = 0.012           # toughened glass: a thin slab, so front and back faces never coincide
-    for ya, yb in zip(ys[:-1], ys[1:]):
-        parts.append(box((pane_t, yb - ya - 0.1, H - 0.25), cls, "car_glass", (xb, (ya + yb) / 2, 0.1 + (H - 0.25) / 2)))
+    for ya, yb in zip(ys[:-1], ys[1:], strict=False):
+        parts.append(
+            box((pane_t, yb - ya - 0.1, H - 0.25), cls, "car_glass", (xb, (ya + yb) / 2, 0.1 + (H - 0.25) / 2))
+        )
     parts.append(box((0.05, L, 0.06), cls, frame, (xb, 0.0, H - 0.1)))
     # side panes; at the +y end an advertising panel lit from inside
     for k, y in enumerate((ys[0], ys[-1])):

@@ -49,13 +49,17 @@ def bench(rng: np.random.Generator, length: float | None = None, backrest: bool 
     frames_y = [-L / 2 + 0.12, L / 2 - 0.12] if L < 2.2 else [-L / 2 + 0.12, 0.0, L / 2 - 0.12]
     for y in frames_y:
         # front leg, rear leg, seat rail; the rear leg rises into the back support
-        parts.append(box((0.05, 0.05, seat_z - slat_t), CLS, frame, (depth / 2 - 0.06, y, (seat_z - slat_t) / 2), bottom=False))
-        parts.append(box((0.05, 0.05, seat_z - slat_t), CLS, frame, (-depth / 2 + 0.06, y, (seat_z - slat_t) / 2), bottom=False))
+        parts.append(
+            box((0.05, 0.05, seat_z - slat_t), CLS, frame, (depth / 2 - 0.06, y, (seat_z - slat_t) / 2), bottom=False)
+        )
+        parts.append(
+            box((0.05, 0.05, seat_z - slat_t), CLS, frame, (-depth / 2 + 0.06, y, (seat_z - slat_t) / 2), bottom=False)
+        )
         parts.append(box((depth, 0.05, 0.05), CLS, frame, (0.0, y, seat_z - slat_t - 0.025)))
         if backrest:
             top = np.array([-depth / 2 - 0.12, y, seat_z + 0.42])
-            parts.append(sweep(np.array([[-depth / 2 + 0.03, y, seat_z - slat_t - 0.03], top]), (0.025, 0.025), CLS, frame, 4,
-                               binormal=(0, 1, 0)))
+            parts.append(sweep(np.array([[-depth / 2 + 0.03, y, seat_z - slat_t - 0.03], top]), (0.025, 0.025), CLS,
+                               frame, 4, binormal=(0, 1, 0)))
         if y in (frames_y[0], frames_y[-1]):   # armrests at the ends
             parts.append(sweep(np.array([[depth / 2 - 0.06, y, seat_z - slat_t], [depth / 2 - 0.02, y, seat_z + 0.2],
                                          [-depth / 2 + 0.05, y, seat_z + 0.22]]), 0.018, CLS, frame, 5))
@@ -111,7 +115,8 @@ def bin(rng: np.random.Generator, style: str | None = None) -> Mesh:  # noqa: A0
         rings = np.array([np.c_[bot, np.full(4, 0.06)], np.c_[topo, np.full(4, h - 0.06)]])
         parts.append(loft(rings, CLS, "truck_paint"))
         parts.append(box((d + 0.04, w + 0.02, 0.05), CLS, "truck_paint", (0.02, 0.0, h - 0.035)))
-        parts.append(sweep(np.array([[-d / 2 - 0.06, -w / 2 + 0.08, h - 0.12], [-d / 2 - 0.06, w / 2 - 0.08, h - 0.12]]),
+        parts.append(sweep(np.array([[-d / 2 - 0.06, -w / 2 + 0.08, h - 0.12],
+                                     [-d / 2 - 0.06, w / 2 - 0.08, h - 0.12]]),
                            0.016, CLS, "rubber", 6))
         for s in (1.0, -1.0):
             wheel = cylinder(0.1, 0.05, CLS, "rubber", 12).transformed(pose(-d / 2 + 0.02, s * (w / 2 - 0.08), 0.1,
@@ -196,7 +201,9 @@ def bike_rack(rng: np.random.Generator, stands: int | None = None, style: str | 
         h = float(rng.uniform(0.35, 0.45))
         for x in (-0.25, 0.25):
             parts.append(sweep(np.array([[x, -span / 2 - 0.1, h], [x, span / 2 + 0.1, h]]), 0.02, CLS, "pole_metal", 6))
-            parts.append(sweep(np.array([[x, -span / 2 - 0.1, 0.03], [x, span / 2 + 0.1, 0.03]]), 0.02, CLS, "pole_metal", 6))
+            parts.append(
+                sweep(np.array([[x, -span / 2 - 0.1, 0.03], [x, span / 2 + 0.1, 0.03]]), 0.02, CLS, "pole_metal", 6)
+            )
         for y in (-span / 2 - 0.1, span / 2 + 0.1):
             for x in (-0.25, 0.25):
                 parts.append(cylinder(0.02, h + 0.02, CLS, "pole_metal", 6).transformed(pose(x, y)))
@@ -204,7 +211,8 @@ def bike_rack(rng: np.random.Generator, stands: int | None = None, style: str | 
             y = (k - (slots - 1) / 2) * pitch
             # a wheel slot: two bent bars, 5 cm apart, rising from the bottom rail over the top rail
             for dy in (-0.03, 0.03):
-                parts.append(sweep(np.array([[-0.35, y + dy, 0.03], [-0.25, y + dy, h], [0.25, y + dy, h], [0.35, y + dy, 0.03]]),
+                parts.append(sweep(np.array([[-0.35, y + dy, 0.03], [-0.25, y + dy, h], [0.25, y + dy, h],
+                                             [0.35, y + dy, 0.03]]),
                                    0.008, CLS, "pole_metal", 4, caps=False))
     return centred(merge(parts))
 
@@ -238,7 +246,9 @@ def hydrant(rng: np.random.Generator, style: str | None = None) -> Mesh:
         parts.append(cylinder(r * 1.0, 0.06, CLS, "chrome", 12, z0=h - 0.04, radius_top=r * 0.3))
         for s in (1.0, -1.0):
             zo = h - 0.35
-            parts.append(cylinder(0.045, 0.09, CLS, "chrome", 10).transformed(pose(0.0, s * r * 0.7, zo, roll=-s * np.pi / 2)))
+            parts.append(
+                cylinder(0.045, 0.09, CLS, "chrome", 10).transformed(pose(0.0, s * r * 0.7, zo, roll=-s * np.pi / 2))
+            )
     else:
         r, h = float(rng.uniform(0.11, 0.13)), float(rng.uniform(0.6, 0.75))
         parts.append(cylinder(r * 1.6, 0.05, CLS, "truck_paint", 12))
@@ -248,8 +258,12 @@ def hydrant(rng: np.random.Generator, style: str | None = None) -> Mesh:
         parts.append(cylinder(0.025, 0.04, CLS, "chrome", 6, z0=h, radius_top=0.02).transformed(pose(z=-0.005)))
         zo = h - 0.32
         for s in (1.0, -1.0):
-            parts.append(cylinder(0.04, 0.08, CLS, "chrome", 10).transformed(pose(0.0, s * r * 0.8, zo, roll=-s * np.pi / 2)))
-        parts.append(cylinder(0.06, 0.09, CLS, "chrome", 10).transformed(pose(r * 0.8, 0.0, zo - 0.05, pitch=np.pi / 2)))
+            parts.append(
+                cylinder(0.04, 0.08, CLS, "chrome", 10).transformed(pose(0.0, s * r * 0.8, zo, roll=-s * np.pi / 2))
+            )
+        parts.append(
+            cylinder(0.06, 0.09, CLS, "chrome", 10).transformed(pose(r * 0.8, 0.0, zo - 0.05, pitch=np.pi / 2))
+        )
     return centred(merge(parts))
 
 

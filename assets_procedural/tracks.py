@@ -17,7 +17,8 @@ GAUGE = 1.435         # standard gauge, between the inner faces of the rail head
 
 #: rail cross-section (y, z), counter-clockwise seen from +x: foot, web and head of a ~60 kg rail
 RAIL_PROFILE = np.array([[-0.075, 0.0], [0.075, 0.0], [0.075, 0.012], [0.009, 0.03], [0.009, 0.115], [0.036, 0.125],
-                         [0.036, 0.16], [-0.036, 0.16], [-0.036, 0.125], [-0.009, 0.115], [-0.009, 0.03], [-0.075, 0.012]])
+                         [0.036, 0.16], [-0.036, 0.16], [-0.036, 0.125], [-0.009, 0.115], [-0.009, 0.03],
+                         [-0.075, 0.012]])
 #: prism coordinates (px, py, pz) -> (x, y, z) = (pz, px, py): extrude a (y, z) profile along x
 _ALONG_X = np.array([[0.0, 0.0, 1.0, 0.0], [1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0]])
 

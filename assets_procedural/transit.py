@@ -44,7 +44,7 @@ def _panes(x0: float, x1: float, z0: float, z1: float, y: float, pitch: float, c
             continue
         n = max(1, int(round((a1 - a0) / pitch)))
         edges = np.linspace(a0, a1, n + 1)
-        for a, b in zip(edges[:-1], edges[1:]):
+        for a, b in zip(edges[:-1], edges[1:], strict=False):
             a, b = a + gap / 2, b - gap / 2
             q = np.array([[a, y, z0], [b, y, z0], [b, y, z1], [a, y, z1]])
             out.append(polygon(q, cls, "car_glass", (0, side, 0)))
@@ -173,7 +173,8 @@ def _pantograph(x: float, z_roof: float, height: float, cls: str) -> list[Mesh]:
         bar = np.array([head + [dx, -0.62, 0.0], head + [dx, 0.62, 0.0]])
         parts.append(sweep(bar, (0.02, 0.03), cls, "chrome", 6))
     for s in (1.0, -1.0):
-        parts.append(sweep(np.array([head + [0.0, s * 0.6, 0.0], head + [0.0, s * 0.8, -0.05], head + [0.0, s * 0.9, -0.18]]),
+        parts.append(sweep(np.array([head + [0.0, s * 0.6, 0.0], head + [0.0, s * 0.8, -0.05],
+                                     head + [0.0, s * 0.9, -0.18]]),
                            0.015, cls, "pole_metal", 5))
     parts.append(box((0.3, 0.6, 0.04), cls, "pole_metal", tuple(head + [0.0, 0.0, -0.05])))
     return parts
@@ -254,7 +255,9 @@ def tram(rng: np.random.Generator, sections: int | None = None, bend_deg: float 
             zl = 0.75
             for s in (1.0, -1.0):
                 mat = "headlight" if sign > 0 else "taillight"
-                parts.append(box((0.05, 0.22, 0.12), cls, mat, (sign * (Lk / 2 - 0.005), s * (W / 2 * 0.78 - 0.25), zl)))
+                parts.append(
+                    box((0.05, 0.22, 0.12), cls, mat, (sign * (Lk / 2 - 0.005), s * (W / 2 * 0.78 - 0.25), zl))
+                )
                 anchors_local.setdefault("headlight" if sign > 0 else "taillight", []).append(
                     (k, np.array([sign * (Lk / 2 + 0.02), s * (W / 2 * 0.78 - 0.25), zl])))
         # bogies under the odd sections (1st, 3rd, 5th): two axles, wheels just inside the skirt
@@ -273,7 +276,7 @@ def tram(rng: np.random.Generator, sections: int | None = None, bend_deg: float 
     out, heading = [], 0.0
     front_end = np.zeros(2)
     anchors = {}
-    for k, (Lk, m) in enumerate(zip(lengths, sections_m)):
+    for k, (Lk, m) in enumerate(zip(lengths, sections_m, strict=False)):
         d = np.array([np.cos(heading), np.sin(heading)])
         centre = front_end - d * Lk / 2
         t = pose(centre[0], centre[1], 0.0, yaw=heading)
@@ -285,7 +288,8 @@ def tram(rng: np.random.Generator, sections: int | None = None, bend_deg: float 
         if k < n - 1:
             pivot = centre - d * (Lk / 2 + gap / 2)
             mid_heading = heading + np.radians(bend_deg) / 2
-            bell = _body([(-gap / 2 - 0.05, W / 2 * 0.9, 0.45, H - 0.12, 0.6), (gap / 2 + 0.05, W / 2 * 0.9, 0.45, H - 0.12, 0.6)],
+            bell = _body([(-gap / 2 - 0.05, W / 2 * 0.9, 0.45, H - 0.12, 0.6),
+                          (gap / 2 + 0.05, W / 2 * 0.9, 0.45, H - 0.12, 0.6)],
                          cls, "rubber", r_top=0.3)
             out.append(bell.transformed(pose(pivot[0], pivot[1], 0.0, yaw=mid_heading)))
             heading += np.radians(bend_deg)

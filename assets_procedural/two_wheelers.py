@@ -62,7 +62,7 @@ def _saddle(top_centre: np.ndarray, cls: str, length: float = 0.27, width: float
     h = 0.05
     rings = []
     a = np.linspace(0, 2 * np.pi, 8, endpoint=False)
-    for x, w in zip(xs, half_w):
+    for x, w in zip(xs, half_w, strict=False):
         rings.append(np.stack([np.full(8, x), w * np.cos(a), -h / 2 + h / 2 * np.sin(a)], 1))
     m = loft(np.array(rings), cls, "rubber")
     return m.transformed(pose(*(top_centre + np.array([0.0, 0.0, 0.0]))))
@@ -136,9 +136,12 @@ def _bicycle_parts(rng: np.random.Generator, style: str | None) -> tuple[list[Me
         clamp = stem_top + np.array([0.10, 0.0, -0.01])
         grip_x, grip_z = clamp[0] + 0.02, clamp[2] - 0.01
         bar_path = lambda s: [  # noqa: E731
-            np.array([grip_x - 0.03, s * p["bar"] / 2, grip_z - 0.11]), np.array([grip_x + 0.06, s * p["bar"] / 2, grip_z - 0.08]),
-            np.array([grip_x + 0.08, s * p["bar"] / 2, grip_z - 0.02]), np.array([grip_x, s * p["bar"] / 2, grip_z]),
-            np.array([clamp[0], 0.0, clamp[2]])]
+            np.array([grip_x - 0.03, s * p["bar"] / 2, grip_z - 0.11]),
+            np.array([grip_x + 0.06, s * p["bar"] / 2, grip_z - 0.08]),
+            np.array([grip_x + 0.08, s * p["bar"] / 2, grip_z - 0.02]),
+            np.array([grip_x, s * p["bar"] / 2, grip_z]),
+            np.array([clamp[0], 0.0, clamp[2]]),
+        ]
     else:
         clamp = stem_top + np.array([0.06, 0.0, 0.0])
         grip_x, grip_z = clamp[0] - 0.01, clamp[2] + 0.015
@@ -183,7 +186,9 @@ def _bicycle_parts(rng: np.random.Generator, style: str | None) -> tuple[list[Me
                               cls, "pole_metal", sections=4))
             parts.append(tube(np.array([-0.14, side * 0.07, rack_z]), np.array([0.22, side * 0.07, rack_z]), 0.007,
                               cls, "pole_metal", sections=4))
-        parts.append(tube(np.array([0.2, -0.08, rack_z]), np.array([0.2, 0.08, rack_z]), 0.007, cls, "pole_metal", sections=4))
+        parts.append(
+            tube(np.array([0.2, -0.08, rack_z]), np.array([0.2, 0.08, rack_z]), 0.007, cls, "pole_metal", sections=4)
+        )
         parts.append(box((0.04, 0.07, 0.05), cls, "headlight", tuple(crown + ahead * 0.06 + np.array([0, 0, 0.02]))))
         parts.append(box((0.03, 0.06, 0.03), cls, "taillight", (-0.16, 0.0, rack_z - 0.01)))
     info = dict(style=style, R=R, saddle=saddle_top, grips=grips, pedals=pedals, bb=bb, crank_phase=crank_phase,

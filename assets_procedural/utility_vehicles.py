@@ -68,7 +68,8 @@ def trailer(rng: np.random.Generator, style: str | None = None) -> Mesh:
     # chassis rails under the deck, drawbar V to the coupling, jockey wheel
     for s in (1.0, -1.0):
         parts.append(box((bl, 0.06, 0.1), cls, "pole_metal", (0.0, s * bw * 0.3, deck - 0.05)))
-        parts.append(sweep(np.array([[bl / 2 - 0.2, s * bw * 0.3, deck - 0.05], [bl / 2 + draw - 0.25, s * 0.04, deck - 0.05]]),
+        parts.append(sweep(np.array([[bl / 2 - 0.2, s * bw * 0.3, deck - 0.05],
+                                     [bl / 2 + draw - 0.25, s * 0.04, deck - 0.05]]),
                            0.035, cls, "pole_metal", 6))
     hitch = np.array([bl / 2 + draw, 0.0, deck - 0.05])
     parts.append(box((0.3, 0.1, 0.09), cls, "chrome", tuple(hitch - [0.12, 0.0, 0.0])))
@@ -80,7 +81,9 @@ def trailer(rng: np.random.Generator, style: str | None = None) -> Mesh:
         for s in (1.0, -1.0):
             parts.append(box((bl, 0.03, wall), cls, "fence_metal", (0.0, s * (bw / 2 - 0.015), deck + 0.04 + wall / 2)))
         for sx in (1.0, -1.0):
-            parts.append(box((0.03, bw - 0.06, wall), cls, "fence_metal", (sx * (bl / 2 - 0.015), 0.0, deck + 0.04 + wall / 2)))
+            parts.append(
+                box((0.03, bw - 0.06, wall), cls, "fence_metal", (sx * (bl / 2 - 0.015), 0.0, deck + 0.04 + wall / 2))
+            )
     else:
         hb = float(rng.uniform(1.3, 1.6))
         parts.append(box((bl, bw, hb), cls, "truck_paint", (0.0, 0.0, deck + 0.04 + hb / 2)))
@@ -196,7 +199,9 @@ def construction_vehicle(rng: np.random.Generator, slew_deg: float | None = None
     prof = np.array(front + back)
     for s in (1.0, -1.0):
         parts.append(_xz_prism(prof, tw, cls, "rubber").transformed(pose(y=s * gauge / 2)))
-        parts.append(box((tl - 2 * rt, 0.06, 0.3), cls, "truck_paint", (0.0, s * (gauge / 2 + tw / 2 + 0.01), rt + 0.05)))
+        parts.append(
+            box((tl - 2 * rt, 0.06, 0.3), cls, "truck_paint", (0.0, s * (gauge / 2 + tw / 2 + 0.01), rt + 0.05))
+        )
     parts.append(box((tl * 0.55, gauge - tw, 0.4), cls, "truck_paint", (0.0, 0.0, th - 0.1)))
     parts.append(cylinder(0.55, 0.25, cls, "pole_metal", 16, z0=th + 0.05))
     # house (in its own frame, yawed by the slew): body, counterweight, cab, engine hood, arm
@@ -231,13 +236,17 @@ def construction_vehicle(rng: np.random.Generator, slew_deg: float | None = None
         wrist = np.array([tip[0] + 0.3, 0.0, 0.0])
     section = (0.22, 0.14)
     house.append(sweep(np.array([foot, elbow, tip]), section, cls, "truck_paint", 4, binormal=(0, 1, 0)))
-    house.append(sweep(np.array([tip + [0.15, 0, 0.15], wrist]), (0.16, 0.12), cls, "truck_paint", 4, binormal=(0, 1, 0)))
+    house.append(
+        sweep(np.array([tip + [0.15, 0, 0.15], wrist]), (0.16, 0.12), cls, "truck_paint", 4, binormal=(0, 1, 0))
+    )
     for p0, p1 in ((foot + [0.3, 0.0, -0.35], foot + 0.6 * (elbow - foot) + [0.0, 0.0, -0.15]),
                    (elbow + [0.1, 0.0, 0.25], tip + [0.1, 0.0, 0.35])):
         house.append(sweep(np.array([p0, p1]), 0.07, cls, "chrome", 6))
     # bucket: a C-shaped profile across y at the wrist, teeth down/forward
     bw = float(rng.uniform(0.8, 1.1))
-    bucket = np.array([(0.0, 0.0), (0.55, -0.45), (0.75, -0.9), (0.55, -0.95), (0.1, -0.75), (-0.25, -0.3), (-0.2, 0.05)])
+    bucket = np.array(
+        [(0.0, 0.0), (0.55, -0.45), (0.75, -0.9), (0.55, -0.95), (0.1, -0.75), (-0.25, -0.3), (-0.2, 0.05)]
+    )
     if boom == "lowered":
         bucket = bucket @ np.array([[np.cos(0.6), -np.sin(0.6)], [np.sin(0.6), np.cos(0.6)]]).T
         wrist[2] = -bucket[:, 1].min() + 0.01

@@ -51,7 +51,9 @@ def _retaining(rng: np.random.Generator, length: float, height: float) -> Mesh:
     # expansion joints every ~6 m: shallow dark vertical strips on the street face
     for x in _posts(length, 6.0, 0.02)[1:-1] if length > 6.5 else []:
         parts.append(box((0.02, 0.01, height - 0.1), CLS, "rubber", (x, -base_t / 2 - 0.005, height / 2 - 0.05)))
-    parts.append(box((length, top_t + 0.04, 0.05), CLS, "curb_concrete", (0.0, -base_t / 2 + top_t / 2, height + 0.025)))
+    parts.append(
+        box((length, top_t + 0.04, 0.05), CLS, "curb_concrete", (0.0, -base_t / 2 + top_t / 2, height + 0.025))
+    )
     # weep holes near the foot
     for x in np.arange(-length / 2 + 1.0, length / 2 - 0.5, 2.0):
         parts.append(box((0.08, 0.01, 0.08), CLS, "rubber", (x, -base_t / 2 - 0.005, 0.3)))
@@ -75,16 +77,16 @@ def _noise(rng: np.random.Generator, length: float, height: float) -> Mesh:
     elem_h = 0.5
     n = max(1, int(round((height - plinth_h) / elem_h)))
     zs = np.linspace(plinth_h, height, n + 1)
-    for xa, xb in zip(posts[:-1], posts[1:]):
+    for xa, xb in zip(posts[:-1], posts[1:], strict=False):
         xa, xb = xa + post_w / 2 - 0.02, xb - post_w / 2 + 0.02
-        for k, (z0, z1) in enumerate(zip(zs[:-1], zs[1:])):
+        for k, (z0, z1) in enumerate(zip(zs[:-1], zs[1:], strict=False)):
             # panels alternate a few millimetres in depth so each element reads as its own
             dy = 0.004 * (k % 2)
             t = 0.12 if panel_mat != "car_glass" else 0.03
             parts.append(box((xb - xa, t, z1 - z0 - 0.004), CLS, panel_mat, ((xa + xb) / 2, dy, (z0 + z1) / 2)))
     if panel_mat == "car_glass":
         # bird-protection: a few narrow vertical dark stripes on the glass, proud of it
-        for xa, xb in zip(posts[:-1], posts[1:]):
+        for xa, xb in zip(posts[:-1], posts[1:], strict=False):
             for x in np.linspace(xa + 0.3, xb - 0.3, 5):
                 parts.append(box((0.02, 0.005, height - plinth_h - 0.1), CLS, "rubber",
                                  (x, -0.03 / 2 - 0.0125, (height + plinth_h) / 2)))

@@ -106,7 +106,7 @@ def rasterize(tri: np.ndarray, colours: np.ndarray, width: int, height: int) -> 
     """
     rgba = np.zeros((height, width, 4), np.uint8)
     zbuf = np.full((height, width), -np.inf)
-    for t, c in zip(tri, colours):
+    for t, c in zip(tri, colours, strict=False):
         x0, y0 = np.floor(t[:, :2].min(0)).astype(int)
         x1, y1 = np.ceil(t[:, :2].max(0)).astype(int)
         x0, y0, x1, y1 = max(x0, 0), max(y0, 0), min(x1, width - 1), min(y1, height - 1)
@@ -185,7 +185,9 @@ def main(argv: list[str] | None = None) -> int:
             draw_view(img, (vx, vy, vx + TILE, vy + TILE), mesh, view, pal, idx)
     args.out.parent.mkdir(parents=True, exist_ok=True)
     img.save(args.out)
-    print(f"{len(examples)} assets, {total} triangles, built and drawn in {time.perf_counter() - t0:.1f} s -> {args.out}")
+    print(
+        f"{len(examples)} assets, {total} triangles, built and drawn in {time.perf_counter() - t0:.1f} s -> {args.out}"
+    )
     return 0
 
 

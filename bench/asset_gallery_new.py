@@ -107,7 +107,8 @@ def main(argv: list[str] | None = None) -> int:
         size = mesh.bounds()[1] - mesh.bounds()[0]
         total += mesh.n_faces
         names = [table.names[c] for c in np.unique(mesh.face_class)]
-        print(f"{label:28s} {mesh.n_faces:6d} tris  size {size[0]:5.2f} x {size[1]:5.2f} x {size[2]:5.2f} m  {', '.join(names)}")
+        print(f"{label:28s} {mesh.n_faces:6d} tris  size {size[0]:5.2f} x {size[1]:5.2f} x {size[2]:5.2f} m  "
+              f"{', '.join(names)}")
         ox, oy = (k % cols) * tile_w, (k // cols) * tile_h
         draw.rectangle([ox, oy, ox + tile_w - 1, oy + tile_h - 1], outline=(180, 180, 180))
         draw.text((ox + 6, oy + 3), f"{label}  {mesh.n_faces} tris  {size[0]:.2f}x{size[1]:.2f}x{size[2]:.2f} m",
@@ -123,7 +124,9 @@ def main(argv: list[str] | None = None) -> int:
             draw_view(img, (vx, vy, vx + tile, vy + tile), mesh, view, pal, idx)
     args.out.parent.mkdir(parents=True, exist_ok=True)
     img.save(args.out)
-    print(f"{len(examples)} assets, {total} triangles, built and drawn in {time.perf_counter() - t0:.1f} s -> {args.out}")
+    print(
+        f"{len(examples)} assets, {total} triangles, built and drawn in {time.perf_counter() - t0:.1f} s -> {args.out}"
+    )
     return 0
 
 

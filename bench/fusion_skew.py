@@ -40,8 +40,8 @@ def _headline(root: Path, deskew: bool) -> tuple[float, int]:
 def main(spec_path: str, dataset: str) -> None:
     from generator.fusion import projection as P
     from generator.fusion.dataset import FusionDataset, frame_images
-    from generator.layout.assemble import build_scene
     from generator.jobs.lidar_sequence import SequenceOptions, write_sequence
+    from generator.layout.assemble import build_scene
     from generator.spec import load_spec
 
     images = frame_images(Path(dataset))
@@ -83,8 +83,10 @@ def main(spec_path: str, dataset: str) -> None:
             fuse_frame(f)
         full = (time.perf_counter() - t0) / len(frames)
         npts = int(np.mean([len(f.xyz) for f in frames]))
-        print(f"per frame ({npts} points, {frames[0].depth.shape[1]}x{frames[0].depth.shape[0]} px): "
-              f"Eq. 1 projection {1000 * base:.1f} ms (baseline), + de-skew, occlusion, boundaries {1000 * full:.1f} ms")
+        print(
+            f"per frame ({npts} points, {frames[0].depth.shape[1]}x{frames[0].depth.shape[0]} px): "
+            f"Eq. 1 projection {1000 * base:.1f} ms (baseline), + de-skew, occlusion, boundaries {1000 * full:.1f} ms"
+        )
 
 
 if __name__ == "__main__":

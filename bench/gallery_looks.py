@@ -27,14 +27,14 @@ import numpy as np
 from PIL import Image, ImageDraw
 
 from assets_procedural import catalog
-from generator.layout.placement.appearance import fleet_paint, outfit
 from assets_procedural.vehicle import CAR_VARIANTS
 from generator import geometry as M
 from generator.labels import class_table
+from generator.layout.placement.appearance import fleet_paint, outfit
 from generator.rng import stream
 from generator.world import rig
-from generator.world.scene import OrientedBox, Path as RoutePath, SceneModel, SceneObject
-
+from generator.world.scene import OrientedBox, SceneModel, SceneObject
+from generator.world.scene import Path as RoutePath
 
 CAR_GAP_M = 14.0
 
@@ -77,7 +77,8 @@ def _scene(seed: int) -> tuple[SceneModel, list[str]]:
         pose = "walking" if j % 2 else "standing"
         mesh = catalog.build("person", g, height=h, pose=pose)
         attrs = outfit(stream(seed, "gallery", "outfit", j))
-        add(f"person_{j}", "person", mesh, M.pose(-14.0, 5.4 - 1.2 * j, 0.0, np.radians(-30 + 20 * (j % 3))), 20 + j, attrs)
+        add(f"person_{j}", "person", mesh, M.pose(-14.0, 5.4 - 1.2 * j, 0.0, np.radians(-30 + 20 * (j % 3))), 20 + j,
+            attrs)
         notes.append(f"person {j} {pose:<8} {h:.2f} m {mesh.n_faces:4d} tris  {attrs['outfit']}")
     xs = np.arange(0.0, 10.0, 1.0)
     paths = [RoutePath("gallery", np.c_[xs, np.zeros_like(xs), np.zeros_like(xs)], np.zeros_like(xs), xs.copy(), False)]

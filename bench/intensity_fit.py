@@ -84,7 +84,7 @@ def welford_lists(seq: sk.Sequence, frames: list[int]) -> dict:
     for i in frames:
         pts = sk.read_scan(seq.scan_path(i))
         sem, _ = sk.read_labels(seq.label_path(i))
-        for key, x in zip(sem.tolist(), pts[:, 3].astype(np.float64).tolist()):
+        for key, x in zip(sem.tolist(), pts[:, 3].astype(np.float64).tolist(), strict=False):
             c = n.get(key, 0) + 1
             n[key] = c
             mu = mean.get(key, 0.0)
@@ -139,7 +139,8 @@ def main() -> None:
         lstd = learn.std()
         worst_pub = max(max(abs(learn.mean[k] - m), abs(lstd[k] - sd)) for k, (m, sd, _) in ref_pub.items())
     rate_ours = summary["points"] / t_ours
-    print(f"intensity fit on {summary['scans']} scans, {summary['points']:,} points ({'synthetic' if args.dataset is None else root})")
+    print(f"intensity fit on {summary['scans']} scans, {summary['points']:,} points "
+          f"({'synthetic' if args.dataset is None else root})")
     print(f"{'method':<28}{'points':>12}{'seconds':>10}{'points/s':>14}{'vs ours':>10}")
     print(f"{'ours (bincount + Chan)':<28}{summary['points']:>12,}{t_ours:>10.3f}{rate_ours:>14,.0f}{1.0:>9.1f}x")
     for name, secs in (("Welford, published loop", t_pub), ("Welford, Python lists", t_list)):

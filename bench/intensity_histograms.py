@@ -62,27 +62,36 @@ def draw(per_model: dict[str, dict[int, np.ndarray]], classes: list[int], out: P
     d = ImageDraw.Draw(img)
     font = ImageFont.load_default()
     x = 10
-    d.text((10, 8), "urbangen: remission per SemanticKITTI class, default town, 5 scans (bars: share of the class's points per bin)", fill="black", font=font)
+    d.text((10, 8), "urbangen: remission per SemanticKITTI class, default town, 5 scans "
+           "(bars: share of the class's points per bin)", fill="black", font=font)
     for i, name in enumerate(per_model):
         d.rectangle([x, 30, x + 14, 42], fill=COLORS[i])
         d.text((x + 20, 30), name, fill="black", font=font)
         x += 20 + 8 * len(name) + 30
     d.line([x, 36, x + 20, 36], fill="black", width=2)
-    d.text((x + 26, 30), "Table III normal density (class_normal target, before clipping to [0, 1])", fill="black", font=font)
+    d.text((x + 26, 30), "Table III normal density (class_normal target, before clipping to [0, 1])", fill="black",
+           font=font)
     edges = np.linspace(0, 1, BINS + 1)
     for j, raw in enumerate(classes):
         ox, oy = (j % cols) * pw, top + (j // cols) * ph
         x0, y0, x1, y1 = ox + pad, oy + 22, ox + pw - 10, oy + ph - 26
-        hists = {m: np.histogram(v.get(raw, np.zeros(0)), edges)[0] / max(len(v.get(raw, [])), 1) for m, v in per_model.items()}
+        hists = {
+            m: np.histogram(v.get(raw, np.zeros(0)), edges)[0] / max(len(v.get(raw, [])), 1)
+            for m, v in per_model.items()
+        }
         uni = table.unified_names[int(table.sk_to_unified[raw])]
         st = prof.unified[uni]
-        pdf = np.exp(-0.5 * ((edges[:-1] + 0.5 / BINS - st.mean) / st.std) ** 2) / (st.std * math.sqrt(2 * math.pi)) / BINS
+        pdf = (
+            np.exp(-0.5 * ((edges[:-1] + 0.5 / BINS - st.mean) / st.std) ** 2)
+            / (st.std * math.sqrt(2 * math.pi))
+            / BINS
+        )
         ymax = max(max(h.max() for h in hists.values()), pdf.max(), 1e-9) * 1.1
         d.rectangle([x0, y0, x1, y1], outline=(160, 160, 160))
         n = {m: len(v.get(raw, [])) for m, v in per_model.items()}
         d.text((x0, oy + 6), f"{raw} {table.sk_labels[raw]} -> {uni}  n={max(n.values()):,}", fill="black", font=font)
         bw = (x1 - x0) / BINS
-        for i, (m, h) in enumerate(hists.items()):
+        for i, h in enumerate(hists.values()):
             for b, v in enumerate(h):
                 if v <= 0:
                     continue
@@ -112,7 +121,11 @@ def main() -> None:
     generate(args.dataset, models, args.frames, args.spec)
     per_model = {m: collect(args.dataset, f"{i:02d}") for i, m in enumerate(models)}
     table = class_table()
-    classes = sorted(k for k in set().union(*per_model.values()) if max(len(v.get(k, [])) for v in per_model.values()) >= args.min_points)
+    classes = sorted(
+        k
+        for k in set().union(*per_model.values())
+        if max(len(v.get(k, [])) for v in per_model.values()) >= args.min_points
+    )
     print(f"{'class':<16}{'model':<14}{'points':>10}{'mean':>8}{'std':>8}{'=0':>8}{'=1':>8}")
     for raw in classes:
         for m, v in per_model.items():

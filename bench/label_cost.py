@@ -116,7 +116,8 @@ def main() -> None:
     n = a.frames * a.rounds
     print(f"{cfg.name} {cfg.width}x{cfg.height}, {cfg.samples} spp, label_supersample {cfg.label_supersample}, "
           f"{a.frames} frames x {a.rounds} rounds, label batch {label_batch_size(cfg)} frames")
-    print(f"{'mode':<10}{'wall s/frame':>14}{'labels add':>12}{'share':>8}{'cpu s/frame':>14}{'labels add':>12}{'share':>8}"
+    print(f"{'mode':<10}{'wall s/frame':>14}{'labels add':>12}{'share':>8}"
+          f"{'cpu s/frame':>14}{'labels add':>12}{'share':>8}"
           f"{'in label calls':>16}{'share':>8}")
     base_w, base_c = wall["rgb only"] / n, cpu["rgb only"] / n
     for name in modes:
@@ -124,8 +125,10 @@ def main() -> None:
         li = inside.get(name, 0.0) / n
         print(f"{name:<10}{w:>14.2f}{w - base_w:>12.2f}{(w - base_w) / base_w:>8.1%}"
               f"{c:>14.2f}{c - base_c:>12.2f}{(c - base_c) / base_c:>8.1%}{li:>16.2f}{li / base_w:>8.1%}")
-    print("share = (frame time - rgb only frame time) / rgb only frame time; 'in label calls': wall seconds inside the\n"
-          "label-pass calls (posing, state switch, renders, vote), whatever the RGB renders pay afterwards. Target <= 10 %.")
+    print("share = (frame time - rgb only frame time) / rgb only frame time; "
+          "'in label calls': wall seconds inside the\n"
+          "label-pass calls (posing, state switch, renders, vote), whatever the RGB renders pay afterwards. "
+          "Target <= 10 %.")
 
 
 if __name__ == "__main__":

@@ -133,8 +133,10 @@ def main() -> None:
 
     print(f"{cfg.name} {cfg.width}x{cfg.height}, {a.frames} frames, camera +{a.step_cm:g} cm/frame; "
           f"1x pass == centre samples of the 7x7 reference on {min(centre_ok):.4%} of pixels")
-    print(f"{'factor':>7}{'spurious flips':>16}{'of pixels':>11}{'wrong vs cov':>14}{'area mean':>11}{'area spread':>13}"
-          f"{'label pass s':>14}{'vs RGB':>9}")
+    print(
+        f"{'factor':>7}{'spurious flips':>16}{'of pixels':>11}{'wrong vs cov':>14}{'area mean':>11}{'area spread':>13}"
+        f"{'label pass s':>14}{'vs RGB':>9}"
+    )
     flip_maps: dict = {}
     for k in FACTORS:
         flips = stable_n = wrong = near_n = 0

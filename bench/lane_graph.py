@@ -20,8 +20,8 @@ import numpy as np
 
 from generator.layout.network.draw import make_grid
 from generator.spec import parse_spec
-from generator.traffic.lanes.graph import LaneGraph
 from generator.traffic.lanes.conflicts import conflict_table
+from generator.traffic.lanes.graph import LaneGraph
 
 
 def _spec(types: dict, blocks: int, lanes: int):

@@ -168,12 +168,14 @@ def cache_table(spec_path: str, sizes: list[int], towns: int, baseline: str | No
             row = {"n": n, "code": code, "new_wall": statistics.median(t["wall"] for t in new),
                    "new_cpu": statistics.median(t["cpu"] for t in new)}
             for k in ("cold", "again"):
-                row[f"{k}_wall"] = _median(runs, lambda r: r[k]["wall"])
-                row[f"{k}_cpu"] = _median(runs, lambda r: r[k]["cpu"])
+                row[f"{k}_wall"] = _median(runs, lambda r, k=k: r[k]["wall"])
+                row[f"{k}_cpu"] = _median(runs, lambda r, k=k: r[k]["cpu"])
             results.append(row)
             print(f"{f'{n}x{n}':>5} {code:>9} {_median(runs, lambda r: r['cold']['wall']):>10.2f} "
-                  f"{_median(runs, lambda r: r['cold']['cpu']):>6.2f} {_median(runs, lambda r: r['again']['wall']):>11.2f} "
-                  f"{_median(runs, lambda r: r['again']['cpu']):>6.2f} {statistics.median(t['wall'] for t in new):>14.2f} "
+                  f"{_median(runs, lambda r: r['cold']['cpu']):>6.2f} "
+                  f"{_median(runs, lambda r: r['again']['wall']):>11.2f} "
+                  f"{_median(runs, lambda r: r['again']['cpu']):>6.2f} "
+                  f"{statistics.median(t['wall'] for t in new):>14.2f} "
                   f"{statistics.median(t['cpu'] for t in new):>6.2f} "
                   f"{rate:>6}  {same}",
                   flush=True)
@@ -193,14 +195,14 @@ def plot(results: list[dict], path: str, title: str) -> None:
     fig, axes = plt.subplots(len(sizes), 2, figsize=(10, 3.8 * len(sizes)), squeeze=False)
     x = np.arange(3)
     width = 0.8 / len(codes)
-    for row, n in zip(axes, sizes):
-        for ax, clock in zip(row, ("cpu", "wall")):
+    for row, n in zip(axes, sizes, strict=False):
+        for ax, clock in zip(row, ("cpu", "wall"), strict=False):
             for k, code in enumerate(codes):
                 r = next(r for r in results if r["n"] == n and r["code"] == code)
                 v = [r[f"cold_{clock}"], r[f"again_{clock}"], r[f"new_{clock}"]]
                 pos = x + (k - (len(codes) - 1) / 2) * width
                 ax.bar(pos, v, width * 0.9, color=f"C{k}", label=code)
-                for px, val in zip(pos, v):
+                for px, val in zip(pos, v, strict=False):
                     ax.text(px, val, f"{val:.2f}", ha="center", va="bottom", fontsize=8)
             if clock == "cpu":
                 ax.axhline(1.5, color="k", lw=0.8, ls="--")
@@ -247,7 +249,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--baseline", default=None, help="another checkout whose build is timed beside (see above)")
     ap.add_argument("--skip-breakdown", action="store_true", help="only the cache table")
     ap.add_argument("--png", default=None, help="also draw the cache table's bars to this PNG")
-    ap.add_argument("--profile", action="store_true", help="cProfile a new town of the first size and print the top costs")
+    ap.add_argument(
+        "--profile", action="store_true", help="cProfile a new town of the first size and print the top costs"
+    )
     args = ap.parse_args(argv)
     if args.profile:
         profile_new_town(args.spec, args.sizes[0])

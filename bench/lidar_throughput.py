@@ -36,11 +36,11 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from generator.layout.assemble import build_scene  # noqa: E402
-from generator.world.rig import Rig  # noqa: E402
 from generator.lidar.caster import EmbreeCaster  # noqa: E402
 from generator.lidar.scan import Scanner  # noqa: E402
 from generator.lidar.sensors import sensor_for_spec  # noqa: E402
 from generator.spec import load_spec, parse_spec  # noqa: E402
+from generator.world.rig import Rig  # noqa: E402
 
 REAL_SENSOR_PPS = 1.33e6
 
@@ -132,7 +132,9 @@ def main(argv=None) -> int:
     # measured in interleaved rounds (best of each) so load from other processes hits all alike
     sensor_rays = sensor.local_rays()
     rays = [sweep_rays(sensor_rays, p) for p in poses]
-    local = [(np.ascontiguousarray(o - caster.center, np.float32), np.ascontiguousarray(d, np.float32)) for o, d in rays]
+    local = [
+        (np.ascontiguousarray(o - caster.center, np.float32), np.ascontiguousarray(d, np.float32)) for o, d in rays
+    ]
     thread_counts = sorted({args.threads, 1}, reverse=True)
     scanners = {th: Scanner(scene, sensor, threads=th, caster=caster) for th in thread_counts}
     best = {k: np.inf for k in [*thread_counts, "raw"]}
@@ -152,7 +154,7 @@ def main(argv=None) -> int:
 
     for _ in range(args.rounds):
         for th, sc in scanners.items():
-            out = measure(th, lambda: [sc.scan(p) for p in poses])
+            out = measure(th, lambda sc=sc: [sc.scan(p) for p in poses])
             scans = out if th == args.threads else scans
         measure("raw", lambda: [caster.run_raw(o, d) for o, d in local])
         if args.threads > 1:  # how much parallelism the machine offers right now, cast only
@@ -194,7 +196,9 @@ def main(argv=None) -> int:
         rt = ray_triangle.RayMeshIntersector(tm)
         rt.intersects_first(o_all[sample[:10]], d_all[sample[:10]])  # builds its r-tree
         secs, _ = timed(lambda: rt.intersects_first(o_all[sample], d_all[sample]))
-        rows.append(row("trimesh ray_triangle intersects_first", len(sample), secs, None, f"numpy, {len(sample)}-ray sample"))
+        rows.append(
+            row("trimesh ray_triangle intersects_first", len(sample), secs, None, f"numpy, {len(sample)}-ray sample")
+        )
     except ImportError as e:  # ray_triangle needs the optional rtree package
         print(f"trimesh ray_triangle unavailable: {e}")
 
@@ -218,7 +222,8 @@ def main(argv=None) -> int:
                 rows.append(row("Blender scene.ray_cast per ray", info["n"], info["loop_s"], None,
                                 f"{info['n']}-ray sample; BVH {info['build_s']:.2f} s; process "
                                 f"{time.perf_counter() - t_spawn:.0f} s; |d_blender - d_embree| max "
-                                f"{agree.max() * 1000:.2f} mm, hit sets differ on {(np.isfinite(dist_b) != np.isfinite(dist_e)).sum()}"))
+                                f"{agree.max() * 1000:.2f} mm, hit sets differ on "
+                                f"{(np.isfinite(dist_b) != np.isfinite(dist_e)).sum()}"))
 
     print()
     print(f"{'method':44s} {'rays':>9s} {'seconds':>8s} {'rays/s':>12s} {'points/s':>12s}  note")
@@ -237,7 +242,9 @@ def main(argv=None) -> int:
 
     if not args.no_towns:
         print()
-        print(f"{'town':6s} {'triangles':>11s} {'layout s':>9s} {'BVH s':>7s} {'scan s/sweep':>13s} {'points/sweep':>13s}")
+        print(
+            f"{'town':6s} {'triangles':>11s} {'layout s':>9s} {'BVH s':>7s} {'scan s/sweep':>13s} {'points/sweep':>13s}"
+        )
         base = json.loads(Path(args.spec).read_text())
         for n in (1, 2, 3, 4):
             doc = json.loads(json.dumps(base))
@@ -253,9 +260,11 @@ def main(argv=None) -> int:
             ps = [rig_n.sweep_poses(f.t, sensor.column_time()) for f in rig_n.frames(5)]
             with Scanner(sc_n, sensor, threads=args.threads, caster=c) as sc:
                 sc.scan(ps[0])
-                secs, scans = timed(lambda: [sc.scan(p) for p in ps], repeat=2)
+                secs, scans = timed(lambda ps=ps: [sc.scan(p) for p in ps], repeat=2)
             npts = np.mean([len(x.points) for x in scans])
-            print(f"{n}x{n:<4d} {len(sc_n.faces):11,d} {t_layout:9.1f} {t_bvh:7.2f} {secs / len(ps):13.4f} {npts:13,.0f}")
+            print(
+                f"{n}x{n:<4d} {len(sc_n.faces):11,d} {t_layout:9.1f} {t_bvh:7.2f} {secs / len(ps):13.4f} {npts:13,.0f}"
+            )
     return 0
 
 

@@ -44,17 +44,17 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from generator.jobs.lidar_returns import return_model
-from generator.layout.assemble import build_scene
-from generator.lidar.caster import EmbreeCaster
-from generator.lidar.sensors import with_returns
-from generator.lidar.scan import Scanner
-from generator.lidar.sensors import sensor_for_spec
-from generator.spec import parse_spec
-from generator.world.actors import Actor, Track, World
-from generator.world.rig import SWEEP_PERIOD_S, Rig
+from generator.jobs.lidar_returns import return_model  # noqa: E402
+from generator.layout.assemble import build_scene  # noqa: E402
+from generator.lidar.caster import EmbreeCaster  # noqa: E402
+from generator.lidar.scan import Scanner  # noqa: E402
+from generator.lidar.sensors import sensor_for_spec, with_returns  # noqa: E402
+from generator.spec import parse_spec  # noqa: E402
+from generator.world.actors import Actor, Track, World  # noqa: E402
+from generator.world.rig import SWEEP_PERIOD_S, Rig  # noqa: E402
 
-TRAFFIC_X3 = {"cars_per_km": 36, "trucks_per_km": 3, "buses_per_km": 1.5, "cyclists_per_km": 6, "motorcyclists_per_km": 3}
+TRAFFIC_X3 = {"cars_per_km": 36, "trucks_per_km": 3, "buses_per_km": 1.5, "cyclists_per_km": 6,
+              "motorcyclists_per_km": 3}
 
 
 def lane_world(spec, scene, n: int, duration_s: float, ego_s: float) -> World:
@@ -206,7 +206,7 @@ def main(argv=None) -> int:
                 wall, cpu = time.perf_counter() - w0, time.process_time() - c0
                 best[k][:, i] = np.minimum(best[k][:, i], (wall, cpu))
     best = {k: tuple(v.sum(1)) for k, v in best.items()}
-    scans = [scanners[(True, args.threads)].scan(p, t0=float(x)) for p, x in zip(poses, times)]
+    scans = [scanners[(True, args.threads)].scan(p, t0=float(x)) for p, x in zip(poses, times, strict=False)]
     kept = {k: np.mean([len(sc.scan(p, t0=float(x), noise_key=i).points)
                         for i, (p, x) in enumerate(zip(poses, times, strict=True))]) for k, sc in physical.items()}
     for sc in scanners.values():
@@ -214,7 +214,8 @@ def main(argv=None) -> int:
     pool.shutdown()
 
     n = args.sweeps
-    print(f"\n{args.sweeps} sweeps of {sensor.rays_per_sweep:,} rays at 10 Hz from t = {args.t0} s, {args.rounds} rounds\n")
+    print(f"\n{args.sweeps} sweeps of {sensor.rays_per_sweep:,} rays at 10 Hz from t = {args.t0} s, "
+          f"{args.rounds} rounds\n")
     print(f"{'method':44s} {'thr':>3s} {'rays/s':>12s} {'sweeps/s':>9s} {'ms/sweep':>9s} {'CPU ms/sweep':>13s}")
     for (name, th), (wall, cpu) in best.items():
         print(f"{name:44s} {th:3d} {sensor.rays_per_sweep * n / wall:12,.0f} {n / wall:9.1f} {1000 * wall / n:9.2f} "
@@ -224,16 +225,21 @@ def main(argv=None) -> int:
     ours_a = best[("ours: Scanner.scan, actors moving", args.threads)]
     raw_f = best[("raw embreex, town + actors frozen", args.threads)]
     cpu = {k: v[1] for k, v in best.items()}
+    cpu_static, cpu_moving = cpu[("ours: Scanner.scan, static town", 1)], cpu[("ours: Scanner.scan, actors moving", 1)]
     print(f"\nstatic: ours / raw embreex, {args.threads} threads: {raw_s[0] / ours_s[0]:.2f}x (target >= 0.95x); "
-          f"CPU per sweep, raw / ours, 1 thread: {cpu[('raw embreex, static town', 1)] / cpu[('ours: Scanner.scan, static town', 1)]:.2f}x")
-    print(f"moving actors: ours {n / ours_a[0]:.1f} sweeps/s = {sensor.rays_per_sweep * n / ours_a[0] / 1e6:.2f} M rays/s "
-          f"on {args.threads} threads (target >= 30 sweeps/s, 4 M rays/s); {raw_f[0] / ours_a[0]:.2f}x raw embreex on the "
+          f"CPU per sweep, raw / ours, 1 thread: {cpu[('raw embreex, static town', 1)] / cpu_static:.2f}x")
+    print(f"moving actors: ours {n / ours_a[0]:.1f} sweeps/s = "
+          f"{sensor.rays_per_sweep * n / ours_a[0] / 1e6:.2f} M rays/s "
+          f"on {args.threads} threads (target >= 30 sweeps/s, 4 M rays/s); "
+          f"{raw_f[0] / ours_a[0]:.2f}x raw embreex on the "
           f"town with the actors frozen; CPU over static-only: "
-          f"+{1000 * (cpu[('ours: Scanner.scan, actors moving', 1)] - cpu[('ours: Scanner.scan, static town', 1)]) / n:.2f} ms/sweep")
+          f"+{1000 * (cpu_moving - cpu_static) / n:.2f} ms/sweep")
     on_actor = np.array([(s.points["instance"] >= 60000).sum() if args.traffic == "lanes" else
                          np.isin(s.points["instance"], [a.instance_id for a in world.actors]).sum() for s in scans])
     mov = np.array([s.points["moving"].sum() for s in scans])
-    plan = [scanners[(True, 1)].actors.plan(p, float(x), sensor.column_time()) for p, x in zip(poses, times)]
+    plan = [
+        scanners[(True, 1)].actors.plan(p, float(x), sensor.column_time()) for p, x in zip(poses, times, strict=False)
+    ]
     cand = [0 if pl is None else int(np.clip(pl.ring1 - pl.ring0, 0, None).sum()) for pl in plan]
     seen = [0 if pl is None else len(np.unique(pl.actor)) for pl in plan]
     base = best[("ours: Scanner.scan, actors moving", args.threads)][0]

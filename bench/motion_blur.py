@@ -274,7 +274,11 @@ def main() -> None:
         masks = all(np.array_equal(getattr(lab, n), getattr(sharp, n)) for n in ("class_id", "instance", "real_class",
                                                                                 "real_instance"))
         fin = np.isfinite(sharp.depth)
-        ddepth = float(np.abs(lab.depth[fin] - sharp.depth[fin]).max()) if np.array_equal(fin, np.isfinite(lab.depth)) else np.inf
+        ddepth = (
+            float(np.abs(lab.depth[fin] - sharp.depth[fin]).max())
+            if np.array_equal(fin, np.isfinite(lab.depth))
+            else np.inf
+        )
         print(f"{m}: masks and instances identical to the sharp render: {masks}; max |depth - sharp| {ddepth:.2g} m; "
               f"mean |RGB - sharp| {np.abs(rgb - sharp_rgb).mean():.4f}")
     images = {m: runs[m][0]["images"][times[0]][0] for m in modes}

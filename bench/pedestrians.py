@@ -28,15 +28,15 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from generator.layout import build_scene
-from generator.layout.placement.prototypes import Library
-from generator.layout.network.draw import make_grid
-from generator.spec import load_spec
-from generator.traffic.pedestrians import simulate as peds
-from generator.traffic.pedestrians import sim as walk_sim
-from generator.traffic.movers import DT_S
-from generator.traffic.lanes.signals import Signals
-from generator.traffic.pedestrians.lines import street_distance
+from generator.layout import build_scene  # noqa: E402
+from generator.layout.network.draw import make_grid  # noqa: E402
+from generator.layout.placement.prototypes import Library  # noqa: E402
+from generator.spec import load_spec  # noqa: E402
+from generator.traffic.lanes.signals import Signals  # noqa: E402
+from generator.traffic.movers import DT_S  # noqa: E402
+from generator.traffic.pedestrians import sim as walk_sim  # noqa: E402
+from generator.traffic.pedestrians import simulate as peds  # noqa: E402
+from generator.traffic.pedestrians.lines import street_distance  # noqa: E402
 
 
 class Clock:

@@ -23,10 +23,10 @@ def run(spec_path: str, config: str, frames: int, first: int) -> dict:
     from generator.blender.renderer import Renderer
     from generator.jobs.images import write_image
     from generator.layout.assemble import build_scene
-    from generator.world.rig import Rig
     from generator.spec import load_spec
     from generator.spec.render import load_render_config
     from generator.weather import draw_lighting
+    from generator.world.rig import Rig
 
     spec, cfg = load_spec(spec_path), load_render_config(config)
     out = Path(tempfile.mkdtemp(prefix="ug_bench_"))

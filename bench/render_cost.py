@@ -122,13 +122,16 @@ def main() -> None:
     images: dict = {}
     res = {"before": _phase("before", legacy_wet_surface, scene, spec, cfg, poses, images, a.diagnose, a.time_of_day),
            "after": _phase("after", wet_surface, scene, spec, cfg, poses, images, a.diagnose, a.time_of_day)}
-    print(f"{cfg.name} {cfg.width}x{cfg.height}, {cfg.samples} spp, {a.time_of_day}, {a.poses} poses x 2 renders each, medians (s)")
+    print(f"{cfg.name} {cfg.width}x{cfg.height}, {cfg.samples} spp, {a.time_of_day}, "
+          f"{a.poses} poses x 2 renders each, medians (s)")
     print(f"{'':<8}{'dry RGB':>9}{'wet RGB':>9}{'wet/dry':>9}"
           + (f"{'dry 0b':>9}{'wet 0b':>9}{'ratio':>7}" if a.diagnose else ""))
     for name, m in res.items():
         line = f"{name:<8}{m['dry']:>9.2f}{m['wet']:>9.2f}{m['wet'] / m['dry']:>9.2f}"
         if a.diagnose:
-            line += f"{m['dry_0_bounces']:>9.2f}{m['wet_0_bounces']:>9.2f}{m['wet_0_bounces'] / m['dry_0_bounces']:>7.2f}"
+            line += (
+                f"{m['dry_0_bounces']:>9.2f}{m['wet_0_bounces']:>9.2f}{m['wet_0_bounces'] / m['dry_0_bounces']:>7.2f}"
+            )
         print(line)
     print("the machine's load is shared: compare within a run.")
     if a.png:

@@ -126,9 +126,12 @@ def main(argv=None) -> None:
             groups[(tod, kind)].append((r["mean"], ratio, r["metered"] or float("nan"), mratio, r["ev"], r["rgb_s"]))
         order = {"day": 0, "dusk": 1, "night": 2}
         for (tod, kind), rows in sorted(groups.items(), key=lambda x: (order.get(x[0][0], 9), x[0][1])):
-            mean, ratio, met, mratio, ev, secs = (statistics.fmean(v for v in col if v is not None and not math.isnan(v))
-                                                  if any(v is not None and not math.isnan(v) for v in col) else float("nan")
-                                                  for col in zip(*rows))
+            mean, ratio, met, mratio, ev, secs = (
+                statistics.fmean(v for v in col if v is not None and not math.isnan(v))
+                if any(v is not None and not math.isnan(v) for v in col)
+                else float("nan")
+                for col in zip(*rows, strict=False)
+            )
             below = -math.log2(ratio) if ratio > 0 else float("nan")
             print(f"{tod:6s} {kind:9s} {mean:10.5f} {ratio:9.5f} {below:8.2f} {met:10.5f} {mratio:9.5f} "
                   f"{ev:7.2f} {secs:6.1f}")

@@ -18,7 +18,7 @@ import time
 from generator.layout import build_scene
 from generator.spec.load import load_spec
 from generator.spec.render import load_render_config
-from generator.weather import Lighting, draw_lighting
+from generator.weather import draw_lighting
 from generator.world.rig import Rig
 
 

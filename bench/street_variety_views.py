@@ -29,9 +29,9 @@ import numpy as np
 from PIL import Image, ImageDraw
 
 from generator.layout import build_scene
-from generator.layout.placement.one_way_signs import one_way_ends
 from generator.layout.network.cross_sections import shared_segments
 from generator.layout.network.draw import make_grid
+from generator.layout.placement.one_way_signs import one_way_ends
 from generator.spec import parse_spec
 from generator.world import rig
 

@@ -29,11 +29,9 @@ from PIL import Image, ImageDraw
 from generator.imaging.exr import LabelledImage, read_exr, write_exr
 from generator.imaging.paths import image_files
 from generator.postfx.fog import fog_image
-from generator.previews.preview import tonemap
 from generator.postfx.rain import rain_image
+from generator.previews.preview import tonemap
 from generator.rng import stream
-
-
 
 # -- synthetic street -------------------------------------------------------------------
 # Ray-cast analytically in the optical camera frame (x right, y down, z forward; camera 1.5 m
@@ -84,7 +82,8 @@ def street(h: int, w: int, time_of_day: str, seed: int = 0) -> tuple[np.ndarray,
     side = (rx > 0).astype(np.int64)
     bh = heights[(block + 17 * side) % 40]
     facade = (fz < 220) & (np.mod(fz, 24.0) < 20.0) & (fh > 0) & (fh < bh) & (fz < z)
-    win = (np.mod(fz, 3.0) > 0.8) & (np.mod(fz, 3.0) < 2.3) & (np.mod(fh, 3.2) > 1.2) & (np.mod(fh, 3.2) < 2.7) & (fh > 2.5)
+    win = ((np.mod(fz, 3.0) > 0.8) & (np.mod(fz, 3.0) < 2.3) & (np.mod(fh, 3.2) > 1.2) & (np.mod(fh, 3.2) < 2.7)
+           & (fh > 2.5))
     win_id = (np.floor(fz / 3.0) * 131 + np.floor(fh / 3.2) * 7 + side * 1009).astype(np.int64)
     z = np.where(facade, fz, z)
 
@@ -212,10 +211,13 @@ def bench(sources: dict, rgb_pass: dict[str, tuple[float, int]], repeat: int) ->
         for tod in ("day", "night"):
             rgb, depth = sources[tod](h, w)
             base = exr_read_time(rgb, depth, max(1, repeat // 2))
-            ops = [("fog V=60 m", lambda: fog_image(rgb, depth, 60.0, tod)),
-                   ("rain 20 mm/h", lambda: rain_image(rgb, depth, 20.0, np.random.default_rng(1), tod)),
-                   ("rain 40 mm/h", lambda: rain_image(rgb, depth, 40.0, np.random.default_rng(1), tod)),
-                   ("rain 20 mm/h + fog V=60 m", lambda: variant(rgb, depth, tod, 60.0, 20.0))]
+            ops = [("fog V=60 m", lambda rgb=rgb, depth=depth, tod=tod: fog_image(rgb, depth, 60.0, tod)),
+                   ("rain 20 mm/h", lambda rgb=rgb, depth=depth, tod=tod:
+                       rain_image(rgb, depth, 20.0, np.random.default_rng(1), tod)),
+                   ("rain 40 mm/h", lambda rgb=rgb, depth=depth, tod=tod:
+                       rain_image(rgb, depth, 40.0, np.random.default_rng(1), tod)),
+                   ("rain 20 mm/h + fog V=60 m", lambda rgb=rgb, depth=depth, tod=tod:
+                       variant(rgb, depth, tod, 60.0, 20.0))]
             for name, fn in ops:
                 t = timed(fn, repeat)
                 ref = rgb_pass.get(tod) or next(iter(rgb_pass.values()), None)
@@ -227,7 +229,8 @@ def bench(sources: dict, rgb_pass: dict[str, tuple[float, int]], repeat: int) ->
                     rp = f"{est:7.1f}{mark:>5}"
                 else:
                     share, rp = "n/a", "n/a"
-                print(f"{f'{w}x{h}':<10} {tod + ' ' + name:<32} {1000 * t:8.1f} {1000 * base:11.1f} {t / base:7.2f} {rp:>12} {share:>7}")
+                print(f"{f'{w}x{h}':<10} {tod + ' ' + name:<32} {1000 * t:8.1f} {1000 * base:11.1f} {t / base:7.2f} "
+                      f"{rp:>12} {share:>7}")
 
 
 def main(argv=None) -> int:

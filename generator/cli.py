@@ -102,7 +102,9 @@ def _plain_help(parser: argparse.ArgumentParser) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = OneLineParser(prog="urbangen", description="Procedural urban scenes: labelled images and LiDAR from one geometry.")
+    parser = OneLineParser(
+        prog="urbangen", description="Procedural urban scenes: labelled images and LiDAR from one geometry."
+    )
     parser.add_argument("--version", action="version", version=f"urbangen {__version__}")
     parser.add_argument("-v", "--verbose", action="count", default=0, help="log progress (-v) or debug details (-vv)")
     parser.add_argument("-q", "--quiet", action="store_true", help="only errors")

@@ -70,7 +70,7 @@ class MaterialTable:
 @functools.cache
 def material_table() -> MaterialTable:
     """The package's material table (read once)."""
-    with open(Path(__file__).with_name("materials.yaml"), "r", encoding="utf-8") as f:
+    with open(Path(__file__).with_name("materials.yaml"), encoding="utf-8") as f:
         raw = yaml.safe_load(f)["materials"]
     return MaterialTable(
         [

@@ -65,12 +65,13 @@ STREET_LUX = 60.0
 
 
 def global_irradiance(elevation_deg: float) -> float:
-    """Clear-sky global horizontal irradiance (render units) at a sun elevation (log-interpolated :data:`GLOBAL_LUX`)."""
+    """Clear-sky global horizontal irradiance (render units) at a sun elevation (log-interpolated
+    :data:`GLOBAL_LUX`)."""
     el, lux = np.array(GLOBAL_LUX).T
     return float(np.exp(np.interp(elevation_deg, el, np.log(lux)))) * UNITS_PER_LUX
 
 
-def light_level(light: "Lighting") -> float:
+def light_level(light: Lighting) -> float:
     """How much light the scene of ``light`` has, relative to the reference clear day (1.0).
 
     Day and dusk: the global horizontal irradiance of the sky (x :data:`OVERCAST_SHARE` +

@@ -13,8 +13,8 @@ from collections import defaultdict
 from pathlib import Path
 
 import pytest
-from kits.paths import ROOT
 
+from kits.paths import ROOT
 
 #: Bottom of the house: imported by anything, import nothing of ours but each other.
 BASE = {"generator", "errors", "atomic", "rng", "safeload", "progress"}  # safeload is a package of its own
@@ -47,8 +47,8 @@ ALLOWED: dict[str, set[str]] = {
              "materials", "motion", "postfx", "previews", "remission", "scan_effects", "spec", "stats", "traffic",
              "weather", "world"},
     "commands": {"dataset", "detection", "exports", "formats", "fusion", "gap", "geometry", "imaging", "jobs", "labels",
-                 "layout", "lidar", "materials", "motion", "previews", "remission", "scan_effects", "spec", "stats", "traffic",
-                 "weather", "world"},
+                 "layout", "lidar", "materials", "motion", "previews", "remission", "scan_effects", "spec", "stats",
+                 "traffic", "weather", "world"},
     "exports": {"dataset", "detection", "formats", "fusion", "geometry", "imaging", "jobs", "labels", "lidar",
                 "previews", "spec", "world"},
     "dataset": {"formats", "imaging", "labels"},
@@ -97,7 +97,9 @@ def graph() -> dict[str, set[str]]:
     """Module -> the project modules and packages it imports."""
     g = {}
     for module, is_init, path in _modules():
-        g[module] = {m for m in _imports(module, is_init, path) if m.split(".")[0] in ("generator", "assets_procedural")}
+        g[module] = {
+            m for m in _imports(module, is_init, path) if m.split(".")[0] in ("generator", "assets_procedural")
+        }
     return g
 
 
@@ -253,7 +255,7 @@ def test_no_import_circle_inside_a_package():
     packages = sorted({m for m, is_init, _ in _modules() if is_init})
     bad = []
     for pkg in packages:
-        def child(m: str) -> str | None:
+        def child(m: str, pkg: str = pkg) -> str | None:
             if m == pkg:
                 return pkg
             return pkg + "." + m[len(pkg) + 1:].split(".")[0] if m.startswith(pkg + ".") else None

@@ -48,7 +48,7 @@ class ActorObjects:
         """Key every actor at ``times`` = (opening, instant, closing), seconds on the world's timeline."""
         times = np.asarray(times, np.float64)
         values = [motion.yaw_values(a.track.position(times), a.track.heading(times)) for a in self.world.actors]
-        for keys, owner in zip(self.keys, self.owners):
+        for keys, owner in zip(self.keys, self.owners, strict=False):
             keys.set(values[owner])
 
 
@@ -92,7 +92,7 @@ def headlights(objs: ActorObjects, make_spot, collection: bpy.types.Collection) 
     (local frame of the actor: location metres, direction a vector).
     """
     n = 0
-    for a, ob in zip(objs.world.actors, objs.objects):
+    for a, ob in zip(objs.world.actors, objs.objects, strict=False):
         anchors = objs.world.prototypes[a.prototype].anchors
         for p in anchors.get("headlight", ()):
             light = make_spot(f"{a.name}_headlight", p, (1.0, 0.0, -0.12), collection)

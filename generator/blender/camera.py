@@ -20,8 +20,8 @@ def _blender(T_world_camera: np.ndarray) -> mathutils.Matrix:
     return mathutils.Matrix(m.tolist())
 
 
-def place(scene: "bpy.types.Scene", T_world_camera: np.ndarray, hfov_deg: float,
-          shutter: np.ndarray | None = None) -> "bpy.types.Object":
+def place(scene: bpy.types.Scene, T_world_camera: np.ndarray, hfov_deg: float,
+          shutter: np.ndarray | None = None) -> bpy.types.Object:
     """Create (once) and place the scene camera.
 
     Parameters
@@ -44,7 +44,9 @@ def place(scene: "bpy.types.Scene", T_world_camera: np.ndarray, hfov_deg: float,
             motion.Keys(cam).remove()
         cam.matrix_world = _blender(T_world_camera)
     else:
-        motion.Keys(cam).set(motion.blender_values(cam, [_blender(shutter[0]), _blender(T_world_camera), _blender(shutter[1])]))
+        motion.Keys(cam).set(
+            motion.blender_values(cam, [_blender(shutter[0]), _blender(T_world_camera), _blender(shutter[1])])
+        )
         motion.set_frame(scene)
     data = cam.data
     data.type = "PERSP"

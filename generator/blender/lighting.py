@@ -21,8 +21,14 @@ import numpy as np
 
 from generator.blender import sky
 from generator.blender.bpy_guard import bpy, mathutils
-from generator.weather import (OVERCAST_SHARE, OVERCAST_SUN, REFERENCE_ELEVATION_DEG, SUN_STRENGTH, UNITS_PER_LUX,
-                               global_irradiance)
+from generator.weather import (
+    OVERCAST_SHARE,
+    OVERCAST_SUN,
+    REFERENCE_ELEVATION_DEG,
+    SUN_STRENGTH,
+    UNITS_PER_LUX,
+    global_irradiance,
+)
 
 __all__ = ["UNITS_PER_LUX", "SUN_STRENGTH", "day_world", "ensure_lamp", "ensure_sun", "sun_direction"]
 
@@ -69,7 +75,7 @@ def sun_irradiance(elevation_deg: float) -> np.ndarray:
     return SUN_STRENGTH * np.exp(-tau * (air_mass(elevation_deg) - air_mass(REFERENCE_ELEVATION_DEG)))
 
 
-def ensure_lamp(scene: "bpy.types.Scene", name: str) -> "bpy.types.Object":
+def ensure_lamp(scene: bpy.types.Scene, name: str) -> bpy.types.Object:
     """A directional lamp ``name`` (created once, switched off).
 
     Every Renderer creates its sun and moon up front and only changes their strength, so the
@@ -83,12 +89,12 @@ def ensure_lamp(scene: "bpy.types.Scene", name: str) -> "bpy.types.Object":
     return lamp
 
 
-def ensure_sun(scene: "bpy.types.Scene") -> "bpy.types.Object":
+def ensure_sun(scene: bpy.types.Scene) -> bpy.types.Object:
     """The sun lamp (see :func:`ensure_lamp`)."""
     return ensure_lamp(scene, "urbangen_sun")
 
 
-def day_world(scene: "bpy.types.Scene", light: DayLight) -> dict:
+def day_world(scene: bpy.types.Scene, light: DayLight) -> dict:
     """Set the sky (clouds or overcast) and the sun lamp of a day or dusk image; return the metadata."""
     el = light.sun_elevation_deg
     e_sun = sun_irradiance(el)

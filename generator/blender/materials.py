@@ -22,7 +22,7 @@ log = logging.getLogger(__name__)
 LABEL_MATERIAL = "urbangen_label"
 
 
-def build_materials(seed: int) -> list["bpy.types.Material"]:
+def build_materials(seed: int) -> list[bpy.types.Material]:
     """Create the material of every material id; index the result with a material id.
 
     Parameters
@@ -48,7 +48,7 @@ def build_materials(seed: int) -> list["bpy.types.Material"]:
     return out
 
 
-def label_material() -> "bpy.types.Material":
+def label_material() -> bpy.types.Material:
     """The label-pass override material (created once)."""
     mat = bpy.data.materials.get(LABEL_MATERIAL)
     if mat is not None:

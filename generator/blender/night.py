@@ -20,11 +20,11 @@ import math
 
 import numpy as np
 
-from generator.geometry import apply
 from generator.blender.bpy_guard import bpy, mathutils
 from generator.blender.geometry import lights_on
 from generator.blender.lighting import UNITS_PER_LUX, ensure_lamp
 from generator.blender.nodes import Nodes
+from generator.geometry import apply
 from generator.world.scene import SceneModel
 
 #: Spot "power" in Blender is that of a point light of the same intensity: I = P / (4 pi) W/sr;
@@ -75,7 +75,7 @@ def headlight(name: str, location, direction, collection) -> bpy.types.Object:
     return ob
 
 
-def build_lights(model: SceneModel, parent: "bpy.types.Collection") -> tuple["bpy.types.Collection", dict]:
+def build_lights(model: SceneModel, parent: bpy.types.Collection) -> tuple[bpy.types.Collection, dict]:
     """Create the night light objects of ``model``; return their collection and counts per group."""
     coll = bpy.data.collections.new("urbangen_night_lights")
     parent.children.link(coll)
@@ -95,12 +95,12 @@ def build_lights(model: SceneModel, parent: "bpy.types.Collection") -> tuple["bp
     return coll, counts
 
 
-def ensure_moon(scene: "bpy.types.Scene") -> "bpy.types.Object":
+def ensure_moon(scene: bpy.types.Scene) -> bpy.types.Object:
     """The moon lamp, created once and dark (see :func:`generator.blender.lighting.ensure_lamp`)."""
     return ensure_lamp(scene, "urbangen_moon")
 
 
-def night_world(scene: "bpy.types.Scene", overcast: bool = False, cloud_seed: float = 0.0) -> dict:
+def night_world(scene: bpy.types.Scene, overcast: bool = False, cloud_seed: float = 0.0) -> dict:
     """The night sky (city glow; an orange-grey deck when overcast) and the moon; return the parameters."""
     world = bpy.data.worlds.get("urbangen_night") or bpy.data.worlds.new("urbangen_night")
     g = Nodes(world.node_tree)
@@ -138,7 +138,7 @@ def lights_record() -> dict:
             "emission_scale": dict(EMISSION_SCALE)}
 
 
-def set_night(scene, lights: "bpy.types.Collection", lit: bool) -> None:
+def set_night(scene, lights: bpy.types.Collection, lit: bool) -> None:
     """Switch the street lamps and headlights on (dusk and night) or off, and the moon off.
 
     The moon is switched on by :func:`night_world`; the sun is set by

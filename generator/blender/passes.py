@@ -25,19 +25,19 @@ Background mode has no pixels in "Render Result", so each render is saved with
 from __future__ import annotations
 
 import time
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Sequence
 
 import numpy as np
 import OpenEXR
 
-from generator.world import rig
 from generator.blender import geometry, session
 from generator.blender.bpy_guard import bpy
 from generator.blender.materials import label_material
 from generator.labels import class_table
 from generator.labels.supersample import majority_labels
+from generator.world import rig
 
 SKY_Z = 1e9
 #: Native class of pixels whose ray hits nothing.
@@ -160,7 +160,7 @@ def render_label_batch(scene, bs: geometry.BlenderScene, k: np.ndarray, scratch:
     session.label_state(scene, label_material())
     geometry.set_proxies_visible(bs, False)
     reals, secs = [], [{} for _ in poses]
-    for place, sec in zip(poses, secs):
+    for place, sec in zip(poses, secs, strict=False):
         place()
         t = time.perf_counter()
         real = _render(scene, scratch / "real.exr")
@@ -174,7 +174,7 @@ def render_label_batch(scene, bs: geometry.BlenderScene, k: np.ndarray, scratch:
     geometry.set_proxies_visible(bs, True)
     out = []
     with session.supersampled(scene, supersample):
-        for place, sec, (real_class, real_instance, depth) in zip(poses, secs, reals):
+        for place, sec, (real_class, real_instance, depth) in zip(poses, secs, reals, strict=False):
             place()
             t = time.perf_counter()
             fine_class, fine_instance = label_samples(_render(scene, scratch / "label.exr"))

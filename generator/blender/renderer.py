@@ -10,14 +10,14 @@ from pathlib import Path
 
 import numpy as np
 
-from generator.world import rig
 from generator.blender import actors, camera, controls, geometry, lighting, materials, motion, night, passes, session
 from generator.blender.bpy_guard import bpy
-from generator.weather import LIT_TIMES
-from generator.world.actors import World
-from generator.world.scene import SceneModel
 from generator.spec.model import SceneSpec
 from generator.spec.render import RenderConfig
+from generator.weather import LIT_TIMES
+from generator.world import rig
+from generator.world.actors import World
+from generator.world.scene import SceneModel
 
 log = logging.getLogger(__name__)
 
@@ -76,7 +76,9 @@ class Renderer:
         self.k = rig.intrinsics(spec.sensors.camera.hfov_deg, cfg.width, cfg.height)
         controls.apply(self.bscene, controls.DAY_DEFAULTS)
         self.build_seconds = time.perf_counter() - t
-        log.info("Blender scene built in %.2f s (%d objects, device %s)", self.build_seconds, len(scene.objects), self.device)
+        log.info(
+            "Blender scene built in %.2f s (%d objects, device %s)", self.build_seconds, len(scene.objects), self.device
+        )
 
     @property
     def cycles_seconds(self) -> dict[str, float]:

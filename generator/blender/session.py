@@ -19,7 +19,7 @@ from generator.spec.render import RenderConfig
 log = logging.getLogger(__name__)
 
 
-def reset() -> "bpy.types.Scene":
+def reset() -> bpy.types.Scene:
     """Start from an empty factory scene and return it."""
     bpy.ops.wm.read_factory_settings(use_empty=True)
     return bpy.context.scene
@@ -50,7 +50,7 @@ def _gpu_available() -> bool:
     return any(_use_backend(b) for b in BACKENDS)
 
 
-def _denoiser(scene: "bpy.types.Scene", cfg: RenderConfig) -> str:
+def _denoiser(scene: bpy.types.Scene, cfg: RenderConfig) -> str:
     """The Cycles denoiser for ``cfg`` ("" for none): OptiX where an OptiX device exists (it denoises
     on that GPU even when the render runs on the CPU), else OpenImageDenoise with a warning."""
     if cfg.denoiser == "none":
@@ -68,7 +68,7 @@ def _denoiser(scene: "bpy.types.Scene", cfg: RenderConfig) -> str:
     return "OPENIMAGEDENOISE"
 
 
-def configure(scene: "bpy.types.Scene", cfg: RenderConfig) -> str:
+def configure(scene: bpy.types.Scene, cfg: RenderConfig) -> str:
     """Apply ``cfg`` to ``scene``; return the device actually used ("CPU" or "GPU").
 
     A GPU or the OptiX denoiser asked for where none exists falls back to the CPU (OpenImageDenoise)
@@ -104,7 +104,7 @@ def configure(scene: "bpy.types.Scene", cfg: RenderConfig) -> str:
     return device
 
 
-def rgb_state(scene: "bpy.types.Scene", cfg: RenderConfig, seed: int) -> None:
+def rgb_state(scene: bpy.types.Scene, cfg: RenderConfig, seed: int) -> None:
     """Settings of the RGB pass."""
     c = scene.cycles
     c.samples = cfg.samples
@@ -137,7 +137,7 @@ def rgb_state(scene: "bpy.types.Scene", cfg: RenderConfig, seed: int) -> None:
         vl.material_override = None
 
 
-def label_state(scene: "bpy.types.Scene", material) -> None:
+def label_state(scene: bpy.types.Scene, material) -> None:
     """Settings of the label pass: exact integers per pixel (``material`` emits them).
 
     The world is left as it is: what the camera sees of it is sky, told apart by the Z pass.
@@ -158,7 +158,7 @@ def label_state(scene: "bpy.types.Scene", material) -> None:
 
 
 @contextmanager
-def supersampled(scene: "bpy.types.Scene", k: int):
+def supersampled(scene: bpy.types.Scene, k: int):
     """Render at ``k`` times the configured resolution inside the block (label pass).
 
     The image plane and field of view are unchanged, so with ``k`` odd the middle sample of

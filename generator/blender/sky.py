@@ -45,7 +45,7 @@ def _split(g: Nodes, vec):
 
 def _join(g: Nodes, x, y, z):
     n = g.node("ShaderNodeCombineXYZ")
-    for s, v in zip(n.inputs, (x, y, z)):
+    for s, v in zip(n.inputs, (x, y, z), strict=False):
         g.set(s, v)
     return n.outputs[0]
 
@@ -71,7 +71,7 @@ def overcast_zenith(horizontal_irradiance: float) -> float:
     return 9.0 * horizontal_irradiance / (7.0 * math.pi)
 
 
-def daylight_world(scene: "bpy.types.Scene", *, sun_elevation_deg: float, sun_azimuth_deg: float,
+def daylight_world(scene: bpy.types.Scene, *, sun_elevation_deg: float, sun_azimuth_deg: float,
                    sun_rgb: tuple, cloud_cover: float, cloud_seed: float, overcast: bool,
                    overcast_irradiance: float) -> dict:
     """Build the world of a day or dusk image and make it the scene's.

@@ -68,10 +68,13 @@ def register(sub) -> None:
     p.add_argument("--classes", nargs="+", default=None,
                    help="--detection kitti: classes (default Car Pedestrian Cyclist); nuscenes: detection classes "
                         "scored (default: those in the ground truth of the split; 'all': nuScenes' ten)")
-    p.add_argument("--split", default=None,
-                   help="--detection kitti: only the samples of GT/ImageSets/SPLIT.txt (e.g. val); nuscenes: a split "
-                        "of GT/v1.0-*/splits.json (default urbangen_val when it has scenes, else urbangen_all); "
-                        "--images with a Cityscapes export: the split folder scored (default val, as cityscapesScripts)")
+    p.add_argument(
+        "--split",
+        default=None,
+        help="--detection kitti: only the samples of GT/ImageSets/SPLIT.txt (e.g. val); nuscenes: a split "
+        "of GT/v1.0-*/splits.json (default urbangen_val when it has scenes, else urbangen_all); "
+        "--images with a Cityscapes export: the split folder scored (default val, as cityscapesScripts)",
+    )
     p.set_defaults(func=run)
 
 

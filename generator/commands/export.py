@@ -24,8 +24,8 @@ kitti-object, nuscenes and coco live in their own modules (:mod:`generator.comma
 from __future__ import annotations
 
 import os
+from collections.abc import Iterator
 from pathlib import Path
-from typing import Iterator
 
 from generator.commands.options import Integer, Number, path, sequence_id, text_path
 from generator.commands.preflight import input_dir, output_dir
@@ -74,7 +74,9 @@ def _metadata(exr: Path) -> tuple[int, str, str]:
         raise UserError(f"{path}: not image metadata (needs frame, time_of_day, weather.kind)") from None
     if type(frame) is not int or not 0 <= frame <= MAX_FRAME_INDEX:
         raise UserError(f"{path}: frame: must be an integer in 0..{MAX_FRAME_INDEX}")
-    if not (isinstance(tod, str) and isinstance(kind, str) and (tod, kind) in set(combinations(TIMES))):  # they name folders: known words only
+    if not (
+        isinstance(tod, str) and isinstance(kind, str) and (tod, kind) in set(combinations(TIMES))
+    ):  # they name folders: known words only
         raise UserError(f"{path}: time_of_day, weather.kind: must be one of the known combinations "
                         f"({'/'.join(TIMES)} x {', '.join(sorted({w for _, w in combinations()}))})")
     return frame, tod, kind
@@ -114,8 +116,9 @@ def run(args) -> int:
     planned = [(city_name(t, w), image_stem(city_name(t, w), seq, f)) for f, t, w in metas]
 
     def images() -> Iterator[CityscapesImage]:
-        for exr, (frame, time_of_day, weather) in progress(list(zip(exrs, metas)), desc="export cityscapes",
-                                                           unit="image"):
+        for exr, (frame, time_of_day, weather) in progress(
+            list(zip(exrs, metas, strict=False)), desc="export cityscapes", unit="image"
+        ):
             im = read_exr(exr)
             yield CityscapesImage(str(exr), city_name(time_of_day, weather), seq, frame,
                                   display_rgb(im.rgb, camera_model_of(exr)), im.class_id, im.instance)

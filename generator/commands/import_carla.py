@@ -41,8 +41,11 @@ PERIOD_S = 0.1
 
 
 def register(sub) -> None:
-    p = sub.add_parser("import-carla", help="convert a KITTI-CARLA town (CARLA semantic-LiDAR PLY) to a SemanticKITTI sequence",
-                       description=__doc__.split("\n\n")[1])
+    p = sub.add_parser(
+        "import-carla",
+        help="convert a KITTI-CARLA town (CARLA semantic-LiDAR PLY) to a SemanticKITTI sequence",
+        description=__doc__.split("\n\n")[1],
+    )
     p.add_argument("town", type=path, help="KITTI-CARLA town folder (TownNN with generated/frames/*.ply)")
     p.add_argument("output", type=path, help="dataset root; the sequence goes to OUT/sequences/NN")
     p.add_argument("--sequence", required=True, type=sequence_id, help="sequence number 00..999999, e.g. 22")
@@ -161,7 +164,8 @@ def _metadata(town, frames, pose_file, name, processing, seed, records, counts, 
         "sequence": name,
         "frames": len(frames),
         "source": {"town": str(town), "first_frame": frames[0].name, "last_frame": frames[-1].name,
-                   "format": "KITTI-CARLA binary PLY (x, y, z, cos_angle_lidar_surface, [timestamp], instance, semantic)"},
+                   "format": "KITTI-CARLA binary PLY "
+                             "(x, y, z, cos_angle_lidar_surface, [timestamp], instance, semantic)"},
         "seed": seed,
         "tag_map": {"file": "generator/formats/carla_semantic_tags.yaml", "carla_version": "0.9.10",
                     "tags": {str(t): {"name": n, "semantickitti": int(lut[t])} for t, n in tag_names.items()}},
@@ -188,7 +192,9 @@ def _label_config(out: Path) -> None:
     names = sk.list_sequences(out)
     missing = [n for n in names if not (out / "sequences" / n / META_NAME).is_file()]
     if missing:
-        log.warning("%s: sequences %s have no %s; semantic-kitti.yaml left as it is", out, ", ".join(missing), META_NAME)
+        log.warning(
+            "%s: sequences %s have no %s; semantic-kitti.yaml left as it is", out, ", ".join(missing), META_NAME
+        )
         return
     try:
         write_dataset_label_config(out)

@@ -99,8 +99,11 @@ def summary(scene, spec, build_s: float) -> dict:
         **_streets(spec, scene.grid),
     }
     if scene.town_map is not None:   # streets crossing at an angle (the towns with right angles read as before)
-        info["intersection_angle"] = {"angle_deg": round(scene.town_map.angle_deg, 4), "lean": scene.town_map.lean,
-                                      "grid_to_world_xy": [[round(float(v), 9) for v in row] for row in scene.town_map.A]}
+        info["intersection_angle"] = {
+            "angle_deg": round(scene.town_map.angle_deg, 4),
+            "lean": scene.town_map.lean,
+            "grid_to_world_xy": [[round(float(v), 9) for v in row] for row in scene.town_map.A],
+        }
     from generator.layout.network.closures import closed_record
     from generator.layout.network.roundabouts import roundabout_record
 

@@ -45,7 +45,9 @@ def register(sub) -> None:
                         "(default 10: one second of driving)")
     p.add_argument("--sequence", type=sequence_id, default="00", help="sequence number, 00..999999 (default 00)")
     p.add_argument("--threads", type=Integer(1, 256), default=None, help="casting threads, 1..256 (default: all cores)")
-    p.add_argument("--range-image", action="store_true", help="also save range/NNNNNN.npy (rings x columns, 0 = no return)")
+    p.add_argument(
+        "--range-image", action="store_true", help="also save range/NNNNNN.npy (rings x columns, 0 = no return)"
+    )
     p.add_argument("--ply", action="store_true", help="also save ply/NNNNNN.ply per scan")
     p.add_argument("--no-bev", action="store_true", help="skip the bird's-eye PNGs")
     p.add_argument("--render-config", type=text_path, default="preview",
@@ -83,7 +85,8 @@ def run(args) -> int:
     check_sweeps(scene, spec, args.frames)
     world = world_for(spec, scene, args.frames)  # traffic problems are refused here, before any write
     opts = SequenceOptions(frames=args.frames, sequence=name, threads=args.threads, range_image=args.range_image,
-                           ply=args.ply, bev=not args.no_bev, resolution=(cfg.width, cfg.height), render_config=cfg.name)
+                           ply=args.ply, bev=not args.no_bev, resolution=(cfg.width, cfg.height),
+                           render_config=cfg.name)
     # The sequence is cast into a stage inside DIR and moved into place when complete: a failure
     # (or Ctrl-C) while casting and writing leaves DIR as it was.
     out.mkdir(parents=True, exist_ok=True)

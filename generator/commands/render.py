@@ -58,7 +58,9 @@ def add_render_arguments(p, out_help: str, frames: int, variants: str) -> None:
                    help="parallel Blender processes (default 1; local: at most one per core)")
     p.add_argument("--executor", default="local", choices=EXECUTORS,
                    help="where the render workers run: local (spawned processes, default) or ray")
-    p.add_argument("--ray-address", default=None, help="address of an existing Ray cluster (default: start a local one)")
+    p.add_argument(
+        "--ray-address", default=None, help="address of an existing Ray cluster (default: start a local one)"
+    )
 
 
 def register(sub) -> None:

@@ -60,7 +60,7 @@ def run(args) -> int:
     with staging(out, "stats") as stage:  # every file written in full before any is moved into place
         staged = write_report(stage, root, sections)
         paths = [out / p.name for p in staged]
-        for p, dest in zip(staged, paths):
+        for p, dest in zip(staged, paths, strict=False):
             os.replace(p, dest)
     print(f"wrote {', '.join(p.name for p in paths)} into {out}")
     return 0

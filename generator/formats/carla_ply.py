@@ -260,7 +260,9 @@ def frame_pose_index(n_lines: int, n_frames: int, frame: int, start_time: float,
     if np.isfinite(start_time) and np.isfinite(times).all():
         i = int(np.argmin(np.abs(times - start_time)))
         if abs(times[i] - start_time) > 1e-3:
-            raise UserError(f"{source}: no pose at the frame's start time {start_time:.6f} s (nearest {times[i]:.6f} s)")
+            raise UserError(
+                f"{source}: no pose at the frame's start time {start_time:.6f} s (nearest {times[i]:.6f} s)"
+            )
         return i
     per = n_lines // n_frames
     if per < 1:

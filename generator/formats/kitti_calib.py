@@ -29,9 +29,9 @@ from pathlib import Path
 import numpy as np
 
 from generator import safeload
-from generator.geometry.transforms import invert
 from generator.atomic import write_text
 from generator.errors import SpecError, UserError
+from generator.geometry.transforms import invert
 
 CALIB_KEYS = ("P0", "P1", "P2", "P3", "Tr")
 #: Tolerance of :func:`rigid_problem` on ``R R^T - I`` and ``det R - 1``.

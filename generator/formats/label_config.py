@@ -43,7 +43,7 @@ MAX_CONFIG_NODES = 1_000_000
 def count_raw_ids(semantic: np.ndarray) -> dict[int, int]:
     """Points per SemanticKITTI raw id in (n,) uint16 ``semantic``."""
     ids, counts = np.unique(np.asarray(semantic), return_counts=True)
-    return {int(i): int(c) for i, c in zip(ids, counts)}
+    return {int(i): int(c) for i, c in zip(ids, counts, strict=False)}
 
 
 def merge_counts(*counts: dict[int, int]) -> dict[int, int]:

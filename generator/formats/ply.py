@@ -57,7 +57,9 @@ def read_ply(path: str | Path) -> np.ndarray:
     where = safeload.printable(path)
     if not data.startswith(b"ply\n") or end < 0:
         raise UserError(f"{where}: not a PLY file")
-    counts = [h.split()[2:] for h in data[:end].decode("ascii", "replace").splitlines() if h.startswith("element vertex")]
+    counts = [
+        h.split()[2:] for h in data[:end].decode("ascii", "replace").splitlines() if h.startswith("element vertex")
+    ]
     if len(counts) != 1 or len(counts[0]) != 1 or not re.fullmatch(r"[0-9]{1,12}", counts[0][0]):
         raise UserError(f"{where}: PLY header needs one 'element vertex <count>' line with a count >= 0")
     n = int(counts[0][0])

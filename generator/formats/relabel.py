@@ -21,9 +21,9 @@ from __future__ import annotations
 
 import logging
 import os
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
@@ -31,7 +31,14 @@ from generator import __version__, safeload
 from generator.atomic import staging, write_bytes, write_json, write_text
 from generator.errors import UserError
 from generator.formats import semantickitti as sk
-from generator.formats.label_config import SPLITS, count_raw_ids, format_label_config, merge_counts, merge_split, read_split
+from generator.formats.label_config import (
+    SPLITS,
+    count_raw_ids,
+    format_label_config,
+    merge_counts,
+    merge_split,
+    read_split,
+)
 from generator.labels import class_table
 from generator.labels.sets import semantickitti_to_unified
 from generator.progress import progress as progress_bar

@@ -18,9 +18,9 @@ from __future__ import annotations
 
 import functools
 import os
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Iterator
 
 import numpy as np
 
@@ -32,8 +32,8 @@ from generator.labels import class_table
 
 __all__ = [
     "encode_labels", "decode_labels", "write_scan", "write_labels", "write_poses", "write_times",
-    "read_scan", "read_labels", "read_poses", "read_times", "read_calib", "check_raw_ids", "sequence_name", "sequence_dir",
-    "list_sequences", "Sequence", "ScanRecord", "iter_sequence",
+    "read_scan", "read_labels", "read_poses", "read_times", "read_calib", "check_raw_ids", "sequence_name",
+    "sequence_dir", "list_sequences", "Sequence", "ScanRecord", "iter_sequence",
 ]
 
 
@@ -293,7 +293,9 @@ class Sequence:
         pts = read_scan(self.scan_path(index))
         sem, inst = read_labels(self.label_path(index))
         if len(sem) != len(pts):
-            raise UserError(f"{self.label_path(index)}: {len(sem)} labels but {self.scan_path(index)} has {len(pts)} points")
+            raise UserError(
+                f"{self.label_path(index)}: {len(sem)} labels but {self.scan_path(index)} has {len(pts)} points"
+            )
         return pts, sem, inst
 
     def read(self, index: int, labels: bool = True, _poses: np.ndarray | None = None) -> ScanRecord:

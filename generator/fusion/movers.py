@@ -21,7 +21,7 @@ instance id to a pose function) to :func:`deskew_movers`.
 from __future__ import annotations
 
 import logging
-from typing import Callable, Mapping
+from collections.abc import Callable, Mapping
 
 import numpy as np
 

@@ -20,7 +20,8 @@ def markdown(report: dict) -> str:
     s = report["settings"]
     hl = report["headline"]
     lines = [
-        "# Camera–LiDAR label agreement", "",
+        "# Camera–LiDAR label agreement",
+        "",
         f"Dataset `{s['dataset']}`, sequence {s['sequence']}, frames {', '.join(map(str, report['frames']))}.",
         "",
         f"* Projection: seed 001 Eq. 1, `d [u v 1]^T = K T X` with `T = inv(T_world_camera) @ T_world_lidar` "
@@ -34,9 +35,13 @@ def markdown(report: dict) -> str:
         "",
         f"**Agreement, non-proxy classes away from 1-px mask boundaries, occlusion test on: "
         f"{_pct(hl['agreement_native'])} % (native), {_pct(hl['agreement_unified11'])} % (unified 11).**",
-        "", "## Agreement per variant", "",
-        "Agreement = share of counted points whose mask class equals their ray-cast class.", "",
-        "| occlusion | proxies | boundaries | points | agreement native % | mIoU native % | agreement unified11 % | mIoU unified11 % |",
+        "",
+        "## Agreement per variant",
+        "",
+        "Agreement = share of counted points whose mask class equals their ray-cast class.",
+        "",
+        "| occlusion | proxies | boundaries | points | agreement native % | mIoU native % "
+        "| agreement unified11 % | mIoU unified11 % |",
         "|---|---|---|---:|---:|---:|---:|---:|",
     ]
     nat, uni = (report["label_sets"][k]["variants"] for k in ("native", "unified11"))
@@ -72,7 +77,8 @@ def _confusion_md(ls: dict, v: tuple[str, str, str]) -> list[str]:
     c = np.array(ls["variants"][variant_key(v)]["confusion_lidar_image"], np.int64)
     used = np.flatnonzero((c.sum(0) + c.sum(1)) > 0)
     names = ls["classes"]
-    out = ["", f"## Confusion, native ({variant_key(v)})", "", "Rows: ray-cast LiDAR class; columns: mask class at the point's pixel.", "",
+    out = ["", f"## Confusion, native ({variant_key(v)})", "",
+           "Rows: ray-cast LiDAR class; columns: mask class at the point's pixel.", "",
            "| LiDAR \\ image | " + " | ".join(names[j] for j in used) + " |", "|---|" + "---:|" * len(used)]
     for i in used:
         out.append(f"| {names[i]} | " + " | ".join(str(int(c[i, j])) for j in used) + " |")

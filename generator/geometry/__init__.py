@@ -8,10 +8,25 @@ edge build on it, never the reverse.
 """
 
 from generator.geometry.mesh import Mesh, empty, face_normals, merge, on_ground
-from generator.geometry.primitives import (box, convex_hull, cylinder, disc, icosphere, loft, polygon, prism, quad,
-                                           quads, rect, resolve_ids, slab, triangulate, tube)
+from generator.geometry.primitives import (
+                                           box,
+                                           convex_hull,
+                                           cylinder,
+                                           disc,
+                                           icosphere,
+                                           loft,
+                                           polygon,
+                                           prism,
+                                           quad,
+                                           quads,
+                                           rect,
+                                           resolve_ids,
+                                           slab,
+                                           triangulate,
+                                           tube,
+)
 from generator.geometry.transforms import apply, invert, mount, pose
 
 __all__ = ["Mesh", "apply", "box", "convex_hull", "cylinder", "disc", "empty", "face_normals", "icosphere", "invert",
-           "loft", "merge", "mount", "on_ground", "polygon", "pose", "prism", "quad", "quads", "rect", "resolve_ids", "slab",
-           "triangulate", "tube"]
+           "loft", "merge", "mount", "on_ground", "polygon", "pose", "prism", "quad", "quads", "rect", "resolve_ids",
+           "slab", "triangulate", "tube"]

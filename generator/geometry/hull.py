@@ -22,8 +22,7 @@ import logging
 
 import numpy as np
 import trimesh
-from scipy.spatial import ConvexHull, QhullError
-from scipy.spatial import cKDTree
+from scipy.spatial import ConvexHull, QhullError, cKDTree
 from trimesh import geometry as tm_geometry
 from trimesh import triangles as tm_triangles
 from trimesh import util as tm_util

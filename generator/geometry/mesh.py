@@ -59,14 +59,14 @@ class Mesh:
             return np.zeros((2, 3))
         return np.stack([self.vertices.min(0), self.vertices.max(0)])
 
-    def transformed(self, matrix: np.ndarray) -> "Mesh":
+    def transformed(self, matrix: np.ndarray) -> Mesh:
         """A copy with vertices and anchors mapped by the 4x4 ``matrix``."""
         return Mesh(
             apply(matrix, self.vertices), self.faces, self.face_class, self.face_material,
             {k: apply(matrix, v) for k, v in self.anchors.items()},
         )
 
-    def select(self, face_mask: np.ndarray) -> "Mesh":
+    def select(self, face_mask: np.ndarray) -> Mesh:
         """The sub-mesh of the faces where ``face_mask`` is True (unused vertices dropped)."""
         faces = self.faces[face_mask]
         used, inverse = np.unique(faces, return_inverse=True)
@@ -105,7 +105,7 @@ def merge(meshes: list[Mesh]) -> Mesh:
             anchors.setdefault(k, []).append(v)
     return Mesh(
         np.concatenate([m.vertices for m in meshes]),
-        np.concatenate([m.faces + o for m, o in zip(meshes, offsets)]),
+        np.concatenate([m.faces + o for m, o in zip(meshes, offsets, strict=False)]),
         np.concatenate([m.face_class for m in meshes]),
         np.concatenate([m.face_material for m in meshes]),
         {k: np.concatenate(v) for k, v in anchors.items()},

@@ -83,7 +83,10 @@ def cylinder(radius: float, height: float, cls: str | int, material: str | int, 
     if caps:
         v = np.concatenate([v, [[0, 0, z0], [0, 0, z0 + height]]])
         cb, ct = 2 * sections, 2 * sections + 1
-        faces += [np.stack([np.full(sections, cb), j, i], 1), np.stack([np.full(sections, ct), i + sections, j + sections], 1)]
+        faces += [
+            np.stack([np.full(sections, cb), j, i], 1),
+            np.stack([np.full(sections, ct), i + sections, j + sections], 1),
+        ]
     c, m = resolve_ids(cls, material)
     return Mesh(v, np.concatenate(faces), c, m)
 

@@ -43,7 +43,9 @@ from generator.errors import UserError
 from generator.labels import class_table
 from generator.safeload import printable
 
-DEPTH_DEFINITION = "distance along the pixel ray from the camera centre to the rendered real geometry, metres; inf = sky"
+DEPTH_DEFINITION = (
+    "distance along the pixel ray from the camera centre to the rendered real geometry, metres; inf = sky"
+)
 #: Largest EXR file, image and channel count read (a 1920x1080 dataset image is ~10 MiB, ~40 channels).
 MAX_EXR_BYTES = safeload.MAX_ARRAY_BYTES
 MAX_PIXELS = 50_000_000

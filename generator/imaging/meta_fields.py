@@ -89,8 +89,12 @@ def matrix(doc: dict, dotted: str, shape: tuple[int, ...], source: str, default:
         return value
     if not _is_numbers(value, shape):
         what = "x".join("n" if n < 0 else str(n) for n in shape)
-        raise SpecError(source, ".".join(p for p in (prefix, dotted) if p), f"must be {'a list of ' + what if len(shape) == 1 else 'a ' + what + ' matrix'}"
-                        f" of numbers, got {kind_of(value)} of another shape or with non-numbers")
+        raise SpecError(
+            source,
+            ".".join(p for p in (prefix, dotted) if p),
+            f"must be {'a list of ' + what if len(shape) == 1 else 'a ' + what + ' matrix'}"
+            f" of numbers, got {kind_of(value)} of another shape or with non-numbers",
+        )
     return np.array(value, np.float64).reshape(shape)
 
 
@@ -108,7 +112,11 @@ def integer(doc: dict, dotted: str, source: str, lo: int, hi: int, default: Any 
     if value is default and default is not _REQUIRED:
         return value
     if not isinstance(value, int) or isinstance(value, bool) or not lo <= value <= hi:
-        got = f"{value}" if isinstance(value, int) and not isinstance(value, bool) and abs(value) < 10**12 else kind_of(value)
+        got = (
+            f"{value}"
+            if isinstance(value, int) and not isinstance(value, bool) and abs(value) < 10**12
+            else kind_of(value)
+        )
         raise SpecError(source, dotted, f"must be an integer in [{lo}, {hi}], got {got}")
     return value
 
@@ -138,7 +146,11 @@ def exr_path(doc: dict, meta_path: str | Path, source: str | None = None, must_e
     src = str(meta_path) if source is None else source
     rel = field(doc, "files.exr", src)
     if not isinstance(rel, str) or not rel or "\0" in rel:
-        raise SpecError(src, "files.exr", f"must be a file name, got {kind_of(rel) if not isinstance(rel, str) else 'an empty or invalid string'}")
+        raise SpecError(
+            src,
+            "files.exr",
+            f"must be a file name, got {kind_of(rel) if not isinstance(rel, str) else 'an empty or invalid string'}",
+        )
     base = os.path.realpath(Path(meta_path).parent)
     target = os.path.realpath(os.path.join(base, rel))
     if os.path.isabs(rel) or os.path.commonpath([base, target]) != base:
@@ -161,7 +173,8 @@ def schema_message(err) -> str:
         return f"{where}: must be of type {kinds}, got {kind_of(err.instance)}"
     if v in ("enum", "const"):
         allowed = want if v == "enum" else [want]
-        return f"{where}: must be {'one of ' if v == 'enum' else ''}{', '.join(safeload.printable(a, 40) for a in allowed[:12])}"
+        return (f"{where}: must be {'one of ' if v == 'enum' else ''}"
+                f"{', '.join(safeload.printable(a, 40) for a in allowed[:12])}")
     if v == "additionalProperties" and isinstance(err.instance, dict):
         extra = sorted(set(err.instance) - set(err.schema.get("properties", {})))
         return f"{where}: unknown key {safeload.printable(extra[0] if extra else '?', 64)!r}"

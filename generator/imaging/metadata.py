@@ -59,7 +59,7 @@ def software_versions(blender: str | None = None) -> dict:
 def class_pixels(class_id: np.ndarray) -> dict[str, int]:
     """Pixel count per class present (non-zero counts only), in class-table order."""
     counts = np.bincount(class_id.ravel(), minlength=len(class_table()))
-    return {name: int(c) for name, c in zip(class_table().names, counts) if c > 0}
+    return {name: int(c) for name, c in zip(class_table().names, counts, strict=False) if c > 0}
 
 
 def image_metadata(*, image: str, files: dict, frame, k: np.ndarray, width: int, height: int, hfov_deg: float,

@@ -2,10 +2,11 @@
 
 A 10 Hz stream: sweep ``j`` starts at ``t_j = j * SWEEP_PERIOD_S`` (0.1 s) along the ego's drive
 through the world in time (:func:`generator.traffic.build.build_world`: the static town and the
-moving actors, each column of a sweep seeing them where they are at its firing time); files under ``out/sequences/NN/`` (see :mod:`generator.formats.semantickitti`)
-plus ``bev/NNNNNN.png`` (bird's-eye view), optionally ``range/NNNNNN.npy`` (range image,
-rings x columns float32, 0 = no return) and ``ply/NNNNNN.ply``; ``lidar_meta.json`` says
-how the data was made (sensor, conventions, remission placeholder, point counts); the
+moving actors, each column of a sweep seeing them where they are at its firing time); files under
+``out/sequences/NN/`` (see :mod:`generator.formats.semantickitti`) plus ``bev/NNNNNN.png``
+(bird's-eye view), optionally ``range/NNNNNN.npy`` (range image, rings x columns float32,
+0 = no return) and ``ply/NNNNNN.ply``; ``lidar_meta.json`` says how the data was made (sensor,
+conventions, remission placeholder, point counts); the
 dataset's ``semantic-kitti.yaml`` label config sits in ``out/``.
 Side files for fusion: ``point_times/`` and ``native_labels/`` per scan
 (:mod:`generator.formats.point_sidecars`), the scene flow of every scan but the last
@@ -37,25 +38,26 @@ import numpy as np
 from generator import __version__
 from generator.atomic import atomic_path, inside, write_json
 from generator.errors import UserError
-from generator.formats import kitti_calib, semantickitti as sk
+from generator.formats import kitti_calib
+from generator.formats import semantickitti as sk
 from generator.formats.label_config import count_raw_ids, merge_counts, write_label_config
 from generator.formats.ply import write_ply
-from generator.previews.bev import write_bev
-from generator.labels import class_table
-from generator.labels.sets import semantickitti_labels
 from generator.formats.point_sidecars import write_point_sidecars
 from generator.formats.scene_flow import DESCRIPTION as SCENE_FLOW
-from generator.jobs.scan_flow import ScanFlowWriter, remove_last
-from generator.scan_effects.pipeline import process_scan, processing_for_spec
-from generator.spec.towns import angle_record, town_record
-from generator.remission.models import IntensityFn, intensity_fn_for_spec
 from generator.jobs.lidar_returns import SECOND_DIR, return_model, sweep_alpha, write_second_returns
+from generator.jobs.scan_flow import ScanFlowWriter, remove_last
+from generator.labels import class_table
+from generator.labels.sets import semantickitti_labels
 from generator.lidar.returns import frame_key
 from generator.lidar.scan import Scanner
 from generator.lidar.sensors import Sensor, sensor_for_spec
+from generator.previews.bev import write_bev
+from generator.progress import progress as progress_bar
+from generator.remission.models import IntensityFn, intensity_fn_for_spec
+from generator.scan_effects.pipeline import process_scan, processing_for_spec
+from generator.spec.towns import angle_record, town_record
 from generator.world.actors import MOVING_THRESHOLD_MPS
 from generator.world.rig import SWEEP_PERIOD_S, Rig
-from generator.progress import progress as progress_bar
 
 log = logging.getLogger(__name__)
 

@@ -111,7 +111,7 @@ def render_pair(renderer, spec, cfg, rig, sensor, index: int, seq_dir: Path) -> 
     # both cameras' label passes behind one switch of the render state (see render_label_batch)
     poses = [functools.partial(expose, renderer, rig, t_exp, rig.T_ego_stereo(cam)) for cam in CAMERAS]
     pair_labels = renderer.render_labels_batch(poses)
-    for cam, pose, labels in zip(CAMERAS, poses, pair_labels):
+    for cam, pose, labels in zip(CAMERAS, poses, pair_labels, strict=False):
         T_world_camera = pose()
         rgb, _ = renderer.render_rgb(seed=child_seed(spec.seed, "frame", index, "stereo", cam))
         img, weather = weather_post(spec, index, tod, kind, rgb, labels.depth, renderer.k, ("stereo", cam),

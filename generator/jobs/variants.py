@@ -12,19 +12,29 @@ II therefore cost 6 RGB renders, and a frame's variants differ only in RGB.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
+from generator.jobs.exposure import expose, motion_record
+from generator.jobs.images import write_image
 from generator.postfx.camera import apply_camera, draw_params
 from generator.postfx.fog import fog_image
 from generator.postfx.rain import rain_image
-from generator.jobs.exposure import expose, motion_record
-from generator.jobs.images import write_image
 from generator.rng import child_seed, stream
-from generator.weather import (DEFAULT_TIMES, TIMES, combinations, draw_lighting, draw_weather, frame_wetness, has_fog,
-                               has_rain, light_level, render_key)
+from generator.weather import (
+    DEFAULT_TIMES,
+    TIMES,
+    combinations,
+    draw_lighting,
+    draw_weather,
+    frame_wetness,
+    has_fog,
+    has_rain,
+    light_level,
+    render_key,
+)
 
 #: Memory a worker may hold in finished label arrays of a batch (see :func:`label_batch_size`).
 LABEL_BATCH_BYTES = 256 * 2**20
@@ -65,7 +75,9 @@ def renders_needed(combos: list[tuple[str, str]]) -> list[tuple[str, bool, bool]
 
 def cycles_seed(spec, frame_index: int, time_of_day: str, wet: bool, overcast: bool) -> int:
     """Cycles' seed of one RGB render (the sunny renders keep the seeds they had before skies were drawn)."""
-    return child_seed(spec.seed, "frame", frame_index, "cycles", time_of_day, int(wet), *(("overcast",) if overcast else ()))
+    return child_seed(
+        spec.seed, "frame", frame_index, "cycles", time_of_day, int(wet), *(("overcast",) if overcast else ())
+    )
 
 
 def weather_post(spec, frame_index: int, time_of_day: str, kind: str, rgb: np.ndarray, depth: np.ndarray,
@@ -110,7 +122,8 @@ def weather_post(spec, frame_index: int, time_of_day: str, kind: str, rgb: np.nd
 
 
 def camera_post(spec, cfg, frame_index: int, time_of_day: str, kind: str, rgb: np.ndarray,
-                stream_tag: tuple = (), noise_tag: tuple = (), exposure: dict | None = None) -> tuple[np.ndarray, dict | None]:
+                stream_tag: tuple = (), noise_tag: tuple = (),
+                exposure: dict | None = None) -> tuple[np.ndarray, dict | None]:
     """The camera model (:mod:`generator.postfx.camera`) on one image after its fog and rain.
 
     Off (``cfg.camera_model`` false) it returns ``rgb`` itself and None: the image is written
@@ -174,7 +187,7 @@ def render_frames(renderer, spec, cfg, frames, out: Path, combos: list[tuple[str
     for i in range(0, len(frames), n):
         batch = frames[i:i + n]
         labels = renderer.render_labels_batch([pose_for(renderer, f, rig) for f in batch])
-        for frame, lab in zip(batch, labels):
+        for frame, lab in zip(batch, labels, strict=False):
             yield frame, render_frame(renderer, spec, cfg, frame, out, combos, rig, lab)
 
 

@@ -54,7 +54,7 @@ def run(job, queue) -> None:
             _run(job, queue, scratch)
     except BaseException as e:  # report everything; the parent decides
         queue.put(("error", f"{type(e).__name__}: {e}\n{traceback.format_exc()}"))
-        raise SystemExit(1)
+        raise SystemExit(1) from e
 
 
 def _run(job, queue, scratch: Path) -> None:
@@ -90,7 +90,8 @@ def _run(job, queue, scratch: Path) -> None:
                                                     "rss_mb": _rss_mb(), "frames_done": n}))
     cycles = renderer.cycles_seconds
     queue.put(("done", {
-        "pid": os.getpid(), "frames": len(indices) + len(job.stereo), "max_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
+        "pid": os.getpid(), "frames": len(indices) + len(job.stereo),
+        "max_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
         "rss_mb": _rss_mb(), "setup_s": layout_s + renderer.build_seconds, "frames_s": time.perf_counter() - t_start,
         "cycles_rgb_s": cycles["rgb"], "cycles_labels_s": cycles["labels"],
     }))

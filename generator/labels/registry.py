@@ -39,7 +39,7 @@ class ClassInfo:
 
 
 def _load_yaml(name: str) -> dict:
-    with open(DATA_DIR / name, "r", encoding="utf-8") as f:
+    with open(DATA_DIR / name, encoding="utf-8") as f:
         return yaml.safe_load(f)
 
 

@@ -67,7 +67,9 @@ def label_sets() -> dict[str, LabelSet]:
     t = class_table()
     cfg = t.sk_config
     learning = _lut({int(k): int(v) for k, v in cfg["learning_map"].items()})
-    learn_names = tuple(t.sk_labels[int(cfg["learning_map_inv"][i])] for i in sorted(int(k) for k in cfg["learning_map_inv"]))
+    learn_names = tuple(
+        t.sk_labels[int(cfg["learning_map_inv"][i])] for i in sorted(int(k) for k in cfg["learning_map_inv"])
+    )
     return {
         "unified11": LabelSet("unified11", tuple(t.unified_names[i] for i in sorted(t.unified_names)),
                               t.to_unified.astype(np.int64), _lut(t.sk_to_unified_map)),

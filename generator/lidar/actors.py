@@ -160,7 +160,9 @@ class ActorCaster:
         t = t0 + (column_time[col] if skew else np.zeros(len(col)))
         pos, yaw = self.bank.position_heading(who, t)
         moving = (self.bank.speed(who, t) > MOVING_THRESHOLD_MPS).astype(np.uint8)
-        win = self._column_windows(self.beams, pos, yaw, self._box_center[who], self._box_half[who], P[col if skew else 0 * col])
+        win = self._column_windows(
+            self.beams, pos, yaw, self._box_center[who], self._box_half[who], P[col if skew else 0 * col]
+        )
         return SweepPlan(actor, c0, c1, np.concatenate([[0], np.cumsum(n_cols)]), pos - self.center, np.cos(yaw),
                          np.sin(yaw), moving, win["azimuth"], win["half"], win["ring0"], win["ring1"], win["near"])
 

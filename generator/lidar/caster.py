@@ -36,7 +36,9 @@ class RayCaster(Protocol):
                         mark_misses: bool = True) -> tuple[np.ndarray, np.ndarray]:
         """First hits of re-centred float32 rays; see :meth:`EmbreeCaster.intersect_local`."""
 
-    def intersect(self, origins: np.ndarray, directions: np.ndarray, max_distance: float) -> tuple[np.ndarray, np.ndarray]:
+    def intersect(
+        self, origins: np.ndarray, directions: np.ndarray, max_distance: float
+    ) -> tuple[np.ndarray, np.ndarray]:
         """First hits of rays; see :meth:`EmbreeCaster.intersect`."""
 
     @property
@@ -131,7 +133,9 @@ class EmbreeCaster:
             dist[prim < 0] = np.inf
         return dist, prim
 
-    def intersect(self, origins: np.ndarray, directions: np.ndarray, max_distance: float) -> tuple[np.ndarray, np.ndarray]:
+    def intersect(
+        self, origins: np.ndarray, directions: np.ndarray, max_distance: float
+    ) -> tuple[np.ndarray, np.ndarray]:
         """First hit of every ray.
 
         Parameters

@@ -189,7 +189,7 @@ def _laser_columns(doc: dict, source: str) -> dict[str, np.ndarray]:
             i = given.index(None)
             raise SpecError(source, f"lasers[{i}].ring", "is required when any laser gives a ring (or omit all rings)")
         expect = _rings(col["elevation"], ids)
-        for i, (g, e) in enumerate(zip(given, expect)):
+        for i, (g, e) in enumerate(zip(given, expect, strict=False)):
             if g != e:
                 raise SpecError(source, f"lasers[{i}].ring",
                                 f"must be the elevation rank (0 = highest beam), expected {int(e)}, got {g}")
@@ -253,7 +253,9 @@ def load_preset(name: str) -> Sensor:
     """
     path = PRESET_DIR / f"{name}.yaml"
     if not path.is_file():
-        raise SpecError("sensors.lidar.preset", "", f"unknown LiDAR preset {name!r}; known: {', '.join(preset_names())}")
+        raise SpecError(
+            "sensors.lidar.preset", "", f"unknown LiDAR preset {name!r}; known: {', '.join(preset_names())}"
+        )
     return load_sensor(path, f"generator/lidar/sensors/{name}.yaml")
 
 

@@ -104,7 +104,7 @@ class TrackBank:
             Corners of each actor's axis-aligned box, world frame, metres.
         """
         lo, hi = np.empty((self.n, 3)), np.empty((self.n, 3))
-        for g, (t0, dt, n_samples, xyz, yaw) in enumerate(self._groups):
+        for g, (t0, dt, n_samples, xyz, _yaw) in enumerate(self._groups):
             members = np.flatnonzero(self._group_of == g)
             rows = self._row_of[members]
             ends = [self._eval(members, np.full(len(members), t), False)[0] for t in (t_start, t_end)]

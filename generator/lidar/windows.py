@@ -13,8 +13,9 @@ ray that an actor would stop):
    actor's box (the prototype's bounding box under the actor's pose) seen from the sensor in its
    frame at that instant bounds the beam azimuth (the box's half-width across the line of sight
    over its nearest depth) and elevation (its height range over its horizontal distance range),
-   widened only by the emission-point offsets (across the beam only the 2.6 cm horizontal one). No motion margin is needed: both poses are exact
-   there. For a car 10 m ahead the beams kept are about a quarter of the sphere's.
+   widened only by the emission-point offsets (across the beam only the 2.6 cm horizontal one). No motion
+   margin is needed: both poses are exact there. For a car 10 m ahead the beams kept are about a quarter
+   of the sphere's.
 
 Frames: ``poses`` are ``T_world_sensor``; beam azimuths are CCW from the sensor's +x, elevations
 from its xy-plane; ring ``r`` is the ``r``-th highest beam.
@@ -104,7 +105,9 @@ def sweep_windows(beams: BeamTable, radius: np.ndarray, lo: np.ndarray, hi: np.n
     az = np.arctan2(v[:, 1], v[:, 0])
     lo_psi, hi_psi = az - half - beams.rot.max(), az + half - beams.rot.min()
     k, start = s.azimuth_steps / (2 * np.pi), s.start_azimuth_rad
-    lo_c, hi_c = ((start - hi_psi) * k, (start - lo_psi) * k) if s.clockwise else ((lo_psi - start) * k, (hi_psi - start) * k)
+    lo_c, hi_c = (
+        ((start - hi_psi) * k, (start - lo_psi) * k) if s.clockwise else ((lo_psi - start) * k, (hi_psi - start) * k)
+    )
     ca = np.floor(lo_c).astype(np.int64) - 1
     width = np.floor(hi_c).astype(np.int64) + 2 - ca
     every = (d_xy <= r_tot) | (half >= np.pi) | (width >= s.azimuth_steps)

@@ -43,7 +43,9 @@ def _coefficients(a: float, d: float, white: float, mid_in: float, mid_out: floa
     b = (-ma + wa * mid_out) / den
     c = (wad * ma - wa * mad * mid_out) / den
     if not (b > 0 and c > 0):
-        raise ValueError(f"response curve without a monotone solution: a={a} d={d} white={white} mid={mid_in}->{mid_out}")
+        raise ValueError(
+            f"response curve without a monotone solution: a={a} d={d} white={white} mid={mid_in}->{mid_out}"
+        )
     return b, c
 
 

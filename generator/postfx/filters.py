@@ -125,7 +125,7 @@ def blur_sum(img: np.ndarray, sigmas_px, weights) -> np.ndarray:
     f0 = max(1, int(min(sigmas_px) / 3.0))
     base = block_mean(img, f0)
     acc = np.zeros_like(base)
-    for sigma, weight in zip(sigmas_px, weights):
+    for sigma, weight in zip(sigmas_px, weights, strict=False):
         g = max(1, int(sigma / 3.0 / f0))
         blurred = gaussian(block_mean(base, g), sigma / (f0 * g))
         acc += np.float32(weight) * upsample(blurred, g, *base.shape[:2])

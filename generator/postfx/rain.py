@@ -133,7 +133,7 @@ def streak_alpha(depth: np.ndarray, rate_mmh: float, rng: np.random.Generator, f
     layer = np.searchsorted(np.asarray(LAYER_EDGES_M), dist)[which]
     maps = _splat(x[visible], y[visible], wt[visible], layer[visible], len(LAYER_SIGMA_PX), h, w)
     keep = np.ones((h, w), np.float32)
-    for m, sigma in zip(maps, LAYER_SIGMA_PX):
+    for m, sigma in zip(maps, LAYER_SIGMA_PX, strict=False):
         keep *= 1.0 - np.clip(ndimage.gaussian_filter(m, sigma * scale, truncate=3.0), 0.0, 1.0)
     params = {"streaks": n, "wind_deg": round(wind, 3), "exposure_s": round(exposure_s, 6),
               "median_drop_mm": round(float(np.median(diam)), 3) if n else None}
@@ -156,7 +156,9 @@ def streak_radiance(rgb: np.ndarray, time_of_day: str) -> np.ndarray:
     if time_of_day in LIT_TIMES:  # lamps are lit at dusk and night
         src += np.float32(LAMP_GLINT / STREAK_GAIN[time_of_day]) * block_mean(emitter_map(rgb), f)
     share = ENV_SHARE[time_of_day]
-    small = STREAK_GAIN[time_of_day] * ((1.0 - share) * gaussian(src, sigma / f) + share * src.mean((0, 1), keepdims=True))
+    small = STREAK_GAIN[time_of_day] * (
+        (1.0 - share) * gaussian(src, sigma / f) + share * src.mean((0, 1), keepdims=True)
+    )
     return upsample(small.astype(np.float32), f, h, w)
 
 

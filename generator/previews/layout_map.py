@@ -158,11 +158,11 @@ def render_map(scene: SceneModel, ppm: float | None = None, marker_spacing_m: fl
         s = np.arange(0.0, path.length(), marker_spacing_m)
         pos, hd = path.at(s)
         r = max(3.0, ppm * 0.9)
-        for (x, y), h in zip(to_px(pos[:, :2]), hd):
+        for (x, y), h in zip(to_px(pos[:, :2]), hd, strict=False):
             tip = (x + r * 1.6 * np.cos(h), y - r * 1.6 * np.sin(h))
-            l = (x + r * np.cos(h + 2.4), y - r * np.sin(h + 2.4))
+            left = (x + r * np.cos(h + 2.4), y - r * np.sin(h + 2.4))
             rr = (x + r * np.cos(h - 2.4), y - r * np.sin(h - 2.4))
-            draw.polygon([tip, l, rr], fill=MARKER_RGB, outline=(0, 0, 0))
+            draw.polygon([tip, left, rr], fill=MARKER_RGB, outline=(0, 0, 0))
         x, y = to_px(pos[:1, :2])[0]
         draw.ellipse([x - r * 1.5, y - r * 1.5, x + r * 1.5, y + r * 1.5], outline=(255, 0, 0), width=3)
     _legend(draw, W, table, scene, ppm, title, k)

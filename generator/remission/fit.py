@@ -30,8 +30,8 @@ from generator.atomic import write_text
 from generator.errors import UserError
 from generator.formats import semantickitti as sk
 from generator.labels import class_table
-from generator.remission.class_profiles import LABEL_SPACES, ClassStats, IntensityProfile
 from generator.progress import progress as progress_bar
+from generator.remission.class_profiles import LABEL_SPACES, ClassStats, IntensityProfile
 
 log = logging.getLogger(__name__)
 
@@ -53,11 +53,11 @@ class ClassMoments:
     m2: np.ndarray
 
     @classmethod
-    def empty(cls, k: int = 0) -> "ClassMoments":
+    def empty(cls, k: int = 0) -> ClassMoments:
         return cls(np.zeros(k, np.int64), np.zeros(k), np.zeros(k))
 
     @classmethod
-    def of(cls, keys: np.ndarray, values: np.ndarray, k: int | None = None) -> "ClassMoments":
+    def of(cls, keys: np.ndarray, values: np.ndarray, k: int | None = None) -> ClassMoments:
         """Moments of one batch: (n,) non-negative integer ``keys`` (< k; default max + 1) and (n,) ``values``."""
         keys = np.asarray(keys, np.intp)
         x = np.asarray(values, np.float64)
@@ -68,14 +68,14 @@ class ClassMoments:
         m2 = np.bincount(keys, weights=x * x, minlength=k) - s * mean  # sum of squared deviations
         return cls(n.astype(np.int64), mean, np.maximum(m2, 0.0))
 
-    def padded(self, k: int) -> "ClassMoments":
+    def padded(self, k: int) -> ClassMoments:
         """The same moments with ``k`` slots (zeros appended)."""
         extra = k - len(self.count)
         if extra <= 0:
             return self
         return ClassMoments(np.pad(self.count, (0, extra)), np.pad(self.mean, (0, extra)), np.pad(self.m2, (0, extra)))
 
-    def merge(self, other: "ClassMoments") -> "ClassMoments":
+    def merge(self, other: ClassMoments) -> ClassMoments:
         """Chan et al.'s pairwise combination of two sets of moments (key i of one with key i of the other)."""
         k = max(len(self.count), len(other.count))
         self, other = self.padded(k), other.padded(k)
@@ -87,7 +87,7 @@ class ClassMoments:
         m2 = self.m2 + other.m2 + delta * delta * (na * nb / safe)
         return ClassMoments(n, np.where(n > 0, mean, 0.0), np.where(n > 0, m2, 0.0))
 
-    def grouped(self, groups: np.ndarray, n_groups: int) -> "ClassMoments":
+    def grouped(self, groups: np.ndarray, n_groups: int) -> ClassMoments:
         """Merge keys into ``n_groups`` groups; ``groups`` (K,) int gives each key's group."""
         g = np.asarray(groups, np.intp)
         c = self.count.astype(np.float64)
@@ -114,7 +114,9 @@ def _sequences(root: Path, sequences: list[str] | None) -> list[str]:
     for s in sequences:
         name = sk.sequence_name(s)
         if name not in present:
-            raise UserError(f"{root / 'sequences' / name}: sequence not found (present: {', '.join(present) or 'none'})")
+            raise UserError(
+                f"{root / 'sequences' / name}: sequence not found (present: {', '.join(present) or 'none'})"
+            )
         if not (root / "sequences" / name / "labels").is_dir():
             raise UserError(f"{root / 'sequences' / name / 'labels'}: missing; cannot fit intensities without labels")
         out.append(name)
@@ -136,7 +138,9 @@ def read_semantic_remission(scan_path: Path, label_path: Path) -> tuple[np.ndarr
     return labels.view("<u2")[::2], pts[:, 3]  # little-endian: the low 16 bits first
 
 
-def accumulate(root: str | Path, sequences: list[str] | None = None, progress: bool = True) -> tuple[ClassMoments, dict]:
+def accumulate(
+    root: str | Path, sequences: list[str] | None = None, progress: bool = True
+) -> tuple[ClassMoments, dict]:
     """Stream every labelled scan of the chosen sequences into per-label moments.
 
     Returns
@@ -183,7 +187,9 @@ def profile_from_moments(moments: ClassMoments, label_space: str, name: str, sou
     if label_space == "unified11":
         bad = [int(k) for k in present if k not in names]
         if bad:
-            raise UserError(f"{source}: labels {bad[:5]} are not unified-11 ids 0..{max(names)} (use --labels semantickitti?)")
+            raise UserError(
+                f"{source}: labels {bad[:5]} are not unified-11 ids 0..{max(names)} (use --labels semantickitti?)"
+            )
         return IntensityProfile(name, source, {names[k]: st for k, st in stats.items()}, {}, pooled)
     unknown = [int(k) for k in present if k not in table.sk_labels]
     if unknown:
@@ -215,7 +221,9 @@ def format_profile(profile: IntensityProfile, summary: dict | None = None) -> st
             "# classes absent from the data use 'unlabeled', else 'pooled' (all points together)."]
     if summary:
         head.append(f"# {summary['scans']} scans, {summary['points']} points.")
-    return "\n".join(head) + "\n" + yaml.safe_dump(profile.to_dict(), sort_keys=False, default_flow_style=None, width=120)
+    return (
+        "\n".join(head) + "\n" + yaml.safe_dump(profile.to_dict(), sort_keys=False, default_flow_style=None, width=120)
+    )
 
 
 def write_profile(path: str | Path, profile: IntensityProfile, summary: dict | None = None) -> None:

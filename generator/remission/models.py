@@ -34,8 +34,8 @@ from __future__ import annotations
 
 import functools
 import logging
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 import yaml
@@ -156,10 +156,12 @@ def physical() -> IntensityFn:
 
     fn.description = {
         "model": "physical",
-        "formula": "clip(P * (1 + noise_relative N) + noise_absolute N, 0, 1); P = rho (cos + retro_gain cos^retro_exponent "
-                   "[retroreflective]) (R0 / max(R, min_range_m))^2 exp(-2 clear_alpha R)",
+        "formula": "clip(P * (1 + noise_relative N) + noise_absolute N, 0, 1); "
+                   "P = rho (cos + retro_gain cos^retro_exponent [retroreflective]) "
+                   "(R0 / max(R, min_range_m))^2 exp(-2 clear_alpha R)",
         "normalisation": "P = 1 for a reflectivity-1 Lambertian target at R0 and normal incidence in clear air",
-        "reflectivity": "generator/materials.yaml at 905 nm (per point material, else class_materials of reflectivity.yaml)",
+        "reflectivity": "generator/materials.yaml at 905 nm "
+                        "(per point material, else class_materials of reflectivity.yaml)",
         **{k: float(v) for k, v in p.items()},
     }
     return fn
@@ -174,13 +176,20 @@ def hybrid(profile: IntensityProfile, label_space: str = "semantickitti") -> Int
     def fn(points: np.ndarray, rng: np.random.Generator) -> np.ndarray:
         cos = np.clip(points["cos_incidence"].astype(np.float64), 0.0, 1.0)
         r = np.maximum(points["range"].astype(np.float64), h["min_range_m"])
-        w = ((1 - a) + a * cos) / ((1 - a) + a * h["reference_cos"]) * (h["reference_range_m"] / r) ** h["range_exponent"]
+        w = (
+            ((1 - a) + a * cos)
+            / ((1 - a) + a * h["reference_cos"])
+            * (h["reference_range_m"] / r) ** h["range_exponent"]
+        )
         return np.clip(draw(points, rng) * np.minimum(w, h["max_gain"]), 0.0, 1.0).astype(np.float32)
 
-    fn.description = {"model": "hybrid", **desc,
-                      "formula": "clip(N(mean_c, std_c) * min(max_gain, ((1-a) + a cos) / ((1-a) + a reference_cos) "
-                                 "* (reference_range_m / max(R, min_range_m))^range_exponent), 0, 1), a = incidence_weight",
-                      **{k: float(v) for k, v in h.items()}}
+    fn.description = {
+        "model": "hybrid",
+        **desc,
+        "formula": "clip(N(mean_c, std_c) * min(max_gain, ((1-a) + a cos) / ((1-a) + a reference_cos) "
+        "* (reference_range_m / max(R, min_range_m))^range_exponent), 0, 1), a = incidence_weight",
+        **{k: float(v) for k, v in h.items()},
+    }
     return fn
 
 
@@ -231,7 +240,7 @@ def intensity_fn_for_spec(spec, command_line_profile: str | None = None) -> Inte
 MODEL_NAMES = ("constant", "class_normal", "physical", "hybrid")
 
 
-def intensity_model(name: str, profile: "IntensityProfile | None" = None, constant_value: float = 0.5,
+def intensity_model(name: str, profile: IntensityProfile | None = None, constant_value: float = 0.5,
                     label_space: str = "semantickitti") -> IntensityFn:
     """An intensity function by model name, without a spec (importers, converters).
 

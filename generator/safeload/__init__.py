@@ -38,8 +38,20 @@ escaped so the message stays one line. Reasons never quote the content of the fi
 
 from generator.safeload.documents import check_finite, load_json, parse_json
 from generator.safeload.files import confined_path, read_array, read_bytes, read_matrix_rows, read_text
-from generator.safeload.limits import (MAX_ALIASES, MAX_ARRAY_BYTES, MAX_DEPTH, MAX_DOCUMENT_BYTES, MAX_INT_DIGITS,
-                                       MAX_METADATA_BYTES, MAX_NODES, MAX_TABLE_BYTES, MAX_YAML_BYTES, GiB, KiB, MiB)
+from generator.safeload.limits import (
+                                       MAX_ALIASES,
+                                       MAX_ARRAY_BYTES,
+                                       MAX_DEPTH,
+                                       MAX_DOCUMENT_BYTES,
+                                       MAX_INT_DIGITS,
+                                       MAX_METADATA_BYTES,
+                                       MAX_NODES,
+                                       MAX_TABLE_BYTES,
+                                       MAX_YAML_BYTES,
+                                       GiB,
+                                       KiB,
+                                       MiB,
+)
 from generator.safeload.messages import field_path, file_kind, printable
 from generator.safeload.yaml_docs import load_yaml, parse_yaml
 

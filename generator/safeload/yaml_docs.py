@@ -7,6 +7,8 @@ from typing import Any
 
 import yaml
 
+# --------------------------------------------------------------------------- parsed data
+from generator.safeload.documents import _clean, check_finite
 from generator.safeload.files import read_text
 from generator.safeload.limits import (
     MAX_ALIASES,
@@ -19,10 +21,6 @@ from generator.safeload.messages import (
     _fail,
     printable,
 )
-
-# --------------------------------------------------------------------------- parsed data
-from generator.safeload.documents import _clean, check_finite
-
 
 # --------------------------------------------------------------------------- YAML
 

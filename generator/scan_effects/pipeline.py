@@ -32,11 +32,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from generator.scan_effects.domain_gap import DomainGap, apply_to_points, gap_for_spec
 from generator.remission.models import IntensityFn, intensity_fn_for_spec
-from generator.scan_effects.weather import (LidarWeatherParams, apply_lidar_weather, enabled_for_spec, frame_weather,
-                                     weather_config)
 from generator.rng import stream
+from generator.scan_effects.domain_gap import DomainGap, apply_to_points, gap_for_spec
+from generator.scan_effects.weather import (
+    LidarWeatherParams,
+    apply_lidar_weather,
+    enabled_for_spec,
+    frame_weather,
+    weather_config,
+)
 
 ORDER = "intensity model -> domain gap -> LiDAR weather"
 ORDER_GAINS = "intensity model -> laser gains (physical sensor) -> domain gap -> LiDAR weather"
@@ -71,8 +76,10 @@ class ScanProcessing:
                                       {"model": getattr(self.intensity_fn, "__name__", "custom")})),
             **({} if self.laser_gain is None else {"laser_gain": {
                 "by_laser_id": {str(i): round(float(self.laser_gain[i]), 5) for i in self.laser_ids},
-                "draw": "log-normal, mean 1, sigma = intensity_gain_spread; stream ('lidar_sensor', 'intensity_gain')"}}),
-            "domain_gap": None if self.domain_gap is None else {"source": "seed 002 sec. 3.2 / 4.1.2", **self.domain_gap.to_dict()},
+                "draw": "log-normal, mean 1, sigma = intensity_gain_spread; "
+                        "stream ('lidar_sensor', 'intensity_gain')"}}),
+            "domain_gap": None if self.domain_gap is None else {"source": "seed 002 sec. 3.2 / 4.1.2",
+                                                                **self.domain_gap.to_dict()},
             "weather": None if self.weather is None else {
                 "detection_threshold": self.weather.detection_threshold, "min_range_m": self.weather.min_range_m,
                 "frame_weather": "generator.weather.draw_weather(spec, k, lidar_combination(k)[1])",
@@ -142,8 +149,9 @@ def process_scan(points: np.ndarray, processing: ScanProcessing, spec, frame_ind
     seed = spec.seed
     more = () if part is None else (part,)
     record = {"frame": int(frame_index), "points_cast": int(len(points)), "domain_gap": None, "weather": None}
-    remission = np.asarray(processing.intensity_fn(points, stream(seed, "frame", frame_index, "lidar_intensity", *more)),
-                           np.float32)
+    remission = np.asarray(
+        processing.intensity_fn(points, stream(seed, "frame", frame_index, "lidar_intensity", *more)), np.float32
+    )
     if processing.laser_gain is not None:
         remission = np.clip(remission * processing.laser_gain[points["laser"]], 0.0, 1.0).astype(np.float32)
     if processing.domain_gap is not None:

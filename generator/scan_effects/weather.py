@@ -92,7 +92,9 @@ def extinction_per_m(weather: Weather) -> tuple[float, float]:
 
 def rain_range_sigma(r: np.ndarray, rain_rate_mmh: float) -> np.ndarray:
     """(n,) range noise standard deviation, metres: ``0.02 r (1 - exp(-R))^2``."""
-    return weather_config()["rain"]["range_noise_coeff"] * np.asarray(r, np.float64) * (1.0 - np.exp(-rain_rate_mmh)) ** 2
+    return (
+        weather_config()["rain"]["range_noise_coeff"] * np.asarray(r, np.float64) * (1.0 - np.exp(-rain_rate_mmh)) ** 2
+    )
 
 
 def apply_lidar_weather(points: np.ndarray, remission: np.ndarray, weather: Weather, params: LidarWeatherParams,

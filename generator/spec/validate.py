@@ -26,7 +26,7 @@ SCHEMA_DIR = Path(__file__).resolve().parent / "schemas"
 @functools.cache
 def load_schema(name: str) -> dict:
     """The packaged JSON Schema ``schemas/<name>.schema.json``."""
-    with open(SCHEMA_DIR / f"{name}.schema.json", "r", encoding="utf-8") as f:
+    with open(SCHEMA_DIR / f"{name}.schema.json", encoding="utf-8") as f:
         return json.load(f)
 
 
@@ -126,7 +126,9 @@ def _message(err: jsonschema.ValidationError, root: dict) -> tuple[str, str]:
         return _field_path(path), f"must be {describe(_resolve(err.schema, root))}, got {_value(err.instance)}"
     schema = _resolve(err.schema, root)
     if err.validator == "minProperties":
-        return _field_path(path), f"must name at least one of {', '.join(sorted(schema.get('properties', {})))}, got {{}}"
+        return _field_path(
+            path
+        ), f"must name at least one of {', '.join(sorted(schema.get('properties', {})))}, got {{}}"
     if err.validator == "type" and schema.get("type") == "object":
         return _field_path(path), f"must be an object, got {_value(err.instance)}"
     return _field_path(path), f"must be {describe(schema)}, got {_value(err.instance)}"
@@ -169,7 +171,8 @@ def with_defaults(document: dict, schema: dict, root: dict | None = None) -> dic
 
 
 def check_ranges(document: Any, source: str, path: tuple = ()) -> None:
-    """Every ``[low, high]`` pair under a key ending in ``_m``/``_deg``/``_mmh`` or a known range must have low <= high."""
+    """Every ``[low, high]`` pair under a key ending in ``_m``/``_deg``/``_mmh`` or a known range must have
+    low <= high."""
     if isinstance(document, dict):
         for k, v in document.items():
             check_ranges(v, source, path + (k,))
@@ -177,4 +180,6 @@ def check_ranges(document: Any, source: str, path: tuple = ()) -> None:
           and path and not path[-1].endswith(("xyz_m", "rpy_deg", "resolution"))):
         lo, hi = document
         if not (math.isfinite(lo) and math.isfinite(hi)) or lo > hi:
-            raise SpecError(source, _field_path(path), f"must be a range [low, high] with low <= high, got {_value(document)}")
+            raise SpecError(
+                source, _field_path(path), f"must be a range [low, high] with low <= high, got {_value(document)}"
+            )

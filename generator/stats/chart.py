@@ -69,7 +69,7 @@ def log_bar_chart(labels: list[str], values: list[float], colors: list[tuple[int
         d.line([(x, top - 4), (x, plot_bottom)], fill=(215, 215, 215))
         d.text((x, plot_bottom + 4), _fmt(10.0**e), fill=(60, 60, 60), font=small, anchor="ma")
     d.text((left + span / 2, plot_bottom + 24), xlabel, fill=(0, 0, 0), font=small, anchor="ma")
-    for i, (label, v, c) in enumerate(zip(labels, values, colors)):
+    for i, (label, v, c) in enumerate(zip(labels, values, colors, strict=False)):
         y = top + i * (bar_h + gap)
         d.text((left - 8, y + bar_h / 2), label, fill=(0, 0, 0), font=font, anchor="rm")
         x1 = x_of(v) if v > 0 else left

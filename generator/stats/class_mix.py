@@ -113,8 +113,10 @@ def section(data: MixData) -> Section:
                              "reference label config's content, mapped through learning_map."]))
     have_sk = [names[c] for c in range(1, 20) if data.points[c] > 0]
     have_cs = [n for i, n in CITYSCAPES_TRAIN if data.pixels[i] > 0]
-    summary.append(f"SemanticKITTI learning classes in the scans: {len(have_sk)} of 19"
-                   + (f" (missing: {', '.join(n for n in names[1:20] if n not in have_sk)})" if len(have_sk) < 19 else ""))
+    summary.append(
+        f"SemanticKITTI learning classes in the scans: {len(have_sk)} of 19"
+        + (f" (missing: {', '.join(n for n in names[1:20] if n not in have_sk)})" if len(have_sk) < 19 else "")
+    )
     summary.append(f"Cityscapes train classes in the images: {len(have_cs)} of 19"
                    + (f" (missing: {', '.join(n for _, n in CITYSCAPES_TRAIN if n not in have_cs)})"
                       if len(have_cs) < 19 else ""))

@@ -27,18 +27,19 @@ Label sets (:data:`LABEL_SETS`): ``unified11`` (seed 000's 11 classes, from the 
 from __future__ import annotations
 
 import os
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Iterator
 
 import numpy as np
 
 from generator.errors import UserError
 from generator.formats import semantickitti as sk
 from generator.formats.point_sidecars import NATIVE_DIR, read_sidecar
-from generator.labels.sets import LABEL_SET_NAMES as LABEL_SETS, LabelSet, label_sets
-from generator.stats.panoptic import MIN_POINTS, PanopticAccumulator, panoptic_result
+from generator.labels.sets import LABEL_SET_NAMES as LABEL_SETS
+from generator.labels.sets import LabelSet, label_sets
 from generator.progress import progress as progress_bar
+from generator.stats.panoptic import MIN_POINTS, PanopticAccumulator, panoptic_result
 
 IGNORE = 0
 #: Which classes the means average: every non-ignored class (the reference) or those present.
@@ -114,13 +115,17 @@ def iou_from_confusion(conf: np.ndarray, ignore: tuple[int, ...] = (IGNORE,), me
     evaluated = include if mean_over == "all" else present
     miou = float(np.nan_to_num(iou[evaluated], nan=0.0).mean()) if evaluated.any() else float("nan")
     denom = tp[include].sum() + fp[include].sum()
-    return IoUResult(iou, tp, fp, fn, present, evaluated, miou, float(tp[include].sum() / denom) if denom else float("nan"))
+    return IoUResult(
+        iou, tp, fp, fn, present, evaluated, miou, float(tp[include].sum() / denom) if denom else float("nan")
+    )
 
 
 def _read_native(seq: Path, index: int, raw: np.ndarray) -> np.ndarray:
     native = read_sidecar(seq, NATIVE_DIR, index, len(raw))
     if native is None:
-        raise UserError(f"{seq / NATIVE_DIR}: no native labels for scan {index:06d} (use --labels unified11 or semantickitti)")
+        raise UserError(
+            f"{seq / NATIVE_DIR}: no native labels for scan {index:06d} (use --labels unified11 or semantickitti)"
+        )
     return native.astype(np.int64)
 
 
@@ -256,7 +261,9 @@ def format_table(result: dict) -> str:
             iou = "absent" if c["iou"] is None else f"{100 * c['iou']:8.2f}"
             lines.append(f"{c['name']:<16} {iou:>8} {c['tp']:10d} {c['fp']:10d} {c['fn']:10d}")
     miou = result["miou"]
-    lines.append(f"{'mIoU':<16} {'n/a' if miou is None else f'{100 * miou:8.2f}':>8}  over {result['evaluated_classes']} classes")
+    lines.append(
+        f"{'mIoU':<16} {'n/a' if miou is None else f'{100 * miou:8.2f}':>8}  over {result['evaluated_classes']} classes"
+    )
     if result["absent_classes"]:
         how = "counted as IoU 0 in the mean, as semantic-kitti-api does" if result["mean_over"] == "all" \
             else "left out of the mean: --mean-over present"

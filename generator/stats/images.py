@@ -24,11 +24,11 @@ from generator.errors import UserError
 from generator.imaging import meta_fields as md
 from generator.imaging.paths import image_files, images_root
 from generator.labels import class_table
+from generator.progress import progress
 from generator.safeload import printable
 from generator.stats.chart import log_bar_chart
 from generator.stats.report import Figure, Section, Table
 from generator.weather import DEFAULT_TIMES, KINDS, TIMES
-from generator.progress import progress
 
 log = logging.getLogger(__name__)
 
@@ -175,7 +175,9 @@ def verify(data: ImageData) -> list[str]:
         actual = np.bincount(class_id.ravel(), minlength=len(table)).astype(np.int64)
         diff = np.flatnonzero(actual != r.pixels)
         if diff.size:
-            what = ", ".join(f"{table.names[i]} {int(r.pixels[i])} in metadata vs {int(actual[i])} in EXR" for i in diff)
+            what = ", ".join(
+                f"{table.names[i]} {int(r.pixels[i])} in metadata vs {int(actual[i])} in EXR" for i in diff
+            )
             problems.append(f"{r.name}: {what}")
     return problems
 
@@ -227,9 +229,10 @@ def table2(data: ImageData) -> Table:
     rows = [[KIND_TITLES[k], *map(int, counts[i]), int(counts[i].sum())] for i, k in enumerate(KINDS)]
     rows.append(["Total", *map(int, counts.sum(0)), int(counts.sum())])
     ids = [*KINDS, "total"]
-    return Table("table2_conditions", "Table II. Distribution of images with respect to lighting and weather conditions",
+    return Table("table2_conditions",
+                 "Table II. Distribution of images with respect to lighting and weather conditions",
                  ["Weather", *(TIME_TITLES[t] for t in times), "Total"],
-                 ["weather", *times, "total"], rows, csv_rows=[[k, *r[1:]] for k, r in zip(ids, rows)])
+                 ["weather", *times, "total"], rows, csv_rows=[[k, *r[1:]] for k, r in zip(ids, rows, strict=False)])
 
 
 def chart(t1: Table) -> Figure:

@@ -75,7 +75,9 @@ class PanopticAccumulator:
         self.fn = np.zeros(n_classes, np.int64)
         self.iou_sum = np.zeros(n_classes, np.float64)
 
-    def add(self, pred_class: np.ndarray, pred_segment: np.ndarray, gt_class: np.ndarray, gt_segment: np.ndarray) -> None:
+    def add(
+        self, pred_class: np.ndarray, pred_segment: np.ndarray, gt_class: np.ndarray, gt_segment: np.ndarray
+    ) -> None:
         """Add one scan.
 
         Parameters
@@ -169,7 +171,9 @@ def format_panoptic(result: dict) -> str:
     def pct(v):
         return "n/a" if v is None else f"{100 * v:.2f}"
 
-    lines.append(f"PQ {pct(result['pq'])}  SQ {pct(result['sq'])}  RQ {pct(result['rq'])}  "
-                 f"PQ_things {pct(result['pq_things'])}  PQ_stuff {pct(result['pq_stuff'])}  PQ† {pct(result['pq_dagger'])}"
-                 f"  (min {result['min_points']} points per unmatched segment)")
+    lines.append(
+        f"PQ {pct(result['pq'])}  SQ {pct(result['sq'])}  RQ {pct(result['rq'])}  "
+        f"PQ_things {pct(result['pq_things'])}  PQ_stuff {pct(result['pq_stuff'])}  PQ† {pct(result['pq_dagger'])}"
+        f"  (min {result['min_points']} points per unmatched segment)"
+    )
     return "\n".join(lines)

@@ -58,7 +58,11 @@ class Track:
     def _where(self, t) -> tuple[np.ndarray, np.ndarray]:
         x = (np.atleast_1d(np.asarray(t, np.float64)) - self.t0) / self.dt
         x = np.clip(x, 0.0, len(self.yaw) - 1.0)
-        i = np.minimum(np.floor(x).astype(np.int64), len(self.yaw) - 2) if len(self.yaw) > 1 else np.zeros(len(x), np.int64)
+        i = (
+            np.minimum(np.floor(x).astype(np.int64), len(self.yaw) - 2)
+            if len(self.yaw) > 1
+            else np.zeros(len(x), np.int64)
+        )
         return i, x - i
 
     def position(self, t) -> np.ndarray:

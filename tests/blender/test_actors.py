@@ -196,7 +196,8 @@ def test_motion_blur_leaves_labels_exact(renders, town):
         moving |= off["labels"].instance == a.instance_id
     near = moving.copy()
     for shift in range(1, 9):
-        near |= np.roll(moving, shift, 1) | np.roll(moving, -shift, 1) | np.roll(moving, shift, 0) | np.roll(moving, -shift, 0)
+        near |= (np.roll(moving, shift, 1) | np.roll(moving, -shift, 1)
+                 | np.roll(moving, shift, 0) | np.roll(moving, -shift, 0))
     diff = np.abs(renders["on"]["still_rgb"] - off["rgb"]).mean(-1)
     crossing = off["labels"].instance == world.actors[1].instance_id
     assert diff[crossing].mean() > 10 * diff[~near].mean(), (diff[crossing].mean(), diff[~near].mean())
@@ -241,7 +242,7 @@ def test_written_metadata_records_time_and_visible_actors(tmp_path, test_spec, t
         assert a["speed_mps"] == pytest.approx(CARS[uid][3]) and a["instance_id"] == world.actors[uid].instance_id
     # (same Blender scene) each car's headlights drive with it: at its anchors, posed at the time set
     r.set_time(t + LATER)
-    for a, ob in zip(world.actors, r.actors.objects):
+    for a, ob in zip(world.actors, r.actors.objects, strict=False):
         lights = [np.array(x.matrix_world.translation) for x in r.night_lights.objects if x.parent == ob]
         anchors = world.prototypes[a.prototype].anchors["headlight"]
         pose = a.track.pose(t + LATER)[0]

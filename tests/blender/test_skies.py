@@ -98,14 +98,13 @@ def test_same_seed_same_image(rendered, tmp_path, root):
 def test_moving_cars_burn_tail_lights_at_night_parked_ones_do_not(tmp_path, test_spec, test_scene):
     """A car driving ahead of the camera shows red emitters at night (tail lights: red radiance some
     20x a lamp-lit white wall); the town's parked cars stay dark."""
-    from kits.actor_world import FRAME as ACTOR_FRAME
-    from kits.actor_world import car_world
-
     from generator.blender.renderer import Renderer
     from generator.jobs.exposure import expose
     from generator.spec.render import load_render_config
     from generator.weather import Lighting
     from generator.world.rig import Rig
+    from kits.actor_world import FRAME as ACTOR_FRAME
+    from kits.actor_world import car_world
 
     rig = Rig.from_spec(test_spec, test_scene)
     t = rig.frame(ACTOR_FRAME).t

@@ -5,9 +5,9 @@ from __future__ import annotations
 import json
 
 import pytest
-from kits.kitti_kit import as_predictions, synthetic, write_dir
 
 from generator import cli
+from kits.kitti_kit import as_predictions, synthetic, write_dir
 
 
 @pytest.fixture

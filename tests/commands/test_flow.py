@@ -8,10 +8,10 @@ import json
 from pathlib import Path
 
 import pytest
-from kits import motion_kit as mk
 
 from generator import cli
 from generator.dataset import Dataset
+from kits import motion_kit as mk
 
 
 @pytest.fixture(autouse=True)

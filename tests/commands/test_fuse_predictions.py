@@ -7,7 +7,6 @@ import shutil
 
 import numpy as np
 import pytest
-from kits.fusion_kit import write_raycast_images, write_raycast_stream
 from PIL import Image
 
 from generator.cli import main
@@ -16,6 +15,7 @@ from generator.imaging.exr import read_exr
 from generator.labels import class_table
 from generator.labels.class_sets import builtin_sets
 from generator.stats.evaluate import iou_from_confusion
+from kits.fusion_kit import write_raycast_images, write_raycast_stream
 
 T = class_table()
 HEAD = "occlusion=on,boundaries_and_proxies=excluded"

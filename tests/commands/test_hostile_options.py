@@ -24,14 +24,14 @@ from pathlib import Path
 
 import pytest
 
-hypothesis = pytest.importorskip("hypothesis")
-from hypothesis import HealthCheck, assume, given, settings
-from hypothesis import strategies as st
-
 from generator import cli
 from generator.commands import options
 from generator.safeload import printable
 from kits.paths import ROOT
+
+hypothesis = pytest.importorskip("hypothesis")
+from hypothesis import HealthCheck, assume, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
 
 SPEC = str(ROOT / "scenes" / "test_town.json")
 #: Seconds one refused command may take (option errors take milliseconds; a spec load ~0.1 s).
@@ -308,9 +308,13 @@ def test_number_accepts_exactly_finite_decimals_in_range(text, bounds):
 # -- whole command lines -----------------------------------------------------------------------------------------
 
 _FLAGS = sorted({o for n in COMMANDS for a in _parser_of(n)._actions for o in a.option_strings})
-_TOKENS = st.one_of(st.sampled_from(_FLAGS), st.sampled_from(_WORDS), st.sampled_from([c[0] for c in COMMANDS.values()]),
-                    st.sampled_from([".", "..", "-", "fit", "cityscapes", "all", "day:fog", "-q", "-v", "-vv"]),
-                    st.text(max_size=8))
+_TOKENS = st.one_of(
+    st.sampled_from(_FLAGS),
+    st.sampled_from(_WORDS),
+    st.sampled_from([c[0] for c in COMMANDS.values()]),
+    st.sampled_from([".", "..", "-", "fit", "cityscapes", "all", "day:fog", "-q", "-v", "-vv"]),
+    st.text(max_size=8),
+)
 
 
 @_cli_settings

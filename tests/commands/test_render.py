@@ -10,11 +10,11 @@ import json
 import numpy as np
 import pytest
 
-from generator.imaging.paths import image_dir
 from generator.cli import main
 from generator.imaging.exr import read_exr
-from generator.previews.preview import tonemap
+from generator.imaging.paths import image_dir
 from generator.labels import class_table
+from generator.previews.preview import tonemap
 from generator.weather import combinations
 
 pytestmark = pytest.mark.blender

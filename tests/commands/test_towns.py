@@ -90,7 +90,11 @@ def test_lidar_casts_the_town_it_is_asked_for(root, tmp_path):
 def test_render_groups_frames_by_town_as_generate_does(root, tmp_path):
     spec = load_spec(_spec(root, tmp_path, every=3))
     towns = towns_of(spec, [7, 0, 2, 3, 4])
-    assert [(t.town_index, first, frames) for t, first, frames in towns] == [(0, 0, [0, 2]), (1, 3, [3, 4]), (2, 6, [7])]
+    assert [(t.town_index, first, frames) for t, first, frames in towns] == [
+        (0, 0, [0, 2]),
+        (1, 3, [3, 4]),
+        (2, 6, [7]),
+    ]
     assert [t.seed for t, _, _ in towns] == [town_spec(spec, i).seed for i in range(3)]
     plain = parse_spec(json.loads((root / "scenes" / "test_town.json").read_text()), "plain.json")
     assert towns_of(plain, [2, 1]) == [(plain, 0, [1, 2])]

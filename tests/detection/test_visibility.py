@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from kits.box_kit import CUT, HEIGHT, HIDDEN, TRUCK, WIDTH, box_scene, instance_pass
 
 from generator.detection import subjects
 from generator.detection.visibility import difficulty, image_boxes, nuscenes_bin, occlusion_level
+from kits.box_kit import CUT, HEIGHT, HIDDEN, TRUCK, WIDTH, box_scene, instance_pass
 
 
 @pytest.fixture(scope="module")

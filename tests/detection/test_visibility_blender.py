@@ -5,10 +5,10 @@ from __future__ import annotations
 import dataclasses
 
 import pytest
-from kits.box_kit import CUT, HIDDEN, TRUCK, box_scene
 
 from generator.detection import subjects
 from generator.detection.visibility import image_boxes
+from kits.box_kit import CUT, HIDDEN, TRUCK, box_scene
 
 pytestmark = pytest.mark.blender
 

@@ -5,11 +5,11 @@ from __future__ import annotations
 from types import SimpleNamespace
 
 import numpy as np
-from kits import motion_kit as mk
 
 from generator.imaging.metadata import validate_metadata
 from generator.jobs.exposure import motion_record
 from generator.world import rig
+from kits import motion_kit as mk
 
 
 def test_motion_record_splits_ego_and_object_motion():

@@ -95,7 +95,9 @@ def test_compaction_is_the_union_in_a_canonical_order(tmp_path):
     b.load()
     b.compact()
     assert [p.name for p in b.segments()] == ["merged.log"]
-    assert (tmp_path / "a" / "journal" / "merged.log").read_bytes() == (tmp_path / "b" / "journal" / "merged.log").read_bytes()
+    assert (tmp_path / "a" / "journal" / "merged.log").read_bytes() == (
+        tmp_path / "b" / "journal" / "merged.log"
+    ).read_bytes()
     text = (tmp_path / "a" / "journal" / "merged.log").read_text()
     assert "frames 0-1 day:clear,night:rain" in text and "frames 2-2 day:clear" in text
 

@@ -5,13 +5,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from kits.stereo_kit import write_raycast_stereo
 
 from generator import cli
 from generator.formats.box_file import read_box_file
 from generator.formats.kitti_calib import read_calib
 from generator.formats.kitti_object import read_labels
 from generator.labels.detection import KITTI_TYPES
+from kits.stereo_kit import write_raycast_stereo
 
 SWEEPS = 21
 PAIRS = (0, 10, 20)

@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from kits import motion_kit as mk
 
 from generator.dataset import Dataset
 from generator.formats.kitti_flow import read_disparity_png, read_flow_png
 from generator.jobs.motion import write_motion
+from kits import motion_kit as mk
 
 
 @pytest.fixture(scope="module")

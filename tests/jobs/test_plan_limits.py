@@ -109,8 +109,9 @@ def test_generate_refuses_an_absurd_plan_at_once(tmp_path, capsys, extra, messag
 
 def test_render_frame_numbers_stay_six_digits(tmp_path, capsys):
     out = tmp_path / "ds"
-    err = _refused(capsys, ["render", SPEC, "--config", "test", "--out", str(out), "--first", "999999", "--frames", "2"],
-                   out)
+    err = _refused(
+        capsys, ["render", SPEC, "--config", "test", "--out", str(out), "--first", "999999", "--frames", "2"], out
+    )
     assert "frame 1000000 planned" in err
 
 
@@ -141,9 +142,13 @@ def test_a_resumed_plan_is_checked_merged(tmp_path, capsys):
 
     out = tmp_path / "ds"
     out.mkdir()
-    manifest = {"spec_hash": load_spec(SPEC).spec_hash, "render_config": {"config_hash": load_render_config("test").config_hash},
-                "plan": {"frame_ranges": [[999_998, 1_000_000]], "combos": [["day", "clear"]], "sequence": "00"},
-                "finished": {"images": 0}, "runs": []}
+    manifest = {
+        "spec_hash": load_spec(SPEC).spec_hash,
+        "render_config": {"config_hash": load_render_config("test").config_hash},
+        "plan": {"frame_ranges": [[999_998, 1_000_000]], "combos": [["day", "clear"]], "sequence": "00"},
+        "finished": {"images": 0},
+        "runs": [],
+    }
     (out / "manifest.json").write_text(json.dumps(manifest))
     before = sorted(p.name for p in out.iterdir())
     capsys.readouterr()

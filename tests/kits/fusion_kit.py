@@ -12,10 +12,10 @@ from pathlib import Path
 
 import numpy as np
 
-from generator.world import rig
 from generator.imaging.exr import LabelledImage, write_exr
 from generator.imaging.paths import image_path
 from generator.labels import class_table
+from generator.world import rig
 
 SKY = class_table().id("sky")
 
@@ -37,15 +37,17 @@ def raycast_image(caster, scene, T_world_camera: np.ndarray, K: np.ndarray, widt
 def write_raycast_images(root: Path, scene, spec, n_frames: int, width: int = 160, height: int = 96) -> None:
     """``root/images/SSSS/NNNNNN_day_clear.{exr,json}`` for frames 0..n-1 (the shard layout of
     :mod:`generator.imaging.paths`), ray-cast (metadata: the keys fusion reads)."""
-    from generator.world.rig import Rig
     from generator.lidar.caster import EmbreeCaster
+    from generator.world.rig import Rig
 
     caster = EmbreeCaster.from_scene(scene)
     K = rig.intrinsics(spec.sensors.camera.hfov_deg, width, height)
     for f in Rig.from_spec(spec, scene).frames(n_frames):
         cls, inst, depth = raycast_image(caster, scene, f.T_world_camera, K, width, height)
         name = f"{f.index:06d}_day_clear"
-        write_exr(image_path(root, name, ".exr"), LabelledImage(np.zeros((height, width, 3), np.float32), cls, inst, depth))
+        write_exr(
+            image_path(root, name, ".exr"), LabelledImage(np.zeros((height, width, 3), np.float32), cls, inst, depth)
+        )
         meta = {"image": name, "files": {"exr": f"{name}.exr"}, "frame": f.index,
                 "camera": {"T_world_camera": f.T_world_camera.tolist(), "T_ego_camera": f.T_ego_camera.tolist(),
                            "intrinsics": {"width": width, "height": height, "K": K.tolist()}},

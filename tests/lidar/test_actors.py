@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from kits.scene_kit import scene_of
 
 from generator.formats import semantickitti as sk
 from generator.geometry import box, icosphere, rect
@@ -21,6 +20,7 @@ from generator.lidar.tracks import TrackBank
 from generator.materials import material_table
 from generator.world import rig
 from generator.world.actors import MOVING_THRESHOLD_MPS, Actor, Track, World
+from kits.scene_kit import scene_of
 
 H = 1.73  # KITTI mount height
 DT = 0.05
@@ -128,7 +128,9 @@ def test_a_passing_car_is_smeared_exactly_as_each_column_saw_it(hdl64e, ground):
     on_car = p["instance"] == 42
     car = p[on_car]
     assert len(car) > 1000
-    assert np.all(car["class"] == class_table().id("car")) and np.all(car["material"] == material_table().id("car_paint"))
+    assert np.all(car["class"] == class_table().id("car")) and np.all(
+        car["material"] == material_table().id("car_paint")
+    )
     assert np.all(car["moving"] == 1) and not p["moving"][~on_car].any()
     # every hit, moved into the car's frame at its own firing time, lies on the box surface
     local = points_in_actor_frame(car, poses, tr, t0, s)
@@ -300,7 +302,10 @@ def test_culling_never_changes_a_point(hdl64e, ideal, tight, ego_speed, ego_turn
         if gap > np.linalg.norm(protos[kind].vertices, axis=1).max() + 0.5:  # nothing swallows the sensor
             movers.append((kind, 100 + i, tr))
     world = world_of(scene, movers, protos)
-    with Scanner(scene, sensor, threads=2, world=world) as culled, Scanner(scene, sensor, threads=2, world=world) as every:
+    with (
+        Scanner(scene, sensor, threads=2, world=world) as culled,
+        Scanner(scene, sensor, threads=2, world=world) as every,
+    ):
         every.actors.radius = np.full(len(movers), 1e4)  # every window is the whole sweep ...
         every.actors._column_windows = every_beam  # ... every beam of it, nothing is pre-culled
         a, b = culled.scan(poses, t0=0.3).points, every.scan(poses, t0=0.3).points

@@ -7,7 +7,6 @@ import dataclasses
 
 import numpy as np
 import pytest
-from kits.lidar_helpers import scene_of
 
 from generator.geometry import box, polygon, rect
 from generator.labels import class_table
@@ -15,6 +14,7 @@ from generator.lidar.returns import ReturnModel, ReturnParams, optics_from_mater
 from generator.lidar.scan import Scanner
 from generator.lidar.sensors import load_preset, with_returns
 from generator.world import rig
+from kits.lidar_helpers import scene_of
 
 H = 1.73
 POSE = rig.mount((0, 0, H), (0, 0, 0))
@@ -162,11 +162,10 @@ def test_physical_scans_do_not_depend_on_threads_or_chunks_and_noise_is_keyed(hd
 def test_points_that_are_not_mixed_agree_with_the_camera(hdl64e, test_spec, test_scene):
     """Project a physical sweep of the test town into a camera image ray-cast at the same instant: the
     points the camera sees (occlusion test) carry the class of their pixel, >= 99.5 % of those not mixed."""
-    from kits.fusion_kit import raycast_image
-
     from generator.fusion.projection import camera_from_lidar, project, transform, visible
     from generator.lidar.caster import EmbreeCaster
     from generator.world.rig import Rig
+    from kits.fusion_kit import raycast_image
 
     r = Rig.from_spec(test_spec, test_scene)
     f = r.frame(0)

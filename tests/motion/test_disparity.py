@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from kits import motion_kit as mk
 
 from generator.lidar.caster import EmbreeCaster
 from generator.motion.disparity import baseline, disparity
 from generator.world import rig
+from kits import motion_kit as mk
 
 W, H = 160, 96
 K = rig.intrinsics(90.0, W, H)

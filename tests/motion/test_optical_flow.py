@@ -8,12 +8,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from kits import motion_kit as mk
 
 from generator.fusion.projection import boundary_mask
 from generator.motion.optical_flow import ACTOR, KNOWN, VISIBLE, optical_flow
 from generator.world import rig
 from generator.world.kinematics import movers
+from kits import motion_kit as mk
 
 W, H = 160, 96
 K = rig.intrinsics(90.0, W, H)

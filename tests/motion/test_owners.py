@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import numpy as np
-from kits import motion_kit as mk
 
 from generator.motion.owners import _dilate, pixel_owners
 from generator.world import rig
 from generator.world.kinematics import movers
+from kits import motion_kit as mk
 
 W, H = 160, 96
 K = rig.intrinsics(90.0, W, H)

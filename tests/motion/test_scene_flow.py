@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from kits import motion_kit as mk
 from scipy.spatial import cKDTree
 
 from generator.formats.scene_flow import ego_flow
@@ -13,6 +12,7 @@ from generator.lidar.scan import Scanner
 from generator.lidar.sensors import load_preset
 from generator.motion.scene_flow import GONE, HIDDEN, SEEN, SceneFlow, next_sweep_flags, scene_flow
 from generator.world import rig as R
+from kits import motion_kit as mk
 
 DT = R.SWEEP_PERIOD_S
 MOVERS = (301, 302)

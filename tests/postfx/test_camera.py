@@ -240,7 +240,9 @@ class _Labels:
         self.class_id[: h // 4] = len(_class_names()) - 1
         self.instance = np.zeros((h, w), np.uint32)
         self.instance[h // 2 :, : w // 4] = 7
-        self.depth = np.where(np.arange(h)[:, None] < h // 4, np.inf, 5.0 + np.arange(w)[None, :] / 4).astype(np.float32)
+        self.depth = np.where(np.arange(h)[:, None] < h // 4, np.inf, 5.0 + np.arange(w)[None, :] / 4).astype(
+            np.float32
+        )
         self.seconds = {"real_pass": 0.01, "label_pass": 0.02}
 
 
@@ -318,9 +320,7 @@ def test_off_is_bit_identical_to_no_camera_model(written, test_spec, tod, kind):
     """Off: the EXR RGB is fog/rain's output as it was, the preview the fixed tone map, no record."""
     from generator.jobs.variants import camera_post, weather_post
     from generator.spec.render import load_render_config
-    from generator.weather import draw_lighting
-
-    from generator.weather import light_level
+    from generator.weather import draw_lighting, light_level
 
     img, meta, png = _read(written[0], tod, kind)
     r = _FakeRenderer(96, 160)
@@ -390,7 +390,9 @@ def test_rendered_night_is_darker_than_day_and_labels_match_off(tmp_path, root):
     from generator.imaging.exr import read_exr
 
     cfg = tmp_path / "test_camera.yaml"
-    cfg.write_text((root / "render_configs" / "test.yaml").read_text().replace("camera_model: false", "camera_model: true"))
+    cfg.write_text(
+        (root / "render_configs" / "test.yaml").read_text().replace("camera_model: false", "camera_model: true")
+    )
     outs = {}
     for name, config in (("on", str(cfg)), ("off", "test")):
         outs[name] = tmp_path / name

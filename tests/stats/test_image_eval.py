@@ -9,11 +9,11 @@ import sys
 
 import numpy as np
 import pytest
-from kits.label_images import perturb, write_dataset_images
 from PIL import Image
 
 import generator.cli as cli
 from generator.stats.image_eval import AVG_CLASS_SIZE, PixelEvaluator
+from kits.label_images import perturb, write_dataset_images
 
 FRAMES = (0, 1, 2)
 

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from kits import motion_kit as mk
 
 from generator.world import rig
 from generator.world.kinematics import camera_motion, ego_motion, movers
+from kits import motion_kit as mk
 
 R, V = 20.0, 8.0  # a circle of 20 m at 8 m/s: yaw rate 0.4 rad/s
 
