@@ -2,7 +2,7 @@
 
 Walks every module's imports with ``ast`` (module-level and function-level alike, so a lazy
 import cannot hide a back edge) and checks them against :data:`ALLOWED`, the layer table
-README's "Tour of the code" shows, and that no package has an import circle among its modules
+docs/architecture.md shows, and that no package has an import circle among its modules
 and sub-packages (:func:`test_no_import_circle_inside_a_package`).
 """
 
@@ -109,7 +109,7 @@ def _known(g: dict[str, set[str]], name: str) -> bool:
 
 def test_every_package_is_in_the_layer_table(graph):
     packages = {_package(m) for m in graph} - BASE
-    assert packages <= set(ALLOWED), f"add these packages to ALLOWED (and README): {sorted(packages - set(ALLOWED))}"
+    assert packages <= set(ALLOWED), f"add these packages to ALLOWED (and docs/architecture.md): {sorted(packages - set(ALLOWED))}"
 
 
 def test_imports_follow_the_layer_table(graph):

@@ -24,7 +24,8 @@ from generator.jobs.plan import check_free_space
 def register(sub) -> None:
     p = sub.add_parser("convert", help="relabel a SemanticKITTI-layout dataset into the unified 11 classes",
                        description=__doc__.split("\n\n")[1])
-    p.add_argument("input", type=path, help="SemanticKITTI root (holds sequences/NN) or a dataset folder (lidar/sequences/NN)")
+    p.add_argument("input", type=path, help="SemanticKITTI root (holds sequences/NN) or a dataset folder "
+                                                "(lidar/sequences/NN)")
     p.add_argument("output", type=path, help="output dataset root")
     p.add_argument("--labels", required=True, choices=tuple(TARGETS), help="target label set")
     p.add_argument("--sequences", type=sequence_list, default=None,

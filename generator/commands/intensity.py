@@ -29,7 +29,8 @@ def register(sub) -> None:
     actions = p.add_subparsers(dest="intensity_command", metavar="ACTION", parser_class=type(p))
     actions.required = True
     f = actions.add_parser("fit", help="fit a per-class intensity profile from a SemanticKITTI-layout dataset")
-    f.add_argument("dataset", type=path, help="SemanticKITTI root (sequences/NN/velodyne and labels) or a dataset folder (lidar/sequences/NN)")
+    f.add_argument("dataset", type=path, help="SemanticKITTI root (sequences/NN/velodyne and labels) or a "
+                                                  "dataset folder (lidar/sequences/NN)")
     f.add_argument("--sequences", type=sequence_list, default=None,
                    help="comma-separated sequence numbers (default: every labelled sequence)")
     f.add_argument("--labels", choices=LABEL_SPACES, default="semantickitti",

@@ -39,7 +39,8 @@ def register(sub) -> None:
     p = sub.add_parser("lidar", help="cast the virtual LiDAR along the route and write a SemanticKITTI sequence",
                        description=__doc__.split("\n\n")[1])
     p.add_argument("spec", type=text_path, help="scene spec JSON (e.g. scenes/default_town.json)")
-    p.add_argument("--out", required=True, type=path, help="dataset folder (lidar/sequences/NN/ is written inside, as generate does)")
+    p.add_argument("--out", required=True, type=path, help="dataset folder (lidar/sequences/NN/ is written inside, as "
+                                                                     "generate does)")
     p.add_argument("--frames", type=Integer(1, MAX_FRAMES), default=10,
                    help=f"number of consecutive 10 Hz sweeps (times.txt steps 0.1 s), 1..{MAX_FRAMES} "
                         "(default 10: one second of driving)")

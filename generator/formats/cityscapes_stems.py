@@ -18,7 +18,7 @@ from generator.errors import UserError
 from generator.formats.cityscapes import city_name, image_stem
 from generator.safeload import MAX_METADATA_BYTES, load_json, printable
 
-#: ``NNNNNN_<time>_<weather>``: the name of a dataset image (README, "What a dataset holds").
+#: ``NNNNNN_<time>_<weather>``: the name of a dataset image (docs/dataset.md).
 IMAGE_NAME = re.compile(r"^(\d{6})_([a-z]+)_([a-z_]+)$")
 
 

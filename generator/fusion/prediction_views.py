@@ -1,6 +1,6 @@
 """A model's image predictions found for the images of a sequence and projected onto its scans.
 
-Two kinds of images carry a sequence's camera view (README, "What a dataset holds"):
+Two kinds of images carry a sequence's camera view (docs/dataset.md):
 
 * the seed-003 images ``images/NNNNNN_<time>_<weather>`` of each frame, all weather x time variants sharing
   one camera, depth and label pass; a prediction is found by the Cityscapes stem the frame's export would

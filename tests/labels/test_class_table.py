@@ -10,7 +10,7 @@ from generator.labels import class_table
 from generator.materials import material_table
 
 T = class_table()
-# DESIGN.md's table: native -> (SemanticKITTI raw id, unified-11 name, Cityscapes id)
+# The class table (generator/labels/classes.yaml): native -> (SemanticKITTI raw id, unified-11 name, Cityscapes id)
 EXPECTED = {
     "unlabeled": (0, "unlabeled", 0), "road": (40, "road", 7), "road_marking": (60, "road", 7),
     "crosswalk": (60, "road", 7), "curb": (48, "sidewalk", 8), "sidewalk": (48, "sidewalk", 8),

@@ -1,6 +1,6 @@
 """The traffic drives in the town it is given: its grid, and its asset library.
 
-A re-drawn town (``town.redraw_every_frames``) shares the asset library of the spec's seed (README:
+A re-drawn town (``town.redraw_every_frames``) shares the asset library of the spec's seed (docs/architecture.md:
 "its asset prototypes stay those of ``seed``"), so a car driving past is one of the models parked in
 every town of the run. The moving fleet used to be drawn from a library of the town's own seed.
 """
