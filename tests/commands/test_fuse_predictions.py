@@ -12,6 +12,7 @@ from PIL import Image
 from generator.cli import main
 from generator.formats import semantickitti as sk
 from generator.imaging.exr import read_exr
+from generator.imaging.paths import find_image
 from generator.labels import class_table
 from generator.labels.class_sets import builtin_sets
 from generator.stats.evaluate import iou_from_confusion
@@ -39,7 +40,7 @@ def _predictions(root, folder, swap=None):
     """The ground truth as a model's output: export-stem PNGs of the frames, image_2-named PNGs of the stream."""
     folder.mkdir(parents=True)
     maps = {f"urbangen-day-clear_000000_{k:06d}_pred.png": T.to_cityscapes[read_exr(
-        root / "images" / f"{k:06d}_day_clear.exr").class_id] for k in (0, 1)}
+        find_image(root, f"{k:06d}_day_clear", ".exr")).class_id] for k in (0, 1)}
     maps["000001.png"] = np.array(Image.open(root / "lidar/sequences/00/semantic_2/000001.png"))
     for name, ids in maps.items():
         ids = ids.copy()

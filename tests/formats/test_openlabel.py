@@ -19,6 +19,7 @@ from generator.labels.detection import detection_classes
 from generator.world import rig
 from generator.world.scene import OrientedBox
 from kits.paths import SHARED
+from kits.sensor_kit import ideal
 
 REFERENCE_SCHEMA = SHARED / "reference" / "openlabel_json_schema-v1.0.0.json"
 
@@ -31,7 +32,9 @@ def town_dataset(tmp_path_factory, test_spec):
 
     root = tmp_path_factory.mktemp("olds")
     scene = build_scene(test_spec)
-    write_sequence(scene, test_spec, root / "lidar", SequenceOptions(frames=3, threads=2, bev=False), progress=False)
+    # the ideal sensor: cuboids are checked to hold every point of their object
+    write_sequence(scene, ideal(test_spec), root / "lidar", SequenceOptions(frames=3, threads=2, bev=False),
+                   progress=False)
     assert main(["openlabel", test_spec.source, str(root)]) == 0
     doc = json.loads((root / "openlabel" / "00.json").read_text())
     return root, scene, doc

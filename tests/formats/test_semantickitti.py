@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 import filecmp
 from pathlib import Path
 
@@ -21,6 +20,7 @@ from generator.labels import class_table
 from generator.world import rig
 from generator.world.rig import Rig
 from kits.scene_kit import scene_of, straight_path
+from kits.sensor_kit import with_lidar
 
 HEADING = 0.7  # a diagonal route, so the pose chain is tested with a rotation
 
@@ -138,8 +138,7 @@ def _static_scene():
 
 
 def _no_skew(spec):
-    lidar = dataclasses.replace(spec.sensors.lidar, motion_skew=False)
-    return dataclasses.replace(spec, sensors=dataclasses.replace(spec.sensors, lidar=lidar))
+    return with_lidar(spec, motion_skew=False, returns="ideal")  # points on their faces to the millimetre
 
 
 def _box_distance(p, center, size):

@@ -8,7 +8,6 @@ The exact checks cast the ideal sensor (first hits: points on the geometry); the
 
 from __future__ import annotations
 
-import dataclasses
 import json
 
 import numpy as np
@@ -20,6 +19,7 @@ from generator.formats import semantickitti as sk
 from generator.formats.box_file import read_box_file
 from generator.formats.point_sidecars import TIMES_DIR, read_sidecar
 from generator.labels import class_table
+from kits.sensor_kit import with_lidar
 
 SWEEPS = 5
 
@@ -37,8 +37,7 @@ def _cast(tmp_path_factory, root, returns):
                       "pedestrians_per_100m": 3, "standing_pedestrians_per_100m": 1}
     out = tmp_path_factory.mktemp("boxds")
     spec = parse_spec(doc, str(out / "spec.json"))
-    lidar = dataclasses.replace(spec.sensors.lidar, returns=returns)
-    spec = dataclasses.replace(spec, sensors=dataclasses.replace(spec.sensors, lidar=lidar))
+    spec = with_lidar(spec, returns=returns)
     scene = build_scene(spec)
     write_sequence(scene, spec, out / "lidar", SequenceOptions(frames=SWEEPS, threads=2, bev=False), progress=False)
     path, stats = write_sequence_boxes(spec, out, scene=scene)

@@ -16,6 +16,7 @@ from generator.cli import main
 from generator.dataset import Dataset
 from generator.formats.kitti_flow import read_disparity_png, read_flow_png
 from generator.fusion.projection import boundary_mask
+from generator.imaging.paths import find_image
 from generator.labels import class_table
 from generator.world import rig
 
@@ -92,7 +93,7 @@ def test_every_stream_and_scan_has_its_motion_files(dataset):
     assert dataset.image_flow("000001_day_clear").backward is not None
     scans = dataset.scan_indices()
     assert dataset.scene_flow(scans[0]) is not None and dataset.scene_flow(scans[-1]) is None
-    meta = json.loads((root / "images/000001_day_clear.json").read_text())
+    meta = json.loads(find_image(root, "000001_day_clear", ".json").read_text())
     ego = meta["motion"]["ego"]
     assert ego["speed_mps"] > 0.5 and set(ego["camera"]) == {"velocity_mps", "angular_velocity_rad_s"}
     assert all("velocity_camera_mps" in a for a in meta["motion"]["actors"])

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 import hashlib
 
 import numpy as np
@@ -10,6 +9,7 @@ import pytest
 
 from generator.formats import semantickitti as sk
 from generator.jobs.lidar_sequence import SequenceOptions, write_sequence
+from kits.sensor_kit import with_lidar
 
 #: sha256 of velodyne/00000[0-2].bin then labels/00000[0-2].label of ``urbangen lidar scenes/test_town.json
 #: --frames 3`` written before the physical sensor existed (commit dadd108)
@@ -17,8 +17,7 @@ IDEAL_TEST_TOWN = "22a9ddc354cca166ed47f6df92935d37592c1dc80932b0918808512654281
 
 
 def _with_returns(spec, returns):
-    lidar = dataclasses.replace(spec.sensors.lidar, returns=returns)
-    return dataclasses.replace(spec, sensors=dataclasses.replace(spec.sensors, lidar=lidar))
+    return with_lidar(spec, returns=returns)
 
 
 def _digest(seq) -> str:

@@ -12,6 +12,7 @@ from generator import cli
 from generator.formats import semantickitti as sk
 from generator.formats.box_file import read_box_file
 from generator.formats.point_sidecars import SIDECARS, read_sidecar
+from generator.imaging.paths import image_relpath
 from generator.rng import stream
 from generator.scan_effects.domain_gap import PRESETS, apply_domain_gap
 
@@ -94,7 +95,7 @@ def test_images_and_the_stereo_stream_come_along_unchanged(frozen_detection_data
     out = tmp_path / "twin"
     assert cli.main(["process", str(frozen_detection_dataset), str(out), "--domain-gap", "seed002",
                      "--dropout", "0.2"]) == 0
-    for rel in ("images/000001_day_clear.exr", "lidar/sequences/00/image_2/000010.png",
+    for rel in (image_relpath("000001_day_clear"), "lidar/sequences/00/image_2/000010.png",
                 "lidar/sequences/00/passes_3/000020.exr", "lidar/sequences/00/times.txt"):
         assert (out / rel).read_bytes() == (frozen_detection_dataset / rel).read_bytes()
     meta = json.loads((out / "lidar/sequences/00/lidar_meta.json").read_text())

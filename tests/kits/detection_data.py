@@ -13,7 +13,6 @@ point in its thing's box, which the physical sensor's mixed points and range noi
 
 from __future__ import annotations
 
-import dataclasses
 import json
 from pathlib import Path
 
@@ -42,10 +41,10 @@ def frozen_dataset(root: Path, spec, scene, sweeps: int = 21, pairs=(0, 10, 20),
     seed-003 frames, ``boxes/00.npz`` and ``openlabel/00.json``."""
     from generator.jobs.lidar_sequence import SequenceOptions, write_sequence
     from kits.fusion_kit import write_raycast_images
+    from kits.sensor_kit import ideal
     from kits.stereo_kit import write_raycast_stereo
 
-    lidar = dataclasses.replace(spec.sensors.lidar, returns="ideal")
-    spec = dataclasses.replace(spec, sensors=dataclasses.replace(spec.sensors, lidar=lidar))
+    spec = ideal(spec)
     write_sequence(scene, spec, root / "lidar", SequenceOptions(frames=sweeps, threads=2, bev=False), progress=False)
     write_raycast_stereo(root, scene, spec, pairs)
     if images:

@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from generator.imaging.exr import LabelledImage, write_exr
+from generator.imaging.paths import image_path
 from generator.labels import class_table
 
 T = class_table()
@@ -49,14 +50,15 @@ def street_image(frame: int, h: int = 60, w: int = 96) -> LabelledImage:
 
 def write_dataset_images(root: Path, frames, variants=(("day", "clear"), ("night", "rain_fog")),
                          sequence: str = "00") -> None:
-    """``root/images/NNNNNN_<time>_<weather>.{exr,json}`` and a manifest naming the sequence."""
+    """``root/images/SSSS/NNNNNN_<time>_<weather>.{exr,json}`` and a manifest naming the sequence."""
     for frame in frames:
         im = street_image(frame)
         for tod, weather in variants:
             name = f"{frame:06d}_{tod}_{weather}"
-            write_exr(root / "images" / f"{name}.exr", im)
+            image_path(root, name).parent.mkdir(parents=True, exist_ok=True)
+            write_exr(image_path(root, name, ".exr"), im)
             meta = {"image": name, "frame": frame, "time_of_day": tod, "weather": {"kind": weather}}
-            (root / "images" / f"{name}.json").write_text(json.dumps(meta))
+            image_path(root, name, ".json").write_text(json.dumps(meta))
     (root / "manifest.json").write_text(json.dumps({"plan": {"sequence": sequence, "frames": list(frames)}}))
 
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from generator import geometry as M
+from generator.imaging.paths import image_path
 from generator.labels import class_table
 from generator.lidar.caster import EmbreeCaster
 from generator.motion.optical_flow import View
@@ -131,11 +132,12 @@ def write_dataset(root, spec, scene, frames: int, stereo_sweeps=(), size=(96, 64
     for k in range(frames):
         f = local_frame(drive.rig, k)
         name = f"{k:06d}_day_clear"
-        write(root / "images" / f"{name}.exr", f.T_world_camera, f.t)
+        image_path(root, name).parent.mkdir(parents=True, exist_ok=True)
+        write(image_path(root, name, ".exr"), f.T_world_camera, f.t)
         meta = {"image": name, "frame": k, "time_s": f.t,
                 "camera": {"T_world_camera": f.T_world_camera.tolist(), "T_ego_camera": f.T_ego_camera.tolist(),
                            "intrinsics": {"width": w, "height": h, "K": K.tolist()}}}
-        (root / "images" / f"{name}.json").write_text(json.dumps(meta))
+        image_path(root, name, ".json").write_text(json.dumps(meta))
     seq = root / "lidar" / "sequences" / "00"
     for j in stereo_sweeps:
         t = rig.Rig.sweep_time(j)
