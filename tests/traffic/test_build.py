@@ -55,3 +55,20 @@ def test_the_traffic_drives_on_the_grid_and_library_the_town_was_built_from(town
     assert scene1.library.seed == DOC["seed"]            # the spec's seed, not the town's
     for a in world.actors:                               # every moving model is the library's own mesh
         assert world.prototypes[a.prototype] is scene1.library.protos[a.prototype.removeprefix("actor_")].mesh
+
+
+def test_a_vehicle_no_lane_admits_is_a_spec_error(root, monkeypatch):
+    """A town whose every lane is too narrow for a requested vehicle beside its parked objects (kitti_like's
+    2.75 m lanes for a bus, in some towns) refuses the spec naming the field, not with an internal error."""
+    import json
+
+    import generator.traffic.build as tb
+    from generator.errors import SpecError
+
+    doc = json.loads((root / "scenes" / "test_town.json").read_text())
+    doc["traffic"] = {"cars_per_km": 0, "buses_per_km": 3}
+    spec = parse_spec(doc, "buses.json")
+    scene = build_scene(spec)
+    monkeypatch.setattr(tb, "too_narrow", lambda graph, *a: [e.index for e in graph.lanes()])
+    with pytest.raises(SpecError, match=r"buses.json.*traffic.buses_per_km.*no lane of the town is wide enough"):
+        build_world(spec, scene, 10.0)
