@@ -289,8 +289,9 @@ def _check_capacity(spec) -> None:
 
 def _free_spot(graph, free, taken, length, g, field_name, spec):
     if not free:  # every lane too narrow for this vehicle between the parked objects
-        raise SpecError(spec.source, f"traffic.{field_name}", "no lane of the town is wide enough for this vehicle "
-                                                              "beside the parked objects; set it to 0 or widen the lanes")
+        raise SpecError(spec.source, f"traffic.{field_name}",
+                        "no lane of the town is wide enough for this vehicle beside the parked objects; "
+                        "set it to 0 or widen the lanes")
     lengths = np.array([e.length for e in free])
     for _ in range(200):
         e = free[int(g.choice(len(free), p=lengths / lengths.sum()))]
