@@ -121,7 +121,7 @@ def skeleton(rng: np.random.Generator, sp: Species, height: float, base: float, 
         r0 = trunk_r * rng.uniform(0.4, 0.5)
         segs.append((start, end, r0, r0 * 0.5))
         frontier.append((start, end, r0 * 0.5))
-    for level in range(sp.levels):
+    for _level in range(sp.levels):
         nxt = []
         for p0, p1, r in frontier:
             d = _unit(p1 - p0)

@@ -101,8 +101,9 @@ def tree(rng: np.random.Generator, height: float, species: str | None = None) ->
     Mesh
         Trunk and branches (class ``tree_trunk``, the species' bark material) and separate
         leaf clumps (class ``tree_crown``, the species' leaf material; big 80-triangle clumps
-        and, for broad-leaved species, small 20-triangle tufts) with open gaps between them, at most :data:`TRI_BUDGET` triangles. The crown base is at least 2.4 m above
-        the ground; the top is exactly ``height``.
+        and, for broad-leaved species, small 20-triangle tufts) with open gaps between them, at most
+        :data:`TRI_BUDGET` triangles. The crown base is at least 2.4 m above the ground; the top is
+        exactly ``height``.
     """
     if not 3.0 <= height <= 30.0:
         raise ValueError(f"tree height must be in [3, 30] m, got {height}")

@@ -154,7 +154,8 @@ def car(rng: np.random.Generator, variant: str | None = None) -> Mesh:
     bottom_f, bottom_r = float(info["bottom"][-1]), float(info["bottom"][0])
     parts.append(box((0.08, 2 * yl - 0.42, 0.13), "car", "car_trim", (L / 2 - 0.035, 0, nose - 0.12)))  # grille
     parts.append(box((0.03, 0.52, 0.11), "car", "licence_plate", (L / 2 + PROUD_M - 0.015, 0, bottom_f + 0.1)))
-    parts.append(box((0.03, 0.52, 0.11), "car", "licence_plate", (-L / 2 - PROUD_M + 0.015, 0, max(bottom_r + 0.1, tail_top - 0.3))))
+    plate_z = max(bottom_r + 0.1, tail_top - 0.3)
+    parts.append(box((0.03, 0.52, 0.11), "car", "licence_plate", (-L / 2 - PROUD_M + 0.015, 0, plate_z)))
     i_a = int(np.searchsorted(xs, info["xa"]))
     hw_a = float(half[min(i_a, len(half) - 1)])
     for side in (1.0, -1.0):
@@ -187,7 +188,8 @@ def truck(rng: np.random.Generator) -> Mesh:
     cab = prism(np.array(prof), -W / 2, W / 2, "truck", "truck_paint", bottom=True).transformed(pose(roll=np.pi / 2))
     floor = float(rng.uniform(1.05, 1.2))
     x_box0 = xback - 0.12
-    parts = [cab, box((x_box0 + L / 2, W, H - floor), "truck", "truck_paint", ((x_box0 - L / 2) / 2, 0, (H + floor) / 2)),
+    parts = [cab,
+             box((x_box0 + L / 2, W, H - floor), "truck", "truck_paint", ((x_box0 - L / 2) / 2, 0, (H + floor) / 2)),
              box((x_box0 + L / 2 - 0.3, 0.9, 0.3), "truck", "rubber", ((x_box0 - L / 2 + 0.3) / 2, 0, floor - 0.15)),
              box((0.25, 0.12, 0.25), "truck", "rubber", (xback - 0.06, 0, floor - 0.1)),
              box((0.15, W - 0.04, 0.22), "truck", "rubber", (L / 2 - 0.075, 0, zb + 0.05)),
@@ -204,7 +206,8 @@ def truck(rng: np.random.Generator) -> Mesh:
         parts.append(box((0.08, 0.08, 0.4), "truck", "chrome", (xfront - 0.3, side * (W / 2 + 0.04), cab_h - 0.75)))
         parts.append(wheel(xf, W / 2 - 0.02, side, r, 0.28, "truck", 16))
         parts.append(wheel(xr, W / 2 - 0.02, side, r, 0.28, "truck", 16))
-        parts.append(cylinder(r, 0.28, "truck", "rubber", 16).transformed(pose(xr, side * (W / 2 - 0.32), r, roll=side * np.pi / 2)))
+        rear = cylinder(r, 0.28, "truck", "rubber", 16)
+        parts.append(rear.transformed(pose(xr, side * (W / 2 - 0.32), r, roll=side * np.pi / 2)))
     head = np.array([[xfront + 0.02, s * (W / 2 - 0.3), 0.75] for s in (1, -1)])
     tail = np.array([[-L / 2 - 0.02, s * (W / 2 - 0.25), floor - 0.3] for s in (1, -1)])
     for c in head:

@@ -131,7 +131,8 @@ def road_shots(scene) -> list[tuple[str, np.ndarray]]:
         out.append((f"road: {path.name} at {s * path.length():.0f} m", look_at(eye, p + d * ahead)))
     (p,), (hd,) = path.at(0.4 * path.length())
     d = np.array([np.cos(hd), np.sin(hd), 0.0])
-    out.append(("road from 14 m above (manholes, patches, cracks)", look_at(p + [0.0, 0.0, 14.0] - 0.5 * d, p + d * 1.0)))
+    out.append(("road from 14 m above (manholes, patches, cracks)",
+                look_at(p + [0.0, 0.0, 14.0] - 0.5 * d, p + d * 1.0)))
     return out
 
 
@@ -155,8 +156,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--only", nargs="*", default=["trees", "facades", "road"])
     args = ap.parse_args(argv)
 
-    from generator.layout import build_scene
     from generator.blender.renderer import Renderer
+    from generator.layout import build_scene
 
     spec = load_spec(args.spec)
     t0 = time.perf_counter()

@@ -17,8 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from generator.geometry import Mesh
 from generator.blender.bpy_guard import bpy, mathutils
+from generator.geometry import Mesh
 from generator.materials import material_table
 from generator.world.scene import SceneModel
 
@@ -31,14 +31,14 @@ SMOOTH_MATERIALS = frozenset({"leaves", "hedge_leaves", "bark", "skin", "hair", 
 class BlenderScene:
     """Handles to what :func:`build` created."""
 
-    real: "bpy.types.Collection"
-    proxies: "bpy.types.Collection"
+    real: bpy.types.Collection
+    proxies: bpy.types.Collection
     objects: list
     proxy_objects: list
     meshes: dict
 
 
-def mesh(name: str, m: Mesh, materials: list) -> "bpy.types.Mesh":
+def mesh(name: str, m: Mesh, materials: list) -> bpy.types.Mesh:
     """A Blender mesh of ``m``: its faces, material slots, flat/smooth shading and per-face ``class_id``."""
     me = bpy.data.meshes.new(name)
     n_v, n_f = len(m.vertices), m.n_faces
@@ -61,7 +61,7 @@ def mesh(name: str, m: Mesh, materials: list) -> "bpy.types.Mesh":
     return me
 
 
-def build(scene: SceneModel, materials: list, parent: "bpy.types.Collection") -> BlenderScene:
+def build(scene: SceneModel, materials: list, parent: bpy.types.Collection) -> BlenderScene:
     """Create every object of ``scene`` under ``parent``.
 
     Parameters
@@ -118,7 +118,7 @@ def lights_on(attrs: dict) -> bool:
     return attrs.get("placement") not in ("parked", "rack")
 
 
-def _matrix(t: np.ndarray) -> "mathutils.Matrix":
+def _matrix(t: np.ndarray) -> mathutils.Matrix:
     return mathutils.Matrix([list(map(float, row)) for row in t])
 
 
@@ -140,7 +140,7 @@ def set_proxies_visible(bs: BlenderScene, visible: bool) -> None:
             setattr(ob, flag, visible)
 
 
-def evaluated_triangles(depsgraph, collection: "bpy.types.Collection") -> tuple[int, np.ndarray]:
+def evaluated_triangles(depsgraph, collection: bpy.types.Collection) -> tuple[int, np.ndarray]:
     """Triangle count and (2, 3) world bounds of the evaluated objects of ``collection``.
 
     Used by tests to hold Blender's geometry equal to the SceneModel.

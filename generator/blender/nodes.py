@@ -30,7 +30,7 @@ def _rgba(v):
 class Nodes:
     """Node-tree builder for one material, world or node group."""
 
-    def __init__(self, tree: "bpy.types.NodeTree", clear: bool = True):
+    def __init__(self, tree: bpy.types.NodeTree, clear: bool = True):
         self.tree = tree
         if clear:
             tree.nodes.clear()
@@ -157,7 +157,7 @@ class Nodes:
             els.remove(els[-1])
         while len(els) < len(stops):
             els.new(0.5)
-        for el, (pos, col) in zip(els, stops):
+        for el, (pos, col) in zip(els, stops, strict=False):
             el.position = pos
             el.color = _rgba(col)
         self.set(n.inputs[0], factor)

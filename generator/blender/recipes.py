@@ -123,7 +123,8 @@ def facade_plaster(g, rng):
     uv, co = _wall_coords(g)
     n = g.noise(co, scale=4, detail=6)
     stains = g.smooth(g.noise(g.mapping(co, scale=(1, 1, 0.3)), scale=0.8, detail=4), 0.55, 0.75)
-    base = g.mix(g.mul(stains, 0.35), g.ramp(n, [(0.4, (0.92,) * 3), (0.6, (1.0,) * 3)]), (0.45, 0.42, 0.38), "MULTIPLY")
+    base = g.mix(g.mul(stains, 0.35), g.ramp(n, [(0.4, (0.92,) * 3), (0.6, (1.0,) * 3)]), (0.45, 0.42, 0.38),
+                 "MULTIPLY")
     return g.principled(base_color=_tint(g, base), roughness=0.9, normal=g.bump(n, 0.15, 0.02))
 
 

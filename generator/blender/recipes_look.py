@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from generator.blender.controls import CONTROL
 from generator.blender.nodes import Nodes
 from generator.blender.recipes import _emit, _foliage, _jit, _tint, _wall_coords
-from generator.blender.controls import CONTROL
 
 
 def bark_birch(g: Nodes, rng: np.random.Generator):

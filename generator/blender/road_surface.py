@@ -56,14 +56,17 @@ def road_wear(g: Nodes, co, base, tone: float, rng: np.random.Generator):
     inside = g.mul(band(fx, 0.12, 0.82), band(fy, 0.15, 0.8))
     seam = g.math("SUBTRACT", g.mul(band(fx, 0.11, 0.83), band(fy, 0.14, 0.81)), inside)
     patch = g.mul(present, inside)
-    patch_col = g.mix(g.math("GREATER_THAN", r, PATCH_SHARE / 2), (tone * 0.7,) * 3, (tone * 1.6, tone * 1.55, tone * 1.5))
+    patch_col = g.mix(g.math("GREATER_THAN", r, PATCH_SHARE / 2), (tone * 0.7,) * 3,
+                      (tone * 1.6, tone * 1.55, tone * 1.5))
     out = g.mix(g.mul(patch, 0.85), base, patch_col)
     out = g.mix(g.mul(g.mul(present, seam), 0.9), out, (0.012, 0.012, 0.012))
     # oil and tyre stains: soft dark blotches, a little glossier
-    stains = g.mul(g.smooth(g.noise(co, scale=0.35, detail=3), 0.56, 0.68), g.smooth(g.noise(co, scale=2.5, detail=3), 0.3, 0.6))
+    stains = g.mul(g.smooth(g.noise(co, scale=0.35, detail=3), 0.56, 0.68),
+                   g.smooth(g.noise(co, scale=2.5, detail=3), 0.3, 0.6))
     out = g.mix(g.mul(stains, 0.75), out, (tone * 0.35,) * 3)
     # alligator cracking in worn zones: a fine cell network on noise-warped coordinates
-    warp = _vadd(g, g.mapping(co, scale=(1, 1, 0)), g.mapping(g.noise(co, scale=1.5, detail=2, out="Color"), scale=(0.6, 0.6, 0)))
+    warp = _vadd(g, g.mapping(co, scale=(1, 1, 0)),
+                 g.mapping(g.noise(co, scale=1.5, detail=2, out="Color"), scale=(0.6, 0.6, 0)))
     net = g.math("SUBTRACT", 1.0, g.smooth(g.voronoi(warp, scale=1.6, feature="DISTANCE_TO_EDGE"), 0.0, 0.025))
     zone = g.smooth(g.noise(co, scale=0.09, detail=2), 0.6, 0.66)
     cracks = g.mul(net, zone)

@@ -109,9 +109,9 @@ class Scanner:
     Notes
     -----
     Per sweep, each chunk of firing columns is rotated into the world in float32 relative
-    to the caster's re-centring point (:func:`generator.lidar.kernels.world_rays`) (the float64 pose translation minus the centre is
-    taken first, so nothing large is ever rounded), cast against the town, then against the
-    actors that can reach it (their plan is computed on the calling thread while the workers
+    to the caster's re-centring point (:func:`generator.lidar.kernels.world_rays`) (the float64 pose
+    translation minus the centre is taken first, so nothing large is ever rounded), cast against the town,
+    then against the actors that can reach it (their plan is computed on the calling thread while the workers
     cast the town), and turned into records (:meth:`generator.lidar.points.RecordTables.fill`)
     written straight into the sweep's array at the chunk's offset, which the chunk learns
     from the previous one once that one knows its hit count (chunks start in order, so
