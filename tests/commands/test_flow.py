@@ -11,6 +11,7 @@ import pytest
 
 from generator import cli
 from generator.dataset import Dataset
+from generator.imaging.paths import find_image
 from kits import motion_kit as mk
 
 
@@ -79,7 +80,7 @@ def test_a_folder_without_a_manifest_is_refused(tmp_path, capsys, test_spec, tes
 
 def test_a_damaged_image_json_is_refused(tmp_path, capsys, test_spec, test_scene):
     mk.write_dataset(tmp_path, test_spec, test_scene, 2)
-    meta = tmp_path / "images/000001_day_clear.json"
+    meta = find_image(tmp_path, "000001_day_clear", ".json")
     doc = json.loads(meta.read_text())
     doc["camera"]["T_world_camera"] = [[1, 0], [0, 1]]
     meta.write_text(json.dumps(doc))
