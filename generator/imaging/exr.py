@@ -201,6 +201,23 @@ def _class_names(hdr: dict, path) -> list[str]:
     return names
 
 
+def _read_checked(path: str | Path) -> tuple[bytes, dict, int, int]:
+    """(file bytes, header, width, height) of an EXR whose size and channel count are within the limits
+    (:data:`MAX_EXR_BYTES`, :data:`MAX_PIXELS`, :data:`MAX_CHANNELS`); one-line UserError otherwise."""
+    data = safeload.read_bytes(path, max_bytes=MAX_EXR_BYTES)
+    hdr, _ = _open(data, path, header_only=True)
+    try:
+        lo, hi = (np.asarray(v, np.int64) for v in hdr["dataWindow"])
+        w, h = (int(v) + 1 for v in hi - lo)
+        n_channels = len(hdr["channels"])
+    except (KeyError, TypeError, ValueError):
+        raise UserError(f"{printable(path)}: EXR header without a data window or channel list") from None
+    if not (0 < w and 0 < h and w * h <= MAX_PIXELS) or n_channels > MAX_CHANNELS:
+        raise UserError(f"{printable(path)}: EXR of {w}x{h} pixels and {n_channels} channels; at most "
+                        f"{MAX_PIXELS} pixels and {MAX_CHANNELS} channels are read")
+    return data, hdr, w, h
+
+
 def read_exr(path: str | Path) -> LabelledImage:
     """Read a dataset EXR; the class map is rebuilt from the mask channels, matched to the current
     class table BY NAME (the header's ``urbangen.classes`` says which masks the file has).
@@ -216,17 +233,7 @@ def read_exr(path: str | Path) -> LabelledImage:
         know, lacks a channel, has channels of the wrong type or size, or its masks are not a
         partition. One line, never quoting the file.
     """
-    data = safeload.read_bytes(path, max_bytes=MAX_EXR_BYTES)
-    hdr, _ = _open(data, path, header_only=True)
-    try:
-        lo, hi = (np.asarray(v, np.int64) for v in hdr["dataWindow"])
-        w, h = (int(v) + 1 for v in hi - lo)
-        n_channels = len(hdr["channels"])
-    except (KeyError, TypeError, ValueError):
-        raise UserError(f"{printable(path)}: EXR header without a data window or channel list") from None
-    if not (0 < w and 0 < h and w * h <= MAX_PIXELS) or n_channels > MAX_CHANNELS:
-        raise UserError(f"{printable(path)}: EXR of {w}x{h} pixels and {n_channels} channels; at most "
-                        f"{MAX_PIXELS} pixels and {MAX_CHANNELS} channels are read")
+    data, hdr, w, h = _read_checked(path)
     names = _class_names({k: v for k, v in hdr.items() if isinstance(k, str)}, path)
     _, ch = _open(data, path, header_only=False)
     masks = {n: mask_channel(n) if mask_channel(n) in ch else f"mask.{n}" for n in names}
@@ -264,17 +271,7 @@ def read_channels(path: str | Path, names: list[str]) -> tuple[dict[str, np.ndar
     UserError
         Not a (complete) EXR, too large, or a channel in ``names`` missing or of another size; one line.
     """
-    data = safeload.read_bytes(path, max_bytes=MAX_EXR_BYTES)
-    hdr, _ = _open(data, path, header_only=True)
-    try:
-        lo, hi = (np.asarray(v, np.int64) for v in hdr["dataWindow"])
-        w, h = (int(v) + 1 for v in hi - lo)
-        n_channels = len(hdr["channels"])
-    except (KeyError, TypeError, ValueError):
-        raise UserError(f"{printable(path)}: EXR header without a data window or channel list") from None
-    if not (0 < w and 0 < h and w * h <= MAX_PIXELS) or n_channels > MAX_CHANNELS:
-        raise UserError(f"{printable(path)}: EXR of {w}x{h} pixels and {n_channels} channels; at most "
-                        f"{MAX_PIXELS} pixels and {MAX_CHANNELS} channels are read")
+    data, hdr, w, h = _read_checked(path)
     _, ch = _open(data, path, header_only=False)
     missing = [c for c in names if c not in ch]
     if missing:
