@@ -206,7 +206,8 @@ def list_sequences(root: str | Path) -> list[str]:
     """Sequence folder names under ``root/sequences`` (digits only), in numeric order (``99`` before ``100``)."""
     base = Path(root) / "sequences"
     if not base.is_dir():
-        raise UserError(f"{base}: not a SemanticKITTI dataset (no sequences/ folder)")
+        raise UserError(f"{base}: not a SemanticKITTI dataset (no sequences/ folder, nor lidar/sequences/ of a "
+                        "dataset folder)")
     return sorted((p.name for p in base.iterdir() if p.is_dir() and p.name.isascii() and p.name.isdigit()),
                   key=lambda n: (int(n), n))
 

@@ -76,7 +76,7 @@ class SemanticKittiSource:
             names = sk.list_sequences(self.root)
         except UserError:
             raise UserError(f"{role}: {printable(self.root)}: not a SemanticKITTI-layout folder "
-                            "(no sequences/ folder)") from None
+                            "(no sequences/ folder, nor lidar/sequences/ of a dataset folder)") from None
         self.sequences = [sk.Sequence(self.root, n) for n in (sequences or names)
                           if sequences or (self.root / "sequences" / n / "velodyne").is_dir()]
         self.frames = {s.dir.name: s.frames[::every] for s in self.sequences}
