@@ -163,9 +163,11 @@ class RunSource:
                     attempt=attempt)
 
     def _town_threads(self) -> int | None:
+        """Threads of a scan or finish task: its share of the cores. A run of one town has nothing to run
+        beside its scan and its finishing (they come before and after its renders), so they get every core."""
         if self.s.executor != "local" or self.s.workers <= 1:
             return None
-        return max(1, (os.cpu_count() or 1) // self.s.workers)
+        return max(1, (os.cpu_count() or 1) // min(self.s.workers, len(self.s.towns)))
 
     def _stage_task(self, t: _Town, stage: str, attempt: int = 0) -> Task:
         run = t.run
