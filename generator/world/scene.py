@@ -90,6 +90,8 @@ class Path:
 
     def at(self, s: np.ndarray | float) -> tuple[np.ndarray, np.ndarray]:
         """Positions (k, 3) and headings (k,) at arc lengths ``s`` (metres; wrapped on loops)."""
+        if not self.closed and isinstance(s, float):   # one vehicle's pose, every step of the traffic simulation
+            return self._at_one(s)
         s = np.atleast_1d(np.asarray(s, np.float64))
         pts, hd, ss = self.points, self.headings, self.s
         if self.closed:
@@ -104,6 +106,19 @@ class Path:
         pos = pts[i] * (1 - t) + pts[i + 1] * t
         dh = np.angle(np.exp(1j * (hd[i + 1] - hd[i])))
         return pos, np.angle(np.exp(1j * (hd[i] + t[:, 0] * dh)))
+
+    def _at_one(self, s: float) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`at` of one arc length on an open path: the same arithmetic on scalars (same bytes)."""
+        pts, hd, ss = self.points, self.headings, self.s
+        s = s if s > 0.0 else 0.0               # np.clip's order: max with the low end, then min with the high
+        last = ss[-1]
+        s = s if s < last else last
+        i = min(max(int(ss.searchsorted(s, side="right")) - 1, 0), len(ss) - 2)
+        gap = ss[i + 1] - ss[i]
+        t = (s - ss[i]) / (gap if gap >= 1e-12 else 1e-12)
+        pos = pts[i] * (1 - t) + pts[i + 1] * t
+        dh = np.angle(np.exp(1j * (hd[i + 1] - hd[i])))
+        return pos[None], np.atleast_1d(np.angle(np.exp(1j * (hd[i] + t * dh))))
 
 
 @dataclass

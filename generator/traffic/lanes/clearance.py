@@ -102,6 +102,14 @@ def blocked_lanes(graph, scene, half_width: float) -> set[int]:
     set of int
         Indices of the blocked lane edges.
     """
+    memo = graph.__dict__.setdefault("_blocked_lane_memo", {})   # asked once per moving vehicle: by width
+    key = (id(scene), float(half_width))
+    if key not in memo:
+        memo[key] = _blocked_lanes(graph, scene, half_width)
+    return set(memo[key])
+
+
+def _blocked_lanes(graph, scene, half_width: float) -> set[int]:
     quads = [o.box.corners_xy() for o in scene.objects if o.instance_id > 0]
     if not quads:
         return set()

@@ -38,8 +38,12 @@ ABOUT_TO_ENTER_M = 10.0  #: a vehicle this close to its give-way line counts as 
 
 def approach_arm(graph, lane) -> int:
     """The arm of ``lane.node`` (a node it arrives at) that the lane edge ``lane`` comes in by."""
-    d = lane.path.points[-1, :2] - graph.grid.node_xy(lane.node)
-    return int(np.argmax(ARM_DIRS @ d))
+    memo = graph.__dict__.setdefault("_approach_arm_memo", {})   # asked for every waiting vehicle every step
+    arm = memo.get(lane.index)
+    if arm is None:
+        d = lane.path.points[-1, :2] - graph.grid.node_xy(lane.node)
+        arm = memo[lane.index] = int(np.argmax(ARM_DIRS @ d))
+    return arm
 
 
 @functools.lru_cache(maxsize=256)
