@@ -27,13 +27,16 @@ GLASS_STEP_M = 1e-3
 SPLIT_STEP_M, SPLIT_STEP_REL = 0.05, 0.01
 
 
-def _actor_hits(scanner, plan, cols, o, d, dist, face, rows=None, offset=None):
-    """Actors occlude the rays (arrays updated in place); returns per-ray (instance or -1, moving)."""
+def _actor_hits(scanner, plan, cols, o, d, dist, face, aimed, rows=None, offset=None):
+    """Actors occlude the rays (arrays updated in place); returns per-ray (instance or -1, moving).
+
+    ``aimed`` is :meth:`generator.lidar.actors.ActorCaster.aim` of ``cols``, computed once per chunk.
+    """
     inst = np.full(len(dist), -1, np.int32)
     moving = np.zeros(len(dist), np.uint8)
-    if plan is None or len(dist) == 0:
+    if plan is None or aimed is None or len(dist) == 0:
         return inst, moving
-    hit = scanner.actors.cast(plan, cols, o, d, dist, face, rows=rows, offset=offset)
+    hit = scanner.actors.cast(plan, cols, o, d, dist, face, rows=rows, offset=offset, aimed=aimed)
     if hit is not None:
         actor, mov = hit
         m = np.flatnonzero(actor >= 0)
@@ -56,7 +59,7 @@ def _unique_pairs(beam: np.ndarray, which: np.ndarray, k: int) -> tuple[np.ndarr
     return code // k, code % k
 
 
-def _cast_subrays(scanner, plan, cols, o_w, d_world, beam_rows, which, pattern, i0, n_in, max_range) -> dict:
+def _cast_subrays(scanner, plan, cols, aimed, o_w, d_world, beam_rows, which, pattern, i0, n_in, max_range) -> dict:
     """Cast the sub-rays ``(beam_rows, which)`` (ordered by beam) against the town and the actors."""
     m = len(beam_rows)
     o, d = np.empty((m, 3), np.float32), np.empty((m, 3), np.float32)
@@ -66,7 +69,7 @@ def _cast_subrays(scanner, plan, cols, o_w, d_world, beam_rows, which, pattern, 
     beam = beam_rows - i0
     ptr = np.zeros(n_in + 1, np.int64)
     ptr[1:] = np.bincount(beam, minlength=n_in)
-    inst, moving = _actor_hits(scanner, plan, cols, o, d, dist, face, rows=(np.cumsum(ptr), np.arange(m)))
+    inst, moving = _actor_hits(scanner, plan, cols, o, d, dist, face, aimed, rows=(np.cumsum(ptr), np.arange(m)))
     return {"o": o, "dw": dw, "df": d, "dist": dist, "face": face, "inst": inst, "moving": moving, "beam": beam}
 
 
@@ -85,13 +88,19 @@ def run_physical_chunk(scanner, sweep, i: int, cols: slice) -> None:
         d_world = d_w.copy()  # the actors replace the directions of their hits by local ones
         dist, face = scanner.caster.intersect_local(o_w, d_w, hi_r, mark_misses=False)
         plan = sweep.get_plan()
-        inst, moving = _actor_hits(scanner, plan, slice(a, b), o_w, d_w, dist, face)
+        # which beams may meet which actor: once per chunk, for the central rays, the sub-rays and the glass
+        aimed = scanner.actors.aim(plan, slice(a, b)) if plan is not None else None
+        inst, moving = _actor_hits(scanner, plan, slice(a, b), o_w, d_w, dist, face, aimed)
         i0, i1 = (cols.start - a) * L, (cols.stop - a) * L
         n_in = i1 - i0
-        edge, side = np.empty(n_in, np.int64), np.empty(n_in, np.uint8)
-        n_edge = edge_beams(dist, face, inst, faces, a, cols.start, cols.stop, L, lo_r, hi_r, p.edge_step, edge, side)
-        edge, side = edge[:n_edge], side[:n_edge]
+        aimed = scanner.actors.inner(aimed, i0, n_in) if plan is not None else None
         k = len(model.pattern)
+        n_edge = 0
+        if k:  # without sub-rays (one ray per beam) no beam needs to know its neighbours
+            edge, side = np.empty(n_in, np.int64), np.empty(n_in, np.uint8)
+            n_edge = edge_beams(dist, face, inst, faces, a, cols.start, cols.stop, L, lo_r, hi_r, p.edge_step, edge,
+                                side)
+            edge, side = edge[:n_edge], side[:n_edge]
         weight = np.ones(n_in, np.float32)
         parts = {"o": [o_w[i0:i1]], "dw": [d_world[i0:i1]], "df": [d_w[i0:i1]], "dist": [dist[i0:i1]],
                  "face": [face[i0:i1]], "inst": [inst[i0:i1]], "moving": [moving[i0:i1]],
@@ -103,7 +112,7 @@ def run_physical_chunk(scanner, sweep, i: int, cols: slice) -> None:
             e, s = np.nonzero((side[:, None] >> np.arange(4, dtype=np.uint8)) & 1)
             pb, pw = edge[e], model.probes[s]
             pb, pw = _unique_pairs(pb, pw, k)
-            probe = _cast_subrays(scanner, plan, cols, o_w, d_world, pb, pw, model.pattern, i0, n_in, hi_r)
+            probe = _cast_subrays(scanner, plan, cols, aimed, o_w, d_world, pb, pw, model.pattern, i0, n_in, hi_r)
             centre_lab = _labels(face[pb], inst[pb], faces, dist[pb], lo_r, hi_r)
             probe_lab = _labels(probe["face"], probe["inst"], faces, probe["dist"], lo_r, hi_r)
             step = np.abs(probe["dist"] - dist[pb]) > SPLIT_STEP_M + SPLIT_STEP_REL * dist[pb]
@@ -114,7 +123,7 @@ def run_physical_chunk(scanner, sweep, i: int, cols: slice) -> None:
                 have = np.zeros((len(split), k), bool)
                 have[np.searchsorted(split, pb[keep]), pw[keep]] = True
                 rb, rw = np.nonzero(~have)
-                rest = _cast_subrays(scanner, plan, cols, o_w, d_world, split[rb], rw.astype(np.int64),
+                rest = _cast_subrays(scanner, plan, cols, aimed, o_w, d_world, split[rb], rw.astype(np.int64),
                                      model.pattern, i0, n_in, hi_r)
                 weight[split - i0] = share
                 for key in parts:
@@ -125,7 +134,7 @@ def run_physical_chunk(scanner, sweep, i: int, cols: slice) -> None:
                 parts["weight"].append(np.full(m, share, np.float32))
                 parts["offset"].append(np.zeros(m, np.float32))
                 parts["tau"].append(np.ones(m, np.float32))
-        _behind_glass(scanner, plan, cols, parts, opt.transmittance, faces, p.glass_layers, hi_r, n_in)
+        _behind_glass(scanner, plan, cols, aimed, parts, opt.transmittance, faces, p.glass_layers, hi_r, n_in)
         cat = {key: np.concatenate(v) if len(v) > 1 else v[0] for key, v in parts.items() if key not in ("o", "dw")}
         per_beam = 2 if p.mode == "dual" else 1
         buf = np.empty(per_beam * n_in, POINT_DTYPE)
@@ -143,7 +152,7 @@ def run_physical_chunk(scanner, sweep, i: int, cols: slice) -> None:
     sweep.out[start:start + got] = buf[:got]
 
 
-def _behind_glass(scanner, plan, cols, parts, transmittance, faces, layers, max_range, n_in) -> None:
+def _behind_glass(scanner, plan, cols, aimed, parts, transmittance, faces, layers, max_range, n_in) -> None:
     """Append to ``parts`` the rays continued behind every pane their ray list hits (``layers`` deep)."""
     is_glass = transmittance > 0
     # the first layer: the rows of the ray list that end on glass, gathered part by part (no copy of the rest)
@@ -176,7 +185,7 @@ def _behind_glass(scanner, plan, cols, parts, transmittance, faces, layers, max_
         ptr = np.zeros(n_in + 1, np.int64)
         ptr[1:] = np.bincount(beam, minlength=n_in)
         rows = (np.cumsum(ptr), order.astype(np.int64))
-        inst, moving = _actor_hits(scanner, plan, cols, o, d, dist, face, rows=rows, offset=offset)
+        inst, moving = _actor_hits(scanner, plan, cols, o, d, dist, face, aimed, rows=rows, offset=offset)
         # the interior of the object whose glass the ray crossed is not modelled: absorbed there
         pane = _labels(layer["face"][glass], layer["inst"][glass], faces)
         face = np.where((face >= 0) & (_labels(face, inst, faces) == pane), -1, face).astype(np.int32)
