@@ -18,7 +18,7 @@ import numpy as np
 
 from generator.lidar.kernels import world_rays
 from generator.lidar.points import POINT_DTYPE
-from generator.lidar.return_kernels import beam_returns, edge_beams, subrays
+from generator.lidar.return_kernels import absorb_interior, beam_returns, edge_beams, pane_rays, subrays
 
 #: how far behind a pane a continued ray starts, metres
 GLASS_STEP_M = 1e-3
@@ -134,7 +134,7 @@ def run_physical_chunk(scanner, sweep, i: int, cols: slice) -> None:
                 parts["weight"].append(np.full(m, share, np.float32))
                 parts["offset"].append(np.zeros(m, np.float32))
                 parts["tau"].append(np.ones(m, np.float32))
-        _behind_glass(scanner, plan, cols, aimed, parts, opt.transmittance, faces, p.glass_layers, hi_r, n_in)
+        _behind_glass(scanner, plan, cols, aimed, parts, scanner.face_lookup, p.glass_layers, hi_r, n_in)
         cat = {key: np.concatenate(v) if len(v) > 1 else v[0] for key, v in parts.items() if key not in ("o", "dw")}
         per_beam = 2 if p.mode == "dual" else 1
         buf = np.empty(per_beam * n_in, POINT_DTYPE)
@@ -152,44 +152,60 @@ def run_physical_chunk(scanner, sweep, i: int, cols: slice) -> None:
     sweep.out[start:start + got] = buf[:got]
 
 
-def _behind_glass(scanner, plan, cols, aimed, parts, transmittance, faces, layers, max_range, n_in) -> None:
+class FaceLookup:
+    """Per face-table row what the glass pass reads, gathered once per scanner.
+
+    Attributes
+    ----------
+    glass : (F + 1,) bool
+        The face's material lets light through; the last entry (for face -1, no hit) is False.
+    transmittance : (F + 1,) float32
+        One-way transmittance of the face's material.
+    label : (F + 1,) int64
+        ``class << 16 | instance`` of the face (-1 in the last entry).
+    """
+
+    def __init__(self, faces: np.ndarray, transmittance: np.ndarray):
+        mat = faces["material"]
+        self.transmittance = np.append(transmittance[mat], np.float32(0.0)).astype(np.float32)
+        self.glass = self.transmittance > 0
+        self.label = np.append((faces["class"].astype(np.int64) << 16) | faces["instance"], -1).astype(np.int64)
+
+
+def _behind_glass(scanner, plan, cols, aimed, parts, lookup, layers, max_range, n_in) -> None:
     """Append to ``parts`` the rays continued behind every pane their ray list hits (``layers`` deep)."""
-    is_glass = transmittance > 0
-    # the first layer: the rows of the ray list that end on glass, gathered part by part (no copy of the rest)
-    picked = []
-    for i, f in enumerate(parts["face"]):
-        g = np.flatnonzero(is_glass[faces["material"][np.maximum(f, 0)]] & (f >= 0))
-        if len(g):
-            picked.append((i, g))
-    if not picked:
-        return
-    layer = {key: np.concatenate([v[i][g] for i, g in picked]) for key, v in parts.items()}
+    r_max, step_m = np.float32(max_range), np.float32(GLASS_STEP_M)
+    src = [{key: v[i] for key, v in parts.items()} for i in range(len(parts["face"]))]
     for _ in range(layers):
-        f = layer["face"]
-        hit = (f >= 0) & (layer["offset"] + layer["dist"] < max_range)
-        mat = faces["material"][np.maximum(f, 0)]
-        glass = np.flatnonzero(hit & is_glass[mat])
-        if len(glass) == 0:
+        picked = []
+        for part in src:  # the rows that end on glass, continued behind it (part by part: no copy of the rest)
+            n = len(part["face"])
+            rows, o = np.empty(n, np.int64), np.empty((n, 3), np.float32)
+            off, tau, left = np.empty(n, np.float32), np.empty(n, np.float32), np.empty(n, np.float32)
+            pane = np.empty(n, np.int64)
+            m = pane_rays(part["face"], part["dist"], part["offset"], part["tau"], part["inst"], part["o"], part["dw"],
+                          lookup.glass, lookup.transmittance, lookup.label, r_max, step_m, rows, o, off, tau, left,
+                          pane)
+            if m:
+                rows = rows[:m]
+                picked.append((o[:m], part["dw"][rows], off[:m], tau[:m], left[:m], pane[:m], part["beam"][rows],
+                               part["weight"][rows]))
+        if not picked:
             return
-        step = layer["dist"][glass] + np.float32(GLASS_STEP_M)
-        dw = layer["dw"][glass]
-        o = layer["o"][glass] + step[:, None] * dw
-        offset = layer["offset"][glass] + step
-        t = transmittance[mat[glass]]
-        tau = layer["tau"][glass] * t * t
-        left = np.maximum(np.float32(max_range) - offset, np.float32(1e-3)).astype(np.float32)
+        o, dw, offset, tau, left, pane, beam, weight = (np.concatenate(c) if len(picked) > 1 else c[0]
+                                                        for c in zip(*picked, strict=True))
         d = dw.copy()
         dist, face = scanner.caster.intersect_local(o, d, left, mark_misses=False)
-        beam = layer["beam"][glass]
         order = np.argsort(beam, kind="stable")  # the actors want each beam's rays together
         ptr = np.zeros(n_in + 1, np.int64)
         ptr[1:] = np.bincount(beam, minlength=n_in)
         rows = (np.cumsum(ptr), order.astype(np.int64))
         inst, moving = _actor_hits(scanner, plan, cols, o, d, dist, face, aimed, rows=rows, offset=offset)
         # the interior of the object whose glass the ray crossed is not modelled: absorbed there
-        pane = _labels(layer["face"][glass], layer["inst"][glass], faces)
-        face = np.where((face >= 0) & (_labels(face, inst, faces) == pane), -1, face).astype(np.int32)
+        face = np.ascontiguousarray(face, np.int32)
+        absorb_interior(face, inst, pane, lookup.label)
         layer = {"o": o, "dw": dw, "df": d, "dist": dist, "face": face, "inst": inst, "moving": moving, "beam": beam,
-                 "weight": layer["weight"][glass], "offset": offset, "tau": tau}
+                 "weight": weight, "offset": offset, "tau": tau}
         for key, v in layer.items():
             parts[key].append(v)
+        src = [layer]

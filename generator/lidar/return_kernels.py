@@ -341,3 +341,82 @@ def beam_returns(out, n_beams, ray0, beam, weight, offset, tau, dist, face, d_f,
                    np.float32(abs(c)), inst[r], moving[r], 1 if c_mix[k] else 0, echo, np.float32(c_pow[k]), skew)
             m += 1
     return m
+
+
+@njit(nogil=True, cache=True)
+def pane_rays(face, dist, offset, tau, inst, o, dw, glass_face, face_trans, face_label, max_range, step_m,
+              rows, o_out, off_out, tau_out, left_out, pane_out):  # pragma: no cover - compiled
+    """The rays of a ray list that end on a pane, continued from just behind it (one pass).
+
+    The float32 arithmetic of the numpy expressions it replaces, in their order: ``step = dist + step_m``,
+    ``o' = o + step d``, ``offset' = offset + step``, ``tau' = tau t t``, ``left = max(R - offset', 1 mm)``.
+
+    Parameters
+    ----------
+    face, dist, offset, tau, inst : (n,) int32, float32, float32, float32, int32
+        The ray list (:func:`beam_returns`); ``inst`` -1 = the face's own instance.
+    o, dw : (n, 3) float32
+        Re-centred origins and world directions.
+    glass_face : (F + 1,) bool
+        Per face-table row: its material lets light through (the last entry, for ``face`` -1, False).
+    face_trans : (F + 1,) float32
+        Per face-table row its material's one-way transmittance.
+    face_label : (F + 1,) int64
+        Per face-table row ``class << 16 | instance`` (instance of the face table).
+    max_range, step_m : float32
+        The sensor's maximum range; how far behind the pane the continued ray starts, metres.
+    rows : (n,) int64
+        Written: the rows that end on a pane (before ``max_range`` from the sensor), ascending.
+    o_out : (n, 3) float32
+    off_out, tau_out, left_out : (n,) float32
+        Written beside ``rows``: the continued ray's origin, the distance from the sensor to it, the
+        two-way transmission so far, and the range it has left (at least 1 mm).
+    pane_out : (n,) int64
+        Written: ``class << 16 | instance`` of the pane (a ray meeting it again is absorbed).
+
+    Returns
+    -------
+    count : int
+    """
+    k = 0
+    for r in range(face.shape[0]):
+        f = face[r]
+        if f < 0 or not glass_face[f] or not offset[r] + dist[r] < max_range:
+            continue
+        step = dist[r] + step_m
+        o_out[k, 0] = o[r, 0] + step * dw[r, 0]
+        o_out[k, 1] = o[r, 1] + step * dw[r, 1]
+        o_out[k, 2] = o[r, 2] + step * dw[r, 2]
+        off = offset[r] + step
+        off_out[k] = off
+        t = face_trans[f]
+        tau_out[k] = tau[r] * t * t
+        left = max_range - off
+        left_out[k] = left if left > np.float32(1e-3) else np.float32(1e-3)
+        pane_out[k] = (face_label[f] & ~np.int64(0xFFFF)) | np.int64(inst[r]) if inst[r] >= 0 else face_label[f]
+        rows[k] = r
+        k += 1
+    return k
+
+
+@njit(nogil=True, cache=True)
+def absorb_interior(face, inst, pane, face_label):  # pragma: no cover - compiled
+    """Rays behind a pane that meet the pane's own object (same class and instance) end there: ``face`` = -1.
+
+    Parameters
+    ----------
+    face : (n,) int32
+        Hits of the continued rays, updated in place.
+    inst : (n,) int32
+        Actor instance per hit (-1: the face's own).
+    pane : (n,) int64
+        Label of the pane each ray crossed (:func:`pane_rays`).
+    face_label : (F + 1,) int64
+    """
+    for r in range(face.shape[0]):
+        f = face[r]
+        if f < 0:
+            continue
+        lab = (face_label[f] & ~np.int64(0xFFFF)) | np.int64(inst[r]) if inst[r] >= 0 else face_label[f]
+        if lab == pane[r]:
+            face[r] = -1

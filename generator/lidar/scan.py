@@ -37,7 +37,7 @@ import numpy as np
 from generator.lidar.actors import ActorCaster
 from generator.lidar.caster import RayCaster, make_caster
 from generator.lidar.kernels import returns, world_rays
-from generator.lidar.physical_chunk import run_physical_chunk
+from generator.lidar.physical_chunk import FaceLookup, run_physical_chunk
 from generator.lidar.points import POINT_DTYPE, RecordTables
 from generator.lidar.returns import ReturnModel
 from generator.lidar.sensors import Sensor
@@ -137,6 +137,9 @@ class Scanner:
             np.concatenate([scene.face_material, *(m.face_material for m in protos)]),
             np.concatenate([self.caster.face_normals, *(self.actors.face_normals() if protos else [])]))
         self._o32, self._d32 = self._records.origins, self._records.directions  # (steps, L, 3), ring order
+        #: what the physical chunks read per face-table row (None without the physical model)
+        self.face_lookup = (FaceLookup(self._records._faces, self.returns.optics.transmittance)
+                            if self.returns is not None else None)
         steps = sensor.azimuth_steps
         n_chunks = min(steps, self.threads * max(1, chunks_per_thread))
         edges = np.linspace(0, steps, n_chunks + 1).round().astype(int)
