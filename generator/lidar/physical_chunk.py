@@ -18,7 +18,15 @@ import numpy as np
 
 from generator.lidar.kernels import world_rays
 from generator.lidar.points import POINT_DTYPE
-from generator.lidar.return_kernels import absorb_interior, beam_returns, edge_beams, pane_rays, subrays
+from generator.lidar.return_kernels import (
+    absorb_interior,
+    beam_returns,
+    edge_beams,
+    pane_rays,
+    probe_pairs,
+    split_beams,
+    subrays,
+)
 
 #: how far behind a pane a continued ray starts, metres
 GLASS_STEP_M = 1e-3
@@ -43,20 +51,6 @@ def _actor_hits(scanner, plan, cols, o, d, dist, face, aimed, rows=None, offset=
         inst[m] = scanner.actors.instance[actor[m]]
         moving[m] = mov[m]
     return inst, moving
-
-
-def _labels(face: np.ndarray, inst: np.ndarray, faces: np.ndarray, dist=None, lo=0.0, hi=np.inf) -> np.ndarray:
-    """(n,) int64 class << 16 | instance of each hit (-1 without one, or out of ``[lo, hi)`` given ``dist``)."""
-    f = np.maximum(face, 0)
-    ins = np.where(inst >= 0, inst, faces["instance"][f].astype(np.int64))
-    ok = face >= 0 if dist is None else (face >= 0) & (dist >= lo) & (dist < hi)
-    return np.where(ok, (faces["class"][f].astype(np.int64) << 16) | ins, -1)
-
-
-def _unique_pairs(beam: np.ndarray, which: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
-    """(beam row, sub-ray) pairs without repeats, ordered by beam."""
-    code = np.unique(beam * k + which)
-    return code // k, code % k
 
 
 def _cast_subrays(scanner, plan, cols, aimed, o_w, d_world, beam_rows, which, pattern, i0, n_in, max_range) -> dict:
@@ -109,22 +103,20 @@ def run_physical_chunk(scanner, sweep, i: int, cols: slice) -> None:
         if k and n_edge:
             share = np.float32(1.0 / (k + 1))
             # probe: the sub-ray towards each neighbour that differs
-            e, s = np.nonzero((side[:, None] >> np.arange(4, dtype=np.uint8)) & 1)
-            pb, pw = edge[e], model.probes[s]
-            pb, pw = _unique_pairs(pb, pw, k)
+            pb, pw = np.empty(4 * n_edge, np.int64), np.empty(4 * n_edge, np.int64)
+            n_probe = probe_pairs(edge, side, model.probes, pb, pw)
+            pb, pw = pb[:n_probe], pw[:n_probe]
             probe = _cast_subrays(scanner, plan, cols, aimed, o_w, d_world, pb, pw, model.pattern, i0, n_in, hi_r)
-            centre_lab = _labels(face[pb], inst[pb], faces, dist[pb], lo_r, hi_r)
-            probe_lab = _labels(probe["face"], probe["inst"], faces, probe["dist"], lo_r, hi_r)
-            step = np.abs(probe["dist"] - dist[pb]) > SPLIT_STEP_M + SPLIT_STEP_REL * dist[pb]
-            split = np.unique(pb[(probe_lab != centre_lab) | ((centre_lab >= 0) & step)])
-            if len(split):
+            keep, split = np.empty(n_probe, bool), np.empty(n_probe, np.int64)
+            rb, rw = np.empty(n_probe * k, np.int64), np.empty(n_probe * k, np.int64)
+            n_split, n_rest = split_beams(pb, pw, dist, face, inst, probe["dist"],
+                                          np.ascontiguousarray(probe["face"], np.int32), probe["inst"],
+                                          scanner.face_lookup.label, np.float32(lo_r), np.float32(hi_r),
+                                          np.float32(SPLIT_STEP_M), np.float32(SPLIT_STEP_REL), k, keep, split, rb, rw)
+            split, rb, rw = split[:n_split], rb[:n_rest], rw[:n_rest]
+            if n_split:
                 # the split beams' other sub-rays; their probes are kept
-                keep = np.isin(pb, split)
-                have = np.zeros((len(split), k), bool)
-                have[np.searchsorted(split, pb[keep]), pw[keep]] = True
-                rb, rw = np.nonzero(~have)
-                rest = _cast_subrays(scanner, plan, cols, aimed, o_w, d_world, split[rb], rw.astype(np.int64),
-                                     model.pattern, i0, n_in, hi_r)
+                rest = _cast_subrays(scanner, plan, cols, aimed, o_w, d_world, rb, rw, model.pattern, i0, n_in, hi_r)
                 weight[split - i0] = share
                 for key in parts:
                     if key in ("weight", "offset", "tau"):
