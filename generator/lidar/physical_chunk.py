@@ -137,11 +137,10 @@ def run_physical_chunk(scanner, sweep, i: int, cols: slice) -> None:
                            faces, opt.reflectivity, opt.lobe_gain, opt.lobe_exponent, opt.reference_range_m,
                            opt.min_range_m, sweep.alpha, p.detection_threshold, p.separation_m, p.mode == "dual",
                            lo_r, hi_r, sweep.key, model.ring_sigma, sweep.skew, model.k_inc)
-        start = sweep.claim(i, got)
     except BaseException:
         sweep.fail(i)
         raise
-    sweep.out[start:start + got] = buf[:got]
+    sweep.deliver(i, buf, got)
 
 
 class FaceLookup:

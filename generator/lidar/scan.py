@@ -272,6 +272,9 @@ class _Sweep:
         self.alpha, self.key = alpha, key
         self.ends: list[int | None] = [None] * n_chunks
         self._done = [threading.Event() for _ in range(n_chunks)]
+        self._lock = threading.Lock()
+        self._pending: dict[int, tuple[np.ndarray, int]] = {}
+        self._next = 0  # the first chunk whose offset is not known yet (deliver)
         self._plan, self._plan_error = None, None
         self._planned = threading.Event()
 
@@ -307,6 +310,27 @@ class _Sweep:
         self.ends[i] = start + n
         self._done[i].set()
         return start
+
+    def deliver(self, i: int, buf: np.ndarray, n: int) -> None:
+        """Hand in chunk ``i``'s ``n`` points (``buf[:n]``) without waiting for the chunks before it.
+
+        The points go to their place in :attr:`out` as soon as every earlier chunk's count is known,
+        copied by whichever chunk completes the chain; a chunk finished early does not hold its thread.
+        (Use either this or :meth:`claim` for all the chunks of a sweep.)
+        """
+        todo = []
+        with self._lock:
+            self._pending[i] = (buf, n)
+            j = self._next
+            while j in self._pending:
+                b, m = self._pending.pop(j)
+                start = self.ends[j - 1] if j else 0
+                self.ends[j] = start + m
+                todo.append((start, b, m))
+                j += 1
+            self._next = j
+        for start, b, m in todo:
+            self.out[start:start + m] = b[:m]
 
     def fail(self, i: int) -> None:
         """Release the chunks waiting on chunk ``i`` (they raise)."""
