@@ -4,12 +4,22 @@ Steps, per chunk ``[c0, c1)`` of a sweep (the scanner's threads run chunks in pa
 
 1. the central rays of ``[c0 - 1, c1 + 1)`` (one halo column each side, so a beam's neighbours are
    known whatever the chunking) against the town, then the actors, as the ideal scanner casts them;
-2. the chunk's edge beams (:func:`generator.lidar.return_kernels.edge_beams`) get their off-centre
-   sub-rays, cast against the town and the actors;
-3. rays that end on glass go on behind it, up to ``glass_layers`` panes; a continued ray that meets
-   the object whose glass it crossed (same class and instance) is absorbed in its interior;
+   which beams may meet which actor (:meth:`generator.lidar.actors.ActorCaster.aim`) is worked out
+   once here and reused by every later ray list of the chunk;
+2. the chunk's edge beams (:func:`generator.lidar.return_kernels.edge_beams`) get their probe
+   sub-rays (:func:`~generator.lidar.return_kernels.probe_pairs`), and the beams the probes split
+   (:func:`~generator.lidar.return_kernels.split_beams`) the rest, cast against the town and the actors;
+3. rays that end on glass go on behind it, up to ``glass_layers`` panes
+   (:func:`~generator.lidar.return_kernels.pane_rays`); a continued ray that meets the object whose
+   glass it crossed (same class and instance) is absorbed in its interior
+   (:func:`~generator.lidar.return_kernels.absorb_interior`);
 4. the waveform of every beam (:func:`generator.lidar.return_kernels.beam_returns`) gives its
-   returns, written into the sweep at the chunk's offset.
+   returns, handed to the sweep (:meth:`generator.lidar.scan._Sweep.deliver`), which places them
+   once the chunks before have counted theirs: no chunk waits for another.
+
+Per-hit work runs in compiled passes with the GIL released; what stays in numpy is per chunk, not
+per ray list row. Every step keeps the float32 arithmetic and the order of the numpy version it
+replaced, so the points are those of the code before, byte for byte.
 """
 
 from __future__ import annotations
