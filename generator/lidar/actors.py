@@ -35,6 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from generator.lidar.caster import EmbreeCaster
+from generator.lidar.kernels import to_actor_frames
 from generator.lidar.tracks import TrackBank
 from generator.lidar.windows import BeamTable, column_windows, sweep_windows
 from generator.world.actors import MOVING_THRESHOLD_MPS
@@ -261,6 +262,8 @@ class ActorCaster:
         if rows is not None:  # beams -> their rays
             ptr, ids = rows
             n_r = ptr[ray + 1] - ptr[ray]
+            some = np.flatnonzero(n_r)  # most beams have no sub-ray or ray behind glass
+            ray, pair, cand, n_r = ray.take(some), pair.take(some), cand.take(some), n_r.take(some)
             owner, at = _ragged(ptr[ray], n_r)
             ray, pair, cand = ids.take(at), pair.take(owner), cand.take(owner)
             reach = dist.take(ray) if offset is None else dist.take(ray) + offset.take(ray)
@@ -270,11 +273,8 @@ class ActorCaster:
         if len(keep) == 0:
             return None
         ray, pair, cand = ray.take(keep), pair.take(keep), cand.take(keep)
-        c, s = plan.cos[pair], plan.sin[pair]
-        o = o_w.take(ray, axis=0).astype(np.float64) - plan.position[pair]
-        d = d_w.take(ray, axis=0).astype(np.float64)
-        o_loc = np.stack([c * o[:, 0] + s * o[:, 1], c * o[:, 1] - s * o[:, 0], o[:, 2]], -1).astype(np.float32)
-        d_loc = np.stack([c * d[:, 0] + s * d[:, 1], c * d[:, 1] - s * d[:, 0], d[:, 2]], -1).astype(np.float32)
+        o_loc, d_loc = np.empty((len(ray), 3), np.float32), np.empty((len(ray), 3), np.float32)
+        to_actor_frames(o_w, d_w, ray, pair, plan.position, plan.cos, plan.sin, o_loc, d_loc)
         proto = self.proto_of[plan.actor[cand]]
         bound = np.minimum(dist.take(ray), np.float32(self.sensor.max_range_m))
         hits = []
