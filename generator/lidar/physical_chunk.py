@@ -7,12 +7,12 @@ Steps, per chunk ``[c0, c1)`` of a sweep (the scanner's threads run chunks in pa
    which beams may meet which actor (:meth:`generator.lidar.actors.ActorCaster.aim`) is worked out
    once here and reused by every later ray list of the chunk;
 2. the chunk's edge beams (:func:`generator.lidar.return_kernels.edge_beams`) get their probe
-   sub-rays (:func:`~generator.lidar.return_kernels.probe_pairs`), and the beams the probes split
-   (:func:`~generator.lidar.return_kernels.split_beams`) the rest, cast against the town and the actors;
+   sub-rays (:func:`~generator.lidar.return_rays.probe_pairs`), and the beams the probes split
+   (:func:`~generator.lidar.return_rays.split_beams`) the rest, cast against the town and the actors;
 3. rays that end on glass go on behind it, up to ``glass_layers`` panes
-   (:func:`~generator.lidar.return_kernels.pane_rays`); a continued ray that meets the object whose
+   (:func:`~generator.lidar.return_rays.pane_rays`); a continued ray that meets the object whose
    glass it crossed (same class and instance) is absorbed in its interior
-   (:func:`~generator.lidar.return_kernels.absorb_interior`);
+   (:func:`~generator.lidar.return_rays.absorb_interior`);
 4. the waveform of every beam (:func:`generator.lidar.return_kernels.beam_returns`) gives its
    returns, handed to the sweep (:meth:`generator.lidar.scan._Sweep.deliver`), which places them
    once the chunks before have counted theirs: no chunk waits for another.
@@ -28,15 +28,8 @@ import numpy as np
 
 from generator.lidar.kernels import world_rays
 from generator.lidar.points import POINT_DTYPE
-from generator.lidar.return_kernels import (
-    absorb_interior,
-    beam_returns,
-    edge_beams,
-    pane_rays,
-    probe_pairs,
-    split_beams,
-    subrays,
-)
+from generator.lidar.return_kernels import beam_returns, edge_beams, subrays
+from generator.lidar.return_rays import absorb_interior, pane_rays, probe_pairs, split_beams
 
 #: how far behind a pane a continued ray starts, metres
 GLASS_STEP_M = 1e-3
