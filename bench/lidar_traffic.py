@@ -243,11 +243,15 @@ def main(argv=None) -> int:
     cand = [0 if pl is None else int(np.clip(pl.ring1 - pl.ring0, 0, None).sum()) for pl in plan]
     seen = [0 if pl is None else len(np.unique(pl.actor)) for pl in plan]
     base = best[("ours: Scanner.scan, actors moving", args.threads)][0]
+    # issue #27 on its machine: ideal at 5.3x real time, divergence >= 2x real time (<= 2.65x ideal's time),
+    # received power <= +5 %; judged here as ratios to the ideal scanner in the same run
+    ratio_target = {"physical: received power only": 1.05}
     for k in physical:
         w = best[(k, args.threads)][0]
         ideal_pts = np.mean([len(s.points) for s in scans])
         print(f"{k}: {n / w:.1f} sweeps/s = {n / w / sensor.rotation_hz:.2f}x the real sensor's "
-              f"{sensor.rotation_hz:.0f} Hz (target >= 2x), {w / base:.2f}x the ideal scanner's time; "
+              f"{sensor.rotation_hz:.0f} Hz, {w / base:.2f}x the ideal scanner's time "
+              f"(target <= {ratio_target.get(k, 2.65):.2f}x); "
               f"{kept[k]:,.0f} points per sweep ({100 * kept[k] / sensor.rays_per_sweep:.1f} % of the rays; "
               f"ideal {ideal_pts:,.0f})")
     print(f"ideal, actors moving: {n / base:.1f} sweeps/s = {n / base / sensor.rotation_hz:.2f}x real time")

@@ -35,6 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from generator.lidar.caster import EmbreeCaster
+from generator.lidar.kernels import to_actor_frames
 from generator.lidar.tracks import TrackBank
 from generator.lidar.windows import BeamTable, column_windows, sweep_windows
 from generator.world.actors import MOVING_THRESHOLD_MPS
@@ -167,9 +168,61 @@ class ActorCaster:
                          np.sin(yaw), moving, win["azimuth"], win["half"], win["ring0"], win["ring1"], win["near"])
 
     # -- per chunk of columns -----------------------------------------------------------------------
+    def aim(self, plan: SweepPlan, cols: slice) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """The beams of a chunk of columns that point into an actor's window (before the distance cull).
+
+        Parameters
+        ----------
+        plan : SweepPlan
+        cols : slice
+            The chunk's firing columns; its beams are ``(column - cols.start) * L + ring``.
+
+        Returns
+        -------
+        (beam, pair, cand) : three (m,) int64, or None when no beam can reach an actor
+            Per (beam, candidate) entry: the chunk's beam, its (candidate, column) pair in ``plan`` and the
+            candidate; ordered by candidate, column, ring. :meth:`cast` takes it (or :meth:`inner` of it)
+            so that the sub-rays and the rays behind glass of a chunk reuse its central rays' list.
+        """
+        L = self.sensor.n_lasers
+        k = np.flatnonzero((plan.c0 < cols.stop) & (plan.c1 > cols.start))
+        if len(k) == 0:
+            return None
+        cs, ce = np.maximum(plan.c0[k], cols.start), np.minimum(plan.c1[k], cols.stop)
+        owner, col = _ragged(cs, ce - cs)
+        cand = k[owner]
+        pair = plan.pair_off[cand] + (col - plan.c0[cand])
+        live = np.flatnonzero(plan.ring1.take(pair) > plan.ring0.take(pair))
+        pair, col, cand = pair.take(live), col.take(live), cand.take(live)
+        row, ring = _ragged(plan.ring0.take(pair), plan.ring1.take(pair) - plan.ring0.take(pair))
+        pair, col, cand = pair.take(row), col.take(row), cand.take(row)
+        off = self.beams.psi.take(col) + self.beams.rot.take(ring) - plan.azimuth.take(pair)
+        off = np.abs(np.mod(off + np.pi, 2 * np.pi) - np.pi)  # this laser's beam vs the actor's direction
+        aim = np.flatnonzero(off <= plan.half.take(pair))
+        if len(aim) == 0:
+            return None
+        return ((col.take(aim) - cols.start) * L + ring.take(aim)), pair.take(aim), cand.take(aim)
+
+    @staticmethod
+    def inner(aimed, first: int, count: int):
+        """``aimed`` of a chunk's columns with one halo column each side -> that of its inner beams.
+
+        Parameters
+        ----------
+        aimed : tuple or None
+            :meth:`aim` of the halo columns.
+        first, count : int
+            Halo-row index of the first inner beam, and the number of inner beams.
+        """
+        if aimed is None:
+            return None
+        beam, pair, cand = aimed
+        m = np.flatnonzero((beam >= first) & (beam < first + count))
+        return beam.take(m) - first, pair.take(m), cand.take(m)
+
     def cast(self, plan: SweepPlan, cols: slice, o_w: np.ndarray, d_w: np.ndarray, dist: np.ndarray,
              face: np.ndarray, rows: tuple[np.ndarray, np.ndarray] | None = None,
-             offset: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray] | None:
+             offset: np.ndarray | None = None, aimed=None) -> tuple[np.ndarray, np.ndarray] | None:
         """Let the actors occlude the static hits of one chunk of columns (arrays updated in place).
 
         Parameters
@@ -193,46 +246,35 @@ class ActorCaster:
             replace it where nearer.
         face : (n,) int32
             Face-table row of the hit; actor hits get their prototype's rows.
+        aimed : tuple, optional
+            :meth:`aim` of ``cols`` when the caller already has it (default: computed here).
 
         Returns
         -------
         (actor, moving) : ((n,) int32, (n,) uint8), or None when no actor is hit
             Actor index per ray (-1 for the town) and its moving flag at the firing time.
         """
-        L = self.sensor.n_lasers
-        k = np.flatnonzero((plan.c0 < cols.stop) & (plan.c1 > cols.start))
-        if len(k) == 0:
+        if aimed is None:
+            aimed = self.aim(plan, cols)
+        if aimed is None:
             return None
-        cs, ce = np.maximum(plan.c0[k], cols.start), np.minimum(plan.c1[k], cols.stop)
-        owner, col = _ragged(cs, ce - cs)
-        cand = k[owner]
-        pair = plan.pair_off[cand] + (col - plan.c0[cand])
-        live = np.flatnonzero(plan.ring1.take(pair) > plan.ring0.take(pair))
-        pair, col, cand = pair.take(live), col.take(live), cand.take(live)
-        row, ring = _ragged(plan.ring0.take(pair), plan.ring1.take(pair) - plan.ring0.take(pair))
-        pair, col, cand = pair.take(row), col.take(row), cand.take(row)
-        ray = (col - cols.start) * L + ring
-        off = self.beams.psi.take(col) + self.beams.rot.take(ring) - plan.azimuth.take(pair)
-        off = np.abs(np.mod(off + np.pi, 2 * np.pi) - np.pi)  # this laser's beam vs the actor's direction
+        ray, pair, cand = aimed
         if rows is not None:  # beams -> their rays
             ptr, ids = rows
-            aim = np.flatnonzero(off <= plan.half.take(pair))
-            ray, pair, cand = ray.take(aim), pair.take(aim), cand.take(aim)
             n_r = ptr[ray + 1] - ptr[ray]
+            some = np.flatnonzero(n_r)  # most beams have no sub-ray or ray behind glass
+            ray, pair, cand, n_r = ray.take(some), pair.take(some), cand.take(some), n_r.take(some)
             owner, at = _ragged(ptr[ray], n_r)
             ray, pair, cand = ids.take(at), pair.take(owner), cand.take(owner)
             reach = dist.take(ray) if offset is None else dist.take(ray) + offset.take(ray)
             keep = np.flatnonzero(reach > plan.near.take(pair))
         else:
-            keep = np.flatnonzero((off <= plan.half.take(pair)) & (dist.take(ray) > plan.near.take(pair)))
+            keep = np.flatnonzero(dist.take(ray) > plan.near.take(pair))
         if len(keep) == 0:
             return None
         ray, pair, cand = ray.take(keep), pair.take(keep), cand.take(keep)
-        c, s = plan.cos[pair], plan.sin[pair]
-        o = o_w.take(ray, axis=0).astype(np.float64) - plan.position[pair]
-        d = d_w.take(ray, axis=0).astype(np.float64)
-        o_loc = np.stack([c * o[:, 0] + s * o[:, 1], c * o[:, 1] - s * o[:, 0], o[:, 2]], -1).astype(np.float32)
-        d_loc = np.stack([c * d[:, 0] + s * d[:, 1], c * d[:, 1] - s * d[:, 0], d[:, 2]], -1).astype(np.float32)
+        o_loc, d_loc = np.empty((len(ray), 3), np.float32), np.empty((len(ray), 3), np.float32)
+        to_actor_frames(o_w, d_w, ray, pair, plan.position, plan.cos, plan.sin, o_loc, d_loc)
         proto = self.proto_of[plan.actor[cand]]
         bound = np.minimum(dist.take(ray), np.float32(self.sensor.max_range_m))
         hits = []

@@ -148,3 +148,38 @@ def fill_records(out, hit, ray0, dist, face, d_w, o_loc, d_loc, azimuth, column_
         rec.mixed = 0
         rec.echo = 0
         rec.power = zero
+
+
+@njit(nogil=True, cache=True, boundscheck=False)
+def to_actor_frames(o_w, d_w, ray, pair, position, cos, sin, o_out, d_out):  # pragma: no cover - compiled
+    """Rays into the local frames of the actors they may meet (float64, then float32), one pass.
+
+    ``o = o_w - position`` and ``(c o_x + s o_y, c o_y - s o_x, o_z)`` per entry, and the same rotation of
+    ``d_w``: the float64 arithmetic of the numpy expressions it replaces, in their order.
+
+    Parameters
+    ----------
+    o_w, d_w : (n, 3) float32
+        Ray origins (minus the static caster's centre) and directions, world axes.
+    ray, pair : (m,) int64
+        Per entry: the ray and its (candidate, column) pair of the sweep plan.
+    position : (P, 3) float64
+        Actor origin per pair, minus the static caster's centre.
+    cos, sin : (P,) float64
+        Cosine and sine of the actor's heading per pair.
+    o_out, d_out : (m, 3) float32
+        Written: origin and direction in the actor's frame.
+    """
+    for i in range(ray.shape[0]):
+        r, p = ray[i], pair[i]
+        c, s = cos[p], sin[p]
+        ox = np.float64(o_w[r, 0]) - position[p, 0]
+        oy = np.float64(o_w[r, 1]) - position[p, 1]
+        oz = np.float64(o_w[r, 2]) - position[p, 2]
+        o_out[i, 0] = np.float32(c * ox + s * oy)
+        o_out[i, 1] = np.float32(c * oy - s * ox)
+        o_out[i, 2] = np.float32(oz)
+        dx, dy, dz = np.float64(d_w[r, 0]), np.float64(d_w[r, 1]), np.float64(d_w[r, 2])
+        d_out[i, 0] = np.float32(c * dx + s * dy)
+        d_out[i, 1] = np.float32(c * dy - s * dx)
+        d_out[i, 2] = np.float32(dz)

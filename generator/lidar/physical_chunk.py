@@ -4,12 +4,22 @@ Steps, per chunk ``[c0, c1)`` of a sweep (the scanner's threads run chunks in pa
 
 1. the central rays of ``[c0 - 1, c1 + 1)`` (one halo column each side, so a beam's neighbours are
    known whatever the chunking) against the town, then the actors, as the ideal scanner casts them;
-2. the chunk's edge beams (:func:`generator.lidar.return_kernels.edge_beams`) get their off-centre
-   sub-rays, cast against the town and the actors;
-3. rays that end on glass go on behind it, up to ``glass_layers`` panes; a continued ray that meets
-   the object whose glass it crossed (same class and instance) is absorbed in its interior;
+   which beams may meet which actor (:meth:`generator.lidar.actors.ActorCaster.aim`) is worked out
+   once here and reused by every later ray list of the chunk;
+2. the chunk's edge beams (:func:`generator.lidar.return_kernels.edge_beams`) get their probe
+   sub-rays (:func:`~generator.lidar.return_rays.probe_pairs`), and the beams the probes split
+   (:func:`~generator.lidar.return_rays.split_beams`) the rest, cast against the town and the actors;
+3. rays that end on glass go on behind it, up to ``glass_layers`` panes
+   (:func:`~generator.lidar.return_rays.pane_rays`); a continued ray that meets the object whose
+   glass it crossed (same class and instance) is absorbed in its interior
+   (:func:`~generator.lidar.return_rays.absorb_interior`);
 4. the waveform of every beam (:func:`generator.lidar.return_kernels.beam_returns`) gives its
-   returns, written into the sweep at the chunk's offset.
+   returns, handed to the sweep (:meth:`generator.lidar.scan._Sweep.deliver`), which places them
+   once the chunks before have counted theirs: no chunk waits for another.
+
+Per-hit work runs in compiled passes with the GIL released; what stays in numpy is per chunk, not
+per ray list row. Every step keeps the float32 arithmetic and the order of the numpy version it
+replaced, so the points are those of the code before, byte for byte.
 """
 
 from __future__ import annotations
@@ -19,6 +29,7 @@ import numpy as np
 from generator.lidar.kernels import world_rays
 from generator.lidar.points import POINT_DTYPE
 from generator.lidar.return_kernels import beam_returns, edge_beams, subrays
+from generator.lidar.return_rays import absorb_interior, pane_rays, probe_pairs, split_beams
 
 #: how far behind a pane a continued ray starts, metres
 GLASS_STEP_M = 1e-3
@@ -27,13 +38,16 @@ GLASS_STEP_M = 1e-3
 SPLIT_STEP_M, SPLIT_STEP_REL = 0.05, 0.01
 
 
-def _actor_hits(scanner, plan, cols, o, d, dist, face, rows=None, offset=None):
-    """Actors occlude the rays (arrays updated in place); returns per-ray (instance or -1, moving)."""
+def _actor_hits(scanner, plan, cols, o, d, dist, face, aimed, rows=None, offset=None):
+    """Actors occlude the rays (arrays updated in place); returns per-ray (instance or -1, moving).
+
+    ``aimed`` is :meth:`generator.lidar.actors.ActorCaster.aim` of ``cols``, computed once per chunk.
+    """
     inst = np.full(len(dist), -1, np.int32)
     moving = np.zeros(len(dist), np.uint8)
-    if plan is None or len(dist) == 0:
+    if plan is None or aimed is None or len(dist) == 0:
         return inst, moving
-    hit = scanner.actors.cast(plan, cols, o, d, dist, face, rows=rows, offset=offset)
+    hit = scanner.actors.cast(plan, cols, o, d, dist, face, rows=rows, offset=offset, aimed=aimed)
     if hit is not None:
         actor, mov = hit
         m = np.flatnonzero(actor >= 0)
@@ -42,21 +56,7 @@ def _actor_hits(scanner, plan, cols, o, d, dist, face, rows=None, offset=None):
     return inst, moving
 
 
-def _labels(face: np.ndarray, inst: np.ndarray, faces: np.ndarray, dist=None, lo=0.0, hi=np.inf) -> np.ndarray:
-    """(n,) int64 class << 16 | instance of each hit (-1 without one, or out of ``[lo, hi)`` given ``dist``)."""
-    f = np.maximum(face, 0)
-    ins = np.where(inst >= 0, inst, faces["instance"][f].astype(np.int64))
-    ok = face >= 0 if dist is None else (face >= 0) & (dist >= lo) & (dist < hi)
-    return np.where(ok, (faces["class"][f].astype(np.int64) << 16) | ins, -1)
-
-
-def _unique_pairs(beam: np.ndarray, which: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
-    """(beam row, sub-ray) pairs without repeats, ordered by beam."""
-    code = np.unique(beam * k + which)
-    return code // k, code % k
-
-
-def _cast_subrays(scanner, plan, cols, o_w, d_world, beam_rows, which, pattern, i0, n_in, max_range) -> dict:
+def _cast_subrays(scanner, plan, cols, aimed, o_w, d_world, beam_rows, which, pattern, i0, n_in, max_range) -> dict:
     """Cast the sub-rays ``(beam_rows, which)`` (ordered by beam) against the town and the actors."""
     m = len(beam_rows)
     o, d = np.empty((m, 3), np.float32), np.empty((m, 3), np.float32)
@@ -66,7 +66,7 @@ def _cast_subrays(scanner, plan, cols, o_w, d_world, beam_rows, which, pattern, 
     beam = beam_rows - i0
     ptr = np.zeros(n_in + 1, np.int64)
     ptr[1:] = np.bincount(beam, minlength=n_in)
-    inst, moving = _actor_hits(scanner, plan, cols, o, d, dist, face, rows=(np.cumsum(ptr), np.arange(m)))
+    inst, moving = _actor_hits(scanner, plan, cols, o, d, dist, face, aimed, rows=(np.cumsum(ptr), np.arange(m)))
     return {"o": o, "dw": dw, "df": d, "dist": dist, "face": face, "inst": inst, "moving": moving, "beam": beam}
 
 
@@ -85,13 +85,19 @@ def run_physical_chunk(scanner, sweep, i: int, cols: slice) -> None:
         d_world = d_w.copy()  # the actors replace the directions of their hits by local ones
         dist, face = scanner.caster.intersect_local(o_w, d_w, hi_r, mark_misses=False)
         plan = sweep.get_plan()
-        inst, moving = _actor_hits(scanner, plan, slice(a, b), o_w, d_w, dist, face)
+        # which beams may meet which actor: once per chunk, for the central rays, the sub-rays and the glass
+        aimed = scanner.actors.aim(plan, slice(a, b)) if plan is not None else None
+        inst, moving = _actor_hits(scanner, plan, slice(a, b), o_w, d_w, dist, face, aimed)
         i0, i1 = (cols.start - a) * L, (cols.stop - a) * L
         n_in = i1 - i0
-        edge, side = np.empty(n_in, np.int64), np.empty(n_in, np.uint8)
-        n_edge = edge_beams(dist, face, inst, faces, a, cols.start, cols.stop, L, lo_r, hi_r, p.edge_step, edge, side)
-        edge, side = edge[:n_edge], side[:n_edge]
+        aimed = scanner.actors.inner(aimed, i0, n_in) if plan is not None else None
         k = len(model.pattern)
+        n_edge = 0
+        if k:  # without sub-rays (one ray per beam) no beam needs to know its neighbours
+            edge, side = np.empty(n_in, np.int64), np.empty(n_in, np.uint8)
+            n_edge = edge_beams(dist, face, inst, faces, a, cols.start, cols.stop, L, lo_r, hi_r, p.edge_step, edge,
+                                side)
+            edge, side = edge[:n_edge], side[:n_edge]
         weight = np.ones(n_in, np.float32)
         parts = {"o": [o_w[i0:i1]], "dw": [d_world[i0:i1]], "df": [d_w[i0:i1]], "dist": [dist[i0:i1]],
                  "face": [face[i0:i1]], "inst": [inst[i0:i1]], "moving": [moving[i0:i1]],
@@ -100,22 +106,20 @@ def run_physical_chunk(scanner, sweep, i: int, cols: slice) -> None:
         if k and n_edge:
             share = np.float32(1.0 / (k + 1))
             # probe: the sub-ray towards each neighbour that differs
-            e, s = np.nonzero((side[:, None] >> np.arange(4, dtype=np.uint8)) & 1)
-            pb, pw = edge[e], model.probes[s]
-            pb, pw = _unique_pairs(pb, pw, k)
-            probe = _cast_subrays(scanner, plan, cols, o_w, d_world, pb, pw, model.pattern, i0, n_in, hi_r)
-            centre_lab = _labels(face[pb], inst[pb], faces, dist[pb], lo_r, hi_r)
-            probe_lab = _labels(probe["face"], probe["inst"], faces, probe["dist"], lo_r, hi_r)
-            step = np.abs(probe["dist"] - dist[pb]) > SPLIT_STEP_M + SPLIT_STEP_REL * dist[pb]
-            split = np.unique(pb[(probe_lab != centre_lab) | ((centre_lab >= 0) & step)])
-            if len(split):
+            pb, pw = np.empty(4 * n_edge, np.int64), np.empty(4 * n_edge, np.int64)
+            n_probe = probe_pairs(edge, side, model.probes, pb, pw)
+            pb, pw = pb[:n_probe], pw[:n_probe]
+            probe = _cast_subrays(scanner, plan, cols, aimed, o_w, d_world, pb, pw, model.pattern, i0, n_in, hi_r)
+            keep, split = np.empty(n_probe, bool), np.empty(n_probe, np.int64)
+            rb, rw = np.empty(n_probe * k, np.int64), np.empty(n_probe * k, np.int64)
+            n_split, n_rest = split_beams(pb, pw, dist, face, inst, probe["dist"],
+                                          np.ascontiguousarray(probe["face"], np.int32), probe["inst"],
+                                          scanner.face_lookup.label, np.float32(lo_r), np.float32(hi_r),
+                                          np.float32(SPLIT_STEP_M), np.float32(SPLIT_STEP_REL), k, keep, split, rb, rw)
+            split, rb, rw = split[:n_split], rb[:n_rest], rw[:n_rest]
+            if n_split:
                 # the split beams' other sub-rays; their probes are kept
-                keep = np.isin(pb, split)
-                have = np.zeros((len(split), k), bool)
-                have[np.searchsorted(split, pb[keep]), pw[keep]] = True
-                rb, rw = np.nonzero(~have)
-                rest = _cast_subrays(scanner, plan, cols, o_w, d_world, split[rb], rw.astype(np.int64),
-                                     model.pattern, i0, n_in, hi_r)
+                rest = _cast_subrays(scanner, plan, cols, aimed, o_w, d_world, rb, rw, model.pattern, i0, n_in, hi_r)
                 weight[split - i0] = share
                 for key in parts:
                     if key in ("weight", "offset", "tau"):
@@ -125,7 +129,7 @@ def run_physical_chunk(scanner, sweep, i: int, cols: slice) -> None:
                 parts["weight"].append(np.full(m, share, np.float32))
                 parts["offset"].append(np.zeros(m, np.float32))
                 parts["tau"].append(np.ones(m, np.float32))
-        _behind_glass(scanner, plan, cols, parts, opt.transmittance, faces, p.glass_layers, hi_r, n_in)
+        _behind_glass(scanner, plan, cols, aimed, parts, scanner.face_lookup, p.glass_layers, hi_r, n_in)
         cat = {key: np.concatenate(v) if len(v) > 1 else v[0] for key, v in parts.items() if key not in ("o", "dw")}
         per_beam = 2 if p.mode == "dual" else 1
         buf = np.empty(per_beam * n_in, POINT_DTYPE)
@@ -136,51 +140,66 @@ def run_physical_chunk(scanner, sweep, i: int, cols: slice) -> None:
                            faces, opt.reflectivity, opt.lobe_gain, opt.lobe_exponent, opt.reference_range_m,
                            opt.min_range_m, sweep.alpha, p.detection_threshold, p.separation_m, p.mode == "dual",
                            lo_r, hi_r, sweep.key, model.ring_sigma, sweep.skew, model.k_inc)
-        start = sweep.claim(i, got)
     except BaseException:
         sweep.fail(i)
         raise
-    sweep.out[start:start + got] = buf[:got]
+    sweep.deliver(i, buf, got)
 
 
-def _behind_glass(scanner, plan, cols, parts, transmittance, faces, layers, max_range, n_in) -> None:
+class FaceLookup:
+    """Per face-table row what the glass pass reads, gathered once per scanner.
+
+    Attributes
+    ----------
+    glass : (F + 1,) bool
+        The face's material lets light through; the last entry (for face -1, no hit) is False.
+    transmittance : (F + 1,) float32
+        One-way transmittance of the face's material.
+    label : (F + 1,) int64
+        ``class << 16 | instance`` of the face (-1 in the last entry).
+    """
+
+    def __init__(self, faces: np.ndarray, transmittance: np.ndarray):
+        mat = faces["material"]
+        self.transmittance = np.append(transmittance[mat], np.float32(0.0)).astype(np.float32)
+        self.glass = self.transmittance > 0
+        self.label = np.append((faces["class"].astype(np.int64) << 16) | faces["instance"], -1).astype(np.int64)
+
+
+def _behind_glass(scanner, plan, cols, aimed, parts, lookup, layers, max_range, n_in) -> None:
     """Append to ``parts`` the rays continued behind every pane their ray list hits (``layers`` deep)."""
-    is_glass = transmittance > 0
-    # the first layer: the rows of the ray list that end on glass, gathered part by part (no copy of the rest)
-    picked = []
-    for i, f in enumerate(parts["face"]):
-        g = np.flatnonzero(is_glass[faces["material"][np.maximum(f, 0)]] & (f >= 0))
-        if len(g):
-            picked.append((i, g))
-    if not picked:
-        return
-    layer = {key: np.concatenate([v[i][g] for i, g in picked]) for key, v in parts.items()}
+    r_max, step_m = np.float32(max_range), np.float32(GLASS_STEP_M)
+    src = [{key: v[i] for key, v in parts.items()} for i in range(len(parts["face"]))]
     for _ in range(layers):
-        f = layer["face"]
-        hit = (f >= 0) & (layer["offset"] + layer["dist"] < max_range)
-        mat = faces["material"][np.maximum(f, 0)]
-        glass = np.flatnonzero(hit & is_glass[mat])
-        if len(glass) == 0:
+        picked = []
+        for part in src:  # the rows that end on glass, continued behind it (part by part: no copy of the rest)
+            n = len(part["face"])
+            rows, o = np.empty(n, np.int64), np.empty((n, 3), np.float32)
+            off, tau, left = np.empty(n, np.float32), np.empty(n, np.float32), np.empty(n, np.float32)
+            pane = np.empty(n, np.int64)
+            m = pane_rays(part["face"], part["dist"], part["offset"], part["tau"], part["inst"], part["o"], part["dw"],
+                          lookup.glass, lookup.transmittance, lookup.label, r_max, step_m, rows, o, off, tau, left,
+                          pane)
+            if m:
+                rows = rows[:m]
+                picked.append((o[:m], part["dw"][rows], off[:m], tau[:m], left[:m], pane[:m], part["beam"][rows],
+                               part["weight"][rows]))
+        if not picked:
             return
-        step = layer["dist"][glass] + np.float32(GLASS_STEP_M)
-        dw = layer["dw"][glass]
-        o = layer["o"][glass] + step[:, None] * dw
-        offset = layer["offset"][glass] + step
-        t = transmittance[mat[glass]]
-        tau = layer["tau"][glass] * t * t
-        left = np.maximum(np.float32(max_range) - offset, np.float32(1e-3)).astype(np.float32)
+        o, dw, offset, tau, left, pane, beam, weight = (np.concatenate(c) if len(picked) > 1 else c[0]
+                                                        for c in zip(*picked, strict=True))
         d = dw.copy()
         dist, face = scanner.caster.intersect_local(o, d, left, mark_misses=False)
-        beam = layer["beam"][glass]
         order = np.argsort(beam, kind="stable")  # the actors want each beam's rays together
         ptr = np.zeros(n_in + 1, np.int64)
         ptr[1:] = np.bincount(beam, minlength=n_in)
         rows = (np.cumsum(ptr), order.astype(np.int64))
-        inst, moving = _actor_hits(scanner, plan, cols, o, d, dist, face, rows=rows, offset=offset)
+        inst, moving = _actor_hits(scanner, plan, cols, o, d, dist, face, aimed, rows=rows, offset=offset)
         # the interior of the object whose glass the ray crossed is not modelled: absorbed there
-        pane = _labels(layer["face"][glass], layer["inst"][glass], faces)
-        face = np.where((face >= 0) & (_labels(face, inst, faces) == pane), -1, face).astype(np.int32)
+        face = np.ascontiguousarray(face, np.int32)
+        absorb_interior(face, inst, pane, lookup.label)
         layer = {"o": o, "dw": dw, "df": d, "dist": dist, "face": face, "inst": inst, "moving": moving, "beam": beam,
-                 "weight": layer["weight"][glass], "offset": offset, "tau": tau}
+                 "weight": weight, "offset": offset, "tau": tau}
         for key, v in layer.items():
             parts[key].append(v)
+        src = [layer]

@@ -341,3 +341,4 @@ def beam_returns(out, n_beams, ray0, beam, weight, offset, tau, dist, face, d_f,
                    np.float32(abs(c)), inst[r], moving[r], 1 if c_mix[k] else 0, echo, np.float32(c_pow[k]), skew)
             m += 1
     return m
+

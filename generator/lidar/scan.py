@@ -37,7 +37,7 @@ import numpy as np
 from generator.lidar.actors import ActorCaster
 from generator.lidar.caster import RayCaster, make_caster
 from generator.lidar.kernels import returns, world_rays
-from generator.lidar.physical_chunk import run_physical_chunk
+from generator.lidar.physical_chunk import FaceLookup, run_physical_chunk
 from generator.lidar.points import POINT_DTYPE, RecordTables
 from generator.lidar.returns import ReturnModel
 from generator.lidar.sensors import Sensor
@@ -137,6 +137,9 @@ class Scanner:
             np.concatenate([scene.face_material, *(m.face_material for m in protos)]),
             np.concatenate([self.caster.face_normals, *(self.actors.face_normals() if protos else [])]))
         self._o32, self._d32 = self._records.origins, self._records.directions  # (steps, L, 3), ring order
+        #: what the physical chunks read per face-table row (None without the physical model)
+        self.face_lookup = (FaceLookup(self._records._faces, self.returns.optics.transmittance)
+                            if self.returns is not None else None)
         steps = sensor.azimuth_steps
         n_chunks = min(steps, self.threads * max(1, chunks_per_thread))
         edges = np.linspace(0, steps, n_chunks + 1).round().astype(int)
@@ -269,6 +272,9 @@ class _Sweep:
         self.alpha, self.key = alpha, key
         self.ends: list[int | None] = [None] * n_chunks
         self._done = [threading.Event() for _ in range(n_chunks)]
+        self._lock = threading.Lock()
+        self._pending: dict[int, tuple[np.ndarray, int]] = {}
+        self._next = 0  # the first chunk whose offset is not known yet (deliver)
         self._plan, self._plan_error = None, None
         self._planned = threading.Event()
 
@@ -304,6 +310,27 @@ class _Sweep:
         self.ends[i] = start + n
         self._done[i].set()
         return start
+
+    def deliver(self, i: int, buf: np.ndarray, n: int) -> None:
+        """Hand in chunk ``i``'s ``n`` points (``buf[:n]``) without waiting for the chunks before it.
+
+        The points go to their place in :attr:`out` as soon as every earlier chunk's count is known,
+        copied by whichever chunk completes the chain; a chunk finished early does not hold its thread.
+        (Use either this or :meth:`claim` for all the chunks of a sweep.)
+        """
+        todo = []
+        with self._lock:
+            self._pending[i] = (buf, n)
+            j = self._next
+            while j in self._pending:
+                b, m = self._pending.pop(j)
+                start = self.ends[j - 1] if j else 0
+                self.ends[j] = start + m
+                todo.append((start, b, m))
+                j += 1
+            self._next = j
+        for start, b, m in todo:
+            self.out[start:start + m] = b[:m]
 
     def fail(self, i: int) -> None:
         """Release the chunks waiting on chunk ``i`` (they raise)."""
