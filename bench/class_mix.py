@@ -1,11 +1,12 @@
 """LiDAR class mix of a spec over several towns, beside SemanticKITTI's, with the TV distance.
 
     python bench/class_mix.py scenes/kitti_like.json [--towns 3] [--sweeps 40] [--first 0 3 6]
-                              [--drive 600] [--baseline scenes/default_town.json | none] [--json out.json]
+                              [--drive 600] [--seeds 2027 7 99] [--baseline scenes/default_town.json | none]
+                              [--json out.json]
 
-Each town is the spec with another seed (``seed + first + k``). With ``--drive N`` (what a user gets) a
-town's sweeps are the first N consecutive 10 Hz sweeps of its drive, cast exactly as ``urbangen lidar
-SPEC --frames N`` casts them: the ego on route 0 through the spec's traffic, the spec's sensor with its
+Each town is the spec with another seed (``seed + first + k``, or the ``--seeds`` given). With ``--drive N``
+(what a user gets) a town's sweeps are the first N consecutive 10 Hz sweeps of its drive, cast exactly as
+``urbangen lidar SPEC --frames N`` casts them: the ego on route 0 through the spec's traffic, the spec's sensor with its
 return model (the HDL-64E's physical returns); the report then adds, per town, the TV and the ratio of
 each class above 1 % of SemanticKITTI's points to its share there (target: within 1.5x), and the
 first sweep where each of the 19 classes appears. Without it the sweeps are frames spread evenly over
@@ -86,19 +87,23 @@ def measure_town(spec, sweeps: int) -> np.ndarray:
     return counts
 
 
-def measure(spec_path: str, towns: int, sweeps: int, first: int = 0, drive: int = 0) -> tuple[np.ndarray, float, list]:
+def measure(spec_path: str, towns: int, sweeps: int, first: int = 0, drive: int = 0,
+            seeds: list[int] | None = None) -> tuple[np.ndarray, float, list]:
     """(20,) point counts per learning class over ``towns`` x ``sweeps`` sweeps (or ``drive`` consecutive
-    sweeps), seconds, per-town (seed, counts, first sweep per class or None)."""
+    sweeps), seconds, per-town (seed, counts, first sweep per class or None). ``seeds`` given: those
+    towns instead of ``seed + first + k``."""
     base = load_spec(spec_path)
     per_town = []
     t0 = time.perf_counter()
-    for k in range(first, first + towns):
-        spec = dataclasses.replace(base, seed=base.seed + k)
+    for seed in seeds or [base.seed + k for k in range(first, first + towns)]:
+        spec = dataclasses.replace(base, seed=seed)
         spec = dataclasses.replace(spec, spec_hash=canonical_hash(spec.to_dict()))
         if drive:
             per_town.append((spec.seed, *measure_drive(spec, drive)))
         else:
             per_town.append((spec.seed, measure_town(spec, sweeps), None))
+        print(f"  {Path(spec_path).name} town {spec.seed} measured ({time.perf_counter() - t0:.0f} s so far)",
+              file=sys.stderr, flush=True)
     return sum(t[1] for t in per_town), time.perf_counter() - t0, per_town
 
 
@@ -121,8 +126,12 @@ def main() -> None:
     ap.add_argument("--drive", type=int, default=0,
                     help="consecutive sweeps of the user's drive per town (600: one minute), instead of --sweeps "
                          "spread over a lap")
+    ap.add_argument("--seeds", type=int, nargs="+",
+                    help="measure exactly these town seeds (one set; replaces --towns and --first)")
     ap.add_argument("--json", help="write the counts (per set and per town) to this JSON file")
     args = ap.parse_args()
+    if args.seeds:
+        args.towns, args.first = len(args.seeds), [0]
     names = label_sets()["semantickitti"].names
     q = reference_distribution()
     runs = [(f"set+{f}", args.spec, f) for f in args.first]
@@ -130,7 +139,7 @@ def main() -> None:
         runs.append(("baseline", args.baseline, args.first[0]))
     rows, dump = {}, {}
     for label, path, first in runs:
-        counts, secs, per_town = measure(path, args.towns, args.sweeps, first, args.drive)
+        counts, secs, per_town = measure(path, args.towns, args.sweeps, first, args.drive, args.seeds)
         rows[label] = (distribution(counts), counts, secs, per_town, path, first)
         dump[label] = {"spec": str(path), "first": first, "counts": counts.tolist(), "drive": args.drive,
                        "towns": {str(t[0]): t[1].tolist() for t in per_town},

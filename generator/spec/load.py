@@ -37,8 +37,9 @@ def parse_spec(document: object, source: str) -> SceneSpec:
 
 def spec_hash(spec: SceneSpec) -> str:
     """The spec's :func:`canonical_hash`; ``town.redraw_every_frames``, ``streets.roundabouts``,
-    ``streets.closed_streets``, ``traffic.vans_per_km`` and ``traffic.counts`` count only when set, so the
-    hash of every spec written before those options is unchanged (resumable datasets stay resumable)."""
+    ``streets.closed_streets``, ``streets.residential_strips``, ``streets.drive_types``,
+    ``traffic.vans_per_km`` and ``traffic.counts`` count only when set, so the hash of every spec written
+    before those options is unchanged (resumable datasets stay resumable)."""
     d = spec.to_dict()
     if d["town"].get("redraw_every_frames") is None:
         d["town"].pop("redraw_every_frames", None)
@@ -47,6 +48,10 @@ def spec_hash(spec: SceneSpec) -> str:
             d["streets"].pop(key, None)
     if d.get("streets") is not None and list(d["streets"].get("intersection_angle_deg", (90, 90))) == [90, 90]:
         d["streets"].pop("intersection_angle_deg", None)   # and the angle while right
+    if d.get("streets") is not None and d["streets"].get("residential_strips", "either") == "either":
+        d["streets"].pop("residential_strips", None)       # and the residential strips while drawn per side
+    if d.get("streets") is not None and d["streets"].get("drive_types") is None:
+        d["streets"].pop("drive_types", None)              # and the drive's street types while drawn
     if not d["traffic"].get("vans_per_km"):             # and the traffic's vans and counts while unused
         d["traffic"].pop("vans_per_km", None)
     if d["traffic"].get("counts") is None:
@@ -74,7 +79,8 @@ def check_streets(full: dict, source: str) -> None:
     lo, hi = streets["intersection_angle_deg"]
     if lo < 60 or hi > 90:
         raise SpecError(source, "streets.intersection_angle_deg", f"must lie within [60, 90] degrees, got {[lo, hi]}")
-    varied = sorted(k for k, w in streets["types"].items() if k != "plain" and w > 0)
+    varied = sorted({k for k, w in streets["types"].items() if k != "plain" and w > 0}
+                    | {k for k in streets.get("drive_types") or () if k != "plain"})
     if varied and full["town"]["parking_strip_width_m"] <= 0:
         # every type but plain fills or turns the strips between the lanes and the kerbs
         # (generator.layout.network.cross_sections); without them the weights would be silently ignored

@@ -215,6 +215,11 @@ class Streets:
     #: [low, high] degrees the two street directions cross at, one draw per town
     #: (:mod:`generator.layout.mapping.town_map`)
     intersection_angle_deg: Range = (90.0, 90.0)
+    #: "either": each side of a residential street parking or verge at even odds; "parking_and_verge":
+    #: one side each (:mod:`generator.layout.network.cross_sections`)
+    residential_strips: str = "either"
+    #: types route 0's streets take in turn, in driving order (None: drawn like every street)
+    drive_types: tuple | None = None
 
 
 @dataclass(frozen=True)

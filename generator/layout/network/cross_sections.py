@@ -12,6 +12,7 @@ type          strips (side -1, side +1)             extra
 ============  ====================================  =========================================
 plain         parking, parking                      (every street of a town without ``streets``)
 residential   parking or verge, each at even odds   bushes and small trees on the verges
+              (one of each: see below)
 boulevard     verge, verge                          a tree row on each verge
 arterial      shoulder, shoulder (asphalt)          a raised median island (other-ground), where
                                                     the lanes are wide enough that the ego on its
@@ -24,6 +25,20 @@ shared        furnished, furnished                  paved kerb to kerb (class ro
                                                     markings, bollards in the strips, 20 km/h
                                                     (:data:`SHARED_SPEED_MPS`)
 ============  ====================================  =========================================
+
+With ``streets.residential_strips = "parking_and_verge"`` a residential street has one parking
+strip and one verge, so every residential street has parked cars and greenery and a drive's
+class mix does not hang on how many of its streets happened to draw verges on both sides
+(``kitti_like``). On a street route 0 (the user's drive) passes, the verge lines the drive's own
+kerb and the parked cars stand across the street, on its left; elsewhere the side is drawn at
+even odds (from the same two draws as per side). A car parked beside the ego's lane fills about
+three times the points of one across the street, so a coin per street made the car share of a
+one-minute drive swing threefold from town to town.
+
+With ``streets.drive_types`` the streets route 0 drives take the listed types in turn, in driving
+order from its start (the other streets keep their draws, and every street still takes its draw
+from the stream, so the draws after it stay), so one minute of the drive passes the same mix of
+streets in every town.
 
 A *verge* is grass (terrain) raised to curb height behind a curb along the lane edge; a
 *shoulder* is asphalt (road) with the edge line, no bays; a *furnished* strip is paving at road
@@ -43,6 +58,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from generator.layout.network.cycles import route_node_cycles
 from generator.layout.network.design_vehicle import EGO_HALF_WIDTH_M
 from generator.layout.network.one_way import one_way_directions
 from generator.rng import stream
@@ -114,6 +130,10 @@ def draw_sections(spec, segments, closed=(), roundabouts=frozenset()) -> tuple[C
     g = stream(spec.seed, "layout", "street_types")
     w = np.array([float(streets.types.get(t, 0.0)) for t in TYPES])
     kinds = [TYPES[int(k)] for k in g.choice(len(TYPES), size=n_segments, p=w / w.sum())]
+    drive = drive_directions(segments, spec.town.blocks_x, spec.town.blocks_y)
+    if streets.drive_types:       # route 0's streets in driving order take the listed types in turn
+        for k, i in enumerate(drive):
+            kinds[i] = streets.drive_types[k % len(streets.drive_types)]
     cand = [i for i, k in enumerate(kinds) if k == "one_way"]
     direction = one_way_directions(spec.seed, segments, cand, spec.town.blocks_x, spec.town.blocks_y,
                                    closed, roundabouts)
@@ -129,7 +149,13 @@ def draw_sections(spec, segments, closed=(), roundabouts=frozenset()) -> tuple[C
         if kind in ("plain", "one_way"):
             strips = ("parking", "parking")
         elif kind == "residential":
-            strips = tuple("parking" if r < 0.5 else "verge" for r in g.random(2))
+            r = g.random(2)       # two draws either way: the occupancies and later segments stay put
+            if streets.residential_strips == "parking_and_verge":
+                # driven towards +u (d = +1) the ego keeps to side -1: parking across, on side +1
+                parking_side = drive[i] if i in drive else (-1 if r[0] < 0.5 else 1)
+                strips = ("parking", "verge") if parking_side < 0 else ("verge", "parking")
+            else:
+                strips = tuple("parking" if x < 0.5 else "verge" for x in r)
         elif kind == "shared":
             strips = ("furnished", "furnished")
         elif kind == "boulevard":
@@ -139,6 +165,22 @@ def draw_sections(spec, segments, closed=(), roundabouts=frozenset()) -> tuple[C
         occ = tuple(float(x) for x in g.uniform(lo, hi, 2))
         out.append(CrossSection(kind, strips, occ, kind == "arterial" and island, direction.get(i, 0)))
     return tuple(out)
+
+
+def drive_directions(segments, nx: int, ny: int) -> dict[int, int]:
+    """``segment index -> +1 | -1``: the direction route 0 (the ego's drive) passes each segment it
+    drives (+1 towards +u), in driving order from the route's start; segments it does not drive are
+    absent."""
+    index = {(s.a, s.b): s.index for s in segments}
+    cyc = route_node_cycles(nx, ny)[0]
+    out = {}
+    for k, a in enumerate(cyc):
+        b = cyc[(k + 1) % len(cyc)]
+        if (a, b) in index:
+            out.setdefault(index[(a, b)], 1)
+        elif (b, a) in index:
+            out.setdefault(index[(b, a)], -1)
+    return out
 
 
 def sections_record(grid) -> list[dict]:
