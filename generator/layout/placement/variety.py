@@ -9,9 +9,11 @@ parameters:
   library of ``n`` cars holds each body type in its share (largest deviation one car) and a town
   that picks variants uniformly parks and drives that mix; the dimensions within a body type are
   drawn by the builder from each type's range of real models;
-* **people** -- :func:`draw_figure`: a share ``assets.child_share`` of children aged 4-14 with the
-  WHO growth reference's median height for their age (a 4.5 % spread), the rest adults, half women
-  and half men, heights from the sex's normal distribution clipped to ``heights.person_m``; the
+* **people** -- :func:`draw_figure`: the share ``assets.child_share`` of the variants are children
+  aged 4-14 (every variant ``i`` where ``floor((i + 1) * share)`` steps up: spread evenly over the
+  standing and the walking half) with the WHO growth reference's median height for their age (a 4.5 %
+  spread), the rest adults, half women and half men (drawn), heights from the sex's normal
+  distribution clipped to ``heights.person_m``; the
   builder gives children bigger heads for their height (``age``) and men broader shoulders (``sex``).
 
 Parked, standing, walking and driving things draw on the same variants, so a car that parks and one
@@ -57,19 +59,23 @@ def truck_variant(lib: Library, i: int) -> Proto:
     return lib.variant("truck", int(i) % lib.count("truck", DEFAULT_COUNTS["truck"]))
 
 
-def draw_figure(g: np.random.Generator, adult_m: tuple[float, float], child_share: float) -> dict:
+def is_child(i: int, share: float) -> bool:
+    """Whether person variant ``i`` is a child: ``floor((i + 1) * share) > floor(i * share)``."""
+    return int(np.floor((i + 1) * share + 1e-9)) > int(np.floor(i * share + 1e-9))
+
+
+def draw_figure(g: np.random.Generator, adult_m: tuple[float, float], child: bool) -> dict:
     """One person's ``height`` (metres), ``age`` (years) and ``sex`` (see the module docstring).
 
     Parameters
     ----------
     g : numpy.random.Generator
-        The variant's own stream (five draws, whatever comes out).
+        The variant's own stream (three draws, whatever comes out).
     adult_m : (low, high)
         Adult heights are clipped to this range (the spec's ``heights.person_m``).
-    child_share : float
-        Probability that the person is a child (4-14 years).
+    child : bool
+        A child (4-14 years) or an adult (18-80).
     """
-    child = g.random() < child_share
     sex = "female" if g.random() < 0.5 else "male"
     z = float(g.standard_normal())
     if child:
@@ -88,6 +94,6 @@ def person_variants(lib: Library, spec: SceneSpec) -> list[Proto]:
     share = spec.assets.child_share
 
     def params(g, i):
-        return {**draw_figure(g, (lo, hi), share), "pose": "standing" if i < n // 2 else "walking"}
+        return {**draw_figure(g, (lo, hi), is_child(i, share)), "pose": "standing" if i < n // 2 else "walking"}
 
     return [lib.variant("person", i, lambda g, i=i: params(g, i)) for i in range(n)]
