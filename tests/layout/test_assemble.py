@@ -65,8 +65,9 @@ NEWER_FAMILIES = {"bicycle", "motorcycle", "bus", "on_rails", "other_vehicle", "
 #: SceneModel.digest() of scenes/default_town.json without its traffic (the frozen town of before
 #: traffic existed: lane cars, double-parked trucks, a person on a crosswalk). The newer families
 #: must not change it; update it only for a change that means to alter the default town, and say so
-#: in the commit.
-DEFAULT_TOWN_DIGEST = "6baaa3eac4e210513e04c69c7566d233f15d9eae16633b4b43f1e19f0b2c9096"
+#: in the commit. Re-pinned for issue 29 (asset variety: 48 car and 48 person variants drawn by body
+#: type and by age and sex change every car and person of the town; nothing moved).
+DEFAULT_TOWN_DIGEST = "9bfdfe83e30da4d197d96fdc3280863530c70e35ef246665a418fac7ff1206d5"
 
 
 def test_every_class_is_present_in_the_default_town(default_spec, default_scene):
