@@ -10,6 +10,10 @@ skirt), ``shoes`` (shoes and a carried bag), ``skin`` (face, hands, bare arms an
 Drawn per prototype from its generator: the build (girth 0.88-1.12, shoulder breadth 0.94-1.05), the
 garments (trousers, shorts, skirt, long coat; short sleeves), the hair, and what the arms do
 (hang, hold a phone to the ear, hands in the pockets, carry a bag).
+
+Given by the caller: the height, the ``age`` and the ``sex``. A child's head is a larger part of
+its height (head height about 1/5.5 of stature at 4 years, 1/6.5 at 10, 1/7.5 for adults:
+:data:`HEAD_SCALE`), its build slimmer; men's shoulders are broader than women's.
 """
 
 from __future__ import annotations
@@ -22,6 +26,11 @@ from generator.geometry import Mesh, box, icosphere, loft, merge, on_ground, res
 CLS = "person"
 POSES = ("standing", "walking")
 #: what the arms do, and how often
+#: age (years) -> head size relative to an adult's of the same height (head height / stature: about
+#: 0.18 at 4 years, 0.155 at 10, 0.13 for adults; anthropometric growth charts)
+HEAD_AGE = (4.0, 6.0, 10.0, 14.0, 17.0)
+HEAD_SCALE = (1.38, 1.3, 1.19, 1.07, 1.0)
+SEXES = ("female", "male", None)
 ARMS: dict[str, float] = {"hanging": 0.55, "phone": 0.15, "pockets": 0.15, "bag": 0.15}
 #: lower-body garments, and how often
 GARMENTS: dict[str, float] = {"trousers": 0.58, "shorts": 0.1, "skirt": 0.12, "coat": 0.2}
@@ -44,9 +53,10 @@ def _pick(rng: np.random.Generator, table: dict[str, float]) -> str:
     return names[int(rng.choice(len(names), p=np.array(list(table.values()))))]
 
 
-def _head(h: float, rng: np.random.Generator) -> list[Mesh]:
-    centre = np.array([0.01 * h, 0.0, 0.925 * h])
-    radii = np.array([0.056, 0.05, 0.066]) * h
+def _head(h: float, rng: np.random.Generator, k: float = 1.0) -> list[Mesh]:
+    """Head, hair and neck; ``k`` scales the head about its chin (the neck stays)."""
+    centre = np.array([0.01 * h, 0.0, (0.859 + 0.066 * k) * h])
+    radii = np.array([0.056, 0.05, 0.066]) * h * k
     head = icosphere(1.0, CLS, "skin", 1)
     head.vertices = head.vertices * radii + centre
     hair = icosphere(1.0, CLS, "hair", 1)
@@ -107,7 +117,8 @@ def _arm(side: float, shoulder: np.ndarray, action: str, swing: float, rng: np.r
     return parts
 
 
-def person(rng: np.random.Generator, height: float, pose: str = "standing") -> Mesh:
+def person(rng: np.random.Generator, height: float, pose: str = "standing", age: float = 30.0,
+           sex: str | None = None) -> Mesh:
     """A pedestrian ``height`` metres tall, facing +x.
 
     Parameters
@@ -118,6 +129,11 @@ def person(rng: np.random.Generator, height: float, pose: str = "standing") -> M
         Top of the head, metres (0.9-2.2).
     pose : {"standing", "walking"}
         Walking: legs and free arms swing in opposite phase (stride 15-25 degrees).
+    age : float
+        Years; below 17 the head grows relative to the height (:data:`HEAD_SCALE`) and the build
+        slims (girth x0.92 under 14).
+    sex : {"female", "male"} or None
+        Shoulder breadth -0.03 / +0.03; men wear no skirt (trousers instead). None: neither.
 
     Returns
     -------
@@ -128,15 +144,19 @@ def person(rng: np.random.Generator, height: float, pose: str = "standing") -> M
         raise ValueError(f"person pose must be one of {POSES}, got {pose!r}")
     if not 0.9 <= height <= 2.2:
         raise ValueError(f"person height must be in [0.9, 2.2] m, got {height}")
-    girth = rng.uniform(0.88, 1.12)
-    breadth = rng.uniform(0.94, 1.05)
+    if sex not in SEXES:
+        raise ValueError(f"person sex must be one of {SEXES}, got {sex!r}")
+    girth = rng.uniform(0.88, 1.12) * (0.92 if age < 14 else 1.0)
+    breadth = rng.uniform(0.94, 1.05) + {"female": -0.03, "male": 0.03}.get(sex, 0.0)
     garment = _pick(rng, GARMENTS)
+    if sex == "male" and garment == "skirt":
+        garment = "trousers"
     short_sleeves = garment != "coat" and rng.random() < 0.3
     arms = [_pick(rng, ARMS), "hanging"]
     if rng.random() < 0.5:
         arms.reverse()
     swing = np.radians(rng.uniform(15, 25)) * (1 if rng.random() < 0.5 else -1) if pose == "walking" else 0.0
-    parts = [_torso(girth, breadth, garment)] + _head(1.0, rng)
+    parts = [_torso(girth, breadth, garment)] + _head(1.0, rng, float(np.interp(age, HEAD_AGE, HEAD_SCALE)))
     thigh = "skin" if garment == "skirt" else "clothing_bottom"
     shin = "skin" if garment in ("skirt", "shorts") else "clothing_bottom"
     for (side, phase), action in zip(((1.0, 1.0), (-1.0, -1.0)), arms, strict=False):

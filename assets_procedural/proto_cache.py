@@ -8,8 +8,9 @@ in. Nothing is quantised: cached or not, the scene has the same bytes. The cache
 at what a builder draws.
 
 What it buys: a town built again in the same process (a render worker, ``generate``'s
-per-town passes, tests) and the towns of a re-drawn run (``town.redraw_every_frames``),
-which share the instanced prototypes of their asset library, skip the mesh building. Derived
+per-town passes, tests) and the towns of a re-drawn run that share an asset library
+(``assets.redraw_every_towns`` > 1 or null) skip the mesh building; a town with a fresh library
+builds its meshes once per process. Derived
 per-prototype data (collision bands, label hulls) is cached beside the mesh
 (:meth:`PrototypeCache.derive`).
 

@@ -17,8 +17,14 @@ from generator.geometry import Mesh, box, cylinder, disc, loft, merge, on_ground
 GLASS_OFFSET = 0.02  # metres: glass in front of the body surface (>= 2 cm: no z-fighting)
 PROUD_M = 0.025      #: how far a car's lamps and plates stand out of its nose and tail, metres
 
-#: body types of :func:`car` and their share of a town's car models (a European street:
-#: hatchbacks and SUVs lead, then sedans and estates, few MPVs and pickups)
+#: body types of :func:`car` and their share of a town's cars: compact (``hatchback``), saloon
+#: (``sedan``), estate, SUV/crossover, MPV (``van``) and pickup. Assumed shares of the European car
+#: *parc* (cars on the road, not new sales): SUVs were ~20 % of EU new registrations in 2014 and ~50 %
+#: in 2023 (JATO Dynamics), and the parc averages ~12 years (ACEA, "Vehicles on European roads" 2023),
+#: so SUVs and compacts lead at ~28 % each, saloons and estates follow; MPVs are a fading segment
+#: (~8 %); pickups are ~1 % in Europe and more in North America -- kept at 6 % so that a library of
+#: dozens holds a few. Dimensions per type: :data:`assets_procedural.car_body.BODY_TYPES` (ranges of
+#: the best-selling models of each type), drawn uniformly within the range.
 CAR_VARIANTS: dict[str, float] = {"sedan": 0.18, "hatchback": 0.28, "estate": 0.12, "suv": 0.28, "van": 0.08,
                                   "pickup": 0.06}
 
@@ -107,7 +113,7 @@ def _arch_wall(x: float, y: float, side: float, r: float, arch: float, cls: str)
     return polygon(np.array(pts), cls, "car_trim", (0, side, 0))
 
 
-def car(rng: np.random.Generator, variant: str | None = None) -> Mesh:
+def car(rng: np.random.Generator, variant: str | None = None, quantile: float | None = None) -> Mesh:
     """A passenger car: a lofted, curved body of one body type, with wheels, lights and plates.
 
     Parameters
@@ -117,6 +123,10 @@ def car(rng: np.random.Generator, variant: str | None = None) -> Mesh:
     variant : {"sedan", "hatchback", "estate", "suv", "van", "pickup"}, optional
         Body type (:data:`assets_procedural.car_body.BODY_TYPES`); drawn with the shares of
         :data:`CAR_VARIANTS` when omitted.
+    quantile : float in [0, 1), optional
+        Instead of ``variant``: the body type at this quantile of the cumulative shares of
+        :data:`CAR_VARIANTS` (a library of ``n`` cars asks for ``(i + 0.5) / n`` and so holds every
+        type in its share).
 
     Returns
     -------
@@ -129,6 +139,11 @@ def car(rng: np.random.Generator, variant: str | None = None) -> Mesh:
         Anchors ``"headlight"`` (2, 3) and ``"taillight"`` (2, 3) on the lamp faces.
     """
     names = list(CAR_VARIANTS)
+    if variant is None and quantile is not None:
+        if not 0.0 <= quantile < 1.0:
+            raise ValueError(f"car quantile must be in [0, 1), got {quantile}")
+        cum = np.cumsum(list(CAR_VARIANTS.values()))
+        variant = names[min(int(np.searchsorted(cum / cum[-1], quantile, side="right")), len(names) - 1)]
     if variant is None:
         variant = names[int(rng.choice(len(names), p=np.array(list(CAR_VARIANTS.values()))))]
     if variant not in CAR_VARIANTS:

@@ -4,8 +4,8 @@
     python bench/town_digests.py --write    # record the current code's digests (do this on main's code)
 
 The set: the default town and kitti_like as they are, both at other seeds, the towns 1..3 of a
-re-drawn run of each (``town.redraw_every_frames``: a town seed, the spec's seed as asset seed;
-built one after the other, so the prototype cache is warm as in a real run), a 2x2 and a 4x4
+re-drawn run of each (``town.redraw_every_frames``: a town seed, and each town its own asset
+library, ``assets.redraw_every_towns`` 1; built one after the other as in a real run), a 2x2 and a 4x4
 default town, and the test town and city centre. Every build goes through
 :func:`generator.layout.assemble.build_scene` and :meth:`SceneModel.digest` (every triangle,
 class, material, instance, label hull, object record and route). The digests were recorded with

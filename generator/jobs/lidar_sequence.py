@@ -57,6 +57,7 @@ from generator.remission.models import IntensityFn, intensity_fn_for_spec
 from generator.scan_effects.pipeline import process_scan, processing_for_spec
 from generator.spec.towns import angle_record, town_record
 from generator.world.actors import MOVING_THRESHOLD_MPS
+from generator.world.census import prototype_census
 from generator.world.rig import SWEEP_PERIOD_S, Rig
 
 log = logging.getLogger(__name__)
@@ -237,6 +238,7 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
                        "digest": world.digest(times) if actors else None,
                        "moving_ids": "SemanticKITTI 252-259 for points on an actor moving faster than the "
                                      "threshold at its firing time; instance ids stay the same all sequence"}
+    meta["prototypes"] = prototype_census(scene, world)   # distinct meshes per kind (urbangen stats)
     if options.image_frames:
         meta["image_frames"] = [list(p) for p in options.image_frames]
     meta["processing"], meta["scans"] = processing.describe(), records

@@ -40,9 +40,11 @@ from generator.layout.placement import verges as pv
 from generator.layout.placement.keepout import Keepout
 from generator.layout.placement.placer import Placed, Placer
 from generator.layout.placement.prototypes import Library
+from generator.layout.placement.variety import variant_counts
 from generator.layout.town import Town
 from generator.progress import progress
 from generator.spec.model import SceneSpec
+from generator.spec.towns import library_seed
 from generator.world.scene import Path, SceneModel, SceneObject
 
 log = logging.getLogger(__name__)
@@ -204,7 +206,7 @@ def build_scene(spec: SceneSpec) -> Town:
     lots = make_lots(spec, grid)
     limit = spec.paths.clearance_m + EGO_HALF_WIDTH_M
     keepout = Keepout(np.concatenate([densify(r) for r in routes]), limit)
-    lib = Library(spec.seed if spec.asset_seed is None else spec.asset_seed)  # re-drawn towns share the assets
+    lib = Library(library_seed(spec), variant_counts(spec))   # a fresh library per town (or every M towns)
     tmap = draw_town_map(spec, grid)
     placer = Placer(lib, keepout, town_map=tmap)   # with a map: laid out on the grid, checked in the world
     street = ps.Street(grid)

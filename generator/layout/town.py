@@ -27,9 +27,10 @@ class Town(SceneModel):
     grid : Grid
         The street grid (grid frame), roundabouts, closures and cross-sections included.
     library : Library
-        The asset library every prototype of the town came from: the spec's ``asset_seed`` (the
-        shared library of a re-drawn town, ``town.redraw_every_frames``), else its ``seed``. The
-        moving traffic draws its vehicles and people from it too.
+        The asset library every prototype of the town came from, seeded by
+        :func:`generator.spec.towns.library_seed` (a re-drawn town's own library, or the one it shares
+        with its neighbours, ``assets.redraw_every_towns``; else the spec's ``seed``). The moving
+        traffic draws its vehicles and people from it too.
     town_map : TownMap or None
         The grid -> world map of a town whose streets cross at an angle other than 90 degrees;
         None when they cross at right angles (grid and world are the same frame).

@@ -13,7 +13,7 @@ import json
 from pathlib import Path
 
 from generator.errors import SpecError
-from generator.spec.model import SceneSpec, build
+from generator.spec.model import Assets, SceneSpec, build
 from generator.spec.validate import check_ranges, load_schema, read_document, validate, with_defaults
 
 
@@ -38,8 +38,9 @@ def parse_spec(document: object, source: str) -> SceneSpec:
 def spec_hash(spec: SceneSpec) -> str:
     """The spec's :func:`canonical_hash`; ``town.redraw_every_frames``, ``streets.roundabouts``,
     ``streets.closed_streets``, ``streets.residential_strips``, ``streets.drive_types``,
-    ``traffic.vans_per_km`` and ``traffic.counts`` count only when set, so the hash of every spec written
-    before those options is unchanged (resumable datasets stay resumable)."""
+    ``traffic.vans_per_km``, ``traffic.counts`` and ``assets`` count only when set (``assets``: when not
+    the default), so the hash of every spec written before those options is unchanged (resumable datasets
+    stay resumable)."""
     d = spec.to_dict()
     if d["town"].get("redraw_every_frames") is None:
         d["town"].pop("redraw_every_frames", None)
@@ -58,6 +59,8 @@ def spec_hash(spec: SceneSpec) -> str:
         d["traffic"].pop("counts", None)
     if d["sensors"]["lidar"].get("returns") is None:        # and the LiDAR return model while the sensor's own
         d["sensors"]["lidar"].pop("returns", None)
+    if d.get("assets") == dataclasses.asdict(Assets()):   # and the asset variety while the default
+        d.pop("assets", None)
     return canonical_hash(d)
 
 

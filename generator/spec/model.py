@@ -223,6 +223,30 @@ class Streets:
 
 
 @dataclass(frozen=True)
+class Variants:
+    """Distinct prototype meshes per kind in one asset library (``assets.variants``)."""
+
+    car: int = 48
+    person: int = 48
+    truck: int = 8
+    bus: int = 6
+    bicyclist: int = 8
+    motorcyclist: int = 8
+    construction_vehicle: int = 4
+    box_van: int = 4
+
+
+@dataclass(frozen=True)
+class Assets:
+    """Asset variety (``assets``): variants per kind, how often re-drawn towns draw a fresh library,
+    the share of children among the people."""
+
+    variants: Variants = Variants()
+    redraw_every_towns: int | None = 1
+    child_share: float = 0.14
+
+
+@dataclass(frozen=True)
 class SceneSpec:
     """A validated scene spec (see ``schemas/scene.schema.json`` for every field's meaning).
 
@@ -253,6 +277,7 @@ class SceneSpec:
     lidar: LidarProcessing
     labels: Labels
     streets: Streets | None = None
+    assets: Assets = Assets()
     source: str = ""
     spec_hash: str = ""
     town_index: int | None = None

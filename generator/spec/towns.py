@@ -6,9 +6,11 @@ spec's ``seed``, exactly as before. With ``N`` set, image frame ``k`` belongs to
 
 * ``seed`` = :func:`town_seed` (``child_seed(seed, "town", i)``, 53 bits): its street grid, lots,
   placements, traffic, camera jitter, weather and lighting draws are its own;
-* ``asset_seed`` = the spec's seed: the towns share one asset library (the prototype meshes
-  of cars, trees, people ... are drawn from the spec's seed, arranged anew in every town),
-  which the prototype cache reuses from town to town;
+* ``asset_seed`` = the spec's seed, from which :func:`library_seed` draws the seed of the town's
+  asset library (the prototype meshes of cars, people, trucks, trees ...): with
+  ``assets.redraw_every_towns`` = M (default 1) towns ``j*M .. j*M+M-1`` share library ``j``, drawn
+  from the stream ``("assets", "library", j)``; with it null every town shares the spec seed's
+  library (as before issue 29). Towns that share a library reuse its meshes through the prototype cache;
 * ``town_index`` = ``i`` (recorded in image metadata and ``lidar_meta.json`` as ``town``);
 * the same ``spec_hash`` (it names the spec file, not the town).
 
@@ -71,6 +73,20 @@ def town_spec(spec, index: int | None):
     if redraw_every(spec) is None:
         raise ValueError(f"{spec.source}: town.redraw_every_frames is null (one town)")
     return dataclasses.replace(spec, seed=town_seed(spec.seed, index), town_index=int(index), asset_seed=spec.seed)
+
+
+def library_seed(spec) -> int:
+    """The seed of the asset library :class:`~generator.layout.placement.prototypes.Library` of ``spec``'s town.
+
+    The spec's own seed for a run of one town (``town_index`` None) and for every town when
+    ``assets.redraw_every_towns`` is null; else library ``town_index // redraw_every_towns``, seeded
+    from the base seed's stream ``("assets", "library", j)`` (53 bits, as :func:`town_seed`).
+    """
+    base = spec.seed if spec.asset_seed is None else spec.asset_seed
+    every = spec.assets.redraw_every_towns
+    if spec.town_index is None or every is None:
+        return int(base)
+    return child_seed(int(base), "assets", "library", int(spec.town_index) // int(every)) >> 10
 
 
 def town_record(spec) -> dict | None:

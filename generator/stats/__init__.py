@@ -18,7 +18,7 @@ import importlib
 from types import ModuleType
 
 #: Statistics modules, in report order.
-SECTIONS = ("images", "class_mix", "box_counts")
+SECTIONS = ("images", "class_mix", "box_counts", "assets")
 
 
 def section_modules() -> list[ModuleType]:

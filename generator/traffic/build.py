@@ -34,7 +34,7 @@ from generator.traffic.lanes.signals import CLEAR_S, Signals
 from generator.traffic.mapped_tracks import map_track
 from generator.traffic.movers import DT_S, Mover
 from generator.traffic.pedestrians.simulate import simulate_pedestrians
-from generator.traffic.vehicles.fleet import KINDS, drives, fleet_proto, how_many, widest_half_width
+from generator.traffic.vehicles.fleet import KINDS, drives, fleet_proto, how_many, n_variants, widest_half_width
 from generator.traffic.vehicles.sim import Vehicle, VehicleSim, arm_towards
 from generator.world.actors import Actor, Track, TrackTrajectory, World, frozen_world
 from generator.world.trajectory import EgoTrajectory
@@ -223,7 +223,7 @@ def _drive(spec, graph, scene, signals, lib, blocked, crossing, duration_s, dist
     taken: dict[int, list] = {route[0]: [(0.0, EGO_SIZE_M[0])]}
     for field_name, (kind, n_var, speed, a_max, _) in KINDS.items():
         for _ in range(how_many(tr, field_name, km)):
-            proto = fleet_proto(lib, kind, int(g.integers(n_var)))
+            proto = fleet_proto(lib, kind, int(g.integers(n_variants(lib, kind, n_var))))
             length, width = float(proto.hi[0] - proto.lo[0]), float(proto.hi[1] - proto.lo[1])
             avoid = frozenset(too_narrow(graph, scene, width / 2, set(route), length))
             e, s = _free_spot(graph, [f for f in free if f.index not in avoid] if avoid else free, taken, length, g,

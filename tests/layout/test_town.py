@@ -9,6 +9,7 @@ import pytest
 
 from generator.layout import Town, build_scene
 from generator.layout.network import make_grid
+from generator.spec.towns import library_seed
 from generator.traffic import build_world
 from generator.world.scene import SceneModel
 
@@ -24,9 +25,13 @@ def test_the_town_keeps_its_grid_and_library(test_spec, test_scene):
     assert test_scene.town_map is None and test_scene.layout is None
 
 
-def test_a_redrawn_town_keeps_the_shared_library(test_spec):
+def test_a_redrawn_town_builds_from_its_library_seed(test_spec):
     town = dataclasses.replace(test_spec, seed=99, asset_seed=test_spec.seed, town_index=1)
-    assert build_scene(town).library.seed == test_spec.seed
+    lib = build_scene(town).library
+    assert lib.seed == library_seed(town) != test_spec.seed               # a fresh library (assets.redraw_every_towns)
+    assert lib.count("car", 0) == test_spec.assets.variants.car
+    shared = dataclasses.replace(town, assets=dataclasses.replace(town.assets, redraw_every_towns=None))
+    assert build_scene(shared).library.seed == test_spec.seed              # null: the spec seed's library
 
 
 def test_traffic_needs_the_town_not_a_bare_scene(default_spec, test_scene):

@@ -67,6 +67,11 @@ BAD = [
     ({"density": {"street_objects_per_100m": "many"}}, "density.street_objects_per_100m: must be a number"),
     ({"sensors": {"stereo": {"baseline_m": 0}}}, "sensors.stereo.baseline_m: must be a number in [0.05, 2.0], got 0"),
     ({"sensors": {"stereo": {"every": 0}}}, "sensors.stereo.every: must be an integer in [1, 1000], got 0"),
+    # asset variety (issue 29)
+    ({"assets": {"variants": {"car": 0}}}, "assets.variants.car: must be an integer in [1, 1000], got 0"),
+    ({"assets": {"variants": {"people": 4}}}, "assets.variants.people: unknown key"),
+    ({"assets": {"redraw_every_towns": 0}}, "assets.redraw_every_towns: must be"),
+    ({"assets": {"child_share": 1.5}}, "assets.child_share: must be a number in [0, 1], got 1.5"),
 ]
 
 
@@ -119,3 +124,12 @@ def test_render_config_errors(tmp_path):
     p.write_text("name: r\nresolution: [64, 64]\nsamples: 4\ndenoiser: optics\n")
     with pytest.raises(SpecError, match=r"denoiser: must be one of"):
         load_render_config(p)
+
+
+def test_asset_variety_counts_in_the_hash_only_when_not_the_default():
+    plain = parse_spec({"name": "x", "seed": 1}, "x.json")
+    assert plain.assets.variants.car == 48 and plain.assets.variants.person == 48
+    assert parse_spec({"name": "x", "seed": 1, "assets": {"variants": {"car": 48}}}, "x.json").spec_hash == \
+        plain.spec_hash
+    assert parse_spec({"name": "x", "seed": 1, "assets": {"variants": {"car": 6}}}, "x.json").spec_hash != \
+        plain.spec_hash

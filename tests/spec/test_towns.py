@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import numpy as np
@@ -15,7 +16,7 @@ from generator.jobs.towns import local_frame, town_runs
 from generator.layout import build_scene
 from generator.rng import stream
 from generator.spec import load_spec, parse_spec
-from generator.spec.towns import spec_for_record, town_of, town_record, town_spec
+from generator.spec.towns import library_seed, spec_for_record, town_of, town_record, town_spec
 from generator.world.rig import Rig
 from kits.cli_run import run_cli
 
@@ -57,10 +58,31 @@ def test_towns_differ_and_are_reproducible(redraw, root):
     assert d0 != d1 != build_scene(plain).digest()
     CACHE.clear()  # not the cache's memory: a fresh build from the seed gives the same town
     assert build_scene(town_spec(redraw, 1)).digest() == d1
-    # the towns share the asset library: town 1 places the very car prototypes of town 0
-    cars = [{k: m for k, m in build_scene(t).prototypes.items() if k.startswith("car_v")} for t in (t0, t1)]
+    # each town draws its own asset library (assets.redraw_every_towns = 1): no car mesh of town 0 in town 1
+    cars = [{m.vertices.tobytes() for k, m in build_scene(t).prototypes.items() if k.startswith("car_v")}
+            for t in (t0, t1)]
+    assert cars[0] and cars[1] and not cars[0] & cars[1]
+
+
+def _with_assets(spec, every):
+    return dataclasses.replace(spec, assets=dataclasses.replace(spec.assets, redraw_every_towns=every))
+
+
+def test_towns_share_a_library_for_redraw_every_towns_and_all_of_it_when_null(redraw):
+    seeds = [library_seed(town_spec(redraw, i)) for i in range(4)]
+    assert len(set(seeds)) == 4 and redraw.seed not in seeds              # default: a fresh library per town
+    pairs = [library_seed(town_spec(_with_assets(redraw, 2), i)) for i in range(4)]
+    assert pairs[0] == pairs[1] != pairs[2] == pairs[3] and pairs[0] == seeds[0]
+    assert {library_seed(town_spec(_with_assets(redraw, None), i)) for i in range(4)} == {redraw.seed}
+    assert library_seed(redraw) == redraw.seed                              # the one town of a plain run
+
+
+def test_towns_of_one_library_share_its_car_meshes(redraw):
+    every2 = _with_assets(redraw, 2)
+    cars = [{k: m for k, m in build_scene(town_spec(every2, i)).prototypes.items() if k.startswith("car_v")}
+            for i in (0, 1)]
     shared = set(cars[0]) & set(cars[1])
-    assert shared and all(cars[0][k] is cars[1][k] for k in shared)
+    assert shared and all(cars[0][k] is cars[1][k] for k in shared)       # the very meshes (prototype cache)
 
 
 def test_frames_go_to_towns_and_a_sequence_never_spans_two(redraw):

@@ -1,8 +1,10 @@
 """The traffic drives in the town it is given: its grid, and its asset library.
 
-A re-drawn town (``town.redraw_every_frames``) shares the asset library of the spec's seed (docs/architecture.md:
-"its asset prototypes stay those of ``seed``"), so a car driving past is one of the models parked in
-every town of the run. The moving fleet used to be drawn from a library of the town's own seed.
+A re-drawn town (``town.redraw_every_frames``) has the asset library of its
+:func:`~generator.spec.towns.library_seed`: its own by default (``assets.redraw_every_towns`` 1), the
+spec seed's with ``assets.redraw_every_towns`` null. Either way a car driving past is one of the models
+parked in that town. (The moving fleet once came from a library of the town's seed while the parked
+cars came from the shared one.)
 """
 
 from __future__ import annotations
@@ -22,13 +24,14 @@ DOC = {"name": "redrawn_small_town", "seed": 7,
        "traffic": {"cars_per_km": 30, "pedestrians_per_100m": 2.0, "standing_pedestrians_per_100m": 1.0}}
 
 
-@pytest.fixture(scope="module")
-def towns():
-    """(base scene, town 1's scene, town 1's world): the spec's own town and a re-drawn one."""
-    spec = parse_spec(DOC, "redrawn_small_town.json")
+@pytest.fixture(scope="module", params=[1, None], ids=["own_library", "shared_library"])
+def towns(request):
+    """(base scene, town 1's scene, town 1's world, redraw_every_towns): the spec's own town and a re-drawn one."""
+    doc = {**DOC, "assets": {"redraw_every_towns": request.param}}
+    spec = parse_spec(doc, "redrawn_small_town.json")
     town1 = town_spec(spec, 1)
     scene1 = build_scene(town1)
-    return build_scene(spec), scene1, build_world(town1, scene1, 2.0)
+    return build_scene(spec), scene1, build_world(town1, scene1, 2.0), request.param
 
 
 def _same_mesh(a, b) -> bool:
@@ -36,23 +39,29 @@ def _same_mesh(a, b) -> bool:
             and np.array_equal(a.face_class, b.face_class))
 
 
-def test_a_redrawn_towns_moving_fleet_comes_from_the_shared_asset_library(towns):
-    base, scene1, world = towns
+def test_a_redrawn_towns_moving_fleet_comes_from_the_towns_asset_library(towns):
+    base, scene1, world, every = towns
     assert scene1.seed != base.seed                      # a town of its own ...
-    shared = [k for k in world.prototypes if k.removeprefix("actor_") in base.prototypes]
-    kinds = {k.removeprefix("actor_").split("_v")[0] for k in shared}
-    assert {"car", "person"} <= kinds, f"no moving car or person shares a model with the base town: {shared}"
-    for key in shared:                                   # ... whose cars and people are the run's models
-        model = key.removeprefix("actor_")
-        assert _same_mesh(world.prototypes[key], base.prototypes[model]), f"{key} is not the run's {model}"
-        if model in scene1.prototypes:                   # and the models parked in this very town
-            assert _same_mesh(world.prototypes[key], scene1.prototypes[model]), key
+    parked = [k for k in world.prototypes if k.removeprefix("actor_") in scene1.prototypes]
+    kinds = {k.removeprefix("actor_").split("_v")[0] for k in parked}
+    assert {"car", "person"} <= kinds, f"no moving car or person shares a model with its town: {parked}"
+    for key in parked:                                   # ... whose moving cars and people are its parked models
+        assert _same_mesh(world.prototypes[key], scene1.prototypes[key.removeprefix("actor_")]), key
+    in_base = [k for k in world.prototypes if k.removeprefix("actor_") in base.prototypes]
+    same = [_same_mesh(world.prototypes[k], base.prototypes[k.removeprefix("actor_")]) for k in in_base]
+    if every is None:                                    # one library for the run: the spec seed's models
+        assert in_base and all(same)
+    else:                                                # a fresh library: not one car of the spec seed's town
+        assert not any(s for k, s in zip(in_base, same, strict=True) if "car_v" in k)
 
 
 def test_the_traffic_drives_on_the_grid_and_library_the_town_was_built_from(towns):
-    _, scene1, world = towns
+    _, scene1, world, every = towns
     assert world.scene is scene1
-    assert scene1.library.seed == DOC["seed"]            # the spec's seed, not the town's
+    if every is None:
+        assert scene1.library.seed == DOC["seed"]        # the spec's seed, not the town's
+    else:
+        assert scene1.library.seed not in (DOC["seed"], scene1.seed)   # the library's own seed
     for a in world.actors:                               # every moving model is the library's own mesh
         assert world.prototypes[a.prototype] is scene1.library.protos[a.prototype.removeprefix("actor_")].mesh
 

@@ -73,20 +73,28 @@ class Proto:
 class Library:
     """Builds prototypes through :func:`assets_procedural.catalog.build` and caches them.
 
-    Instanced kinds get a handful of variants (``key = "<kind>_v<i>"``) built from the
-    stream ``("assets", kind, i)``; unique kinds (buildings, fences, hedges) get one
-    prototype per object from ``("assets", kind, n)``.
+    Instanced kinds get variants (``key = "<kind>_v<i>"``) built from the stream
+    ``("assets", kind, i)``; how many a kind gets is ``counts[kind]`` (the spec's
+    ``assets.variants``, :func:`generator.layout.placement.variety.variant_counts`), else the
+    caller's default. Unique kinds (buildings, fences, hedges) get one prototype per object from
+    ``("assets", kind, n)``. ``seed`` is the library's own
+    (:func:`generator.spec.towns.library_seed`): re-drawn towns get fresh libraries.
     """
 
-    def __init__(self, seed: int):
+    def __init__(self, seed: int, counts: dict[str, int] | None = None):
         from assets_procedural import catalog  # imported lazily: the layout math does not need it
         from assets_procedural.proto_cache import CACHE
 
         self.seed = seed
+        self.counts = dict(counts or {})
         self._catalog = catalog
         self._cache = CACHE
         self.protos: dict[str, Proto] = {}
         self._unique: dict[str, int] = defaultdict(int)
+
+    def count(self, kind: str, default: int) -> int:
+        """Variants of instanced ``kind`` in this library (``default`` when the spec does not say)."""
+        return int(self.counts.get(kind, default))
 
     def main_class(self, kind: str) -> str:
         return self._catalog.MAIN_CLASS[kind]

@@ -22,6 +22,7 @@ from generator.layout.placement.prototypes import Proto
 from generator.layout.placement.roundabouts import place_approach_signs, plant_island
 from generator.layout.placement.shared_streets import place_shared_bollards, place_shared_people
 from generator.layout.placement.street_frame import Street, free_lane
+from generator.layout.placement.variety import DEFAULT_COUNTS, car_variant, person_variants, truck_variant
 from generator.rng import stream
 from generator.spec.model import SceneSpec
 
@@ -31,7 +32,7 @@ MIN_TREE_M = 3.0        #: the smallest tree the asset builder makes
 #: street-tree species (``assets_procedural.tree_species``), one per street-tree variant
 STREET_SPECIES = ("linden", "plane", "birch", "young")
 SIGN_SHAPES = ("circle", "triangle", "square", "octagon", "diamond")
-N_CAR, N_TRUCK, N_PEOPLE, N_LAMP, N_TL, N_STREET_TREE = 6, 3, 6, 3, 2, 4
+N_LAMP, N_TL, N_STREET_TREE = 3, 2, 4    #: cars, trucks, people: the spec's assets.variants (variety.py)
 
 
 def place_traffic_lights(placer: Placer, spec: SceneSpec, st: Street) -> None:
@@ -142,7 +143,7 @@ def place_signs(placer: Placer, spec: SceneSpec, st: Street) -> None:
 
 
 def _vehicle(placer: Placer, kind: str, i: int) -> Proto:
-    return placer.lib.variant(kind, i % (N_CAR if kind == "car" else N_TRUCK))
+    return car_variant(placer.lib, i) if kind == "car" else truck_variant(placer.lib, i)
 
 
 def place_parked(placer: Placer, spec: SceneSpec, st: Street) -> None:
@@ -160,7 +161,8 @@ def place_parked(placer: Placer, spec: SceneSpec, st: Street) -> None:
         return
     g = stream(spec.seed, "layout", "parked")
     paint = stream(spec.seed, "layout", "parked", "paint")      # colours never move a car
-    trucks = [_vehicle(placer, "truck", i) for i in range(N_TRUCK)]
+    n_car, n_truck = placer.lib.count("car", DEFAULT_COUNTS["car"]), placer.lib.count("truck", DEFAULT_COUNTS["truck"])
+    trucks = [_vehicle(placer, "truck", i) for i in range(n_truck)]
     p_occ = min(1.0, spec.density.parked_cars_per_100m * BAY_M / 100.0)
     for seg in grid.segments:
         u0, u1 = PARKING_START_U, seg.length - PARKING_START_U
@@ -177,7 +179,7 @@ def place_parked(placer: Placer, spec: SceneSpec, st: Street) -> None:
                     b += 1
                     continue
                 truck = b + 1 < n_bays and g.random() < spec.density.truck_fraction
-                proto = trucks[int(g.integers(N_TRUCK))] if truck else _vehicle(placer, "car", int(g.integers(N_CAR)))
+                proto = trucks[int(g.integers(n_truck))] if truck else _vehicle(placer, "car", int(g.integers(n_car)))
                 nb = 2 if truck else 1
                 fits = proto.hi[1] - proto.lo[1] <= grid.parking_w - 0.1
                 if not fits and spec.traffic.enabled:  # moving traffic needs the lane: no double parking
@@ -218,7 +220,7 @@ def place_lane_cars(placer: Placer, spec: SceneSpec, st: Street) -> None:
         seg, d, v, u0, u1 = lanes[int(g.choice(len(lanes), p=lengths / lengths.sum()))]
         heading = seg.yaw if (grid.section(seg).one_way or d) > 0 else seg.yaw + np.pi   # one-way: its way
         kind = "truck" if g.random() < spec.density.truck_fraction else "car"
-        proto = _vehicle(placer, kind, int(g.integers(N_CAR)))
+        proto = _vehicle(placer, kind, int(g.integers(placer.lib.count("car", DEFAULT_COUNTS["car"]))))
         x, y = seg.to_world(g.uniform(u0, u1), v)[0]
         placer.try_place(proto, x, y, 0.0, heading, {**fleet_paint(paint), "placement": "lane"}, pad=0.5)
 
@@ -230,18 +232,16 @@ def place_people(placer: Placer, spec: SceneSpec, st: Street) -> None:
         return
     g = stream(spec.seed, "layout", "people")
     look = stream(spec.seed, "layout", "people", "outfit")     # outfits never move a person
-    lo, hi = spec.heights.person_m
-    protos = [placer.lib.variant("person", i, lambda g, i=i: {"height": float(g.uniform(lo, hi)),
-                                                               "pose": "standing" if i < N_PEOPLE // 2 else "walking"})
-              for i in range(N_PEOPLE)]
+    protos = person_variants(placer.lib, spec)
+    n_people = len(protos)
     for seg in grid.segments:
         length = seg.length - 2 * st.walk_u0
         for s in (-1, 1):
             for _ in range(int(g.poisson(spec.density.people_per_100m * length / 100))):
-                i = int(g.integers(N_PEOPLE))
+                i = int(g.integers(n_people))
                 u = g.uniform(st.walk_u0 + 0.5, seg.length - st.walk_u0 - 0.5)
                 x, y = seg.to_world(u, s * g.uniform(*st.walk))[0]
-                yaw = seg.yaw + (0 if g.random() < 0.5 else np.pi) + g.normal(0, 0.1) if i >= N_PEOPLE // 2 \
+                yaw = seg.yaw + (0 if g.random() < 0.5 else np.pi) + g.normal(0, 0.1) if i >= n_people // 2 \
                     else g.uniform(0, 2 * np.pi)
                 placer.try_place(protos[i], x, y, st.h, yaw, outfit(look), pad=0.15)
         if g.random() < 0.25 and not spec.traffic.enabled:  # someone frozen on a crosswalk (traffic: they walk)
@@ -249,6 +249,6 @@ def place_people(placer: Placer, spec: SceneSpec, st: Street) -> None:
             v = g.uniform(-grid.road_half + 0.6, grid.road_half - 0.6)
             x, y = seg.to_world(u, v)[0]
             yaw = seg.yaw + (np.pi / 2 if g.random() < 0.5 else -np.pi / 2)
-            i = N_PEOPLE // 2 + int(g.integers(N_PEOPLE - N_PEOPLE // 2))
+            i = n_people // 2 + int(g.integers(n_people - n_people // 2))
             placer.try_place(protos[i], x, y, 0.0, yaw, {**outfit(look), "placement": "crosswalk"}, pad=0.15)
     place_shared_people(placer, spec, st, protos, look)   # hook: people on shared carriageways

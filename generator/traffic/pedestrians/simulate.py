@@ -27,7 +27,7 @@ from generator.layout.network.design_vehicle import EGO_SIZE_M
 from generator.layout.network.grid import Grid
 from generator.layout.placement.appearance import outfit
 from generator.layout.placement.prototypes import Library, Proto
-from generator.layout.placement.street import N_PEOPLE
+from generator.layout.placement.variety import person_variants
 from generator.rng import stream
 from generator.spec.model import SceneSpec
 from generator.traffic.movers import DT_S, Mover
@@ -51,11 +51,8 @@ SPAWN_TRIES = 200
 
 def person_protos(lib: Library, spec: SceneSpec) -> tuple[list[Proto], list[Proto]]:
     """(standing, walking) person prototypes, the same variants the static town uses."""
-    lo, hi = spec.heights.person_m
-    protos = [lib.variant("person", i, lambda g, i=i: {"height": float(g.uniform(lo, hi)),
-                                                       "pose": "standing" if i < N_PEOPLE // 2 else "walking"})
-              for i in range(N_PEOPLE)]
-    return protos[:N_PEOPLE // 2], protos[N_PEOPLE // 2:]
+    protos = person_variants(lib, spec)
+    return protos[:len(protos) // 2], protos[len(protos) // 2:]
 
 
 def sidewalk_length(grid: Grid) -> float:

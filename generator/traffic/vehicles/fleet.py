@@ -21,11 +21,13 @@ import numpy as np
 
 from generator.geometry.mesh import merge
 from generator.layout.placement.prototypes import Library, Proto
+from generator.layout.placement.variety import car_variant
 
 #: kind -> (tag, parameters) of the variant family that drives (kinds not listed: the plain variants)
 TRAVEL_POSE = {"construction_vehicle": ("travel", {"slew_deg": 0.0})}
 
-# spec field -> (asset kind, variants, speed factor of the limit, max acceleration m/s^2, nominal length m)
+# spec field -> (asset kind, variants, speed factor of the limit, max acceleration m/s^2, nominal length m);
+# the variants are the default: a library with the spec's ``assets.variants`` has its own count (:func:`n_variants`)
 KINDS = {
     "cars_per_km": ("car", 6, (0.8, 1.0), 2.0, 4.6),
     "trucks_per_km": ("truck", 3, (0.7, 0.85), 1.2, 8.0),
@@ -36,6 +38,11 @@ KINDS = {
     # last, so towns without vans draw every other vehicle as before
     "vans_per_km": ("box_van", 3, (0.75, 0.9), 1.5, 6.6),
 }
+
+
+def n_variants(lib: Library, kind: str, default: int) -> int:
+    """Variants of moving ``kind`` in ``lib`` (the spec's ``assets.variants``, else the :data:`KINDS` default)."""
+    return lib.count(kind, default)
 
 
 def how_many(traffic, field_name: str, extent: float) -> int:
@@ -71,6 +78,8 @@ def fleet_proto(lib: Library, kind: str, i: int) -> Proto:
     if kind in TRAVEL_POSE:
         tag, params = TRAVEL_POSE[kind]
         return lib.variant(kind, i, lambda g: dict(params), tag=tag)
+    if kind == "car":       # the body type of its place in the library (as the parked cars)
+        return car_variant(lib, i)
     if kind not in ("bicyclist", "motorcyclist"):
         return lib.variant(kind, i)
     key = f"{kind}_riding_v{i}"
@@ -102,7 +111,7 @@ def widest_half_width(spec, lib: Library, kinds: dict, ego_width: float) -> tupl
     for field_name, (kind, n_var, *_rest) in kinds.items():
         if not drives(spec.traffic, field_name):
             continue
-        for i in range(n_var):
+        for i in range(n_variants(lib, kind, n_var)):
             proto = fleet_proto(lib, kind, i)
             half = float(proto.hi[1] - proto.lo[1]) / 2     # the box is centred on the lane centre line
             if half > best:
