@@ -27,15 +27,15 @@ def objects_mode(choice: str, sources) -> str | None:
         ``--objects boxes`` (or ``instances``) asked of a dataset without boxes (labels).
     """
     boxes = all(s.has_boxes for s in sources)
-    labels = all(s.has_labels for s in sources)
+    labels = all(s.has_instances for s in sources)
     if choice == "auto":
         return "boxes" if boxes else "instances" if labels else None
     if choice == "boxes" and not boxes:
         bad = next(s for s in sources if not s.has_boxes)
         raise UserError(f"--objects: {bad.role} ({bad.root}) has no boxes (openlabel/NN.json beside it)")
     if choice == "instances" and not labels:
-        bad = next(s for s in sources if not s.has_labels)
-        raise UserError(f"--objects: {bad.role} ({bad.root}) has no labels/ with instance ids")
+        bad = next(s for s in sources if not s.has_instances)
+        raise UserError(f"--objects: {bad.role} ({bad.root}) has no labels with instance ids")
     return None if choice == "off" else choice
 
 
