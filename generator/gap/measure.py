@@ -44,6 +44,9 @@ def measure(name: str, source, sensor, objects: str | None, threads: int | None 
     prof = Profile(name, RingModel(sensor))
 
     def one(scan):
+        if scan.ring is not None and scan.ring.size and int(scan.ring.max()) >= prof.rings:
+            raise UserError(f"--sensor: {sensor.name} has {prof.rings} rings, {source.root} records ring "
+                            f"{int(scan.ring.max())} (leave --sensor out to use the data's own)")
         obj = None
         if objects == "boxes":
             obj = source.boxes(scan.sequence)(scan.index, scan.xyz)

@@ -208,6 +208,10 @@ class NuScenesSource:
         """The preset of the data's sensor: ``hdl32e_20hz`` (nuScenes) or ``hdl64e`` (urbangen's export)."""
         return "hdl32e_20hz" if self.rings == 32 else "hdl64e"
 
+    def default_sensor(self) -> str:
+        """The ring fit's sensor when ``--sensor`` names none: the data's own (:meth:`sensor_name`)."""
+        return self.sensor_name()
+
     def scans(self) -> Iterator[ScanData]:
         """Every key frame read (one in ``every`` per scene), in scene and timestamp order."""
         for scene, recs in self.frames.items():

@@ -62,17 +62,23 @@ def test_gap_of_a_dataset_and_its_nuscenes_export_is_near_0(nus, traffic_detecti
     assert profs["ours"].points == profs["nus"].points
 
 
-def test_a_64_ring_profile_folds_to_32_rings_two_at_a_time(nus):
+def test_a_64_ring_profile_folds_to_32_rings_two_at_a_time(nus, traffic_detection_dataset):
     prof, _ = measure("nus", open_source(nus, "REAL"), load_preset("hdl64e"), None)
     half = fold_rings(prof, 32)
     assert half.rings == 32 and half.ring_points.sum() == prof.ring_points.sum()
     assert np.array_equal(half.ring_points, prof.ring_points.reshape(32, 2).sum(1))
     assert np.array_equal(half.residual, prof.residual.reshape(32, 2, -1).sum(1))
-    h32 = measure("nus", open_source(nus, "REAL"), load_preset("hdl32e_20hz"), None)[0]
+    # the same key frames with rings fitted by a 32-ring table: curves on one axis of 32 rings
+    h32 = measure("sk", open_source(traffic_detection_dataset[0], "SYNTH", every=5), load_preset("hdl32e_20hz"),
+                  None)[0]
     rep = summarize({"a": prof, "b": h32}, [("a", "b")], None)
     assert len(rep["rays_lost_per_ring"]["curves"]["a"]) == 32 == len(rep["rays_lost_per_ring"]["curves"]["b"])
     assert rep["rays_lost_per_ring"]["rings_folded_from"] == {"a": 64, "b": 32}
-    assert rep["intensity"]["distance"]["values"]["a vs b"] == 0.0  # ring-free metrics unchanged
+    assert rep["rays_lost_per_ring"]["distance"]["values"]["a vs b"] is not None
+    assert rep["intensity"]["distance"]["values"]["a vs b"] < 1e-5  # ring-free metrics as before
+    # a table with fewer rings than the file records is refused, not misread
+    with pytest.raises(UserError, match="hdl32e_20hz has 32 rings"):
+        measure("nus", open_source(nus, "REAL"), load_preset("hdl32e_20hz"), None)
 
 
 def test_bad_nuscenes_roots_name_file_and_field(nus, tmp_path):
