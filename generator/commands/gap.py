@@ -5,9 +5,11 @@ range, points per range, ring regularity, intensity overall and per class, point
 distance, class mix -- each as one curve per dataset and a distance per pair (total variation or
 Wasserstein-1, named in the report), written to REPORT/gap.json, REPORT/gap.md and one PNG per metric
 (REPORT/gap_<metric>.png, all together in REPORT/gap.png). Datasets are SemanticKITTI-layout folders
-(root with sequences/NN/velodyne, labels optional); rings and columns are derived from the points with
-the sensor's calibration (--sensor, default the HDL-64E S3 table), see generator/gap/rings.py. Distances
-are to the last dataset named (--reference another one, or --pairwise for every pair).
+(root with sequences/NN/velodyne, labels optional; rings and columns derived from the points with the
+sensor's calibration, default the HDL-64E S3 table, see generator/gap/rings.py) or nuScenes roots
+(v1.0-*/ tables, samples/LIDAR_TOP, lidarseg optional; the key frames, rings as recorded, sensor
+hdl32e_20hz for nuScenes' 32 rings). Distances are to the last dataset named (--reference another one,
+or --pairwise for every pair).
 """
 
 from __future__ import annotations
@@ -27,14 +29,18 @@ def register(sub) -> None:
     p = sub.add_parser("gap", help="measure how LiDAR datasets differ (seed 002 §3.2): curves and distances",
                        description=__doc__.split("\n\n")[1])
     p.add_argument("datasets", nargs="+", type=path, metavar="DATASET",
-                   help="SemanticKITTI-layout folders: SYNTH REAL, or more (raw, processed, physics, real)")
+                   help="SemanticKITTI-layout folders or nuScenes roots: SYNTH REAL, or more (raw, processed, "
+                        "physics, real)")
     p.add_argument("--out", required=True, type=path, help="report folder (gap.json, gap.md, PNGs)")
     p.add_argument("--names", default=None, help="comma-separated names of the datasets (default: folder names)")
     p.add_argument("--reference", default=None, help="dataset the others are compared with (default: the last)")
     p.add_argument("--pairwise", action="store_true", help="compare every pair instead")
-    p.add_argument("--sensor", default="hdl64e",
-                   help="sensor table for the ring fit: a preset (hdl64e, hdl32e, vlp16) or a sensor YAML "
-                        "(default hdl64e: the S3 calibration)")
+    p.add_argument("--sensor", default=None,
+                   help="sensor table for the ring fit of every dataset: a preset (hdl64e, hdl32e, hdl32e_20hz, "
+                        "vlp16) or a sensor YAML (default: each dataset's own -- hdl64e, the S3 calibration, for "
+                        "SemanticKITTI layouts; for nuScenes roots hdl32e_20hz, or hdl64e when it has 64 rings)")
+    p.add_argument("--nuscenes-version", default=None, metavar="V",
+                   help="the v1.0-* folder of nuScenes roots that hold several (default: the only one)")
     p.add_argument("--every", type=Integer(1, 1000), default=1, help="read every N-th scan (default 1: all)")
     p.add_argument("--objects", default="auto", choices=OBJECTS,
                    help="points per object from boxes (OpenLABEL), instance labels, or off (default auto: boxes "
@@ -83,18 +89,20 @@ def run(args) -> int:
     reference = args.reference or names[-1]
     if reference not in names:
         raise UserError(f"--reference: {reference!r} is none of the names ({', '.join(names)})")
-    sensor = _sensor(args.sensor)
-    sources = [open_source(p, role, args.every) for p, role in zip(args.datasets, roles, strict=True)]
+    sources = [open_source(p, role, args.every, args.nuscenes_version)
+               for p, role in zip(args.datasets, roles, strict=True)]
+    sensors = [_sensor(args.sensor or src.default_sensor()) for src in sources]
     mode = objects_mode(args.objects, sources)
     out = output_dir(args.out, "--out")
     profiles, records = {}, []
-    for name, src in zip(names, sources, strict=True):
+    for name, src, sensor in zip(names, sources, sensors, strict=True):
         prof, rec = measure(name, src, sensor, mode)
+        rec["sensor"] = sensor.source
         profiles[name] = prof
         records.append(rec)
     pairs = pairs_of(names, reference, args.pairwise)
     report = {"datasets": records, "reference": None if args.pairwise else reference,
-              "pairs": [f"{a} vs {b}" for a, b in pairs], "sensor": sensor.source,
+              "pairs": [f"{a} vs {b}" for a, b in pairs], "sensor": sensors[names.index(reference)].source,
               "objects_from": mode, "metrics": summarize(profiles, pairs, mode)}
     pictures = charts(report)
     with staging(out, "gap") as stage:

@@ -27,15 +27,15 @@ def objects_mode(choice: str, sources) -> str | None:
         ``--objects boxes`` (or ``instances``) asked of a dataset without boxes (labels).
     """
     boxes = all(s.has_boxes for s in sources)
-    labels = all(s.has_labels for s in sources)
+    labels = all(s.has_instances for s in sources)
     if choice == "auto":
         return "boxes" if boxes else "instances" if labels else None
     if choice == "boxes" and not boxes:
         bad = next(s for s in sources if not s.has_boxes)
         raise UserError(f"--objects: {bad.role} ({bad.root}) has no boxes (openlabel/NN.json beside it)")
     if choice == "instances" and not labels:
-        bad = next(s for s in sources if not s.has_labels)
-        raise UserError(f"--objects: {bad.role} ({bad.root}) has no labels/ with instance ids")
+        bad = next(s for s in sources if not s.has_instances)
+        raise UserError(f"--objects: {bad.role} ({bad.root}) has no labels with instance ids")
     return None if choice == "off" else choice
 
 
@@ -44,6 +44,9 @@ def measure(name: str, source, sensor, objects: str | None, threads: int | None 
     prof = Profile(name, RingModel(sensor))
 
     def one(scan):
+        if scan.ring is not None and scan.ring.size and int(scan.ring.max()) >= prof.rings:
+            raise UserError(f"--sensor: {sensor.name} has {prof.rings} rings, {source.root} records ring "
+                            f"{int(scan.ring.max())} (leave --sensor out to use the data's own)")
         obj = None
         if objects == "boxes":
             obj = source.boxes(scan.sequence)(scan.index, scan.xyz)

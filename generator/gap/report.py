@@ -24,7 +24,31 @@ def _centres(edges: np.ndarray) -> list[float]:
 
 
 def _rays(p: PR.Profile) -> np.ndarray:
-    return np.full(p.rings, p.steps * p.scans, np.int64)
+    folded = getattr(p, "ring_rays", None)  # set by fold_rings
+    return np.full(p.rings, p.steps * p.scans, np.int64) if folded is None else folded
+
+
+#: Metrics whose curve is per ring: folded to a common ring count when the sensors differ.
+PER_RING = ("rays_lost_per_ring", "ring_regularity")
+
+
+def fold_rings(p: PR.Profile, n: int) -> PR.Profile:
+    """A copy of ``p`` whose per-ring counts are summed into ``n`` rings by normalised ring index.
+
+    Ring ``r`` of ``p.rings`` goes to ``r * n // p.rings`` (0 = highest beam in both): an HDL-64E's rings
+    two at a time against an HDL-32E. Each folded ring keeps the rays of the rings it holds, so loss rates
+    stay rays-weighted and every folded ring holds the same share of the sensor's rays.
+    """
+    import copy
+
+    q = copy.copy(p)
+    group = (np.arange(p.rings) * n) // p.rings
+    q.rings = n
+    q.ring_points = np.bincount(group, p.ring_points, minlength=n).astype(np.int64)
+    q.ring_rays = np.bincount(group, _rays(p), minlength=n).astype(np.int64)
+    q.residual = np.zeros((n, p.residual.shape[1]), np.int64)
+    np.add.at(q.residual, group, p.residual)
+    return q
 
 
 def _ring_lost(p: PR.Profile) -> np.ndarray:
@@ -154,7 +178,9 @@ def pairs_of(names: list[str], reference: str, pairwise: bool) -> list[tuple[str
 def summarize(profiles: dict[str, PR.Profile], pairs: list[tuple[str, str]], objects_from: str | None) -> dict:
     """The ``metrics`` part of ``gap.json``."""
     out = {}
-    first = next(iter(profiles.values()))
+    rings = {p.rings for p in profiles.values()}
+    n = min(rings)
+    folded = {k: fold_rings(p, n) for k, p in profiles.items()} if len(rings) > 1 else profiles
     for key, m in METRICS.items():
         if m.needs == "labels" and not all(p.labelled for p in profiles.values()):
             out[key] = {"what": m.what, "skipped": "not every dataset has labels"}
@@ -162,10 +188,16 @@ def summarize(profiles: dict[str, PR.Profile], pairs: list[tuple[str, str]], obj
         if m.needs == "objects" and objects_from is None:
             out[key] = {"what": m.what, "skipped": "no objects: neither boxes nor instance labels in every dataset"}
             continue
+        use = folded if key in PER_RING else profiles
+        first = next(iter(use.values()))
         entry = {"what": m.what, "x": m.x, "x_values": m.x_values(first),
-                 "curves": {n: _clean(m.curve(p)) for n, p in profiles.items()},
+                 "curves": {name: _clean(m.curve(p)) for name, p in use.items()},
                  "distance": {"kind": m.kind, "unit": m.unit,
-                              "values": {f"{a} vs {b}": m.distance(profiles[a], profiles[b]) for a, b in pairs}}}
+                              "values": {f"{a} vs {b}": m.distance(use[a], use[b]) for a, b in pairs}}}
+        if use is not profiles:
+            entry["x"] = (f"ring, normalised to {n} rings (0 = highest beam; a sensor with more rings has them "
+                          "summed in order, e.g. an HDL-64E's two at a time)")
+            entry["rings_folded_from"] = {name: p.rings for name, p in profiles.items()}
         if m.needs == "objects":
             entry["objects_from"] = objects_from
         out[key] = entry

@@ -1,54 +1,30 @@
 """Datasets ``gap`` reads: scans with remission, labels and objects, one reader per layout.
 
-Today: any SemanticKITTI-layout folder (``sequences/NN/velodyne/*.bin`` with optional ``labels/``), ours or
-KITTI's. A layout is a class with the :class:`Source` interface, chosen by :func:`open_source`; a nuScenes
-reader (``samples/LIDAR_TOP/*.pcd.bin``: x, y, z, intensity 0-255, ring index) would add itself to
-:data:`LAYOUTS`, hand its ring index through :attr:`ScanData.ring` (nothing to derive then) and its
-intensity divided by 255.
+Two layouts (:data:`LAYOUTS`, chosen by :func:`open_source`): any SemanticKITTI-layout folder
+(``sequences/NN/velodyne/*.bin`` with optional ``labels/``), ours or KITTI's; and a nuScenes root
+(:mod:`generator.gap.nuscenes`: ``v1.0-*/`` tables, ``samples/LIDAR_TOP/*.pcd.bin``, optional lidarseg),
+real or ``urbangen export nuscenes``. Every reader has the same interface: ``layout``, ``root``, ``role``,
+``n_scans``, ``has_labels``, ``has_instances``, ``has_boxes``, ``boxes(sequence)``, ``sensor_name()``,
+``default_sensor()``
+(the preset the ring fit uses unless ``--sensor`` says otherwise) and ``scans()`` yielding
+:class:`~generator.gap.scan.ScanData` (a format that records rings hands them through ``ScanData.ring``).
 """
 
 from __future__ import annotations
 
 import os
 from collections.abc import Iterator
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from generator.errors import UserError
 from generator.formats import semantickitti as sk
+from generator.gap.nuscenes import NuScenesSource, is_nuscenes_root
 from generator.gap.objects import BoxReader, box_reader
+from generator.gap.scan import ScanData
 from generator.labels.sets import label_sets
 from generator.safeload import printable
-
-
-@dataclass
-class ScanData:
-    """One scan.
-
-    Attributes
-    ----------
-    sequence : str
-    index : int
-    xyz : (n, 3) float32
-        Sensor frame, metres (raw: as the sensor measured, not de-skewed).
-    remission : (n,) float32
-        In [0, 1].
-    learning : (n,) int64 or None
-        SemanticKITTI learning class (0 = unlabeled/ignored) when the dataset has labels.
-    instance : (n,) int64 or None
-    ring : (n,) int16 or None
-        The ring when the format records it (then it is not derived).
-    """
-
-    sequence: str
-    index: int
-    xyz: np.ndarray
-    remission: np.ndarray
-    learning: np.ndarray | None
-    instance: np.ndarray | None
-    ring: np.ndarray | None = None
 
 
 class SemanticKittiSource:
@@ -91,6 +67,11 @@ class SemanticKittiSource:
         return sum(len(f) for f in self.frames.values())
 
     @property
+    def has_instances(self) -> bool:
+        """SemanticKITTI labels carry instance ids."""
+        return self.has_labels
+
+    @property
     def has_boxes(self) -> bool:
         return all(b is not None for b in self._boxes.values())
 
@@ -109,6 +90,10 @@ class SemanticKittiSource:
                 return name if isinstance(name, str) else None
         return None
 
+    def default_sensor(self) -> str:
+        """The sensor table for the ring fit when ``--sensor`` names none: the HDL-64E S3 (KITTI's and ours)."""
+        return "hdl64e"
+
     def scans(self) -> Iterator[ScanData]:
         """Every scan read (one in ``every``), labels checked against the SemanticKITTI table."""
         for seq in self.sequences:
@@ -123,14 +108,17 @@ class SemanticKittiSource:
 
 
 #: Layout name -> reader class, tried in order.
-LAYOUTS = {"semantickitti": SemanticKittiSource}
+LAYOUTS = {"nuscenes": NuScenesSource, "semantickitti": SemanticKittiSource}
 
 
-def open_source(root: str | Path, role: str, every: int = 1) -> SemanticKittiSource:
-    """The reader for the dataset at ``root`` (today: SemanticKITTI layout; see the module docstring)."""
+def open_source(root: str | Path, role: str, every: int = 1, nuscenes_version: str | None = None):
+    """The reader for the dataset at ``root``: a nuScenes root (a ``v1.0-*`` folder or ``samples/LIDAR_TOP``)
+    or else a SemanticKITTI layout (see the module docstring)."""
     root = Path(root)
     if not root.is_dir():
         raise UserError(f"{role}: {printable(root)}: no such folder")
     if not any(root.iterdir()):
         raise UserError(f"{role}: {printable(root)}: the folder is empty")
+    if is_nuscenes_root(root):
+        return LAYOUTS["nuscenes"](root, role, every, nuscenes_version)
     return LAYOUTS["semantickitti"](sk.semantickitti_root(root), role, every)

@@ -88,3 +88,35 @@ def test_an_empty_real_folder_is_one_line_exit_2_and_nothing_written(pair, tmp_p
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "REAL:" in err[0] and "no scans" in err[0]
     assert not out.exists()
+
+
+@pytest.fixture(scope="module")
+def nus_labelled(nuscenes_traffic, traffic_detection_dataset, tmp_path_factory):
+    from kits.nuscenes_lidarseg import with_lidarseg
+
+    root, _ = traffic_detection_dataset
+    return with_lidarseg(nuscenes_traffic, root, tmp_path_factory.mktemp("gapnus") / "nus")
+
+
+def test_a_nuscenes_root_against_itself_is_0_and_says_its_sensor(nus_labelled, tmp_path):
+    rep = _gap(tmp_path / "nus", nus_labelled, nus_labelled, extra=("--names", "a,b"))
+    dist = _distances(rep)
+    assert rep["objects_from"] == "boxes"  # sample annotations, counted in the sensor frame
+    assert all(v == {"a vs b": 0.0} for v in dist.values()), dist
+    assert len(dist) == 10
+    assert [d["layout"] for d in rep["datasets"]] == ["nuscenes", "nuscenes"]
+    assert rep["datasets"][0]["sensor"].endswith("hdl64e.yaml")  # our export: 64 rings
+
+
+def test_a_lidarseg_of_the_wrong_length_is_one_line_exit_2_and_nothing_written(nus_labelled, tmp_path, capsys):
+    import shutil
+
+    bad = tmp_path / "bad"
+    shutil.copytree(nus_labelled, bad)
+    label = sorted((bad / "lidarseg").rglob("*_lidarseg.bin"))[0]
+    label.write_bytes(label.read_bytes()[:-1])
+    out = tmp_path / "report"
+    assert main(["gap", str(nus_labelled), str(bad), "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and label.name in err[0] and "lidarseg:" in err[0], err
+    assert not out.exists()
