@@ -244,6 +244,11 @@ class _Boxes:
     """Sample annotations of the key frames, counted in the sensor frame (devkit ``Box``, ``points_in_box``)."""
 
     def __init__(self, src: NuScenesSource):
+        try:  # the boxes are counted with the devkit's own geometry: say so before anything is read
+            import nuscenes.utils.data_classes  # noqa: F401
+        except ImportError:
+            raise UserError('gap: points per object of a nuScenes root need nuscenes-devkit: '
+                            'pip install -e ".[detection]" (or --objects off)') from None
         wanted = {r["sample_token"] for v in src.frames.values() for r in v}
         self.anns: dict[str, list] = {}
         for a in src._table("sample_annotation"):
