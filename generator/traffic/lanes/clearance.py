@@ -61,7 +61,7 @@ def blocked_turns(graph, scene, size: tuple[float, float]) -> set[int]:
     set of int
         Indices of the connector edges it must not take.
     """
-    memo = graph.__dict__.setdefault("_blocked_turn_memo", {})
+    memo = graph.memo.setdefault("_blocked_turn_memo", {})
     key = (id(scene), round(float(size[0]), 2), round(float(size[1]), 2))
     if key in memo:
         return memo[key]
@@ -120,11 +120,10 @@ def blocked_lanes(graph, scene, half_width: float) -> set[int]:
     set of int
         Indices of the blocked lane edges.
     """
-    memo = graph.__dict__.setdefault("_blocked_lane_memo", {})   # asked once per moving vehicle: by width
-    key = (id(scene), float(half_width))
-    if key not in memo:
-        memo[key] = _blocked_lanes(graph, scene, half_width)
-    return set(memo[key])
+    key = ("blocked_lanes", id(scene), float(half_width))   # asked once per moving vehicle
+    if key not in graph.memo:
+        graph.memo[key] = (scene, _blocked_lanes(graph, scene, half_width))   # the scene kept: its id stays its own
+    return set(graph.memo[key][1])
 
 
 def _blocked_lanes(graph, scene, half_width: float) -> set[int]:

@@ -49,10 +49,14 @@ class LaneGraph:
         Distance from a node centre to the connectors' ends and to the stop line, metres.
     conflict : dict
         ``(arm_in, arm_out, lane) -> set of (arm_in, arm_out, lane)`` it conflicts with.
+    memo : dict
+        Answers about the graph's fixed geometry that the traffic simulation asks every step (turn
+        radii, approach arms, lanes blocked by a scene for a width), computed once each.
     """
 
     def __init__(self, grid: Grid):
         self.grid = grid
+        self.memo: dict = {}
         self.entry_m = entry_distance(grid.lanes, grid.lane_w, grid.road_half)
         self.stop_m = grid.road_half + STOP_U[1]
         self.edges: list[Edge] = []
@@ -125,6 +129,12 @@ class LaneGraph:
 
     def turn_radius(self, edge: Edge) -> float | None:
         """Tightest radius of a connector's arcs, metres (None: a straight connector or a lane)."""
+        key = ("turn_radius", edge.index)
+        if key not in self.memo:
+            self.memo[key] = self._turn_radius(edge)
+        return self.memo[key]
+
+    def _turn_radius(self, edge: Edge) -> float | None:
         if edge.kind != "connector":
             return None
         if self.grid.is_roundabout(edge.node):

@@ -38,12 +38,11 @@ ABOUT_TO_ENTER_M = 10.0  #: a vehicle this close to its give-way line counts as 
 
 def approach_arm(graph, lane) -> int:
     """The arm of ``lane.node`` (a node it arrives at) that the lane edge ``lane`` comes in by."""
-    memo = graph.__dict__.setdefault("_approach_arm_memo", {})   # asked for every waiting vehicle every step
-    arm = memo.get(lane.index)
-    if arm is None:
+    key = ("approach_arm", lane.index)   # asked for every waiting vehicle every step
+    if key not in graph.memo:
         d = lane.path.points[-1, :2] - graph.grid.node_xy(lane.node)
-        arm = memo[lane.index] = int(np.argmax(ARM_DIRS @ d))
-    return arm
+        graph.memo[key] = int(np.argmax(ARM_DIRS @ d))
+    return graph.memo[key]
 
 
 @functools.lru_cache(maxsize=256)
@@ -124,7 +123,7 @@ def setbacks(graph, key: tuple, size: tuple[float, float], wait_w: float) -> dic
         ``(arm, lane) -> metres`` (> 0) the front of a vehicle waiting on that approach lane must
         keep back from the give-way line; lanes not listed need none.
     """
-    memo = graph.__dict__.setdefault("_setback_memo", {})   # asked every step: skip the rounding
+    memo = graph.memo.setdefault("_setback_memo", {})   # asked every step: skip the rounding
     got = memo.get((key, size[0], size[1], wait_w))
     if got is None:
         got = memo[(key, size[0], size[1], wait_w)] = _setbacks(

@@ -60,7 +60,7 @@ def node_setbacks(graph, conn, size: tuple[float, float], wait_w: float) -> dict
         ``(arm, slot) -> metres`` (> 0) the front of a vehicle waiting on that approach lane must keep
         back from its stop or give-way line; lanes not listed need none.
     """
-    fast = graph.__dict__.setdefault("_edge_setback_memo", {})   # asked every step: skip the keys and rounding
+    fast = graph.memo.setdefault("_edge_setback_memo", {})   # asked every step: skip the keys and rounding
     got = fast.get((conn.index, size[0], size[1], wait_w))
     if got is None:
         got = fast[(conn.index, size[0], size[1], wait_w)] = _node_setbacks(graph, conn, size, wait_w)
@@ -71,7 +71,7 @@ def _node_setbacks(graph, conn, size: tuple[float, float], wait_w: float) -> dic
     key = _key(graph, conn)
     if graph.grid.is_roundabout(conn.node):
         return setbacks(graph, key, size, wait_w)
-    memo = graph.__dict__.setdefault("_plain_setback_memo", {})
+    memo = graph.memo.setdefault("_plain_setback_memo", {})
     mkey = (key, round(float(size[0]), 2), round(float(size[1]), 2), round(float(wait_w), 2))
     got = memo.get(mkey)
     if got is None:   # the same connector kind sweeps the same ground at every plain node
@@ -84,7 +84,7 @@ def _node_setbacks(graph, conn, size: tuple[float, float], wait_w: float) -> dic
 
 def _approaches(graph, node) -> list:
     """``[(lane edge, arm)]`` of the lane edges arriving at ``node`` (cached on the graph)."""
-    table = graph.__dict__.setdefault("_node_approaches", {})
+    table = graph.memo.setdefault("_node_approaches", {})
     if not table:
         for e in graph.lanes():
             table.setdefault(e.node, []).append((e, approach_arm(graph, e)))

@@ -94,7 +94,6 @@ class VehicleSim:
         self.holders: dict = {}   # node -> {vehicle index: connector edge}
         self.caps = speed_caps(graph)   # edge -> speed limit (shared streets), m/s
         self.occ: dict = {}             # this step's occupancy (edge -> [(s, vehicle)]), for turn_clearance
-        self._radius: dict = {}         # edge -> LaneGraph.turn_radius (asked for every vehicle every step)
 
     # -- plans ---------------------------------------------------------------------------------
     def _extend(self, veh: Vehicle) -> None:
@@ -184,7 +183,7 @@ class VehicleSim:
         ahead = -veh.s
         for e in veh.plan[:3]:
             edge = self.g.edges[e]
-            r = self._radius[e] if e in self._radius else self._radius.setdefault(e, self.g.turn_radius(edge))
+            r = self.g.turn_radius(edge)
             if r is not None:
                 v_turn = np.sqrt(A_LAT * r)
                 v0 = min(v0, np.sqrt(v_turn ** 2 + 2 * B_COMF * max(0.0, ahead - veh.length / 2)))
