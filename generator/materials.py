@@ -21,6 +21,7 @@ class MaterialInfo:
     color: tuple[int, int, int]
     emissive: str | None
     transmittance: float = 0.0
+    behind: str | None = None
 
 
 class MaterialTable:
@@ -29,6 +30,10 @@ class MaterialTable:
     def __init__(self, rows: list[MaterialInfo]):
         if [r.id for r in rows] != list(range(len(rows))):
             raise ValueError("materials.yaml: ids must be 0..N-1 in order")
+        for r in rows:
+            if r.behind not in (None, "room") or (r.behind and r.transmittance <= 0):
+                raise ValueError(f"materials.yaml: {r.name}.behind must be 'room' on a glass material "
+                                 f"(transmittance > 0), got {r.behind!r}")
         self.rows = rows
         self.names = [r.name for r in rows]
         self._by_name = {r.name: r for r in rows}
@@ -62,6 +67,11 @@ class MaterialTable:
         return np.array([r.transmittance for r in self.rows], np.float32)
 
     @functools.cached_property
+    def room_behind(self) -> np.ndarray:
+        """(n_materials,) bool: the pane is the window of an unmodelled room (``behind: room``)."""
+        return np.array([r.behind == "room" for r in self.rows], bool)
+
+    @functools.cached_property
     def colors(self) -> np.ndarray:
         """(n_materials, 3) uint8 preview colour."""
         return np.array([r.color for r in self.rows], np.uint8)
@@ -76,7 +86,7 @@ def material_table() -> MaterialTable:
         [
             MaterialInfo(int(r["id"]), str(r["name"]), float(r["reflectivity"]), bool(r["retro"]),
                          tuple(int(c) for c in r["color"]), r["emissive"],
-                         float(r.get("transmittance", 0.0)))
+                         float(r.get("transmittance", 0.0)), r.get("behind"))
             for r in raw
         ]
     )

@@ -152,17 +152,18 @@ class FaceLookup:
     Attributes
     ----------
     glass : (F + 1,) bool
-        The face's material lets light through; the last entry (for face -1, no hit) is False.
+        The beam goes on behind the face: its material lets light through and has no room behind it
+        (``Optics.room``); the last entry (for face -1, no hit) is False.
     transmittance : (F + 1,) float32
         One-way transmittance of the face's material.
     label : (F + 1,) int64
         ``class << 16 | instance`` of the face (-1 in the last entry).
     """
 
-    def __init__(self, faces: np.ndarray, transmittance: np.ndarray):
+    def __init__(self, faces: np.ndarray, transmittance: np.ndarray, room: np.ndarray):
         mat = faces["material"]
         self.transmittance = np.append(transmittance[mat], np.float32(0.0)).astype(np.float32)
-        self.glass = self.transmittance > 0
+        self.glass = (self.transmittance > 0) & ~np.append(room[mat], False)
         self.label = np.append((faces["class"].astype(np.int64) << 16) | faces["instance"], -1).astype(np.int64)
 
 

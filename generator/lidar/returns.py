@@ -32,7 +32,10 @@ specular glint near normal incidence, and lets ``transmittance`` of the power th
 on (up to ``glass_layers`` panes). Behind the glass of an object lies its interior (a car's cabin, a
 building's room), which the scene does not model: a continued beam that meets the same object
 (same class and instance) again is absorbed there. So car windows are the holes of real scans, and a
-free-standing pane (a shelter, a glass wall panel) shows what stands behind it.
+free-standing pane (a shelter, a glass wall panel) shows what stands behind it. A building's
+facade glass (``behind: room`` in ``materials.yaml``) ends the beam at once: the room behind it
+absorbs it, and the scene's buildings have no floor, so a beam cast on would meet the ground
+under the building.
 
 Waveform: each beam's hits (sub-rays, panes, what lies behind them) sorted by range; hits closer
 than ``separation_m`` (half the pulse length, ``c tau / 2``) merge into one return whose range is
@@ -108,6 +111,8 @@ class Optics:
         Share of the power a pane lets through, one way (0: opaque).
     smooth : (M,) bool
         Smooth surfaces (glass) whose diffuse term keeps Lambert's cosine.
+    room : (M,) bool
+        Panes with an unmodelled room behind them (``behind: room``): the beam ends there.
     reference_range_m, min_range_m : float
         ``R0`` of the normalisation and the range below which ``P`` stops growing.
     """
@@ -117,6 +122,7 @@ class Optics:
     lobe_exponent: np.ndarray
     transmittance: np.ndarray
     smooth: np.ndarray
+    room: np.ndarray
     reference_range_m: float = 10.0
     min_range_m: float = 1.0
 
@@ -137,7 +143,8 @@ def optics_from_materials(retro_gain: float = 20.0, retro_exponent: float = 8.0,
     refl = np.where(trans > 0, GLASS_DIFFUSE, mats.reflectivity).astype(np.float32)
     gain = np.where(mats.retro, retro_gain, np.where(trans > 0, GLASS_LOBE[0], 0.0)).astype(np.float32)
     expo = np.where(mats.retro, retro_exponent, np.where(trans > 0, GLASS_LOBE[1], 1.0)).astype(np.float32)
-    return Optics(refl, gain, expo, trans, trans > 0, float(reference_range_m), float(min_range_m))
+    return Optics(refl, gain, expo, trans, trans > 0, mats.room_behind.copy(), float(reference_range_m),
+                  float(min_range_m))
 
 
 def probe_index(pattern: np.ndarray, clockwise: bool) -> np.ndarray:
@@ -236,7 +243,8 @@ class ReturnModel:
                                    "second return) and second_return/first_index/*.bin (uint32 row of the same beam's "
                                    "first point in velodyne/*.bin); velodyne/ and labels/ hold one point per beam",
             "glass": "transmittance per material (materials.yaml); a beam that crossed an object's glass and meets "
-                     "the same object again is absorbed (unmodelled interior)",
+                     "the same object again is absorbed (unmodelled interior); facade glass (behind: room) ends "
+                     "the beam",
             "range_noise_sigma_m_per_laser": [round(float(s), 5) for s in self.ring_sigma[np.argsort(np.arange(
                 len(self.ring_sigma)))]],
             "randomness": "per-laser draws: stream(seed, 'lidar_sensor', ...); per frame: stream(seed, 'frame', k, "

@@ -85,6 +85,16 @@ def test_material_table():
     assert m.names[0] == "default" and len(set(m.names)) == len(m)
     assert ((m.reflectivity >= 0) & (m.reflectivity <= 1)).all()
     assert m.retro[m.id("sign_face")] and not m.retro[m.id("asphalt")]
+    # only a building's facade glass has a room behind it; a vehicle's glass and free panes go on
+    assert [m.names[i] for i in np.flatnonzero(m.room_behind)] == ["window_glass", "shop_glass"]
+    assert (m.transmittance[m.room_behind] > 0).all()
+
+
+def test_a_room_behind_an_opaque_material_is_refused():
+    from generator.materials import MaterialInfo, MaterialTable
+
+    with pytest.raises(ValueError, match="plaster.behind must be 'room' on a glass material"):
+        MaterialTable([MaterialInfo(0, "plaster", 0.5, False, (1, 1, 1), None, 0.0, "room")])
 
 
 # -- moving actors: SemanticKITTI's moving-* raw ids ---------------------------------------------------------

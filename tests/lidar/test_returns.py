@@ -137,6 +137,40 @@ def test_car_windows_are_holes_and_a_free_standing_pane_shows_what_is_behind(hdl
     assert np.all(same["class"] == CLS.id("building")) and np.all(same["x"] > 11.9)
 
 
+def test_a_beam_through_a_shop_window_ends_in_the_room_not_on_the_ground_under_the_building(hdl64e):
+    """A room without a floor (the scene's buildings stand on the ground) behind a pane: through a
+    building's facade glass (``behind: room``) no beam reaches the ground inside; through the same
+    pane as free-standing glass, the ground behind it shows."""
+    ground = rect(-5, -30, 40, 30, 0.0, "road", "asphalt")
+    back = box((0.3, 12.0, 4.0), "building", "facade_plaster", center=(16.15, 0.0, 0.0))
+    sides = [box((6.0, 0.3, 4.0), "building", "facade_plaster", center=(13.0, y, 0.0)) for y in (-6.15, 6.15)]
+    roof = rect(10.0, -6.3, 16.3, 6.3, 4.0, "building", "roof")
+    lintel = box((0.3, 12.0, 1.0), "building", "facade_plaster", center=(9.85, 0.0, 3.0))
+
+    def scene(material):
+        pane = polygon(np.array([[10.0, -6.0, 0.0], [10.0, 6.0, 0.0], [10.0, 6.0, 3.0], [10.0, -6.0, 3.0]]),
+                       "building", material, (-1.0, 0.0, 0.0))
+        parts = [("ground", ground, 0), ("back", back, 3), ("pane", pane, 3), ("lintel", lintel, 3),
+                 ("roof", roof, 3)] + [(f"side{i}", m, 3) for i, m in enumerate(sides)]
+        return scene_of(parts)
+
+    def inside(p):
+        return (p["x"] > 10.05) & (p["x"] < 15.95) & (np.abs(p["y"]) < 5.95) & (p["z"] < 0.3 - H)
+
+    model = model_of(hdl64e, range_noise_m=0.0)
+    shop, free = scan(scene("shop_glass"), hdl64e, model), scan(scene("car_glass"), hdl64e, model)
+    ideal = scan(scene("shop_glass"), hdl64e)
+    assert not inside(ideal).any()          # the ideal sensor stops on the pane
+    assert inside(free).sum() >= 50         # a free-standing pane: the floorless room's ground shows
+    assert not inside(shop).any()           # facade glass: the room absorbs the beam
+    # and the window is mostly a hole, as in real scans: the pane's own diffuse return is too weak at
+    # 10 m; only the glint near normal incidence (the beams straight ahead) comes back, from the pane
+    beam = lambda p: p["column"].astype(np.int64) * 64 + p["ring"]  # noqa: E731
+    on_pane = beam(ideal[(ideal["x"] < 10.05) & (ideal["x"] > 9.95) & (ideal["z"] < 2.9 - H)])
+    back = shop[np.isin(beam(shop), on_pane)]
+    assert len(on_pane) >= 200 and len(back) <= 0.2 * len(on_pane) and np.all(back["x"] < 10.05)
+
+
 def test_model_off_is_the_ideal_scanner_byte_for_byte(hdl64e):
     scene = wall_edge_scene(10.5)
     off = model_of(hdl64e)
