@@ -2,18 +2,23 @@
 actor-static overlaps and vehicle-person overlaps at one instant (world frame, metres).
 
 The kit judges contact with its own geometry, not production's: footprints are computed here from
-each box's centre, size and yaw, and two footprints touch when shapely's polygons intersect
-(touching edges count, as production's separating-axis test counts them). A wrong overlap test in
-:mod:`generator.geometry.boxes` therefore cannot pass the simulation's tests;
-``tests/geometry/test_boxes.py`` checks that both agree on many random boxes.
+each box's centre, size and yaw, and two footprints touch when no axis separates them -- a
+separating-axis test over every edge normal of both quads, for all pairs of a time step at once
+in numpy after a broad phase by bounding circles. Touching edges count, and so does a gap below
+:data:`SLACK_M` (a micrometre's thousandth): the test is never weaker than shapely's polygon
+intersection, which ``tests/traffic/test_contact_kit.py`` holds it to on random boxes (touching
+and near-miss pairs included). A wrong overlap test in :mod:`generator.geometry.boxes` therefore
+cannot pass the simulation's tests; ``tests/geometry/test_boxes.py`` checks that both agree on many
+random boxes.
 """
 
 from __future__ import annotations
 
 import numpy as np
-import shapely
 
 EGO_SIZE_M = (4.6, 1.9, 1.5)
+#: a gap narrower than this (metres) counts as contact: rounding can never hide a touch shapely sees
+SLACK_M = 1e-9
 
 
 class Box:
@@ -36,16 +41,40 @@ def footprints(boxes) -> np.ndarray:
     return np.stack([footprint(b) for b in boxes]) if len(boxes) else np.zeros((0, 4, 2))
 
 
-def _polygons(quads: np.ndarray) -> np.ndarray:
-    return shapely.polygons(np.asarray(quads, np.float64))
+def _axes(q: np.ndarray) -> np.ndarray:
+    """(k, 4, 2) unit normals of the four edges of the (k, 4, 2) quads ``q`` (0 for a zero-length edge)."""
+    e = np.roll(q, -1, axis=1) - q
+    n = np.stack([-e[..., 1], e[..., 0]], -1)
+    norm = np.linalg.norm(n, axis=-1, keepdims=True)
+    return np.divide(n, norm, out=np.zeros_like(n), where=norm > 0)
+
+
+def quads_touch(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(k,) bool: does convex quad ``a[i]`` touch or overlap ``b[i]`` ((k, 4, 2) each)?
+
+    Separating axes: the edge normals of both quads; the pair is apart only when on one of them
+    the projections are more than :data:`SLACK_M` apart.
+    """
+    axes = np.concatenate([_axes(a), _axes(b)], 1)                     # (k, 8, 2)
+    pa = np.einsum("kad,kpd->kap", axes, a)                            # (k, 8, 4)
+    pb = np.einsum("kad,kpd->kap", axes, b)
+    apart = (pa.max(2) < pb.min(2) - SLACK_M) | (pb.max(2) < pa.min(2) - SLACK_M)
+    return ~apart.any(1)
 
 
 def touching(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """(n, m) bool: which of the (n, 4, 2) footprints ``a`` touch or overlap which of ``b`` (m, 4, 2)."""
+    a, b = np.asarray(a, np.float64).reshape(-1, 4, 2), np.asarray(b, np.float64).reshape(-1, 4, 2)
     out = np.zeros((len(a), len(b)), bool)
-    if len(a) and len(b):
-        i, j = shapely.STRtree(_polygons(b)).query(_polygons(a), predicate="intersects")
-        out[i, j] = True
+    if not (len(a) and len(b)):
+        return out
+    ca, cb = a.mean(1), b.mean(1)                                      # broad phase: bounding circles
+    ra = np.linalg.norm(a - ca[:, None], axis=-1).max(1)
+    rb = np.linalg.norm(b - cb[:, None], axis=-1).max(1)
+    d = np.linalg.norm(ca[:, None] - cb[None], axis=-1)
+    i, j = np.nonzero(d <= ra[:, None] + rb[None] + 1e-6)
+    if len(i):
+        out[i, j] = quads_touch(a[i], b[j])
     return out
 
 
