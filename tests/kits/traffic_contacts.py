@@ -78,6 +78,79 @@ def touching(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return out
 
 
+class _Tracks:
+    """The tracks of ``actors`` packed for footprints of all of them at once: each interpolated as
+    :class:`generator.world.actors.Track` does (linear in time between samples, clamped to its span),
+    each box placed as :meth:`generator.world.actors.Actor.box` places it (its centre turned by the
+    heading, then moved to the position)."""
+
+    CHECK_EVERY = 20     #: every this many calls, the footprints are checked against the actors' own boxes
+
+    def __init__(self, actors):
+        self.actors = list(actors)
+        n = np.array([len(a.track.yaw) for a in self.actors], np.int64)
+        width = int(n.max(initial=1)) + 1                 # one spare sample: index i + 1 always exists
+        self.t0 = np.array([a.track.t0 for a in self.actors], np.float64)
+        self.dt = np.array([a.track.dt for a in self.actors], np.float64)
+        self.n = n
+        self.xyz = np.zeros((len(n), width, 3))
+        self.yaw = np.zeros((len(n), width))
+        for k, a in enumerate(self.actors):              # pad with the last sample (a held pose)
+            self.xyz[k, :n[k]], self.xyz[k, n[k]:] = a.track.xyz, a.track.xyz[-1]
+            self.yaw[k, :n[k]], self.yaw[k, n[k]:] = a.track.yaw, a.track.yaw[-1]
+        self.centre = np.array([a.box_center for a in self.actors], np.float64).reshape(-1, 3)
+        self.half = np.array([a.size[:2] for a in self.actors], np.float64).reshape(-1, 2) / 2.0
+        self.calls = 0
+
+    def quads(self, t: float) -> np.ndarray:
+        """(n, 4, 2) footprints of the actors at time ``t`` (s)."""
+        rows = np.arange(len(self.n))
+        x = np.clip((float(t) - self.t0) / self.dt, 0.0, self.n - 1.0)
+        i = np.where(self.n > 1, np.minimum(np.floor(x).astype(np.int64), self.n - 2), 0)
+        f = x - i
+        p = self.xyz[rows, i] * (1 - f[:, None]) + self.xyz[rows, i + 1] * f[:, None]
+        h = self.yaw[rows, i] * (1 - f) + self.yaw[rows, i + 1] * f
+        c, s = np.cos(h), np.sin(h)
+        cx = c * self.centre[:, 0] - s * self.centre[:, 1] + p[:, 0]
+        cy = s * self.centre[:, 0] + c * self.centre[:, 1] + p[:, 1]
+        sx, sy = np.array([-1.0, 1.0, 1.0, -1.0]), np.array([-1.0, -1.0, 1.0, 1.0])
+        lx, ly = sx * self.half[:, :1], sy * self.half[:, 1:]                     # (n, 4) box-frame corners
+        q = np.stack([cx[:, None] + lx * c[:, None] - ly * s[:, None],
+                      cy[:, None] + lx * s[:, None] + ly * c[:, None]], -1)
+        self._xy, self._h = np.stack([cx, cy], -1), h
+        if self.calls % self.CHECK_EVERY == 0:            # the actors' own boxes say the same
+            boxes = [a.box(t) for a in self.actors]
+            own = footprints(boxes)
+            assert np.abs(own - q).max(initial=0.0) < 1e-9, f"the kit's footprints are not the actors' boxes at t={t}"
+            assert all(abs(b.yaw - y) < 1e-12 for b, y in zip(boxes, h, strict=True)), t
+        self.calls += 1
+        return q
+
+
+_PACKED: dict = {"world": None, "packs": {}}    # the packed actor lists of the last world asked about
+
+
+def actor_quads(world, t: float, actors=None) -> np.ndarray:
+    """(n, 4, 2) footprints of ``actors`` (default: every actor of ``world``) at time ``t`` (s): the
+    footprints of their boxes (:meth:`generator.world.actors.Actor.box`), all at once."""
+    actors = world.actors if actors is None else actors
+    if _PACKED["world"] is not world:
+        _PACKED.update(world=world, packs={})
+    key = tuple(id(a) for a in actors)              # the actors live as long as the world kept here
+    if key not in _PACKED["packs"]:
+        _PACKED["packs"][key] = _Tracks(actors)
+    return _PACKED["packs"][key].quads(t)
+
+
+def actor_poses(world, t: float, actors=None) -> tuple[np.ndarray, np.ndarray]:
+    """((n, 2) box centres, (n,) yaws) of ``actors`` (default: every actor of ``world``) at time ``t``
+    (s): the centres and yaws of their boxes (:meth:`generator.world.actors.Actor.box`), all at once."""
+    actor_quads(world, t, actors)
+    actors = world.actors if actors is None else actors
+    pack = _PACKED["packs"][tuple(id(a) for a in actors)]
+    return pack._xy, pack._h
+
+
 def ego_box(world, t: float) -> Box:
     """The ego vehicle's box at time ``t`` (s)."""
     E = world.ego.T_world_ego(t)[0]
@@ -92,7 +165,7 @@ def static_quads(scene) -> np.ndarray:
 def assert_no_contact(world, t: float, parked: np.ndarray | None = None, ego: bool = True) -> np.ndarray:
     """No two actors overlap at ``t``, none touches the ego (unless ``ego`` is False), and none a
     ``parked`` footprint. Returns the (n, 4, 2) actor footprints at ``t``."""
-    q = footprints(world.boxes(t))
+    q = actor_quads(world, t)
     ov = touching(q, q)
     np.fill_diagonal(ov, False)
     assert not ov.any(), f"actors {np.argwhere(ov)[0]} overlap at t={t:.1f}"
@@ -105,6 +178,6 @@ def assert_no_contact(world, t: float, parked: np.ndarray | None = None, ego: bo
 
 def assert_vehicles_miss_people(world, t: float, vehicles: list, people: list) -> None:
     """No vehicle (nor the ego) touches a person at ``t``."""
-    p = footprints([a.box(t) for a in people])
-    hit = touching(footprints([a.box(t) for a in vehicles] + [ego_box(world, t)]), p)
+    p = actor_quads(world, t, people)
+    hit = touching(np.concatenate([actor_quads(world, t, vehicles), footprint(ego_box(world, t))[None]]), p)
     assert not hit.any(), (t, np.argwhere(hit)[:3])

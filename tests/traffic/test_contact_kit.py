@@ -110,3 +110,30 @@ def test_edge_to_edge_counts_as_contact_and_a_micrometre_does_not(gap, want):
 def test_empty_inputs_touch_nothing():
     q = footprint(Box((0, 0, 0), (4.0, 2.0, 1), 0.0))[None]
     assert touching(q, np.zeros((0, 4, 2))).shape == (1, 0) and touching(np.zeros((0, 4, 2)), q).shape == (0, 1)
+
+
+def test_actor_footprints_are_the_footprints_of_the_actors_boxes():
+    """The kit's footprints (and box centres and yaws) of all actors at once equal those of :meth:`Actor.box` at
+    any instant: between samples, on them, before a track starts and after it ends (held), for
+    tracks of different starts, spacings and lengths (a one-sample track included)."""
+    from types import SimpleNamespace
+
+    from generator.world.actors import Actor, Track
+    from kits.traffic_contacts import actor_poses, actor_quads
+
+    rng = np.random.default_rng(5)
+    actors = []
+    for k, n in enumerate((1, 2, 7, 40, 41, 300)):
+        xyz = np.cumsum(rng.normal(0, 0.5, (n, 3)), 0)
+        track = Track(float(rng.uniform(-1, 1)), float(rng.choice([0.1, 0.05, 0.2])), xyz,
+                      np.cumsum(rng.normal(0, 0.2, n)))
+        actors.append(Actor(k, f"a{k}", "car", "car", k + 1, "p", tuple(rng.uniform(0.5, 5.0, 3)),
+                            tuple(rng.uniform(-1, 1, 3)), track))
+    world = SimpleNamespace(actors=actors)
+    for t in np.r_[-3.0, rng.uniform(-1.5, 70.0, 200), 0.0, 0.1, 100.0]:
+        own = footprints([a.box(t) for a in actors])
+        assert np.abs(actor_quads(world, t) - own).max() < 1e-9, t
+        assert np.abs(actor_quads(world, t, actors[2:4]) - own[2:4]).max() < 1e-9, t
+        xy, yaw = actor_poses(world, t, actors[1:])
+        assert np.abs(xy - [a.box(t).center[:2] for a in actors[1:]]).max() < 1e-9
+        assert np.abs(yaw - [a.box(t).yaw for a in actors[1:]]).max() < 1e-12
