@@ -87,8 +87,9 @@ def build_world(spec, scene: Town, duration_s: float, distance_m: float = 0.0) -
     horizon_s = duration_s + 1.0 + LOOKAHEAD_S
     if distance_m > 0:  # the drive may take longer than asked: cover a slow ego
         horizon_s = max(horizon_s, distance_m / (0.25 * spec.paths.speed_mps) + 5.0 + LOOKAHEAD_S)
+    network: dict = {}      # the walk network does not depend on the horizon: built once
     while True:  # vehicles look ahead at crosswalks: pedestrians must be simulated past the drive's end
-        peds = _pedestrians(spec, grid, scene, signals, lib, int(np.ceil(horizon_s / DT_S)) + 1)
+        peds = _pedestrians(spec, grid, scene, signals, lib, int(np.ceil(horizon_s / DT_S)) + 1, network)
         crossing = _crosswalk_occupancy(grid, graph, peds)
         blocked = blocked_lanes(graph, scene, half_width)
         movers, ego_track, ego_dist = _drive(spec, graph, scene, signals, lib, blocked, crossing, duration_s,
@@ -96,7 +97,7 @@ def build_world(spec, scene: Town, duration_s: float, distance_m: float = 0.0) -
         if crossing is None or crossing.asked_s <= horizon_s:
             break
         horizon_s = 2.0 * crossing.asked_s  # same answers up to the old horizon (causal): a longer run, same world
-        graph = LaneGraph(grid)
+        graph = _fresh_graph(grid, graph)
     peds = [_lead_in(_extend_track(p, len(ego_dist)), grid.ground_height if p.attrs.get("role") == "walking" else None)
             for p in peds]
     if tmap is not None:
@@ -109,10 +110,23 @@ def build_world(spec, scene: Town, duration_s: float, distance_m: float = 0.0) -
     return world
 
 
-def _pedestrians(spec, grid, scene, signals, lib, n_steps: int) -> list[Mover]:
+def _pedestrians(spec, grid, scene, signals, lib, n_steps: int, network: dict | None = None) -> list[Mover]:
     if not (drives(spec.traffic, "pedestrians_per_100m") or drives(spec.traffic, "standing_pedestrians_per_100m")):
         return []
-    return simulate_pedestrians(spec, grid, scene, signals, lib, n_steps, DT_S)
+    return simulate_pedestrians(spec, grid, scene, signals, lib, n_steps, DT_S, network)
+
+
+#: answers of :attr:`LaneGraph.memo` that hang on the lanes' and connectors' paths and the scene
+#: only, not on the pruning a drive does: a new graph of the same grid may keep them
+_GEOMETRY_MEMOS = ("blocked_lanes", "_blocked_turn_memo", "_swept_poses")
+
+
+def _fresh_graph(grid, old: LaneGraph) -> LaneGraph:
+    """A new lane graph of ``grid`` (the drive prunes the old one's successors) that keeps the old
+    one's answers about blocked lanes and turns (the same paths: the graph is built deterministically)."""
+    graph = LaneGraph(grid)
+    graph.memo.update({k: v for k, v in old.memo.items() if (k[0] if isinstance(k, tuple) else k) in _GEOMETRY_MEMOS})
+    return graph
 
 
 def _lead_in(m: Mover, ground=None) -> Mover:

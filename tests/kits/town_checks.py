@@ -95,6 +95,24 @@ def on_carriageway(grid, xy: np.ndarray):
     return None
 
 
+def on_carriageways(grid, xy: np.ndarray) -> tuple[list, np.ndarray]:
+    """:func:`on_carriageway` of many world points ``xy`` ((n, 2)) at once: ``(segments, uv)``, the
+    first one-way segment (in ``grid.segments`` order) whose carriageway holds each point (None
+    where none does) and the (n, 2) ``(u, v)`` of the point in that segment's frame."""
+    xy = np.asarray(xy, np.float64).reshape(-1, 2)
+    segs, uv = [None] * len(xy), np.zeros((len(xy), 2))
+    free = np.ones(len(xy), bool)
+    for seg in grid.segments:
+        if not grid.section(seg).one_way:
+            continue
+        p = segment_frame_points(seg, xy)
+        hit = free & (p[:, 0] > 0.0) & (p[:, 0] < seg.length) & (np.abs(p[:, 1]) < grid.road_half)
+        for k in np.flatnonzero(hit):
+            segs[k] = seg
+        uv[hit], free = p[hit], free & ~hit
+    return segs, uv
+
+
 def check_lane_graph(grid, graph) -> None:
     """The lane graph of ``grid`` obeys its one-way streets (also with closures and roundabouts, see
     test_street_mix): every lane runs its direction on its slot and ends at the node it names,

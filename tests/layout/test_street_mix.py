@@ -25,8 +25,15 @@ from generator.traffic.build import build_world
 from generator.traffic.lanes.graph import LaneGraph
 from generator.traffic.vehicles.sim import conflict_key
 from kits.street_towns import MIX_TRAFFIC, full_spec
-from kits.town_checks import check_lane_graph, forward, no_collisions, on_carriageway, radii, rests_on_ground
-from kits.traffic_contacts import assert_no_contact
+from kits.town_checks import (
+    check_lane_graph,
+    forward,
+    no_collisions,
+    on_carriageways,
+    radii,
+    rests_on_ground,
+)
+from kits.traffic_contacts import actor_poses, assert_no_contact
 
 SECONDS = 20.0
 TRAFFIC = MIX_TRAFFIC
@@ -131,12 +138,12 @@ def test_routes_in_a_full_mix_town_are_smooth_on_the_lanes_and_one_way_forwards(
         assert inside.all(), route.name
         for node in grid.roundabouts:
             assert np.hypot(*(xy - grid.node_xy(node)).T).min() > grid.ring.island_r
-        for p, hd in zip(xy, h, strict=False):
-            hit = on_carriageway(grid, p[None])
-            if hit is None or not 1.0 < hit[1] < hit[0].length - 1.0:
+        segs, uv = on_carriageways(grid, xy)
+        for seg, (u, _), hd in zip(segs, uv, h, strict=False):
+            if seg is None or not 1.0 < u < seg.length - 1.0:
                 continue
             n += 1
-            assert np.dot([np.cos(hd), np.sin(hd)], forward(hit[0], grid.section(hit[0]).one_way)) > 0.99
+            assert np.dot([np.cos(hd), np.sin(hd)], forward(seg, grid.section(seg).one_way)) > 0.99
     assert n > 0, "the routes drive no one-way street"
 
 
@@ -160,22 +167,22 @@ def test_full_mix_traffic_obeys_one_way_never_touches_and_keeps_out_of_parks(ful
     vehicles = [a for a in world.actors if a.kind != "person"]
     assert len(vehicles) > 10
     n = 0
+    parks = [seg.rect_world(0.0, seg.length, -grid.road_half, grid.road_half) for seg in grid.closed]
     for t in np.arange(0.0, SECONDS, 0.2):
         assert_no_contact(world, t)
         E = world.ego.T_world_ego(t)[0]
-        ego_yaw = float(np.arctan2(E[1, 0], E[0, 0]))
-        poses = [(a.box(t).center[:2], a.box(t).yaw) for a in vehicles] + [((E[0, 3], E[1, 3]), ego_yaw)]
-        for xy, yaw in poses:
-            xy = np.asarray(xy, float)
-            for seg in grid.closed:
-                x0, y0, x1, y1 = seg.rect_world(0.0, seg.length, -grid.road_half, grid.road_half)
-                assert not (x0 < xy[0] < x1 and y0 < xy[1] < y1), f"a vehicle in a park at t={t:.1f}"
-            hit = on_carriageway(grid, xy[None])
-            if hit is None or not STOP_U[1] < hit[1] < hit[0].length - STOP_U[1]:
+        xy, yaw = actor_poses(world, t, vehicles)
+        xy, yaw = np.vstack([xy, [E[0, 3], E[1, 3]]]), np.r_[yaw, np.arctan2(E[1, 0], E[0, 0])]
+        for x0, y0, x1, y1 in parks:
+            inside = (x0 < xy[:, 0]) & (xy[:, 0] < x1) & (y0 < xy[:, 1]) & (xy[:, 1] < y1)
+            assert not inside.any(), f"a vehicle in a park at t={t:.1f}"
+        segs, uv = on_carriageways(grid, xy)
+        for seg, (u, _), p, h in zip(segs, uv, xy, yaw, strict=True):
+            if seg is None or not STOP_U[1] < u < seg.length - STOP_U[1]:
                 continue
             n += 1
-            fwd = forward(hit[0], grid.section(hit[0]).one_way)
-            assert np.dot([np.cos(yaw), np.sin(yaw)], fwd) > 0.9, (t, xy)
+            fwd = forward(seg, grid.section(seg).one_way)
+            assert np.dot([np.cos(h), np.sin(h)], fwd) > 0.9, (t, p)
     assert n > 50, "too few vehicle poses on one-way streets to tell"
 
 

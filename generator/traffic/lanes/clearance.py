@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from generator.geometry.boxes import corners, quads_overlap
+from generator.geometry.boxes import corners, quad_pairs_overlap, quads_overlap
 from generator.layout.network.design_vehicle import STANDARD_CAR_M
 
 MARGIN_M = 0.05      #: clearance beyond the widest box's side, metres
@@ -72,10 +72,13 @@ def blocked_turns(graph, scene, size: tuple[float, float]) -> set[int]:
         centres = quads.mean(1)
         hl, hw = size[0] / 2 + MARGIN_M, size[1] / 2 + MARGIN_M
         reach = np.hypot(hl, hw) + float(np.max(np.linalg.norm(quads - centres[:, None], axis=-1)))
+        swept = graph.memo.setdefault("_swept_poses", {})    # a connector's poses, whatever the size
         for e in graph.edges:
             if e.kind != "connector":
                 continue
-            p, h = swept_poses(e.path.points[:, :2], e.path.headings)
+            if e.index not in swept:
+                swept[e.index] = swept_poses(e.path.points[:, :2], e.path.headings)
+            p, h = swept[e.index]
             lo, hi = p.min(0) - reach, p.max(0) + reach
             near = np.all((centres >= lo) & (centres <= hi), axis=1)
             if not near.any():
@@ -131,12 +134,17 @@ def _blocked_lanes(graph, scene, half_width: float) -> set[int]:
     if not quads:
         return set()
     quads = np.stack(quads)
-    out = set()
-    for e in graph.lanes():
+    lanes, bands = graph.lanes(), []
+    for e in lanes:
         p0, p1 = e.path.points[0, :2], e.path.points[-1, :2]
         d = (p1 - p0) / max(np.linalg.norm(p1 - p0), 1e-9)
         n = np.array([-d[1], d[0]]) * (half_width + MARGIN_M)
-        lane = np.array([[p0 - n, p1 - n, p1 + n, p0 + n]])
-        if quads_overlap(lane, quads).any():
-            out.add(e.index)
-    return out
+        bands.append([p0 - n, p1 - n, p1 + n, p0 + n])
+    bands = np.array(bands).reshape(-1, 4, 2)
+    # only pairs whose bounding boxes meet (1 mm spare) can overlap; each pair's test is its own arithmetic,
+    # so testing just those gives the answer of testing every pair
+    lo_b, hi_b, lo_q, hi_q = bands.min(1), bands.max(1), quads.min(1), quads.max(1)
+    near = np.all((lo_b[:, None] <= hi_q[None] + 1e-3) & (lo_q[None] <= hi_b[:, None] + 1e-3), axis=-1)
+    i, j = np.nonzero(near)
+    hit = quad_pairs_overlap(bands[i], quads[j])
+    return {lanes[k].index for k in np.unique(i[hit])}

@@ -66,7 +66,7 @@ def max_speed(spec: SceneSpec) -> float:
 
 
 def simulate_pedestrians(spec: SceneSpec, grid: Grid, scene, signals, lib: Library, n_steps: int,
-                         dt: float = DT_S) -> list[Mover]:
+                         dt: float = DT_S, network: dict | None = None) -> list[Mover]:
     """Walking and standing pedestrians of the town for ``n_steps`` samples from t = 0.
 
     Parameters
@@ -85,6 +85,9 @@ def simulate_pedestrians(spec: SceneSpec, grid: Grid, scene, signals, lib: Libra
         Samples per track; track ``k`` is at t = k * dt seconds.
     dt : float
         Sample spacing, seconds.
+    network : dict, optional
+        Keeps the obstacles and the walk network between calls for the same town (a longer run of
+        :func:`generator.traffic.build.build_world` asks again with more steps; they do not depend on them).
 
     Returns
     -------
@@ -101,8 +104,11 @@ def simulate_pedestrians(spec: SceneSpec, grid: Grid, scene, signals, lib: Libra
     t0 = time.perf_counter()
     standing, walking = person_protos(lib, spec)
     body = wc.body_of(walking + standing, MARGIN_M)
-    obstacles = obstacles_of(grid, scene, body)
-    ww = build_walkways(grid, obstacles, body)
+    if network is None or "walkways" not in network:
+        obstacles = obstacles_of(grid, scene, body)
+        network = {} if network is None else network
+        network.update(obstacles=obstacles, walkways=build_walkways(grid, obstacles, body))
+    obstacles, ww = network["obstacles"], network["walkways"]
     t1 = time.perf_counter()
     cls = lib.main_class("person")
     movers = _walkers(spec, grid, ww, body, signals, walking, n_walk, n_steps, dt, cls) if n_walk and ww.paths else []

@@ -22,7 +22,7 @@ from generator.layout.network.routes import make_routes
 from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
 from generator.traffic.lanes.graph import LaneGraph
-from kits.traffic_contacts import assert_no_contact, static_quads
+from kits.traffic_contacts import actor_poses, assert_no_contact, static_quads
 
 TRAFFIC = {"cars_per_km": 25, "trucks_per_km": 2, "buses_per_km": 1, "cyclists_per_km": 3, "motorcyclists_per_km": 2,
            "other_vehicles_per_km": 1, "pedestrians_per_100m": 1.5, "standing_pedestrians_per_100m": 0.5}
@@ -158,8 +158,8 @@ def test_a_minute_of_traffic_and_walkers_round_the_closed_streets(town):
     assert len(people) > 10 and len(vehicles) > 10
     for t in np.arange(0.0, 60.0, 0.1):
         assert_no_contact(world, t, parked)
+        vc = actor_poses(world, t, vehicles)[0]
         for seg in grid.closed:
-            vc = np.array([a.box(t).center[:2] for a in vehicles])
             assert not _in_corridor(grid, seg, vc, grid.road_half).any(), f"a vehicle in a park at t={t:.1f}"
     for a in people:        # people on a closed street walk its sidewalks and caps, at kerb height
         xyz = a.track.xyz

@@ -26,7 +26,8 @@ from generator.layout.network.routes import make_routes
 from generator.spec import load_spec, parse_spec
 from generator.traffic.build import build_world
 from kits.street_towns import one_way_spec
-from kits.town_checks import ON_LANES, forward, no_collisions, on_carriageway, rests_on_ground
+from kits.town_checks import ON_LANES, forward, no_collisions, on_carriageway, on_carriageways, rests_on_ground
+from kits.traffic_contacts import actor_poses
 
 
 def test_no_u_turn_trap_is_accepted():
@@ -52,12 +53,12 @@ def test_routes_drive_one_way_streets_forwards_only(seed):
         if d:
             assert driven.get(s.index, {d}) == {d}
     for path in make_routes(grid):
-        for p, h in zip(path.points[:, :2], path.headings, strict=False):
-            hit = on_carriageway(grid, p[None])
-            if hit is None or not 1.0 < hit[1] < hit[0].length - 1.0:
+        segs, uv = on_carriageways(grid, path.points[:, :2])
+        for seg, (u, _), h in zip(segs, uv, path.headings, strict=False):
+            if seg is None or not 1.0 < u < seg.length - 1.0:
                 continue
             n += 1
-            assert np.dot([np.cos(h), np.sin(h)], forward(hit[0], grid.section(hit[0]).one_way)) > 0.99, path.name
+            assert np.dot([np.cos(h), np.sin(h)], forward(seg, grid.section(seg).one_way)) > 0.99, path.name
     assert n > 0          # the routes do drive one-way streets (else this test checks nothing)
 
 
@@ -82,16 +83,16 @@ def test_every_vehicle_drives_one_way_streets_forwards(traffic_town):
     spec, grid, _, world = traffic_town
     n = 0
     for t in np.arange(0.0, 12.0, 0.25):
-        poses = [(a.box(t).center[:2], a.box(t).yaw) for a in world.actors]
+        xy, yaw = actor_poses(world, t)
         E = world.ego.T_world_ego(t)[0]
-        poses.append(((E[0, 3], E[1, 3]), float(np.arctan2(E[1, 0], E[0, 0]))))
-        for xy, yaw in poses:
-            hit = on_carriageway(grid, np.asarray(xy, float)[None])
-            if hit is None or not STOP_U[1] < hit[1] < hit[0].length - STOP_U[1]:
+        xy, yaw = np.vstack([xy, [E[0, 3], E[1, 3]]]), np.r_[yaw, np.arctan2(E[1, 0], E[0, 0])]
+        segs, uv = on_carriageways(grid, xy)
+        for seg, (u, _), p, h in zip(segs, uv, xy, yaw, strict=True):
+            if seg is None or not STOP_U[1] < u < seg.length - STOP_U[1]:
                 continue
             n += 1
-            fwd = forward(hit[0], grid.section(hit[0]).one_way)
-            assert np.dot([np.cos(yaw), np.sin(yaw)], fwd) > 0.9, (t, xy)
+            fwd = forward(seg, grid.section(seg).one_way)
+            assert np.dot([np.cos(h), np.sin(h)], fwd) > 0.9, (t, p)
     assert n > 50
 
 
@@ -215,3 +216,20 @@ def test_hostile_new_weights_exit_2_with_one_line_and_write_nothing(tmp_path, ca
         else "streets.types"       # a NaN/Infinity token is refused as the file's JSON, before any field
     assert err.count("\n") == 1 and err.startswith(f"urbangen layout: {spec}: {where}"), err
     assert not out.exists()
+
+
+def test_the_carriageway_lookup_of_many_points_is_that_of_each():
+    """kits.town_checks.on_carriageways (every point at once, used above) answers as on_carriageway does
+    point by point: the same first one-way segment, or none, and the same frame coordinates."""
+    grid = make_grid(one_way_spec(3, blocks=(3, 3), one_way=1))
+    lo, hi = np.min([grid.node_xy(n) for n in grid.nodes], 0), np.max([grid.node_xy(n) for n in grid.nodes], 0)
+    xy = np.random.default_rng(2).uniform(lo - 5, hi + 5, (3000, 2))
+    segs, uv = on_carriageways(grid, xy)
+    found = 0
+    for p, seg, q in zip(xy, segs, uv, strict=True):
+        one = on_carriageway(grid, p[None])
+        assert (one is None) == (seg is None)
+        if one is not None:
+            found += 1
+            assert one[0] is seg and (one[1], one[2]) == (q[0], q[1])
+    assert found > 100

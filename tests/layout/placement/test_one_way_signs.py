@@ -187,7 +187,7 @@ def test_no_moving_actor_touches_a_one_way_sign():
     """With traffic and pedestrians (20 s, every 0.2 s), no vehicle, rider or pedestrian box
     overlaps the footprint of a one-way or no-entry sign (pedestrians walk round them)."""
     from generator.traffic.build import build_world
-    from kits.traffic_contacts import footprints, touching
+    from kits.traffic_contacts import actor_quads, footprints, touching
 
     spec = full_spec(3, traffic={**MIX_TRAFFIC, "pedestrians_per_100m": 3.0})
     scene = build_scene(spec)
@@ -195,5 +195,5 @@ def test_no_moving_actor_touches_a_one_way_sign():
     signs = footprints([o.box for o in scene.objects if _face_kind(scene, o)])
     assert len(signs) >= 10 and sum(a.kind == "person" for a in world.actors) >= 20
     for t in np.arange(0.0, 20.0, 0.2):
-        assert not touching(footprints([a.box(t) for a in world.actors]),
+        assert not touching(actor_quads(world, t),
                             signs).any(), f"an actor touches a sign at t = {t:.1f} s"

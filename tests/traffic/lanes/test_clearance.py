@@ -15,7 +15,7 @@ from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
 from generator.traffic.vehicles.fleet import KINDS, widest_half_width
 from kits.paths import ROOT
-from kits.traffic_contacts import footprints, static_quads, touching
+from kits.traffic_contacts import actor_quads, static_quads, touching
 
 BUSES = {"cars_per_km": 10, "trucks_per_km": 1, "buses_per_km": 4, "other_vehicles_per_km": 1, "cyclists_per_km": 1}
 
@@ -58,5 +58,5 @@ def test_no_moving_vehicle_box_ever_overlaps_a_static_object(scene, seed):
     assert sum(a.kind == "bus" for a in vehicles) >= 3
     static = static_quads(town)
     for t in np.arange(0.0, 20.0, 0.1):
-        hit = touching(footprints([a.box(t) for a in vehicles]), static)
+        hit = touching(actor_quads(world, t, vehicles), static)
         assert not hit.any(), f"{vehicles[np.argwhere(hit)[0][0]].name} touches a static object at t={t:.1f}"

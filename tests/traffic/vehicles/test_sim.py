@@ -16,9 +16,12 @@ from generator.world.actors import MOVING_THRESHOLD_MPS, Track
 from generator.world.rig import SWEEP_PERIOD_S, Rig
 from kits.paths import ROOT
 from kits.traffic_contacts import (
+    actor_poses,
+    actor_quads,
     assert_no_contact,
     assert_vehicles_miss_people,
     ego_box,
+    footprint,
     footprints,
     static_quads,
     touching,
@@ -51,7 +54,7 @@ def test_vehicles_exist_move_and_the_ego_is_not_an_actor(town):
     spec, scene, world = town
     kinds = {a.kind for a in world.actors}
     assert {"car", "truck", "bus", "bicyclist", "motorcyclist", "construction_vehicle"} <= kinds
-    speeds = np.array([[a.track.speed(t)[0] for a in world.actors] for t in _times()])
+    speeds = np.array([a.track.speed(_times()) for a in world.actors]).T     # (time, actor)
     assert (speeds > MOVING_THRESHOLD_MPS).mean() > 0.3          # traffic flows ...
     assert speeds.max() <= spec.traffic.speed_limit_mps + 1e-6   # ... within the limit
     assert len({a.instance_id for a in world.actors}) == len(world.actors)
@@ -81,11 +84,11 @@ def test_vehicles_stay_on_the_driving_lanes(town):
     grid = make_grid(spec)
     drive = grid.drivable_rects()
     for t in _times()[::5]:
-        for a in world.actors:
-            c = np.asarray(a.box(t).center[:2])
-            inside = ((c[0] >= drive[:, 0]) & (c[0] <= drive[:, 2]) & (c[1] >= drive[:, 1]) & (c[1] <= drive[:,
-                                                                                                             3])).any()
-            assert inside, f"{a.name} off the lanes at t={t:.1f}: {c}"
+        c = actor_poses(world, t)[0]
+        inside = ((c[:, None, 0] >= drive[:, 0]) & (c[:, None, 0] <= drive[:, 2]) & (c[:, None, 1] >= drive[:, 1])
+                  & (c[:, None, 1] <= drive[:, 3])).any(1)
+        for k in np.flatnonzero(~inside):
+            raise AssertionError(f"{world.actors[k].name} off the lanes at t={t:.1f}: {c[k]}")
 
 
 def test_motion_is_continuous_and_bounded(town):
@@ -234,7 +237,7 @@ def test_a_rebuilt_world_is_checked_against_the_recorded_digest(town):
     shorter = build_world(spec, scene, 5.2)  # causal: a shorter run has the same poses at these times
     shorter.check_digest(recorded, times, "lidar_meta.json")
     shorter.check_digest(recorded, times + 1e-7, "lidar_meta.json")  # times.txt rounding does not matter
-    moved = build_world(spec, scene, 5.2)
+    moved = shorter                          # the same rebuilt world, one actor moved by 1 cm (checked above first)
     moved.actors[3].track.xyz[20:] += 0.01
     with pytest.raises(UserError, match="lidar_meta.json: traffic.digest: .* not the one"):
         moved.check_digest(recorded, times, "lidar_meta.json")
@@ -248,9 +251,12 @@ def test_a_digest_recorded_before_negative_zeros_were_folded_is_still_accepted(t
     assert world.digest(times) != legacy  # the ego's rotation holds -0.0 entries: the fold changes the digest
 
 
-def test_the_traffic_digest_is_the_same_on_avx2_and_avx512_machines(root):
+def test_the_traffic_digest_is_the_same_on_avx2_and_avx512_machines(root, default_spec, default_scene):
     """A sequence cast on one kind of machine is rebuilt on another (a cluster node, a laptop running fuse):
-    numpy's AVX-512 and AVX2 exp/arctan2 differ in the last bit, which must not refuse the rebuilt world."""
+    numpy's AVX-512 and AVX2 exp/arctan2 differ in the last bit, which must not refuse the rebuilt world.
+    The AVX-512 world is this process's (numpy with every feature of the machine), built on the session's
+    default town; the AVX2 one a child's with the AVX-512 features switched off before numpy loads."""
+    import os
     import subprocess
     import sys
 
@@ -259,12 +265,14 @@ def test_the_traffic_digest_is_the_same_on_avx2_and_avx512_machines(root):
         pytest.skip("needs an AVX-512 machine to compare against its AVX2 arithmetic")
     code = ("import numpy as np; from generator.spec import load_spec; from generator.layout import build_scene; "
             "from generator.traffic import build_world; s = load_spec('scenes/default_town.json'); "
-            "w = build_world(s, build_scene(s), 6.0); print(w.digest(np.arange(60) * 0.1))")
+            "w = build_world(s, build_scene(s), 6.0); print(np.lib.utils._opt_info()); "
+            "print(w.digest(np.arange(60) * 0.1))")
     no512 = "AVX512F AVX512CD AVX512_SKX AVX512_CLX AVX512_CNL AVX512_ICL"
-    out = [subprocess.run([sys.executable, "-c", code], cwd=root, capture_output=True, text=True, check=True,
-                          env={**__import__("os").environ, **env}).stdout.split()[-1]
-           for env in ({}, {"NPY_DISABLE_CPU_FEATURES": no512})]
-    assert out[0] == out[1]
+    out = subprocess.run([sys.executable, "-c", code], cwd=root, capture_output=True, text=True, check=True,
+                         env={**os.environ, "NPY_DISABLE_CPU_FEATURES": no512}).stdout.split("\n")
+    assert "AVX512F*" not in out[-3] and "AVX2*" in out[-3]     # the child really ran on AVX2 arithmetic
+    here = build_world(default_spec, default_scene, 6.0).digest(np.arange(60) * 0.1)
+    assert out[-2] == here
 
 
 def _sweep_town(seed: int, roundabouts: float, dense: bool = False):
@@ -309,7 +317,7 @@ def test_no_moving_actor_ever_touches_a_static_object(seed, roundabouts, dense):
     assert bool(make_grid(spec).roundabouts) == (roundabouts > 0)
     static = static_quads(scene)
     for t in np.arange(0.0, 20.0, 0.1):
-        hit = touching(footprints(world.boxes(t)), static)
+        hit = touching(actor_quads(world, t), static)
         assert not hit.any(), f"{world.actors[np.argwhere(hit)[0][0]].name} touches a static object at t={t:.1f}"
 
 
@@ -328,5 +336,5 @@ def test_no_vehicle_touches_a_person_in_roundabout_towns_with_excavators(seed):
     static_people = footprints([o.box for o in scene.objects if o.instance_id > 0 and o.cls == "person"])
     for t in np.arange(0.0, 30.0, 0.1):
         assert_vehicles_miss_people(world, t, vehicles, people)
-        q = footprints([a.box(t) for a in vehicles] + [ego_box(world, t)])
+        q = np.concatenate([actor_quads(world, t, vehicles), footprint(ego_box(world, t))[None]])
         assert not touching(q, static_people).any(), f"a vehicle touches a person of the static town at t={t:.1f}"
