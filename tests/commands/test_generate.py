@@ -26,25 +26,17 @@ import pytest
 from generator.cli import main
 from generator.imaging.exr import read_exr
 from generator.imaging.paths import image_files, image_path
+from kits.generated_town import generate_args, reference_run
 from kits.shared_build import SharedBuild
 
 pytestmark = [pytest.mark.blender, pytest.mark.slow]
-VARIANTS = "day:clear,night:rain,day:fog"
-FRAMES = "3"
-
-
-def _args(root, out, *extra):
-    return ["generate", str(root / "scenes/test_town.json"), "--config", "test", "--out", str(out),
-            "--frames", FRAMES, "--variants", VARIANTS, *extra]
+_args = generate_args  # FRAMES = "3" frames of VARIANTS = "day:clear,night:rain,day:fog": the counts below
 
 
 @pytest.fixture(scope="session")
 def shared_reference(tmp_path_factory, root) -> SharedBuild:
-    """The uninterrupted 2-worker run, made when a test first asks for it (read-only)."""
-    def build(out: Path) -> None:
-        assert main(["-q", *_args(root, out, "--workers", "2")]) == 0
-
-    return SharedBuild(tmp_path_factory, "generate_reference", build)
+    """The uninterrupted 2-worker run (:mod:`kits.generated_town`), made when a test first asks for it."""
+    return reference_run(tmp_path_factory, root)
 
 
 @pytest.fixture(scope="module")
