@@ -48,6 +48,7 @@ from hypothesis import HealthCheck, given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
 from generator import cli  # noqa: E402
+from kits.cli_run import shared_parser  # noqa: E402
 from kits.json_kit import value_paths  # noqa: E402
 from kits.paths import ROOT  # noqa: E402
 
@@ -129,6 +130,12 @@ def kit(built_kit, monkeypatch):
     kit, scene = built_kit
     monkeypatch.setattr(assemble, "build_scene", lambda s: scene)  # openlabel rebuilds the scene of its spec
     return kit
+
+
+@pytest.fixture(autouse=True)
+def _one_parser(monkeypatch):
+    """The examples share one parser (:func:`kits.cli_run.shared_parser`)."""
+    monkeypatch.setattr(cli, "build_parser", shared_parser)
 
 
 # -- corrupting one file -------------------------------------------------------------------------------------------

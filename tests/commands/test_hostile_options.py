@@ -16,7 +16,6 @@ Profiles (``tests/conftest.py``): ``CI=1`` runs 25 examples per property, the de
 from __future__ import annotations
 
 import argparse
-import functools
 import math
 import os
 import stat
@@ -29,6 +28,7 @@ import pytest
 from generator import cli
 from generator.commands import options
 from generator.safeload import printable
+from kits.cli_run import shared_parser
 from kits.paths import ROOT
 
 hypothesis = pytest.importorskip("hypothesis")
@@ -149,16 +149,8 @@ def hostile_value(draw, action: argparse.Action) -> str:
 
 @pytest.fixture(autouse=True)
 def _one_parser(monkeypatch):
-    """The examples of a test share one parser: ``build_parser`` makes the same parser every time and parsing
-    leaves it as it was, so ``cli.main`` runs exactly as in a fresh process, without rebuilding ~700 options
-    (~20 ms) for each of the thousands of command lines."""
-    parser = _shared_parser()
-    monkeypatch.setattr(cli, "build_parser", lambda: parser)
-
-
-@functools.cache
-def _shared_parser() -> argparse.ArgumentParser:
-    return cli.build_parser()
+    """The examples share one parser (:func:`kits.cli_run.shared_parser`)."""
+    monkeypatch.setattr(cli, "build_parser", shared_parser)
 
 
 def _listing(folder: Path) -> set[str]:
