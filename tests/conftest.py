@@ -94,29 +94,41 @@ if _hyp_settings is not None:
     _hyp_settings.load_profile(_os.environ.get("HYPOTHESIS_PROFILE") or ("ci" if _os.environ.get("CI") else "dev"))
 
 
-# -- detection datasets and their exports (tests/kits/detection_data.py), built once per session ---------
+# -- detection datasets and their exports (tests/kits/detection_data.py), built once per test run ----------
+# (kits.shared_build: by the first pytest-xdist worker that asks; the other waits instead of building its own)
 @pytest.fixture(scope="session")
 def frozen_detection_dataset(tmp_path_factory, test_spec, test_scene):
     """The cast test town with a ray-cast stereo stream, seed-003 images, box file and OpenLABEL (read-only)."""
     from kits.detection_data import frozen_dataset
+    from kits.shared_build import SharedBuild
 
-    return frozen_dataset(tmp_path_factory.mktemp("frozen_det"), test_spec, test_scene)
+    def build(out: Path) -> None:
+        out.mkdir()
+        frozen_dataset(out, test_spec, test_scene)
+
+    return SharedBuild(tmp_path_factory, "frozen_det", build).path()
 
 
 @pytest.fixture(scope="session")
 def traffic_detection_dataset(tmp_path_factory):
     """(dataset, spec file) of a small town with moving traffic, its box file and OpenLABEL (read-only)."""
     from kits.detection_data import traffic_dataset
+    from kits.shared_build import SharedBuild
 
-    return traffic_dataset(tmp_path_factory.mktemp("traffic_det") / "ds")
+    folder = SharedBuild(tmp_path_factory, "traffic_det", lambda out: traffic_dataset(out / "ds")).path()
+    return folder / "ds", folder / "ds_spec.json"
 
 
 @pytest.fixture(scope="session")
 def nuscenes_traffic(traffic_detection_dataset, tmp_path_factory):
     """``urbangen export nuscenes`` of the traffic dataset (read-only)."""
     from generator import cli
+    from kits.shared_build import SharedBuild
 
     root, _ = traffic_detection_dataset
-    out = tmp_path_factory.mktemp("nus_traffic") / "nus"
-    assert cli.main(["export", "nuscenes", str(root), str(out)]) == 0
-    return out
+
+    def build(out: Path) -> None:
+        out.mkdir()
+        assert cli.main(["export", "nuscenes", str(root), str(out / "nus")]) == 0
+
+    return SharedBuild(tmp_path_factory, "nus_traffic", build).path() / "nus"

@@ -34,6 +34,11 @@ SHARD_RE = re.compile(r"[0-9]{4}")
 _STEM_RE = re.compile(r"([0-9]{6})_")
 
 
+def image_name(frame_index: int, time_of_day: str = "day", weather: str = "clear") -> str:
+    """File stem of an image: ``NNNNNN_<time>_<weather>``."""
+    return f"{frame_index:06d}_{time_of_day}_{weather}"
+
+
 def shard_name(frame: int) -> str:
     """``SSSS``: the shard folder of frame ``frame`` (0..999 999)."""
     return f"{int(frame) // SHARD_FRAMES:04d}"

@@ -18,9 +18,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from generator.atomic import TMP_PREFIX
-from generator.imaging.paths import image_path
+from generator.imaging.paths import image_name, image_path  # not from jobs.images: EXR, schema, PIL (~0.5 s a worker)
 from generator.jobs.frameset import iter_frames
-from generator.jobs.images import image_name
 
 STAND_IN_DIR = "stand-in"
 

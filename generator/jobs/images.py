@@ -15,13 +15,8 @@ from pathlib import Path
 from generator.atomic import inside, write_json
 from generator.imaging.exr import LabelledImage, write_exr
 from generator.imaging.metadata import image_metadata, validate_metadata
-from generator.imaging.paths import IMAGES_DIR, shard_name
+from generator.imaging.paths import IMAGES_DIR, image_name, shard_name
 from generator.previews.preview import write_preview
-
-
-def image_name(frame_index: int, time_of_day: str = "day", weather: str = "clear") -> str:
-    """File stem of an image: ``NNNNNN_<time>_<weather>``."""
-    return f"{frame_index:06d}_{time_of_day}_{weather}"
 
 
 def write_image(out: Path, frame, spec, cfg, renderer, rendered, time_of_day: str, weather: dict,

@@ -24,8 +24,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from generator.errors import UserError
+from generator.imaging.paths import image_name
 from generator.jobs.frameset import FrameSet
-from generator.jobs.images import image_name
 from generator.safeload import printable
 from generator.weather import combinations
 

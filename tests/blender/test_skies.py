@@ -1,7 +1,9 @@
 """Skies and light rendered (Blender, issue 14 items 2, 3): night is night, rain is overcast, dusk sits
 between, clouds are drawn, and the same seed gives the same image.
 
-One frame of the test town at the test preset (camera model off: the EXR RGB is the scene radiance).
+One frame of the test town at the test preset (camera model off: the EXR RGB is the scene radiance): the
+day and night images are those of the all-variant render the render tests read (:mod:`kits.rendered_frame`),
+dusk (not a time of the test town, so not in "all") is rendered here.
 """
 
 from __future__ import annotations
@@ -17,25 +19,28 @@ from generator.imaging.exr import read_exr
 from generator.imaging.paths import image_dir
 from generator.labels import class_table
 from generator.postfx.filters import luminance
+from kits.rendered_frame import FRAME, all_variants, copy_images, render_args
 
 pytestmark = pytest.mark.blender
-FRAME = 3
-VARIANTS = "day:clear,day:rain,dusk:clear,night:clear,night:rain"
 #: A night's mean radiance is at least this many EV below the day's of the same frame (a real street:
 #: ~10 EV in log-average; the mean is lifted by the lamps themselves).
 NIGHT_EV_BELOW_DAY = 6.0
 SKY = class_table().id("sky")
 
 
-def _render(out, root, variants=VARIANTS):
-    assert main(["-q", "render", str(root / "scenes/test_town.json"), "--config", "test", "--out", str(out),
-                 "--frames", "1", "--first", str(FRAME), "--variants", variants]) == 0
+def _render(out, root, variants):
+    assert main(render_args(root, out, variants)) == 0
     return image_dir(out, FRAME)
 
 
 @pytest.fixture(scope="module")
 def rendered(tmp_path_factory, root):
-    return _render(tmp_path_factory.mktemp("skies"), root)
+    """An images folder with day:clear, day:rain, dusk:clear, night:clear and night:rain of frame 3."""
+    images = _render(tmp_path_factory.mktemp("skies"), root, "dusk:clear")
+    shared = image_dir(all_variants(tmp_path_factory, root).path(), FRAME)
+    copy_images(shared, images, [f"{FRAME:06d}_{t}_{k}" for t, k in
+                                 (("day", "clear"), ("day", "rain"), ("night", "clear"), ("night", "rain"))])
+    return images
 
 
 def _load(images, tod, kind):

@@ -2,6 +2,10 @@
 
 One uninterrupted 2-worker run is the reference; a run killed with SIGKILL and rerun,
 and a Ray run, must end with the same files and identical LiDAR bytes.
+
+The reference is made once per test run (:mod:`kits.shared_build`): the tests that read it form one
+unit of work; the SIGKILL and the Ray test each make their own run first, on whichever worker is free,
+and wait for the reference only to compare.
 """
 
 from __future__ import annotations
@@ -22,22 +26,22 @@ import pytest
 from generator.cli import main
 from generator.imaging.exr import read_exr
 from generator.imaging.paths import image_files, image_path
+from kits.generated_town import generate_args, reference_run
+from kits.shared_build import SharedBuild
 
 pytestmark = [pytest.mark.blender, pytest.mark.slow]
-VARIANTS = "day:clear,night:rain,day:fog"
-FRAMES = "3"
+_args = generate_args  # FRAMES = "3" frames of VARIANTS = "day:clear,night:rain,day:fog": the counts below
 
 
-def _args(root, out, *extra):
-    return ["generate", str(root / "scenes/test_town.json"), "--config", "test", "--out", str(out),
-            "--frames", FRAMES, "--variants", VARIANTS, *extra]
+@pytest.fixture(scope="session")
+def shared_reference(tmp_path_factory, root) -> SharedBuild:
+    """The uninterrupted 2-worker run (:mod:`kits.generated_town`), made when a test first asks for it."""
+    return reference_run(tmp_path_factory, root)
 
 
 @pytest.fixture(scope="module")
-def reference(tmp_path_factory, root):
-    out = tmp_path_factory.mktemp("gen") / "ref"
-    assert main(["-q", *_args(root, out, "--workers", "2")]) == 0
-    return out
+def reference(shared_reference) -> Path:
+    return shared_reference.path()
 
 
 def _files(root: Path) -> set[str]:
@@ -76,11 +80,13 @@ def test_dataset_is_complete_balanced_and_valid(reference, capsys):
     assert "valid: 9 images, 16 scans, 1 OpenLABEL" in capsys.readouterr().out
 
 
-def test_rerun_skips_finished_work(reference, root, capsys):
-    before = {p: p.stat().st_mtime_ns for p in image_files(reference, "*.exr")}
-    assert main(["-q", *_args(root, reference, "--workers", "2")]) == 0
+def test_rerun_skips_finished_work(reference, root, tmp_path, capsys):
+    data = tmp_path / "data"  # a copy: the reference is shared with tests running beside this one
+    shutil.copytree(reference, data)
+    before = {p: p.stat().st_mtime_ns for p in image_files(data, "*.exr")}
+    assert main(["-q", *_args(root, data, "--workers", "2")]) == 0
     assert "nothing left to render" in capsys.readouterr().out
-    assert before == {p: p.stat().st_mtime_ns for p in image_files(reference, "*.exr")}
+    assert before == {p: p.stat().st_mtime_ns for p in image_files(data, "*.exr")}
 
 
 def test_preview_sheets(reference, tmp_path):
@@ -148,7 +154,7 @@ def test_validate_catches_each_fault(reference, tmp_path, capsys, fault, expecte
     assert "1 problem(s)" in err
 
 
-def test_sigkill_then_resume_gives_the_uninterrupted_files(reference, root, tmp_path):
+def test_sigkill_then_resume_gives_the_uninterrupted_files(shared_reference, root, tmp_path):
     out = tmp_path / "killed"
     cmd = [sys.executable, "-m", "generator.cli", "-q", *_args(root, out, "--workers", "2")]
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
@@ -163,16 +169,20 @@ def test_sigkill_then_resume_gives_the_uninterrupted_files(reference, root, tmp_
     done = len(image_files(out, "*.json"))
     assert 0 < done < 9, "the kill should land mid-run"
     assert main(["-q", *_args(root, out, "--workers", "2")]) == 0
+    reference = shared_reference.path()
     assert _files(out) == _files(reference)
     assert _lidar_bytes(out) == _lidar_bytes(reference)
     _same_images(out, reference)
     assert main(["validate", str(out)]) == 0
 
 
-def test_ray_executor_equals_local(reference, root, tmp_path):
+def test_ray_executor_equals_local(shared_reference, root, tmp_path, monkeypatch):
     pytest.importorskip("ray")
+    # Ray runs its workers at nice 15: beside the other pytest worker (nice 0) they would get almost no CPU
+    monkeypatch.setenv("RAY_worker_niceness", "0")
     out = tmp_path / "ray"
     assert main(["-q", *_args(root, out, "--workers", "2", "--executor", "ray")]) == 0
+    reference = shared_reference.path()
     assert _files(out) == _files(reference)
     assert _lidar_bytes(out) == _lidar_bytes(reference)
     _same_images(out, reference)

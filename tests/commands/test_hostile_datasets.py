@@ -48,6 +48,7 @@ from hypothesis import HealthCheck, given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
 from generator import cli  # noqa: E402
+from kits.cli_run import shared_parser  # noqa: E402
 from kits.json_kit import value_paths  # noqa: E402
 from kits.paths import ROOT  # noqa: E402
 
@@ -92,8 +93,11 @@ def _write_images(root: Path, scene, spec, n: int, width: int = 96, height: int 
         (root / "images" / f"{name}.json").write_text(json.dumps(rec))
 
 
-@pytest.fixture(scope="module")
-def kit(tmp_path_factory):
+# session scope: each pytest-xdist worker builds its own (a few seconds), so the properties below spread over
+# both workers instead of queueing on the one that holds a module-scoped dataset
+@pytest.fixture(scope="session")
+def built_kit(tmp_path_factory):
+    """(the kit, the scene its spec builds); read-only."""
     from generator.jobs.boxes import write_sequence_openlabel
     from generator.jobs.lidar_sequence import SequenceOptions, write_sequence
     from generator.layout import assemble
@@ -116,9 +120,22 @@ def kit(tmp_path_factory):
     (outside / "secret.txt").write_text(f"{SECRET}\n" * 4)
     (outside / "000000.bin").write_text(SECRET)
     files = sorted(str(p.relative_to(root)) for p in root.rglob("*"))
-    with pytest.MonkeyPatch.context() as mp:  # openlabel rebuilds the scene of its spec: reuse this one
-        mp.setattr(assemble, "build_scene", lambda s: scene)
-        yield Kit(root, spec_path, outside, files)
+    return Kit(root, spec_path, outside, files), scene
+
+
+@pytest.fixture
+def kit(built_kit, monkeypatch):
+    from generator.layout import assemble
+
+    kit, scene = built_kit
+    monkeypatch.setattr(assemble, "build_scene", lambda s: scene)  # openlabel rebuilds the scene of its spec
+    return kit
+
+
+@pytest.fixture(autouse=True)
+def _one_parser(monkeypatch):
+    """The examples share one parser (:func:`kits.cli_run.shared_parser`)."""
+    monkeypatch.setattr(cli, "build_parser", shared_parser)
 
 
 # -- corrupting one file -------------------------------------------------------------------------------------------
@@ -405,7 +422,7 @@ PLY_TOKENS = [MARKER, "-5", "9" * 30, "1e3", "", "list uchar int", "double", "as
               "face 3", "property", "element", "end_header"]
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")  # per worker, as the kit above
 def town(tmp_path_factory) -> Path:
     from kits.carla_town import make_town
 

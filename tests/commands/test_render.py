@@ -1,6 +1,7 @@
 """`urbangen render` end to end on the test town at the test preset (Blender).
 
-One frame in all 12 weather x time-of-day variants, rendered once per session.
+One frame in all 12 weather x time-of-day variants, rendered once per test run (:mod:`kits.rendered_frame`,
+shared with the sky and camera-model tests).
 """
 
 from __future__ import annotations
@@ -16,18 +17,14 @@ from generator.imaging.paths import image_dir
 from generator.labels import class_table
 from generator.previews.preview import tonemap
 from generator.weather import combinations
+from kits.rendered_frame import FRAME, all_variants, render_args
 
 pytestmark = pytest.mark.blender
-FRAME = 3
 
 
 @pytest.fixture(scope="module")
 def rendered(tmp_path_factory, root):
-    out = tmp_path_factory.mktemp("render")
-    code = main(["-q", "render", str(root / "scenes/test_town.json"), "--config", "test", "--out", str(out),
-                 "--frames", "1", "--first", str(FRAME), "--variants", "all"])
-    assert code == 0
-    return image_dir(out, FRAME)
+    return image_dir(all_variants(tmp_path_factory, root).path(), FRAME)
 
 
 def _load(images, tod, kind):
@@ -101,8 +98,7 @@ def test_exr_opens_in_blender(rendered):
 
 
 def test_second_render_gives_identical_masks(rendered, tmp_path, root):
-    code = main(["-q", "render", str(root / "scenes/test_town.json"), "--config", "test", "--out", str(tmp_path),
-                 "--frames", "1", "--first", str(FRAME)])
+    code = main(render_args(root, tmp_path, "clear"))  # the default variants: day:clear
     assert code == 0
     a, _ = _load(rendered, "day", "clear")
     b, _ = _load(image_dir(tmp_path, FRAME), "day", "clear")

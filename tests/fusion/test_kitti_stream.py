@@ -6,22 +6,20 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from generator.cli import main
 from generator.formats import kitti_calib
 from generator.fusion.kitti_stream import sequence_agreement
 from generator.imaging.exr import read_exr
 from generator.jobs.stereo import files_of, stereo_frames
+from kits.generated_town import reference_run
 
 pytestmark = pytest.mark.blender
 
 
 @pytest.fixture(scope="module")
 def sequence(tmp_path_factory, root):
-    out = tmp_path_factory.mktemp("kitti")
-    code = main(["-q", "generate", str(root / "scenes/test_town.json"), "--config", "test", "--out", str(out),
-                 "--frames", "2", "--variants", "clear"])
-    assert code == 0
-    return out / "lidar" / "sequences" / "00"
+    """The stream of the test town's ``generate`` run that tests/commands/test_generate.py makes too (3 frames:
+    16 sweeps, pairs at 0 and 10), made once per test run (:mod:`kits.generated_town`); read-only."""
+    return reference_run(tmp_path_factory, root).path() / "lidar" / "sequences" / "00"
 
 
 def test_every_tenth_sweep_has_a_stereo_pair(sequence, test_spec):

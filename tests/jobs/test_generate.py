@@ -22,13 +22,14 @@ from generator.jobs.frameset import FrameSet
 from generator.jobs.journal import Journal, combo_mask
 from generator.jobs.plan import make_plan
 from kits.paths import ROOT
-from kits.stand_in_run import COMBOS, spec_with_towns
+from kits.stand_in_run import COMBOS, run, spec_with_towns
 
 Usage = namedtuple("Usage", "total used free")
 FRAMES, EVERY = "6", "3"  # two towns of three frames
 
 
 def _kit(out: Path, *extra: str) -> subprocess.CompletedProcess:
+    """The stand-in run as its own program (``kits.stand_in_run``): one a test can kill."""
     path = os.pathsep.join([str(ROOT), str(ROOT / "tests"), os.environ.get("PYTHONPATH", "")])
     env = {**os.environ, "PYTHONPATH": path}
     return subprocess.run([sys.executable, "-m", "kits.stand_in_run", str(out), FRAMES, "--every", EVERY, *extra],
@@ -45,7 +46,14 @@ def _manifest(root: Path) -> dict:
     return {k: v for k, v in m.items() if k not in ("created", "updated", "runs")}
 
 
-@pytest.fixture(scope="module")
+def _resume(out: Path) -> None:
+    """The same run, uninterrupted, in this process (a resume is about the folder, not the process)."""
+    run(out, int(FRAMES), int(EVERY))
+
+
+# session scope: each pytest-xdist worker makes its own reference (a few seconds), so the kill tests below
+# spread over both workers instead of queueing on the one that holds a module-scoped reference
+@pytest.fixture(scope="session")
 def reference(tmp_path_factory):
     out = tmp_path_factory.mktemp("standin") / "ref"
     assert _kit(out).returncode == 0
@@ -110,7 +118,7 @@ def test_a_dataset_from_before_the_journal_resumes_from_its_files(reference, tmp
                      "openlabel": True, "stats": True, "stereo": ["00/0", "01/0"]}
     (out / "manifest.json").write_text(json.dumps(m))
     images = {p: p.stat().st_mtime_ns for p in (out / "images").rglob("*.json")}
-    assert _kit(out).returncode == 0
+    _resume(out)
     assert images == {p: p.stat().st_mtime_ns for p in (out / "images").rglob("*.json")}  # none made again
     assert _files(out) == _files(reference)
     assert json.loads((out / "manifest.json").read_text())["finished"] == _manifest(reference)["finished"]
@@ -120,7 +128,7 @@ def test_a_journal_left_without_its_manifest_is_not_trusted(reference, tmp_path)
     """A folder with a journal but no manifest is a new dataset: its journal (of another run) is dropped."""
     out = tmp_path / "orphan"
     shutil.copytree(reference / "journal", out / "journal")
-    assert _kit(out).returncode == 0
+    _resume(out)
     assert _files(out) == _files(reference)
 
 
@@ -128,8 +136,7 @@ def _killed_then_resumed(reference: Path, tmp_path: Path, point: str) -> None:
     out = tmp_path / "killed"
     first = _kit(out, "--kill-at", point)
     assert first.returncode == -signal.SIGKILL, (point, first.returncode, first.stderr[-2000:])
-    second = _kit(out)
-    assert second.returncode == 0, second.stderr[-2000:]
+    _resume(out)
     assert _files(out) == _files(reference), point
     assert _manifest(out) == _manifest(reference), point
 

@@ -65,6 +65,8 @@ def _kill_after_frames_on(node_id: str, frames: int, kill, monkeypatch) -> dict:
 
 def test_a_node_killed_mid_run_loses_nothing_and_duplicates_nothing(tmp_path, monkeypatch):
     ray = pytest.importorskip("ray")
+    # Ray runs its workers at nice 15: beside the other pytest worker (nice 0) they would get almost no CPU
+    monkeypatch.setenv("RAY_worker_niceness", "0")
     from ray.cluster_utils import Cluster
 
     from generator.spec import load_spec

@@ -3,13 +3,25 @@ on stderr, no traceback, nothing written, in bounded time."""
 
 from __future__ import annotations
 
+import argparse
+import functools
 import time
 from pathlib import Path
 
 from generator import cli
 
+_build_parser = cli.build_parser  # the real one (tests put shared_parser in its place)
+
 #: Seconds one run may take (the slowest valid case builds the test town, ~2 s).
 TIME_LIMIT_S = 30.0  # a hang guard (a refusal must not wait on the input), not a speed measurement
+
+
+@functools.cache
+def shared_parser() -> argparse.ArgumentParser:
+    """``cli.build_parser()`` made once per process: it makes the same parser every time and parsing leaves it as
+    it was, so tests that run thousands of command lines (``monkeypatch.setattr(cli, "build_parser",
+    shared_parser)``) run ``cli.main`` as a fresh process would, without rebuilding ~700 options (~20 ms) each."""
+    return _build_parser()
 
 
 def _listing(folder: Path) -> set[str]:

@@ -1,7 +1,8 @@
 """A ``generate`` run with stand-in tasks (:mod:`generator.jobs.dry`), as a program a test can kill.
 
 ``python -m kits.stand_in_run OUT FRAMES [--every N] [--workers W] [--kill-at POINT]`` runs
-``run_generate`` on the test town with stand-in tasks (no Blender, no LiDAR). ``--kill-at`` makes the
+``run_generate`` on the test town with stand-in tasks (no Blender, no LiDAR); :func:`run` is the same run
+in the caller's process. ``--kill-at`` makes the
 parent SIGKILL itself at one point of its bookkeeping, so a test can kill it anywhere:
 
 * ``append:N`` -- just before the N-th journal line is written;
@@ -85,6 +86,21 @@ def arm(point: str) -> None:
         raise SystemExit(f"unknown kill point {point}")
 
 
+def run(out: Path, frames: int, every: int | None = None, workers: int = 2, delay: float = 0.0) -> dict:
+    """The stand-in run of ``frames`` frames into ``out`` (towns of ``every`` frames), in this process: what
+    the program does when nothing kills it (a test resumes a killed run with it without starting Python)."""
+    from generator.jobs.generate import GenerateOptions, run_generate
+    from generator.jobs.plan import make_plan
+    from generator.spec import load_spec
+    from generator.spec.render import load_render_config
+
+    out.parent.mkdir(parents=True, exist_ok=True)
+    spec = load_spec(spec_with_towns(every, out.parent / f"{out.name}.spec.json"))
+    return run_generate(spec, load_render_config("test"),
+                        GenerateOptions(out, make_plan(frames, combos=COMBOS), workers, "local",
+                                        stand_in=True, stand_in_delay_s=delay))
+
+
 def main() -> None:
     p = argparse.ArgumentParser()
     p.add_argument("out", type=Path)
@@ -94,18 +110,9 @@ def main() -> None:
     p.add_argument("--kill-at", default=None)
     p.add_argument("--delay", type=float, default=0.0)
     args = p.parse_args()
-    from generator.jobs.generate import GenerateOptions, run_generate
-    from generator.jobs.plan import make_plan
-    from generator.spec import load_spec
-    from generator.spec.render import load_render_config
-
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    spec = load_spec(spec_with_towns(args.every, args.out.parent / f"{args.out.name}.spec.json"))
     if args.kill_at:
         arm(args.kill_at)
-    run_generate(spec, load_render_config("test"),
-                 GenerateOptions(args.out, make_plan(args.frames, combos=COMBOS), args.workers, "local",
-                                 stand_in=True, stand_in_delay_s=args.delay))
+    run(args.out, args.frames, args.every, args.workers, args.delay)
 
 
 if __name__ == "__main__":

@@ -385,19 +385,18 @@ def test_a_stereo_pair_is_one_camera_with_two_sensors(test_spec):
 # -- a real render ---------------------------------------------------------------------------------
 
 @pytest.mark.blender
-def test_rendered_night_is_darker_than_day_and_labels_match_off(tmp_path, root):
+def test_rendered_night_is_darker_than_day_and_labels_match_off(tmp_path_factory, tmp_path, root):
     from generator.cli import main
     from generator.imaging.exr import read_exr
+    from kits.rendered_frame import all_variants, render_args
 
     cfg = tmp_path / "test_camera.yaml"
     cfg.write_text(
         (root / "render_configs" / "test.yaml").read_text().replace("camera_model: false", "camera_model: true")
     )
-    outs = {}
-    for name, config in (("on", str(cfg)), ("off", "test")):
-        outs[name] = tmp_path / name
-        assert main(["-q", "render", str(root / "scenes/test_town.json"), "--config", config, "--out", str(outs[name]),
-                     "--frames", "1", "--first", "3", "--variants", "day:clear,night:clear"]) == 0
+    assert main(render_args(root, tmp_path / "on", "day:clear,night:clear", str(cfg))) == 0
+    # off: the test preset's render of frame 3 in every variant, made once for the render tests
+    outs = {"on": tmp_path / "on", "off": all_variants(tmp_path_factory, root).path()}
     imgs = {(n, t): read_exr(image_path(outs[n], f"000003_{t}_clear", ".exr")) for n in outs for t in ("day", "night")}
     pngs = {t: np.asarray(Image.open(image_path(outs["on"], f"000003_{t}_clear", "_preview.png")))[:64, :96]
             for t in ("day", "night")}
