@@ -102,8 +102,12 @@ class _Tracks:
         self.half = np.array([a.size[:2] for a in self.actors], np.float64).reshape(-1, 2) / 2.0
         self.calls = 0
 
-    def quads(self, t: float) -> np.ndarray:
-        """(n, 4, 2) footprints of the actors at time ``t`` (s)."""
+    def poses(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """((n, 2) box centres, (n,) yaws) of the actors at time ``t`` (s)."""
+        return self._poses(t)[:2]
+
+    def _poses(self, t: float):
+        """:meth:`poses`, and the actors' own boxes when this call checked against them (else None)."""
         rows = np.arange(len(self.n))
         x = np.clip((float(t) - self.t0) / self.dt, 0.0, self.n - 1.0)
         i = np.where(self.n > 1, np.minimum(np.floor(x).astype(np.int64), self.n - 2), 0)
@@ -113,42 +117,52 @@ class _Tracks:
         c, s = np.cos(h), np.sin(h)
         cx = c * self.centre[:, 0] - s * self.centre[:, 1] + p[:, 0]
         cy = s * self.centre[:, 0] + c * self.centre[:, 1] + p[:, 1]
-        sx, sy = np.array([-1.0, 1.0, 1.0, -1.0]), np.array([-1.0, -1.0, 1.0, 1.0])
-        lx, ly = sx * self.half[:, :1], sy * self.half[:, 1:]                     # (n, 4) box-frame corners
-        q = np.stack([cx[:, None] + lx * c[:, None] - ly * s[:, None],
-                      cy[:, None] + lx * s[:, None] + ly * c[:, None]], -1)
-        self._xy, self._h = np.stack([cx, cy], -1), h
+        xy, boxes = np.stack([cx, cy], -1), None
         if self.calls % self.CHECK_EVERY == 0:            # the actors' own boxes say the same
             boxes = [a.box(t) for a in self.actors]
-            own = footprints(boxes)
-            assert np.abs(own - q).max(initial=0.0) < 1e-9, f"the kit's footprints are not the actors' boxes at t={t}"
+            own = np.array([b.center[:2] for b in boxes], np.float64).reshape(-1, 2)
+            assert np.abs(own - xy).max(initial=0.0) < 1e-9, f"the kit's box centres are not the actors' at t={t}"
             assert all(abs(b.yaw - y) < 1e-12 for b, y in zip(boxes, h, strict=True)), t
         self.calls += 1
+        return xy, h, boxes
+
+    def quads(self, t: float) -> np.ndarray:
+        """(n, 4, 2) footprints of the actors at time ``t`` (s)."""
+        xy, h, boxes = self._poses(t)
+        c, s = np.cos(h)[:, None], np.sin(h)[:, None]
+        sx, sy = np.array([-1.0, 1.0, 1.0, -1.0]), np.array([-1.0, -1.0, 1.0, 1.0])
+        lx, ly = sx * self.half[:, :1], sy * self.half[:, 1:]                     # (n, 4) box-frame corners
+        q = np.stack([xy[:, :1] + lx * c - ly * s, xy[:, 1:] + lx * s + ly * c], -1)
+        if boxes is not None:                            # checked against the actors' own boxes
+            err = np.abs(footprints(boxes) - q).max(initial=0.0)
+            assert err < 1e-9, f"the kit's footprints are not the actors' boxes at t={t}"
         return q
 
 
 _PACKED: dict = {"world": None, "packs": {}}    # the packed actor lists of the last world asked about
 
 
-def actor_quads(world, t: float, actors=None) -> np.ndarray:
-    """(n, 4, 2) footprints of ``actors`` (default: every actor of ``world``) at time ``t`` (s): the
-    footprints of their boxes (:meth:`generator.world.actors.Actor.box`), all at once."""
+def _pack(world, actors) -> _Tracks:
+    """The packed tracks of ``actors`` (default: every actor of ``world``), kept while ``world`` is the last asked."""
     actors = world.actors if actors is None else actors
     if _PACKED["world"] is not world:
         _PACKED.update(world=world, packs={})
     key = tuple(id(a) for a in actors)              # the actors live as long as the world kept here
     if key not in _PACKED["packs"]:
         _PACKED["packs"][key] = _Tracks(actors)
-    return _PACKED["packs"][key].quads(t)
+    return _PACKED["packs"][key]
+
+
+def actor_quads(world, t: float, actors=None) -> np.ndarray:
+    """(n, 4, 2) footprints of ``actors`` (default: every actor of ``world``) at time ``t`` (s): the
+    footprints of their boxes (:meth:`generator.world.actors.Actor.box`), all at once."""
+    return _pack(world, actors).quads(t)
 
 
 def actor_poses(world, t: float, actors=None) -> tuple[np.ndarray, np.ndarray]:
     """((n, 2) box centres, (n,) yaws) of ``actors`` (default: every actor of ``world``) at time ``t``
     (s): the centres and yaws of their boxes (:meth:`generator.world.actors.Actor.box`), all at once."""
-    actor_quads(world, t, actors)
-    actors = world.actors if actors is None else actors
-    pack = _PACKED["packs"][tuple(id(a) for a in actors)]
-    return pack._xy, pack._h
+    return _pack(world, actors).poses(t)
 
 
 def ego_box(world, t: float) -> Box:
