@@ -84,19 +84,8 @@ def forward(seg, direction: int) -> np.ndarray:
     return direction * np.array([np.cos(seg.yaw), np.sin(seg.yaw)])
 
 
-def on_carriageway(grid, xy: np.ndarray):
-    """(segment, u, v) of the one-way segment whose carriageway holds world point ``xy``, or None."""
-    for seg in grid.segments:
-        if not grid.section(seg).one_way:
-            continue
-        u, v = segment_frame_points(seg, xy)[0]
-        if 0.0 < u < seg.length and abs(v) < grid.road_half:
-            return seg, u, v
-    return None
-
-
 def on_carriageways(grid, xy: np.ndarray) -> tuple[list, np.ndarray]:
-    """:func:`on_carriageway` of many world points ``xy`` ((n, 2)) at once: ``(segments, uv)``, the
+    """The one-way carriageways holding world points ``xy`` ((n, 2)): ``(segments, uv)``, the
     first one-way segment (in ``grid.segments`` order) whose carriageway holds each point (None
     where none does) and the (n, 2) ``(u, v)`` of the point in that segment's frame."""
     xy = np.asarray(xy, np.float64).reshape(-1, 2)

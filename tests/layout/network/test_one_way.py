@@ -26,7 +26,7 @@ from generator.layout.network.routes import make_routes
 from generator.spec import load_spec, parse_spec
 from generator.traffic.build import build_world
 from kits.street_towns import one_way_spec
-from kits.town_checks import ON_LANES, forward, no_collisions, on_carriageway, on_carriageways, rests_on_ground
+from kits.town_checks import ON_LANES, forward, no_collisions, on_carriageways, rests_on_ground
 from kits.traffic_contacts import actor_poses
 
 
@@ -111,11 +111,11 @@ def test_one_way_town_keeps_the_layout_invariants(traffic_town):
     rests_on_ground(spec, grid, scene)
     parked = [o for o in scene.objects if o.attrs.get("placement") == "parked"]
     n = 0
-    for o in parked:
-        hit = on_carriageway(grid, np.asarray(o.box.center, float)[None, :2])
-        if hit is not None:
+    segs, _ = on_carriageways(grid, [np.asarray(o.box.center, float)[:2] for o in parked])
+    for o, seg in zip(parked, segs, strict=True):
+        if seg is not None:
             n += 1
-            fwd = forward(hit[0], grid.section(hit[0]).one_way)
+            fwd = forward(seg, grid.section(seg).one_way)
             assert np.dot([np.cos(o.box.yaw), np.sin(o.box.yaw)], fwd) > 0.99, o.name
     assert n > 0
 
@@ -216,20 +216,3 @@ def test_hostile_new_weights_exit_2_with_one_line_and_write_nothing(tmp_path, ca
         else "streets.types"       # a NaN/Infinity token is refused as the file's JSON, before any field
     assert err.count("\n") == 1 and err.startswith(f"urbangen layout: {spec}: {where}"), err
     assert not out.exists()
-
-
-def test_the_carriageway_lookup_of_many_points_is_that_of_each():
-    """kits.town_checks.on_carriageways (every point at once, used above) answers as on_carriageway does
-    point by point: the same first one-way segment, or none, and the same frame coordinates."""
-    grid = make_grid(one_way_spec(3, blocks=(3, 3), one_way=1))
-    lo, hi = np.min([grid.node_xy(n) for n in grid.nodes], 0), np.max([grid.node_xy(n) for n in grid.nodes], 0)
-    xy = np.random.default_rng(2).uniform(lo - 5, hi + 5, (3000, 2))
-    segs, uv = on_carriageways(grid, xy)
-    found = 0
-    for p, seg, q in zip(xy, segs, uv, strict=True):
-        one = on_carriageway(grid, p[None])
-        assert (one is None) == (seg is None)
-        if one is not None:
-            found += 1
-            assert one[0] is seg and (one[1], one[2]) == (q[0], q[1])
-    assert found > 100
