@@ -72,19 +72,30 @@ def cars(lib: Library, n: int, out: Path) -> None:
         draw(side, p.mesh, (0, 2), 1, flip_depth=True)        # seen from -y: near = small y
         draw(top, p.mesh, (0, 1), 2)                          # from above: near = high z
         side.set_title(f"{p.key} {body}\n{size[0]:.2f} x {size[1]:.2f} x {size[2]:.2f} m", fontsize=7)
-        for a, (ylo, yhi) in ((side, (-0.1, 2.1)), (top, (-1.3, 1.3))):
-            a.set_xlim(-2.9, 2.9)
-            a.set_ylim(ylo, yhi)
-            a.set_aspect("equal")
-            a.set_xticks([])
-            a.set_yticks([])
-    for a in axs.flat[2 * len(protos):]:
+        _tile(side, (-2.9, 2.9), (-0.1, 2.1))
+        _tile(top, (-2.9, 2.9), (-1.3, 1.3))
+    _save(fig, axs, 2 * len(protos),
+          f"{len(protos)} car variants of library seed {lib.seed} (side, plan; one scale: 5.8 m wide tiles)", out)
+    print("car body types:", dict(mix))
+
+
+def _tile(a, xlim: tuple[float, float], ylim: tuple[float, float]) -> None:
+    """One gallery tile: these limits (metres), equal axes, no ticks."""
+    a.set_xlim(*xlim)
+    a.set_ylim(*ylim)
+    a.set_aspect("equal")
+    a.set_xticks([])
+    a.set_yticks([])
+
+
+def _save(fig, axs, used: int, title: str, out: Path) -> None:
+    """Blank the tiles past the first ``used``, title the sheet and write it to ``out``."""
+    for a in axs.flat[used:]:
         a.axis("off")
-    fig.suptitle(f"{len(protos)} car variants of library seed {lib.seed} (side, plan; one scale: 5.8 m wide tiles)")
+    fig.suptitle(title)
     fig.tight_layout()
     fig.savefig(out, dpi=80)
     plt.close(fig)
-    print("car body types:", dict(mix))
 
 
 def _body(p) -> str:
@@ -109,17 +120,9 @@ def people(lib: Library, spec, n: int, out: Path) -> None:
         heights.append(pr["height"])
         front.set_title(f"{pr['height']:.2f} m {pr['age']:.0f} y {pr['sex'][0]}\n{pr['pose'][:4]}", fontsize=7)
         for a in (front, side):
-            a.set_xlim(-0.55, 0.55)
-            a.set_ylim(-0.02, 2.05)
-            a.set_aspect("equal")
-            a.set_xticks([])
-            a.set_yticks([])
-    for a in axs.flat[2 * len(protos):]:
-        a.axis("off")
-    fig.suptitle(f"{len(protos)} person variants of library seed {lib.seed} (front, side; one scale)")
-    fig.tight_layout()
-    fig.savefig(out, dpi=80)
-    plt.close(fig)
+            _tile(a, (-0.55, 0.55), (-0.02, 2.05))
+    title = f"{len(protos)} person variants of library seed {lib.seed} (front, side; one scale)"
+    _save(fig, axs, 2 * len(protos), title, out)
     h = np.array(heights)
     print(f"people: {len(h)}, heights {h.min():.2f}-{h.max():.2f} m, children {(h < 1.5).sum()}")
 
