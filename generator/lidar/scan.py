@@ -330,8 +330,9 @@ class _Sweep:
                 todo.append((start, b, m))
                 j += 1
             self._next = j
-        for start, b, m in todo:
-            self.out[start:start + m] = b[:m]
+        raw = np.dtype((np.void, self.out.dtype.itemsize))  # a plain memory copy: numpy copies a packed
+        for start, b, m in todo:                            # record array field by field, ~20x slower
+            self.out[start:start + m].view(raw)[...] = b[:m].view(raw)
 
     def fail(self, i: int) -> None:
         """Release the chunks waiting on chunk ``i`` (they raise)."""
