@@ -78,7 +78,9 @@ def run_physical_chunk(scanner, sweep, i: int, cols: slice) -> None:
     lo_r, hi_r = float(sensor.min_range_m), float(sensor.max_range_m)
     faces = tables._faces
     try:
-        a, b = max(0, cols.start - 1), min(steps, cols.stop + 1)
+        k = len(model.pattern)
+        # one halo column each side tells an edge beam from its neighbours (only sub-rays need it)
+        a, b = (max(0, cols.start - 1), min(steps, cols.stop + 1)) if k else (cols.start, cols.stop)
         n = (b - a) * L
         o_w, d_w = np.empty((n, 3), np.float32), np.empty((n, 3), np.float32)
         world_rays(scanner._o32, scanner._d32, sweep.rot_t, sweep.trans, a, b, o_w, d_w)
@@ -91,7 +93,6 @@ def run_physical_chunk(scanner, sweep, i: int, cols: slice) -> None:
         i0, i1 = (cols.start - a) * L, (cols.stop - a) * L
         n_in = i1 - i0
         aimed = scanner.actors.inner(aimed, i0, n_in) if plan is not None else None
-        k = len(model.pattern)
         n_edge = 0
         if k:  # without sub-rays (one ray per beam) no beam needs to know its neighbours
             edge, side = np.empty(n_in, np.int64), np.empty(n_in, np.uint8)

@@ -167,7 +167,7 @@ def beam_returns(out, n_beams, ray0, beam, weight, offset, tau, dist, face, d_f,
     n_beams : int
         Inner beams of the chunk; beam ``q`` is sweep ray ``ray0 + q``.
     beam, weight, offset, tau : (n,) int64, float32, float32, float32
-        Per ray of the list: its beam, share of the beam's power, distance travelled before its
+        Per ray of the list (rows ``0 .. n_beams - 1``: the central rays, ``beam[q] == q``): its beam, share of the beam's power, distance travelled before its
         origin (behind glass), two-way transmission of the glass crossed.
     dist, face, d_f : (n,) float32, (n,) int32, (n, 3) float32
         Hit distance from the ray's origin, face-table row (-1: no hit, or absorbed), direction in
@@ -192,24 +192,28 @@ def beam_returns(out, n_beams, ray0, beam, weight, offset, tau, dist, face, d_f,
         Range noise per ring, metres.
     """
     n = beam.shape[0]
-    count = np.zeros(n_beams + 1, np.int64)
+    # rows 0 .. n_beams - 1 are the beams' central rays, in order (beam[q] == q); only the rows after
+    # them (sub-rays, rays behind glass) are gathered per beam, so a beam without extra rays costs
+    # one look at its central row
     total = np.empty(n, np.float64)
+    count = np.zeros(n_beams + 1, np.int64)
     for r in range(n):
         t = np.float64(offset[r]) + np.float64(dist[r])
         total[r] = t
-        if face[r] >= 0 and t >= min_range and t < max_range:
+        if r >= n_beams and face[r] >= 0 and t >= min_range and t < max_range:
             count[beam[r] + 1] += 1
     for q in range(n_beams):
         count[q + 1] += count[q]
-    ev = np.empty(count[n_beams], np.int64)
+    extra = np.empty(count[n_beams], np.int64)
     fill = count[:n_beams].copy()
-    for r in range(n):
+    for r in range(n_beams, n):
         if face[r] >= 0 and total[r] >= min_range and total[r] < max_range:
-            ev[fill[beam[r]]] = r
+            extra[fill[beam[r]]] = r
             fill[beam[r]] += 1
     n_l = ring_of.shape[0]
     m = 0
     cap = 64
+    ev = np.empty(cap, np.int64)
     power = np.empty(cap)
     rng_e = np.empty(cap)
     lab = np.empty(cap, np.int64)
@@ -219,14 +223,13 @@ def beam_returns(out, n_beams, ray0, beam, weight, offset, tau, dist, face, d_f,
     c_rep = np.empty(cap, np.int64)
     c_mix = np.zeros(cap, np.bool_)
     for q in range(n_beams):
+        central = face[q] >= 0 and total[q] >= min_range and total[q] < max_range
         lo, hi = count[q], count[q + 1]
-        ne = hi - lo
+        ne = hi - lo + (1 if central else 0)
         if ne == 0:
             continue
-        if ne > cap:
-            ne = cap
         if ne == 1:  # one hit (most beams): no sorting, no clusters
-            r = ev[lo]
+            r = q if central else extra[lo]
             f = faces[face[r]]
             c = abs(d_f[r, 0] * f.normal[0] + d_f[r, 1] * f.normal[1] + d_f[r, 2] * f.normal[2])
             mat = f.material
@@ -248,16 +251,28 @@ def beam_returns(out, n_beams, ray0, beam, weight, offset, tau, dist, face, d_f,
                    f, np.float32(c), inst[r], moving[r], 0, 0, np.float32(pw), skew)
             m += 1
             continue
+        if ne > cap:
+            ne = cap
+        # the beam's events in row order (its central ray first), at most `cap`
+        i = 0
+        if central:
+            ev[0] = q
+            i = 1
+        for e in range(lo, hi):
+            if i == ne:
+                break
+            ev[i] = extra[e]
+            i += 1
         # insertion sort of the beam's events by range
         for i in range(1, ne):
-            e = ev[lo + i]
+            e = ev[i]
             j = i - 1
-            while j >= 0 and total[ev[lo + j]] > total[e]:
-                ev[lo + j + 1] = ev[lo + j]
+            while j >= 0 and total[ev[j]] > total[e]:
+                ev[j + 1] = ev[j]
                 j -= 1
-            ev[lo + j + 1] = e
+            ev[j + 1] = e
         for i in range(ne):
-            r = ev[lo + i]
+            r = ev[i]
             f = faces[face[r]]
             c = abs(d_f[r, 0] * f.normal[0] + d_f[r, 1] * f.normal[1] + d_f[r, 2] * f.normal[2])
             mat = f.material
@@ -293,12 +308,12 @@ def beam_returns(out, n_beams, ray0, beam, weight, offset, tau, dist, face, d_f,
                 if lab[e] == best_lab and power[e] > rep_p:
                     rep, rep_p = e, power[e]
             mixed = False
-            nr = faces[face[ev[lo + rep]]].normal
+            nr = faces[face[ev[rep]]].normal
             for e in range(i, j + 1):
                 if lab[e] != best_lab:
                     mixed = True
                 else:
-                    ne_ = faces[face[ev[lo + e]]].normal
+                    ne_ = faces[face[ev[e]]].normal
                     if abs(ne_[0] * nr[0] + ne_[1] * nr[1] + ne_[2] * nr[2]) < MIXED_NORMAL_COS:
                         mixed = True
             c_start[nc] = i
@@ -329,7 +344,7 @@ def beam_returns(out, n_beams, ray0, beam, weight, offset, tau, dist, face, d_f,
             k = picks[echo]
             if k < 0:
                 continue
-            r = ev[lo + c_rep[k]]
+            r = ev[c_rep[k]]
             f = faces[face[r]]
             rng_out = c_rng[k] + ring_sigma[ring] * _normal01(key, qq * 2 + echo)
             if rng_out < min_range:
