@@ -27,7 +27,7 @@ class MaterialInfo:
 class MaterialTable:
     """Material rows with name lookup and per-id arrays."""
 
-    def __init__(self, rows: list[MaterialInfo]):
+    def __init__(self, rows: list[MaterialInfo], cabins: tuple[str, ...] = ()):
         if [r.id for r in rows] != list(range(len(rows))):
             raise ValueError("materials.yaml: ids must be 0..N-1 in order")
         for r in rows:
@@ -35,6 +35,8 @@ class MaterialTable:
                 raise ValueError(f"materials.yaml: {r.name}.behind must be 'room' on a glass material "
                                  f"(transmittance > 0), got {r.behind!r}")
         self.rows = rows
+        #: classes whose glass closes an unmodelled cabin (``cabins`` in materials.yaml)
+        self.cabins = tuple(cabins)
         self.names = [r.name for r in rows]
         self._by_name = {r.name: r for r in rows}
 
@@ -81,12 +83,14 @@ class MaterialTable:
 def material_table() -> MaterialTable:
     """The package's material table (read once)."""
     with open(Path(__file__).with_name("materials.yaml"), encoding="utf-8") as f:
-        raw = yaml.safe_load(f)["materials"]
+        doc = yaml.safe_load(f)
+    raw = doc["materials"]
     return MaterialTable(
         [
             MaterialInfo(int(r["id"]), str(r["name"]), float(r["reflectivity"]), bool(r["retro"]),
                          tuple(int(c) for c in r["color"]), r["emissive"],
                          float(r.get("transmittance", 0.0)), r.get("behind"))
             for r in raw
-        ]
+        ],
+        tuple(str(c) for c in doc.get("cabins", ())),
     )

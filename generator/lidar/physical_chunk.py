@@ -153,18 +153,20 @@ class FaceLookup:
     Attributes
     ----------
     glass : (F + 1,) bool
-        The beam goes on behind the face: its material lets light through and has no room behind it
-        (``Optics.room``); the last entry (for face -1, no hit) is False.
+        The beam goes on behind the face: its material lets light through, has no room behind it
+        (``Optics.room``) and its class closes no cabin (``Optics.cabin``); the last entry (for face
+        -1, no hit) is False.
     transmittance : (F + 1,) float32
         One-way transmittance of the face's material.
     label : (F + 1,) int64
         ``class << 16 | instance`` of the face (-1 in the last entry).
     """
 
-    def __init__(self, faces: np.ndarray, transmittance: np.ndarray, room: np.ndarray):
+    def __init__(self, faces: np.ndarray, optics):
         mat = faces["material"]
-        self.transmittance = np.append(transmittance[mat], np.float32(0.0)).astype(np.float32)
-        self.glass = (self.transmittance > 0) & ~np.append(room[mat], False)
+        self.transmittance = np.append(optics.transmittance[mat], np.float32(0.0)).astype(np.float32)
+        ends = optics.room[mat] | optics.cabin[faces["class"]]
+        self.glass = (self.transmittance > 0) & ~np.append(ends, False)
         self.label = np.append((faces["class"].astype(np.int64) << 16) | faces["instance"], -1).astype(np.int64)
 
 

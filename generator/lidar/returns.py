@@ -29,13 +29,14 @@ the 3 mrad column spacing that no central ray touches stays invisible (as withou
 
 Glass (materials with a ``transmittance``): the pane returns its own weak diffuse reflectance and a
 specular glint near normal incidence, and lets ``transmittance`` of the power through; the beam goes
-on (up to ``glass_layers`` panes). Behind the glass of an object lies its interior (a car's cabin, a
-building's room), which the scene does not model: a continued beam that meets the same object
-(same class and instance) again is absorbed there. So car windows are the holes of real scans, and a
-free-standing pane (a shelter, a glass wall panel) shows what stands behind it. A building's
-facade glass (``behind: room`` in ``materials.yaml``) ends the beam at once: the room behind it
-absorbs it, and the scene's buildings have no floor, so a beam cast on would meet the ground
-under the building.
+on (up to ``glass_layers`` panes). Behind the glass of an object lies its interior, which the scene
+does not model: a continued beam that meets the same object (same class and instance) again is
+absorbed there, and a free-standing pane (a shelter, a glass wall panel) shows what stands behind
+it. Two kinds of pane end the beam at once, without casting it on: a building's facade glass
+(``behind: room`` in ``materials.yaml``: the room absorbs the beam, and the scene's buildings have
+no floor, so a beam cast on would meet the ground under the building) and a vehicle's windows (the
+classes listed as ``cabins``: cast on, the beam could only meet its own vehicle again, or slip out
+through a seam of the body). So car windows are the holes of real scans.
 
 Waveform: each beam's hits (sub-rays, panes, what lies behind them) sorted by range; hits closer
 than ``separation_m`` (half the pulse length, ``c tau / 2``) merge into one return whose range is
@@ -63,6 +64,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from generator.labels import class_table
 from generator.materials import material_table
 from generator.rng import stream
 
@@ -113,6 +115,8 @@ class Optics:
         Smooth surfaces (glass) whose diffuse term keeps Lambert's cosine.
     room : (M,) bool
         Panes with an unmodelled room behind them (``behind: room``): the beam ends there.
+    cabin : (C,) bool, indexed by class id
+        Classes whose panes close an unmodelled cabin (``cabins`` in ``materials.yaml``): the beam ends there.
     reference_range_m, min_range_m : float
         ``R0`` of the normalisation and the range below which ``P`` stops growing.
     """
@@ -123,6 +127,7 @@ class Optics:
     transmittance: np.ndarray
     smooth: np.ndarray
     room: np.ndarray
+    cabin: np.ndarray
     reference_range_m: float = 10.0
     min_range_m: float = 1.0
 
@@ -143,7 +148,10 @@ def optics_from_materials(retro_gain: float = 20.0, retro_exponent: float = 8.0,
     refl = np.where(trans > 0, GLASS_DIFFUSE, mats.reflectivity).astype(np.float32)
     gain = np.where(mats.retro, retro_gain, np.where(trans > 0, GLASS_LOBE[0], 0.0)).astype(np.float32)
     expo = np.where(mats.retro, retro_exponent, np.where(trans > 0, GLASS_LOBE[1], 1.0)).astype(np.float32)
-    return Optics(refl, gain, expo, trans, trans > 0, mats.room_behind.copy(), float(reference_range_m),
+    classes = class_table()
+    cabin = np.zeros(len(classes), bool)
+    cabin[[classes.id(name) for name in mats.cabins]] = True
+    return Optics(refl, gain, expo, trans, trans > 0, mats.room_behind.copy(), cabin, float(reference_range_m),
                   float(min_range_m))
 
 

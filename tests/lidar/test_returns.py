@@ -137,6 +137,30 @@ def test_car_windows_are_holes_and_a_free_standing_pane_shows_what_is_behind(hdl
     assert np.all(same["class"] == CLS.id("building")) and np.all(same["x"] > 11.9)
 
 
+def test_a_beam_through_a_vehicle_window_ends_in_the_cabin_even_where_the_body_has_a_seam(hdl64e):
+    """A vehicle's window over an opening of its body (a seam between body parts): the beam ends in the
+    cabin (``cabins`` in materials.yaml) and never returns from what stands beyond the vehicle; the same
+    pane standing free (class fence) shows the wall behind it."""
+    wall = box((0.2, 20.0, 6.0), "building", "facade_plaster", center=(14.1, 0.0, 0.0))
+    # a body open where its window is: a floor and a roof, nothing between them behind the pane
+    floor = box((2.0, 4.0, 0.8), "truck", "truck_paint", center=(9.0, 0.0, 0.0))
+    roof = box((2.0, 4.0, 0.3), "truck", "truck_paint", center=(9.0, 0.0, 1.8))
+
+    def scene(cls):
+        pane = polygon(np.array([[7.99, -1.8, 0.8], [7.99, 1.8, 0.8], [7.99, 1.8, 1.8], [7.99, -1.8, 1.8]]),
+                       cls, "car_glass", (-1.0, 0.0, 0.0))
+        inst = 5 if cls == "truck" else 0
+        return scene_of([("wall", wall, 0), ("floor", floor, 5), ("roof", roof, 5), ("pane", pane, inst)])
+
+    def beyond(p):  # on the wall, in the shadow of the window
+        return (p["x"] > 13.9) & (np.abs(p["y"]) < 2.5) & (p["z"] > 0.3 - H) & (p["z"] < 1.7 - H)
+
+    model = model_of(hdl64e, range_noise_m=0.0)
+    cabin, free = scan(scene("truck"), hdl64e, model), scan(scene("fence"), hdl64e, model)
+    assert beyond(free).sum() >= 50         # a free-standing pane: the wall behind it shows
+    assert not beyond(cabin).any()          # a vehicle's window: the beam ends in the cabin
+
+
 def test_a_beam_through_a_shop_window_ends_in_the_room_not_on_the_ground_under_the_building(hdl64e):
     """A room without a floor (the scene's buildings stand on the ground) behind a pane: through a
     building's facade glass (``behind: room``) no beam reaches the ground inside; through the same
