@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from generator.lidar.hashed_normal import normal01
 from generator.lidar.returns import MIXED_NORMAL_COS
 
 
@@ -112,24 +113,6 @@ def subrays(o_w, d_w, beams, which, pattern, o_out, d_out):  # pragma: no cover 
         d_out[i, 0], d_out[i, 1], d_out[i, 2] = ex / n, ey / n, ez / n
 
 
-@njit(nogil=True, cache=True)
-def _normal01(key, index):  # pragma: no cover - compiled
-    """A standard normal draw hashed from ``(key, index)`` (SplitMix64, Box-Muller)."""
-    z = np.uint64(key) ^ (np.uint64(index) * np.uint64(0x9E3779B97F4A7C15))
-    u0 = _mix64(z + np.uint64(0x9E3779B97F4A7C15))
-    u1 = _mix64(z + np.uint64(0x3C6EF372FE94F82A))
-    return np.sqrt(-2.0 * np.log(u0)) * np.cos(2.0 * np.pi * u1)
-
-
-@njit(nogil=True, cache=True)
-def _mix64(x):  # pragma: no cover - compiled
-    """SplitMix64's finaliser of ``x`` as a uniform in (0, 1)."""
-    x = (x ^ (x >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
-    x = (x ^ (x >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
-    x = x ^ (x >> np.uint64(31))
-    return (np.float64(x >> np.uint64(11)) + 0.5) / 9007199254740992.0
-
-
 @njit(nogil=True, cache=True, inline="always")
 def _write(rec, qq, col, ring, t32, o_loc, d_loc, azimuth, column_time, laser_of, n_l, f, cos, inst, moving, mixed,
            echo, power, skew):  # pragma: no cover - compiled
@@ -153,7 +136,7 @@ def _write(rec, qq, col, ring, t32, o_loc, d_loc, azimuth, column_time, laser_of
     rec.power = power
 
 
-@njit(nogil=True, cache=True)
+@njit(nogil=True, cache=True, error_model="numpy")
 def beam_returns(out, n_beams, ray0, beam, weight, offset, tau, dist, face, d_f, inst, moving,
                  o_loc, d_loc, azimuth, column_time, ring_of, laser_of, faces,
                  refl, lobe_gain, lobe_exp, r0, r_min, alpha, threshold, separation, dual,
@@ -167,8 +150,9 @@ def beam_returns(out, n_beams, ray0, beam, weight, offset, tau, dist, face, d_f,
     n_beams : int
         Inner beams of the chunk; beam ``q`` is sweep ray ``ray0 + q``.
     beam, weight, offset, tau : (n,) int64, float32, float32, float32
-        Per ray of the list (rows ``0 .. n_beams - 1``: the central rays, ``beam[q] == q``): its beam, share of the beam's power, distance travelled before its
-        origin (behind glass), two-way transmission of the glass crossed.
+        Per ray of the list (rows ``0 .. n_beams - 1``: the central rays, ``beam[q] == q``): its
+        beam, share of the beam's power, distance travelled before its origin (behind glass),
+        two-way transmission of the glass crossed.
     dist, face, d_f : (n,) float32, (n,) int32, (n, 3) float32
         Hit distance from the ray's origin, face-table row (-1: no hit, or absorbed), direction in
         the frame of the face's normal.
@@ -244,7 +228,7 @@ def beam_returns(out, n_beams, ray0, beam, weight, offset, tau, dist, face, d_f,
             qq = ray0 + q
             col = qq // n_l
             ring = ring_of[qq - col * n_l]
-            rng_out = t + ring_sigma[ring] * _normal01(key, qq * 2) if ring_sigma[ring] > 0 else t
+            rng_out = t + ring_sigma[ring] * normal01(key, qq * 2) if ring_sigma[ring] > 0 else t
             if rng_out < min_range:
                 rng_out = min_range
             _write(out[m], qq, col, ring, np.float32(rng_out), o_loc, d_loc, azimuth, column_time, laser_of, n_l,
@@ -346,7 +330,7 @@ def beam_returns(out, n_beams, ray0, beam, weight, offset, tau, dist, face, d_f,
                 continue
             r = ev[c_rep[k]]
             f = faces[face[r]]
-            rng_out = c_rng[k] + ring_sigma[ring] * _normal01(key, qq * 2 + echo)
+            rng_out = c_rng[k] + ring_sigma[ring] * normal01(key, qq * 2 + echo)
             if rng_out < min_range:
                 rng_out = min_range
             c = d_f[r, 0] * f.normal[0]

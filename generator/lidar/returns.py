@@ -52,9 +52,9 @@ deviation (drawn once per sensor unit around ``range_noise_m``, log-normal sprea
 ``intensity_gain_spread``) is applied to the remission (:mod:`generator.scan_effects.pipeline`).
 
 Randomness: per-laser draws from ``stream(seed, "lidar_sensor", ...)``; the range noise of frame
-``k`` from a key drawn from ``stream(seed, "frame", k, "lidar_returns")``, hashed per (beam, return),
-so a thread count or chunking never changes a byte, and the strongest returns of a dual scan are the
-points of the strongest scan.
+``k`` from a key drawn from ``stream(seed, "frame", k, "lidar_returns")``, hashed per (beam, return)
+into a standard normal (:mod:`generator.lidar.hashed_normal`), so a thread count or chunking never
+changes a byte, and the strongest returns of a dual scan are the points of the strongest scan.
 """
 
 from __future__ import annotations
