@@ -7,7 +7,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import yaml
+
+from generator.safeload import load_package_yaml
 
 
 @dataclass(frozen=True)
@@ -81,7 +82,7 @@ class MaterialTable:
 def material_table() -> MaterialTable:
     """The package's material table (read once)."""
     with open(Path(__file__).with_name("materials.yaml"), encoding="utf-8") as f:
-        raw = yaml.safe_load(f)["materials"]
+        raw = load_package_yaml(f)["materials"]
     return MaterialTable(
         [
             MaterialInfo(int(r["id"]), str(r["name"]), float(r["reflectivity"]), bool(r["retro"]),
