@@ -7,7 +7,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import yaml
+
+from generator.safeload import load_package_yaml
 
 
 @dataclass(frozen=True)
@@ -83,7 +84,7 @@ class MaterialTable:
 def material_table() -> MaterialTable:
     """The package's material table (read once)."""
     with open(Path(__file__).with_name("materials.yaml"), encoding="utf-8") as f:
-        doc = yaml.safe_load(f)
+        doc = load_package_yaml(f)
     raw = doc["materials"]
     return MaterialTable(
         [

@@ -30,13 +30,13 @@ from pathlib import Path
 from typing import NoReturn
 
 import numpy as np
-import yaml
 
 from generator import safeload
 from generator.errors import SpecError, UserError
 from generator.formats.kitti_calib import rigid_problem
 from generator.formats.semantickitti import MAX_POINT_M, MAX_TRANSLATION_M
 from generator.labels import class_table
+from generator.safeload import load_package_yaml
 
 TAG_FILE = Path(__file__).resolve().with_name("carla_semantic_tags.yaml")
 _PLY_TYPES = {
@@ -179,7 +179,7 @@ def read_frame(path: str | Path) -> np.ndarray:
 @functools.cache
 def tag_map() -> tuple[np.ndarray, dict[int, str]]:
     """((23,) uint16 SemanticKITTI raw id per CARLA tag, tag names) from ``carla_semantic_tags.yaml``."""
-    doc = yaml.safe_load(TAG_FILE.read_text(encoding="utf-8"))["tags"]
+    doc = load_package_yaml(TAG_FILE.read_text(encoding="utf-8"))["tags"]
     known = class_table().sk_labels
     lut = np.zeros(max(doc) + 1, np.uint16)
     for tag, row in doc.items():

@@ -17,7 +17,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import yaml
+
+from generator.safeload import load_package_yaml
 
 DATA_DIR = Path(__file__).resolve().parent
 #: SemanticKITTI raw id written for classes that never return a LiDAR point (sky).
@@ -40,7 +41,7 @@ class ClassInfo:
 
 def _load_yaml(name: str) -> dict:
     with open(DATA_DIR / name, encoding="utf-8") as f:
-        return yaml.safe_load(f)
+        return load_package_yaml(f)
 
 
 class ClassTable:

@@ -38,12 +38,12 @@ from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
-import yaml
 
 from generator.errors import SpecError
 from generator.labels import class_table
 from generator.materials import material_table
 from generator.remission.class_profiles import LABEL_SPACES, IntensityProfile, profile_for_spec, resolve_profile
+from generator.safeload import load_package_yaml
 
 log = logging.getLogger(__name__)
 
@@ -55,7 +55,7 @@ REFLECTIVITY_FILE = Path(__file__).resolve().parent / "reflectivity.yaml"
 @functools.cache
 def reflectivity_config() -> dict:
     """``reflectivity.yaml`` with ``class_materials`` turned into (K,) reflectivity / retro lookups by raw id."""
-    doc = yaml.safe_load(REFLECTIVITY_FILE.read_text(encoding="utf-8"))
+    doc = load_package_yaml(REFLECTIVITY_FILE.read_text(encoding="utf-8"))
     mats = material_table()
     size = max(doc["class_materials"]) + 1
     refl = np.full(size, mats["default"].reflectivity, np.float32)

@@ -53,11 +53,12 @@ from generator.safeload.limits import (
                                        MiB,
 )
 from generator.safeload.messages import field_path, file_kind, printable
-from generator.safeload.yaml_docs import load_yaml, parse_yaml
+from generator.safeload.yaml_docs import load_package_yaml, load_yaml, parse_yaml
 
 __all__ = [
     "MAX_ALIASES", "MAX_ARRAY_BYTES", "MAX_DEPTH", "MAX_DOCUMENT_BYTES", "MAX_INT_DIGITS", "MAX_METADATA_BYTES",
     "MAX_NODES", "MAX_TABLE_BYTES", "MAX_YAML_BYTES", "GiB", "KiB", "MiB",
-    "check_finite", "confined_path", "field_path", "load_json", "load_yaml", "parse_json", "parse_yaml",
+    "check_finite", "confined_path", "field_path", "load_json", "load_package_yaml", "load_yaml", "parse_json",
+    "parse_yaml",
     "file_kind", "printable", "read_array", "read_bytes", "read_matrix_rows", "read_text",
 ]

@@ -24,6 +24,15 @@ from generator.safeload.messages import (
 
 # --------------------------------------------------------------------------- YAML
 
+#: libyaml's parser where PyYAML was built with it: the same documents, about six times faster
+_PACKAGE_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
+
+def load_package_yaml(stream) -> Any:
+    """A YAML data file of the package itself (trusted, not a user's document): ``yaml.safe_load``'s
+    result, parsed by libyaml when PyYAML has it (every process that builds a town reads half a dozen)."""
+    return yaml.load(stream, Loader=_PACKAGE_LOADER)  # noqa: S506 - a safe loader
+
 
 class _Refused(yaml.MarkedYAMLError):
     def __init__(self, problem: str, mark):

@@ -34,10 +34,10 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import yaml
 
 from generator.labels import class_table
 from generator.remission.models import received_power, semantic_ids
+from generator.safeload import load_package_yaml
 from generator.weather import Weather, draw_weather, lidar_combination
 
 CONFIG_FILE = Path(__file__).resolve().parent / "weather.yaml"
@@ -46,7 +46,7 @@ CONFIG_FILE = Path(__file__).resolve().parent / "weather.yaml"
 @functools.cache
 def weather_config() -> dict:
     """``weather.yaml`` as a dict, with ``wet.semantickitti_ids`` (paved ground) from the class table."""
-    cfg = yaml.safe_load(CONFIG_FILE.read_text(encoding="utf-8"))
+    cfg = load_package_yaml(CONFIG_FILE.read_text(encoding="utf-8"))
     cfg["wet"] = {"semantickitti_ids": list(class_table().wet_ground_raw_ids), **cfg["wet"]}
     return cfg
 

@@ -30,6 +30,7 @@ from generator.layout.town import Town
 from generator.rng import stream
 from generator.traffic.lanes.clearance import MARGIN_M, blocked_lanes, too_narrow
 from generator.traffic.lanes.graph import LaneGraph
+from generator.traffic.lanes.roundabouts import GIVE_WAY_CLEAR_S
 from generator.traffic.lanes.signals import CLEAR_S, Signals
 from generator.traffic.mapped_tracks import map_track
 from generator.traffic.movers import DT_S, Mover
@@ -44,6 +45,9 @@ log = logging.getLogger(__name__)
 WARMUP_S = 20.0
 LEAD_IN = 2           #: track samples before t = 0 (central differences at t = 0 see real motion)
 LOOKAHEAD_S = CLEAR_S + 1.0  #: vehicles ask about crosswalks up to CLEAR_S ahead (VehicleSim._maybe_grant)
+#: ... and up to GIVE_WAY_CLEAR_S ahead at a roundabout: a town with roundabouts simulates its people that much
+#: further at once instead of finding out after a whole drive and simulating everything again
+GIVE_WAY_LOOKAHEAD_S = max(CLEAR_S, GIVE_WAY_CLEAR_S) + 1.0
 MAX_DRIVE_S = 900.0
 SPACING_M = 6.0       #: lanes hold at most one vehicle per (length + this), for the capacity check
 
@@ -84,9 +88,10 @@ def build_world(spec, scene: Town, duration_s: float, distance_m: float = 0.0) -
     half_width, widest = widest_half_width(spec, lib, KINDS, EGO_SIZE_M[1])
     log.debug("lanes kept clear of static objects to %.2f m from their centre lines (%s)", half_width + MARGIN_M,
               widest)
-    horizon_s = duration_s + 1.0 + LOOKAHEAD_S
+    lookahead_s = GIVE_WAY_LOOKAHEAD_S if grid.roundabouts else LOOKAHEAD_S
+    horizon_s = duration_s + 1.0 + lookahead_s
     if distance_m > 0:  # the drive may take longer than asked: cover a slow ego
-        horizon_s = max(horizon_s, distance_m / (0.25 * spec.paths.speed_mps) + 5.0 + LOOKAHEAD_S)
+        horizon_s = max(horizon_s, distance_m / (0.25 * spec.paths.speed_mps) + 5.0 + lookahead_s)
     network: dict = {}      # the walk network does not depend on the horizon: built once
     while True:  # vehicles look ahead at crosswalks: pedestrians must be simulated past the drive's end
         peds = _pedestrians(spec, grid, scene, signals, lib, int(np.ceil(horizon_s / DT_S)) + 1, network)

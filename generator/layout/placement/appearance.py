@@ -18,7 +18,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import yaml
+
+from generator.safeload import load_package_yaml
 
 DRAWS_PER_COLOUR = 4  #: values one colour takes from its generator: the pick and 3 channel jitters
 
@@ -105,7 +106,7 @@ class Appearance:
 def appearance() -> Appearance:
     """The package's appearance table (read once)."""
     with open(Path(__file__).with_name("appearance.yaml"), encoding="utf-8") as f:
-        raw = yaml.safe_load(f)
+        raw = load_package_yaml(f)
     fleet = Palette.from_rows(raw["fleet"]["paints"], "fleet.paints")
     metallic = frozenset(raw["fleet"].get("metallic", []))
     if not metallic <= set(fleet.names):
