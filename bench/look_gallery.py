@@ -3,13 +3,16 @@
     python bench/look_gallery.py render OUT_DIR [--spec scenes/default_town.json] [--code-root TREE]
                                  [--size 640x360] [--samples 12] [--only ground horizon trees facades road]
     python bench/look_gallery.py compare BEFORE_DIR AFTER_DIR OUT_DIR
+    python bench/look_gallery.py time --baseline MAIN_CHECKOUT [--frames 3] [--rounds 2]
 
 ``render`` writes one PNG per shot into ``OUT_DIR`` (``<shot>.png``, RGB only) and ``sheet.png``
 (RGB beside the label view, one row per shot), and prints the render seconds of every shot beside
 the Blender scene build time measured in the same run. ``--code-root`` renders with another checkout
 of urbangen (e.g. main, for the "before" crops); the default is the tree this script lies in.
 ``compare`` pastes the crops of two ``render`` runs side by side (``<shot>.png``: before | after)
-and into one ``before_after.png``.
+and into one ``before_after.png``. ``time`` renders the same ego views (day and night) at the full
+``preview`` preset with a baseline checkout and with this tree, interleaved, each in its own process, and
+prints seconds per frame side by side.
 
 Shots, all in the town the spec builds (the spec's seed; day: sun at 38 degrees, clear; night: 40 %
 lit windows):
@@ -303,6 +306,72 @@ def compare(args) -> int:
     return 0
 
 
+def drive_poses(town, n: int) -> list[np.ndarray]:
+    """``n`` camera poses along the longest route, 1.65 m up, looking down the lane (ego-like)."""
+    path = max(town.paths, key=lambda p: p.length())
+    out = []
+    for s in (np.arange(n) + 0.5) / n:
+        (p,), (hd,) = path.at(s * path.length())
+        d = np.array([np.cos(hd), np.sin(hd), 0.0])
+        out.append(look_at(p + [0.0, 0.0, 1.65], p + d * 20.0 + [0.0, 0.0, 1.2]))
+    return out
+
+
+def time_one(args) -> int:
+    """Render ``--frames`` ego views at the full ``preview`` preset (label pass, camera model, motion blur
+    settings as the preset has them; a static town); print one JSON line of seconds."""
+    import json
+    sys.path.insert(0, str(Path(args.code_root).resolve()))
+    from generator.blender.renderer import Renderer
+    from generator.layout import build_scene
+    from generator.spec import load_spec
+    from generator.spec.render import load_render_config
+    from generator.weather import Lighting
+
+    spec = load_spec(args.spec)
+    town = build_scene(spec)
+    cfg = load_render_config("preview")
+    with tempfile.TemporaryDirectory() as tmp:
+        t0 = time.perf_counter()
+        r = Renderer(town, spec, cfg, Path(tmp))
+        build = time.perf_counter() - t0
+        rows = []
+        for tod in ("day", "night"):
+            r.set_conditions(Lighting(*DAY) if tod == "day" else Lighting("night", lit_windows=0.4))
+            for T in drive_poses(town, args.frames):
+                f = r.render(T, spec.seed, {})
+                rows.append({k: round(v, 3) for k, v in f.seconds.items()})
+    print(json.dumps({"build": round(build, 3), "triangles": int(len(town.faces)), "frames": rows}))
+    return 0
+
+
+def time_compare(args) -> int:
+    """Main (``--baseline``) beside this tree, interleaved ``--rounds`` times in one run."""
+    import json
+    import subprocess
+    trees = {"baseline": Path(args.baseline).resolve(), "this tree": ROOT}
+    runs: dict[str, list] = {k: [] for k in trees}
+    for _ in range(args.rounds):
+        for name, tree in trees.items():
+            cmd = [sys.executable, str(Path(__file__).resolve()), "_time_one", "--code-root", str(tree),
+                   "--spec", str(args.spec), "--frames", str(args.frames)]
+            out = subprocess.run(cmd, capture_output=True, text=True, check=True, cwd=tree)
+            runs[name].append(json.loads(out.stdout.strip().splitlines()[-1]))
+    print(f"preview preset, {args.frames} ego views x (day, night) x {args.rounds} rounds, {args.spec}")
+    print(f"{'tree':12s} {'triangles':>10s} {'build s':>8s} {'rgb s/frame':>12s} {'labels s/frame':>15s} "
+          f"{'total s/frame':>14s}")
+    total = {}
+    for name, rs in runs.items():
+        fr = [f for r in rs for f in r["frames"]]
+        rgb = np.mean([f["rgb_pass"] for f in fr])
+        tot = np.mean([f["render_total"] for f in fr])
+        total[name] = tot
+        print(f"{name:12s} {rs[0]['triangles']:10d} {np.mean([r['build'] for r in rs]):8.2f} {rgb:12.2f} "
+              f"{tot - rgb:15.2f} {tot:14.2f}")
+    print(f"ratio this tree / baseline (total per frame): {total['this tree'] / total['baseline']:.3f}")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     sub = ap.add_subparsers(dest="cmd", required=True)
@@ -319,8 +388,17 @@ def main(argv: list[str] | None = None) -> int:
     c.add_argument("before")
     c.add_argument("after")
     c.add_argument("out")
+    t = sub.add_parser("time", help="preview-preset render time of a baseline checkout beside this tree")
+    t.add_argument("--baseline", required=True, help="the checkout to compare with (e.g. main)")
+    t.add_argument("--spec", type=Path, default=ROOT / "scenes" / "default_town.json")
+    t.add_argument("--frames", type=int, default=3)
+    t.add_argument("--rounds", type=int, default=2)
+    o = sub.add_parser("_time_one")
+    o.add_argument("--code-root", required=True)
+    o.add_argument("--spec", type=Path, required=True)
+    o.add_argument("--frames", type=int, default=3)
     args = ap.parse_args(argv)
-    return render(args) if args.cmd == "render" else compare(args)
+    return {"render": render, "compare": compare, "time": time_compare, "_time_one": time_one}[args.cmd](args)
 
 
 if __name__ == "__main__":
