@@ -8,6 +8,7 @@ import json
 import numpy as np
 import pytest
 
+from generator.geometry import apply
 from generator.labels import class_table
 from generator.layout import assemble, build_scene
 from generator.layout.ground import far_city as fc
@@ -31,15 +32,21 @@ def test_far_city_stands_outside_the_town_with_labels(default_scene):
     for o in far:
         m = default_scene.prototypes[o.prototype]
         cls, materials = kinds[o.kind]
-        assert o.cls == cls and o.instance_id == 0 and o.proxy is None and np.array_equal(o.transform, np.eye(4))
+        assert o.cls == cls and o.instance_id == 0 and o.attrs["lot"] is None
         assert (m.face_class == classes.id(cls)).all()
         assert {mats.rows[i].name for i in np.unique(m.face_material)} <= materials
-        v = m.vertices
+        v = apply(o.transform, m.vertices)
+        assert np.allclose(o.transform[:2, 3], (v[:, :2].min(0) + v[:, :2].max(0)) / 2), "stands where it is"
+        if cls == "vegetation":         # solid crowns: the label proxy is the crowns themselves, no hull
+            assert o.proxy == o.prototype and default_scene.proxies[o.proxy] is m
+        else:
+            assert o.proxy is None
         gap = np.maximum(np.maximum(bx0 - v[:, 0], v[:, 0] - bx1), np.maximum(by0 - v[:, 1], v[:, 1] - by1))
         assert gap.min() >= fc.TREE_LINE_M - 2.0 - fc.CROWN_R_M[1] - 1e-6, o.name
         assert np.allclose(v[:, 2].min(), default_scene.prototypes["horizon_0000"].vertices[0, 2]), "on the ground"
     # stays on the horizon ground, well inside its outer edge, and cheap for both sensors
-    reach = np.abs(np.concatenate([default_scene.prototypes[o.prototype].vertices[:, :2] for o in far])).max()
+    reach = np.abs(np.concatenate([apply(o.transform, default_scene.prototypes[o.prototype].vertices)[:, :2]
+                                   for o in far])).max()
     assert reach < max(bx1, by1) + fc.REACH_M + 10.0 + fc.WALL_DEPTH_M + 1.0
     n_far = sum(default_scene.prototypes[o.prototype].n_faces for o in far)
     assert 5_000 < n_far < 60_000 and n_far < 0.05 * len(default_scene.faces)
@@ -49,7 +56,7 @@ def test_far_city_closes_the_horizon_all_round(default_scene):
     """From the town's centre every compass direction (0.5 degree steps) meets a far building, and
     the skyline beyond SKYLINE_M rises higher than the blocks near the town."""
     far = [o for o in _far(default_scene) if o.kind == "far_block"]
-    verts = [default_scene.prototypes[o.prototype].vertices for o in far]
+    verts = [apply(o.transform, default_scene.prototypes[o.prototype].vertices) for o in far]
     lo = np.array([v.min(0) for v in verts])
     hi = np.array([v.max(0) for v in verts])
     c = default_scene.bounds.mean(0)
