@@ -85,7 +85,7 @@ def gutter(g: Nodes, co):
     d = g.math("SUBTRACT", kerb, g.math("ABSOLUTE", y))            # metres to the kerb face
     has = g.math("GREATER_THAN", kerb, 0.0)
     wob = g.mul(g.noise(co, scale=1.2, detail=2), 0.25)
-    gut = g.mul(has, inv(g, g.smooth(g.add(d, wob), 0.1, GUTTER_M + 0.1)))
+    gut = g.mul(has, inv(g, g.smooth(g.add(d, wob), 0.25, GUTTER_M + 0.1)))
     # gully grates: one per DRAIN_CELL_M of each kerb, present by a hash of the cell and side
     cell = g.math("FLOOR", g.math("DIVIDE", x, DRAIN_CELL_M))
     side = g.math("SIGN", y)

@@ -43,8 +43,8 @@ def asphalt(g: Nodes, rng, tone=0.055, wear=0.5):
     base, rough, worn = road_wear(g, co, base, tone, rng)
     gut, grate, slots = gd.gutter(g, co)
     leaf, leaf_col = gd.leaves(g, wp, g.mul(gut, 0.6))
-    grime = g.mul(gut, g.add(0.5, g.mul(g.noise(wp, scale=3.0, detail=3), 0.5)))
-    base = g.mix(grime, base, (tone * 2.3, tone * 2.0, tone * 1.5))         # dusty sediment
+    grime = g.mul(gut, g.add(0.6, g.mul(g.noise(wp, scale=3.0, detail=3), 0.4)))
+    base = g.mix(grime, base, (tone * 3.2, tone * 2.8, tone * 2.1))         # dusty sediment
     base = g.mix(g.mul(grime, g.smooth(g.noise(wp, scale=0.8, detail=2), 0.45, 0.6)), base,
                  (tone * 0.4, tone * 0.36, tone * 0.28))                     # and dark wet-dirt stains
     base = g.mix(leaf, base, leaf_col)

@@ -32,7 +32,7 @@ PUDDLE_SCALE, PUDDLE_EDGE = 0.08, (0.56, 0.6)
 #: Ripples: raindrop cells per metre, rings per metre of radius, bump strength and distance (m).
 RIPPLE_CELLS, RIPPLE_RINGS, RIPPLE_STRENGTH, RIPPLE_DISTANCE = 6.0, 9.0, 0.15, 0.01
 #: Water runs to the low parts: a ``low`` mask of 1 (a gutter) lifts the puddle noise by this much.
-LOW_BIAS = 0.14
+LOW_BIAS = 0.25
 
 
 def _shifted_coords(g: Nodes, seed):
