@@ -1,18 +1,32 @@
-"""Render the looks of issue 14 item 4 in Blender: RGB beside the label view, one row per shot.
+"""Render looks in Blender: crops of one town, and before/after sheets of two runs.
 
-    python bench/look_gallery.py OUT.png [--spec scenes/default_town.json]
-                                 [--width 480] [--samples 16] [--only trees facades road]
+    python bench/look_gallery.py render OUT_DIR [--spec scenes/default_town.json] [--code-root TREE]
+                                 [--size 640x360] [--samples 12] [--only ground horizon trees facades road]
+    python bench/look_gallery.py compare BEFORE_DIR AFTER_DIR OUT_DIR
+    python bench/look_gallery.py time --baseline MAIN_CHECKOUT [--frames 3] [--rounds 2]
 
-Shots, all in the town the spec builds (day, clear, the spec's seed):
+``render`` writes one PNG per shot into ``OUT_DIR`` (``<shot>.png``, RGB only) and ``sheet.png``
+(RGB beside the label view, one row per shot), and prints the render seconds of every shot beside
+the Blender scene build time measured in the same run. ``--code-root`` renders with another checkout
+of urbangen (e.g. main, for the "before" crops); the default is the tree this script lies in.
+``compare`` pastes the crops of two ``render`` runs side by side (``<shot>.png``: before | after)
+and into one ``before_after.png``. ``time`` renders the same ego views (day and night) at the full
+``preview`` preset with a baseline checkout and with this tree, interleaved, each in its own process, and
+prints seconds per frame side by side.
 
+Shots, all in the town the spec builds (the spec's seed; day: sun at 38 degrees, clear; night: 40 %
+lit windows):
+
+* ``ground``  -- the road close up beside the kerb (dry, and soaked), the sidewalk, grass, the road
+  from 14 m above (issue 29 item 2);
+* ``horizon`` -- from the outer ring road's corner and from its middle, looking out of town, by day
+  and by night (issue 29 item 6);
 * ``trees``   -- a tree of each species in the town, the camera 1.6 m up, 1.6 crown heights away;
 * ``facades`` -- the buildings with shop fronts and balconies, seen from the sidewalk across the street;
-* ``road``    -- stretches of road seen from 2.2 m up, looking down the lane, and one from 14 m above
-  (patches, sealed seams, cracks, manholes, stains);
+* ``road``    -- stretches of road seen from 2.2 m up, looking down the lane.
 
-Each row: the RGB render (``preview``-like Cycles settings) and the label pass coloured with the
-class palette (what the masks hold: crowns and hedges as their hull proxies). Prints per shot what
-it shows and the render seconds beside the Blender scene build time measured in the same run.
+Render settings: the ``preview`` preset (OpenImageDenoise) at ``--size`` and ``--samples``, motion blur
+and the camera model off (the crops are compared as scene radiance through one fixed tone map).
 """
 
 from __future__ import annotations
@@ -28,13 +42,7 @@ import numpy as np
 from PIL import Image, ImageDraw
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-
-from generator.labels import class_table  # noqa: E402
-from generator.materials import material_table  # noqa: E402
-from generator.spec import load_spec  # noqa: E402
-from generator.spec.render import load_render_config  # noqa: E402
-from generator.weather import Lighting  # noqa: E402
+DAY = ("day", 38.0, 135.0)
 
 
 def look_at(eye, target) -> np.ndarray:
@@ -53,29 +61,41 @@ def look_at(eye, target) -> np.ndarray:
 GROUND_KINDS = ("street", "intersection", "sidewalk", "corner", "lot_ground", "terrain", "horizon")
 
 
+@dataclasses.dataclass
+class Shot:
+    """One crop: a name (file stem), a title, a camera pose, the time of day and wetness."""
+
+    name: str
+    title: str
+    pose: np.ndarray
+    time_of_day: str = "day"
+    wetness: float = 0.0
+
+
 def _materials_of(scene, obj) -> set[str]:
+    from generator.materials import material_table
     names = [r.name for r in material_table().rows]
     return {names[i] for i in np.unique(scene.prototypes[obj.prototype].face_material)}
 
 
-def _clear_eye(scene, eye, target) -> bool:
-    """True when nothing of the town stands within 0.6 m of the camera or 3 m along the first
+def _clear_eye(scene, eye, target, reach: float = 3.0) -> bool:
+    """True when nothing of the town stands within 0.6 m of the camera or ``reach`` m along the first
     stretch of its sight line (object boxes, 2D)."""
     for o in scene.objects:
-        if o.kind in GROUND_KINDS or o.box is None:
+        if o.kind in GROUND_KINDS or o.box is None or o.box.center[2] - o.box.size[2] / 2 > 2.0:
             continue
         c, size = np.asarray(o.box.center[:2]), np.asarray(o.box.size[:2])
-        for t in np.linspace(0.0, 3.0, 7):
+        cs, sn = np.cos(o.box.yaw), np.sin(o.box.yaw)
+        for t in np.linspace(0.0, reach, 7):
             p = eye[:2] + (target[:2] - eye[:2]) / np.linalg.norm(target[:2] - eye[:2]) * t
             d = p - c
-            cs, sn = np.cos(o.box.yaw), np.sin(o.box.yaw)
             lx, ly = abs(d[0] * cs + d[1] * sn), abs(-d[0] * sn + d[1] * cs)
-            if lx < size[0] / 2 + 0.6 and ly < size[1] / 2 + 0.6 and o.box.center[2] - o.box.size[2] / 2 < 2.0:
+            if lx < size[0] / 2 + 0.6 and ly < size[1] / 2 + 0.6:
                 return False
     return True
 
 
-def tree_shots(scene) -> list[tuple[str, np.ndarray]]:
+def tree_shots(scene) -> list[Shot]:
     """One shot per species found in the town (species told apart by their materials and shape)."""
     shots, seen = [], set()
     for o in scene.objects:
@@ -94,112 +114,291 @@ def tree_shots(scene) -> list[tuple[str, np.ndarray]]:
             eye = base + [np.cos(ang) * 1.5 * h, np.sin(ang) * 1.5 * h, 1.6]
             target = base + [0.0, 0.0, 0.5 * h]
             if _clear_eye(scene, eye, target):
-                shots.append((f"tree: {species}, {h:.1f} m", look_at(eye, target)))
+                shots.append(Shot(f"tree_{species.split()[0]}", f"tree: {species}, {h:.1f} m", look_at(eye, target)))
                 seen.add(species)
                 break
     return shots
 
 
-def facade_shots(scene, n: int = 2) -> list[tuple[str, np.ndarray]]:
-    """Buildings with shop fronts (awnings) and with balconies, from across the street."""
+def facade_shots(scene) -> list[Shot]:
+    """Buildings with shop fronts (awnings), balconies and curtain walls, from across the street."""
     shots = []
     for want in ("awning", "balcony_metal", "facade_glass"):
         for o in scene.objects:
             if o.kind != "building" or want not in _materials_of(scene, o):
                 continue
             T = o.transform
-            m = scene.prototypes[o.prototype]
-            lo, hi = m.bounds()
+            lo, hi = scene.prototypes[o.prototype].bounds()
             front = T[:3, :3] @ np.array([0.0, -1.0, 0.0])
             centre = T[:3, :3] @ np.array([(lo[0] + hi[0]) / 2, lo[1], 0.0]) + T[:3, 3]
             eye = centre + front * 22.0 + T[:3, :3] @ np.array([6.0, 0.0, 0.0])
             eye[2] = T[2, 3] + 1.7
             target = centre + [0.0, 0.0, min(hi[2] * 0.35, 8.0)]
             if _clear_eye(scene, eye, target):
-                shots.append((f"facade: {o.attrs.get('facade')} with {want.replace('_', ' ')}", look_at(eye, target)))
+                shots.append(Shot(f"facade_{want}", f"facade: {o.attrs.get('facade')} with {want.replace('_', ' ')}",
+                                  look_at(eye, target)))
                 break
-    return shots[:n + 1]
+    return shots
 
 
-def road_shots(scene) -> list[tuple[str, np.ndarray]]:
+def road_shots(scene) -> list[Shot]:
     path = max(scene.paths, key=lambda p: p.length())
     out = []
-    for s, ahead in ((0.18, 14.0), (0.55, 14.0), (0.33, 6.0), (0.8, 6.0)):
+    for k, (s, ahead) in enumerate(((0.18, 14.0), (0.55, 14.0), (0.33, 6.0), (0.8, 6.0))):
         (p,), (hd,) = path.at(s * path.length())
         d = np.array([np.cos(hd), np.sin(hd), 0.0])
-        eye = p + [0.0, 0.0, 2.2]
-        out.append((f"road: {path.name} at {s * path.length():.0f} m", look_at(eye, p + d * ahead)))
-    (p,), (hd,) = path.at(0.4 * path.length())
-    d = np.array([np.cos(hd), np.sin(hd), 0.0])
-    out.append(("road from 14 m above (manholes, patches, cracks)",
-                look_at(p + [0.0, 0.0, 14.0] - 0.5 * d, p + d * 1.0)))
+        out.append(Shot(f"road_{k}", f"road: {path.name} at {s * path.length():.0f} m",
+                        look_at(p + [0.0, 0.0, 2.2], p + d * ahead)))
     return out
 
 
-def label_rgb(class_id: np.ndarray) -> np.ndarray:
-    return class_table().colors[class_id].astype(np.uint8)
+def _segment_point(seg_T: np.ndarray, u: float, v: float, z: float) -> np.ndarray:
+    return seg_T[:3, :3] @ np.array([u, v, 0.0]) + seg_T[:3, 3] + [0.0, 0.0, z]
 
 
-def to_srgb(rgb: np.ndarray) -> np.ndarray:
-    x = np.clip(rgb, 0, None)
-    x = x / (1 + x)                                          # gentle tone map, the renders are scene-linear
+def ground_shots(town) -> list[Shot]:
+    """Road beside the kerb (dry and wet), the sidewalk, grass, the road from above (issue 29 item 2).
+
+    Streets are found in the scene (object kind ``street``, segment frame: u along, v across); the
+    camera stands over the carriageway 1 m off the kerb, or on the sidewalk, where nothing blocks it.
+    """
+    grid = town.grid
+    rh, wi, ch = grid.road_half, grid.walk_inner, grid.corridor_half
+    shots = []
+    streets = [o for o in town.objects if o.kind == "street"]
+    streets.sort(key=lambda o: -np.asarray(o.box.size)[:2].max())
+    for o in streets:
+        T, L = o.transform, float(np.asarray(o.box.size)[:2].max())
+        eye = _segment_point(T, 0.35 * L, -(rh - 1.2), 1.5)
+        target = _segment_point(T, 0.35 * L + 5.0, -(rh - 0.3), 0.0)
+        if _clear_eye(town, eye, target, 5.0):
+            shots.append(Shot("road_closeup", "road close-up by the kerb, 1.5 m up", look_at(eye, target)))
+            shots.append(Shot("road_closeup_wet", "road close-up by the kerb, wet (0.9)", look_at(eye, target),
+                              wetness=0.9))
+            break
+    for o in streets:
+        T, L = o.transform, float(np.asarray(o.box.size)[:2].max())
+        eye = _segment_point(T, 0.6 * L, (wi + ch) / 2, grid.curb_h + 1.6)
+        target = _segment_point(T, 0.6 * L + 6.0, (wi + ch) / 2 - 0.3, grid.curb_h)
+        if _clear_eye(town, eye, target, 6.0):
+            shots.append(Shot("sidewalk", "sidewalk, 1.6 m up", look_at(eye, target)))
+            break
+    grass = [o for o in town.objects if o.kind == "lot_ground" and o.cls == "terrain"]
+    grass += [o for o in town.objects if o.kind == "terrain"]
+    for o in grass:
+        c = np.asarray(o.box.center)
+        eye = np.array([c[0], c[1], grid.curb_h + 1.6])
+        for ang in np.linspace(0, 2 * np.pi, 8, endpoint=False):
+            target = eye + [4.0 * np.cos(ang), 4.0 * np.sin(ang), -1.6]
+            if _clear_eye(town, eye, target, 4.0):
+                shots.append(Shot("grass", f"grass ({o.kind}), 1.6 m up", look_at(eye, target)))
+                break
+        if shots[-1].name == "grass":
+            break
+    path = max(town.paths, key=lambda p: p.length())
+    (p,), (hd,) = path.at(0.4 * path.length())
+    d = np.array([np.cos(hd), np.sin(hd), 0.0])
+    shots.append(Shot("road_above", "road from 14 m above", look_at(p + [0.0, 0.0, 14.0] - 0.5 * d, p + d * 1.0)))
+    return shots
+
+
+def horizon_shots(town) -> list[Shot]:
+    """Out of town from the outer ring road: its south-west corner looking south-west, the middle of
+    its south side looking south-south-east; each by day and by night (issue 29 item 6)."""
+    grid = town.grid
+    x0, y0, x1, y1 = grid.corridor_rect
+    c = grid.corridor_half
+    corner = np.array([x0 + c, y0 + c, 1.65])
+    mid = np.array([(x0 + x1) / 2 + 3.0, y0 + c - 1.5, 1.65])
+    views = [("corner", corner, corner + [-40.0, -40.0, 3.0]), ("south", mid, mid + [15.0, -40.0, 3.5])]
+    shots = []
+    for name, eye, target in views:
+        for tod in ("day", "night"):
+            shots.append(Shot(f"horizon_{name}_{tod}", f"horizon from the ring road's {name}, {tod}",
+                              look_at(eye, target), time_of_day=tod))
+    return shots
+
+
+def render(args) -> int:
+    sys.path.insert(0, str(Path(args.code_root).resolve() if args.code_root else ROOT))
+    import generator
+    from generator.blender.renderer import Renderer
+    from generator.labels import class_table
+    from generator.layout import build_scene
+    from generator.spec import load_spec
+    from generator.spec.render import load_render_config
+    from generator.weather import Lighting
+    print(f"code: {Path(generator.__file__).parents[1]}")
+    spec = load_spec(args.spec)
+    t0 = time.perf_counter()
+    town = build_scene(spec)
+    t_layout = time.perf_counter() - t0
+    w, h = (int(x) for x in args.size.split("x"))
+    base = load_render_config("preview")
+    cfg = dataclasses.replace(base, resolution=(w, h), samples=args.samples, camera_model=False,
+                              motion_blur=dataclasses.replace(base.motion_blur, enabled=False))
+    makers = {"ground": ground_shots, "horizon": horizon_shots, "trees": tree_shots, "facades": facade_shots,
+              "road": road_shots}
+    shots = [s for key in args.only for s in makers[key](town) if not args.shots or s.name in args.shots]
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        t0 = time.perf_counter()
+        r = Renderer(town, spec, cfg, Path(tmp))
+        t_build = time.perf_counter() - t0
+        for shot in shots:
+            light = Lighting(*DAY) if shot.time_of_day == "day" else Lighting("night", lit_windows=0.4)
+            r.set_conditions(light, wetness=shot.wetness, puddle_seed=17.0)
+            t0 = time.perf_counter()
+            frame = r.render(shot.pose, spec.seed, {})
+            secs = time.perf_counter() - t0
+            present = [class_table().names[c] for c in np.unique(frame.labels.class_id)]
+            print(f"{shot.title:48s} {secs:6.1f} s  classes: {', '.join(present)}")
+            rgb = to_srgb(frame.rgb, night=shot.time_of_day == "night")
+            Image.fromarray(rgb).save(out / f"{shot.name}.png")
+            rows.append((shot.title, rgb, class_table().colors[frame.labels.class_id].astype(np.uint8)))
+    print(f"layout {t_layout:.1f} s, Blender scene build {t_build:.1f} s (baseline for the render seconds above); "
+          f"{len(town.faces)} triangles")
+    sheet = Image.new("RGB", (2 * w + 12, len(rows) * (h + 20) + 4), (240, 240, 240))
+    draw = ImageDraw.Draw(sheet)
+    for k, (title, rgb, lab) in enumerate(rows):
+        y = k * (h + 20)
+        draw.text((4, y + 4), title, fill=(0, 0, 0))
+        sheet.paste(Image.fromarray(rgb), (4, y + 18))
+        sheet.paste(Image.fromarray(lab), (w + 8, y + 18))
+    sheet.save(out / "sheet.png")
+    print(f"{len(rows)} shots -> {out}")
+    return 0
+
+
+def to_srgb(rgb: np.ndarray, night: bool = False) -> np.ndarray:
+    """8-bit sRGB of scene-linear radiance: a fixed gentle tone map (night: 4 EV brighter, to see it)."""
+    x = np.clip(rgb, 0, None) * (16.0 if night else 1.0)
+    x = x / (1 + x)
     x = np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1 / 2.4) - 0.055)
     return (np.clip(x * 1.6, 0, 1) * 255).astype(np.uint8)
 
 
-def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("out", type=Path, help="the gallery PNG to write")
-    ap.add_argument("--spec", type=Path, default=ROOT / "scenes" / "default_town.json")
-    ap.add_argument("--width", type=int, default=480)
-    ap.add_argument("--samples", type=int, default=16)
-    ap.add_argument("--only", nargs="*", default=["trees", "facades", "road"])
-    args = ap.parse_args(argv)
+def compare(args) -> int:
+    before, after, out = Path(args.before), Path(args.after), Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    names = [p.name for p in sorted(after.glob("*.png")) if p.name != "sheet.png" and (before / p.name).exists()]
+    pairs = []
+    for name in names:
+        a, b = Image.open(before / name).convert("RGB"), Image.open(after / name).convert("RGB")
+        w, h = a.size
+        img = Image.new("RGB", (2 * w + 12, h + 20), (240, 240, 240))
+        d = ImageDraw.Draw(img)
+        d.text((4, 3), f"before: {name[:-4]}", fill=(0, 0, 0))
+        d.text((w + 8, 3), "after", fill=(0, 0, 0))
+        img.paste(a, (4, 18))
+        img.paste(b, (w + 8, 18))
+        img.save(out / name)
+        pairs.append(img)
+    if pairs:
+        w, h = pairs[0].size
+        sheet = Image.new("RGB", (w, h * len(pairs)), (240, 240, 240))
+        for k, img in enumerate(pairs):
+            sheet.paste(img, (0, k * h))
+        sheet.save(out / "before_after.png")
+    print(f"{len(pairs)} before/after pairs -> {out}")
+    return 0
 
+
+def drive_poses(town, n: int) -> list[np.ndarray]:
+    """``n`` camera poses along the longest route, 1.65 m up, looking down the lane (ego-like)."""
+    path = max(town.paths, key=lambda p: p.length())
+    out = []
+    for s in (np.arange(n) + 0.5) / n:
+        (p,), (hd,) = path.at(s * path.length())
+        d = np.array([np.cos(hd), np.sin(hd), 0.0])
+        out.append(look_at(p + [0.0, 0.0, 1.65], p + d * 20.0 + [0.0, 0.0, 1.2]))
+    return out
+
+
+def time_one(args) -> int:
+    """Render ``--frames`` ego views at the full ``preview`` preset (label pass, camera model, motion blur
+    settings as the preset has them; a static town); print one JSON line of seconds."""
+    import json
+    sys.path.insert(0, str(Path(args.code_root).resolve()))
     from generator.blender.renderer import Renderer
     from generator.layout import build_scene
+    from generator.spec import load_spec
+    from generator.spec.render import load_render_config
+    from generator.weather import Lighting
 
     spec = load_spec(args.spec)
-    t0 = time.perf_counter()
-    scene = build_scene(spec)
-    t_layout = time.perf_counter() - t0
-    cfg = dataclasses.replace(load_render_config("preview"), resolution=(args.width, args.width * 2 // 3),
-                              samples=args.samples, motion_blur=dataclasses.replace(
-                                  load_render_config("preview").motion_blur, enabled=False), camera_model=False)
-    shots = []
-    if "trees" in args.only:
-        shots += tree_shots(scene)
-    if "facades" in args.only:
-        shots += facade_shots(scene)
-    if "road" in args.only:
-        shots += road_shots(scene)
+    town = build_scene(spec)
+    cfg = load_render_config("preview")
     with tempfile.TemporaryDirectory() as tmp:
         t0 = time.perf_counter()
-        r = Renderer(scene, spec, cfg, Path(tmp))
-        t_build = time.perf_counter() - t0
-        r.set_conditions(Lighting("day", 38.0, 135.0))
+        r = Renderer(town, spec, cfg, Path(tmp))
+        build = time.perf_counter() - t0
         rows = []
-        for title, T in shots:
-            t0 = time.perf_counter()
-            frame = r.render(T, spec.seed, {})
-            secs = time.perf_counter() - t0
-            present = [class_table().names[c] for c in np.unique(frame.labels.class_id)]
-            print(f"{title:48s} {secs:6.1f} s  classes: {', '.join(present)}")
-            rows.append((title, to_srgb(frame.rgb), label_rgb(frame.labels.class_id)))
-    print(f"layout {t_layout:.1f} s, Blender scene build {t_build:.1f} s (baseline for the render seconds above); "
-          f"{len(scene.faces)} triangles")
-    w, h = cfg.width, cfg.height
-    img = Image.new("RGB", (2 * w + 12, len(rows) * (h + 20) + 4), (240, 240, 240))
-    draw = ImageDraw.Draw(img)
-    for k, (title, rgb, lab) in enumerate(rows):
-        y = k * (h + 20)
-        draw.text((4, y + 4), title, fill=(0, 0, 0))
-        img.paste(Image.fromarray(rgb), (4, y + 18))
-        img.paste(Image.fromarray(lab), (w + 8, y + 18))
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    img.save(args.out)
-    print(f"{len(rows)} shots -> {args.out}")
+        for tod in ("day", "night"):
+            r.set_conditions(Lighting(*DAY) if tod == "day" else Lighting("night", lit_windows=0.4))
+            for T in drive_poses(town, args.frames):
+                f = r.render(T, spec.seed, {})
+                rows.append({k: round(v, 3) for k, v in f.seconds.items()})
+    print(json.dumps({"build": round(build, 3), "triangles": int(len(town.faces)), "frames": rows}))
     return 0
+
+
+def time_compare(args) -> int:
+    """Main (``--baseline``) beside this tree, interleaved ``--rounds`` times in one run."""
+    import json
+    import subprocess
+    trees = {"baseline": Path(args.baseline).resolve(), "this tree": ROOT}
+    runs: dict[str, list] = {k: [] for k in trees}
+    for _ in range(args.rounds):
+        for name, tree in trees.items():
+            cmd = [sys.executable, str(Path(__file__).resolve()), "_time_one", "--code-root", str(tree),
+                   "--spec", str(args.spec), "--frames", str(args.frames)]
+            out = subprocess.run(cmd, capture_output=True, text=True, check=True, cwd=tree)
+            runs[name].append(json.loads(out.stdout.strip().splitlines()[-1]))
+    print(f"preview preset, {args.frames} ego views x (day, night) x {args.rounds} rounds, {args.spec}")
+    print(f"{'tree':12s} {'triangles':>10s} {'build s':>8s} {'rgb s/frame':>12s} {'labels s/frame':>15s} "
+          f"{'total s/frame':>14s}")
+    total = {}
+    for name, rs in runs.items():
+        fr = [f for r in rs for f in r["frames"]]
+        rgb = np.mean([f["rgb_pass"] for f in fr])
+        tot = np.mean([f["render_total"] for f in fr])
+        total[name] = tot
+        print(f"{name:12s} {rs[0]['triangles']:10d} {np.mean([r['build'] for r in rs]):8.2f} {rgb:12.2f} "
+              f"{tot - rgb:15.2f} {tot:14.2f}")
+    print(f"ratio this tree / baseline (total per frame): {total['this tree'] / total['baseline']:.3f}")
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    r = sub.add_parser("render", help="render the crops of one tree")
+    r.add_argument("out", help="folder for the crops and sheet.png")
+    r.add_argument("--spec", type=Path, default=ROOT / "scenes" / "default_town.json")
+    r.add_argument("--code-root", default=None, help="the urbangen checkout to render with (default: this one)")
+    r.add_argument("--size", default="640x360", help="WIDTHxHEIGHT of every crop")
+    r.add_argument("--samples", type=int, default=12, help="Cycles samples (denoised)")
+    r.add_argument("--only", nargs="*", default=["ground", "horizon"],
+                   choices=["ground", "horizon", "trees", "facades", "road"])
+    r.add_argument("--shots", nargs="*", default=None, help="render only these shots (file stems)")
+    c = sub.add_parser("compare", help="before | after sheets of two render runs")
+    c.add_argument("before")
+    c.add_argument("after")
+    c.add_argument("out")
+    t = sub.add_parser("time", help="preview-preset render time of a baseline checkout beside this tree")
+    t.add_argument("--baseline", required=True, help="the checkout to compare with (e.g. main)")
+    t.add_argument("--spec", type=Path, default=ROOT / "scenes" / "default_town.json")
+    t.add_argument("--frames", type=int, default=3)
+    t.add_argument("--rounds", type=int, default=2)
+    o = sub.add_parser("_time_one")
+    o.add_argument("--code-root", required=True)
+    o.add_argument("--spec", type=Path, required=True)
+    o.add_argument("--frames", type=int, default=3)
+    args = ap.parse_args(argv)
+    return {"render": render, "compare": compare, "time": time_compare, "_time_one": time_one}[args.cmd](args)
 
 
 if __name__ == "__main__":

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import logging
 
-from generator.blender import recipes, recipes_actors, recipes_look, recipes_street
+from generator.blender import recipes, recipes_actors, recipes_far, recipes_look, recipes_street
 from generator.blender.bpy_guard import bpy
 from generator.blender.nodes import Nodes
 from generator.materials import material_table
@@ -32,8 +32,8 @@ def build_materials(seed: int) -> list[bpy.types.Material]:
     """
     out = []
     for row in material_table().rows:
-        recipe = next((getattr(m, row.name) for m in (recipes, recipes_actors, recipes_look, recipes_street)
-                       if hasattr(m, row.name)), None)
+        modules = (recipes, recipes_actors, recipes_look, recipes_street, recipes_far)
+        recipe = next((getattr(m, row.name) for m in modules if hasattr(m, row.name)), None)
         if recipe is None:
             raise RuntimeError(f"no Blender recipe for material {row.name!r} (generator/blender/recipes*.py)")
         mat = bpy.data.materials.new(row.name)

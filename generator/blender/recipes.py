@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from generator.blender import ground_detail as gd
 from generator.blender.controls import CONTROL
 from generator.blender.nodes import Nodes
 from generator.blender.road_surface import road_wear
@@ -30,18 +31,28 @@ def _emit(g: Nodes, shader, color, strength: float, group: str, factor=1.0):
 
 
 def asphalt(g: Nodes, rng, tone=0.055, wear=0.5):
-    co = g.coords("Object")
+    """Asphalt: aggregate, patches, tar snakes, cracks, stains, manholes; by the kerb a gutter with
+    grime, leaves and gully grates, where the water pools first (:mod:`generator.blender.ground_detail`)."""
+    co, wp = g.coords("Object"), g.geometry("Position")
     tone = tone * rng.uniform(0.85, 1.2)
-    grain = g.noise(co, scale=80, detail=4)
-    patches = g.noise(co, scale=0.06, detail=3)
-    crack_zone = g.smooth(g.noise(co, scale=0.12, detail=2), 0.58, 0.66)
-    edges = g.smooth(g.voronoi(g.mapping(co, scale=(1, 1, 1)), scale=0.25, feature="DISTANCE_TO_EDGE"), 0.0, 0.01)
-    cracks = g.lerp(crack_zone, 1.0, edges)
-    base = g.ramp(grain, [(0.3, (tone * 0.7,) * 3), (0.7, (tone * 1.4,) * 3)])
+    base, stone = gd.aggregate(g, wp, tone)
+    patches = g.noise(wp, scale=0.06, detail=3)
     base = g.mix(g.mul(g.smooth(patches, 0.45, 0.6), wear), base, (tone * 1.8, tone * 1.75, tone * 1.7))
-    base = g.mix(0.5, base, g.mix(cracks, (0.02, 0.02, 0.02), (1, 1, 1)), "MULTIPLY")
+    snakes = gd.tar_snakes(g, wp)
+    base = g.mix(g.mul(snakes, 0.9), base, (0.012, 0.012, 0.012))
     base, rough, worn = road_wear(g, co, base, tone, rng)
-    color, rough, normal = wet_surface(g, base, rough, g.bump(g.add(grain, worn), 0.25, 0.01))
+    gut, grate, slots = gd.gutter(g, co)
+    leaf, leaf_col = gd.leaves(g, wp, g.mul(gut, 0.6))
+    grime = g.mul(gut, g.add(0.6, g.mul(g.noise(wp, scale=3.0, detail=3), 0.4)))
+    base = g.mix(grime, base, (tone * 3.2, tone * 2.8, tone * 2.1))         # dusty sediment
+    base = g.mix(g.mul(grime, g.smooth(g.noise(wp, scale=0.8, detail=2), 0.45, 0.6)), base,
+                 (tone * 0.4, tone * 0.36, tone * 0.28))                     # and dark wet-dirt stains
+    base = g.mix(leaf, base, leaf_col)
+    base = g.mix(grate, base, g.mix(slots, (0.07, 0.065, 0.06), (0.004, 0.004, 0.004)))
+    rough = g.lerp(g.mul(snakes, 0.7), rough, 0.6)
+    rough = g.lerp(grate, rough, 0.45)
+    height = g.add(g.add(g.mul(stone, 0.6), worn), g.add(g.mul(snakes, 0.4), g.mul(slots, -1.5)))
+    color, rough, normal = wet_surface(g, base, rough, g.bump(height, 0.25, 0.01), low=gut)
     return g.principled(base_color=color, roughness=rough, normal=normal)
 
 
@@ -50,9 +61,14 @@ def parking_asphalt(g, rng):
 
 
 def _paint(g, rng, color):
-    co = g.coords("Object")
+    """Road paint, worn: thinner in wheel-worn blotches (the asphalt shows through), dirty, speckled
+    where the aggregate's tips poke through."""
+    co, wp = g.coords("Object"), g.geometry("Position")
     dirt = g.noise(co, scale=3, detail=4)
     base = g.mix(g.mul(g.smooth(dirt, 0.5, 0.8), 0.5), _jit(rng, color, 0.05), (0.35, 0.35, 0.33))
+    worn = g.smooth(g.noise(wp, scale=1.4, detail=5, roughness=0.65), 0.52, 0.7)
+    chips = g.math("GREATER_THAN", g.noise(wp, scale=70, detail=1), 0.62)
+    base = g.mix(g.math("MAXIMUM", g.mul(worn, 0.85), g.mul(chips, 0.6)), base, (0.05, 0.05, 0.05))
     col, rough, normal = wet_surface(g, base, 0.55, None, puddles=False)
     return g.principled(base_color=col, roughness=rough)
 
@@ -66,15 +82,27 @@ def crosswalk_paint(g, rng):
 
 
 def _concrete(g, rng, tone, slabs: bool):
-    co = g.coords("Object")
-    n = g.noise(co, scale=25, detail=5)
+    co, wp = g.coords("Object"), g.geometry("Position")
+    n = g.noise(wp, scale=25, detail=5)
     base = g.ramp(n, [(0.35, _jit(rng, (tone * 0.85,) * 3, 0.05)), (0.65, _jit(rng, (tone * 1.1,) * 3, 0.05))])
-    if slabs:
-        xy = g.mapping(co, scale=(1, 1, 0))
-        joints = g.brick(xy, color1=(1, 1, 1), color2=(0.92, 0.92, 0.92), mortar=(0.45, 0.45, 0.45), scale=1.0,
-                         mortar_size=0.008, brick_width=1.0, row_height=1.0, offset=0.0)
-        base = g.mix(1.0, base, joints, "MULTIPLY")
-    col, rough, normal = wet_surface(g, base, 0.8, g.bump(n, 0.1, 0.01))
+    height = g.mul(n, 0.4)
+    if slabs:   # sidewalk: 0.6 m slabs, dirty joints, gum, stains, fallen leaves (ground_detail)
+        slab, joints, tilt = gd.slabs(g, co, 1.0)
+        base = g.mix(1.0, base, slab, "MULTIPLY")
+        base = g.mix(g.mul(joints, 0.9), base, (tone * 0.3, tone * 0.28, tone * 0.25))
+        gum, blot = gd.stains(g, wp)
+        base = g.mix(blot, base, g.mix(0.5, base, (0.55, 0.5, 0.42), "MULTIPLY"))
+        base = g.mix(g.mul(gum, 0.8), base, (tone * 0.45,) * 3)
+        leaf, leaf_col = gd.leaves(g, wp, g.mul(g.smooth(g.noise(wp, scale=0.2, detail=2), 0.55, 0.8), 0.6))
+        base = g.mix(leaf, base, leaf_col)
+        height = g.add(g.add(height, g.mul(joints, -1.2)), g.mul(tilt, 0.25))
+    else:       # kerb: road grime on its lower face (object z from the road surface), weathering
+        _, _, z = gd.xyz(g, co)
+        low = g.mul(gd.inv(g, g.smooth(z, 0.02, 0.1)), g.add(0.4, g.mul(g.noise(wp, scale=4, detail=3), 0.6)))
+        base = g.mix(low, base, (tone * 0.35, tone * 0.32, tone * 0.27))
+        base = g.mix(g.mul(g.smooth(g.noise(wp, scale=1.3, detail=4), 0.55, 0.75), 0.5), base,
+                     (tone * 0.6, tone * 0.58, tone * 0.52))
+    col, rough, normal = wet_surface(g, base, 0.8, g.bump(height, 0.1, 0.01))
     return g.principled(base_color=col, roughness=rough, normal=normal)
 
 
@@ -87,12 +115,13 @@ def curb_concrete(g, rng):
 
 
 def grass(g, rng):
-    co = g.coords("Object")
-    n = g.noise(co, scale=1.5, detail=6)
-    fine = g.noise(co, scale=60, detail=2)
-    base = g.ramp(n, [(0.3, _jit(rng, (0.06, 0.11, 0.025), 0.1)), (0.7, _jit(rng, (0.13, 0.17, 0.04), 0.1))])
-    base = g.mix(g.mul(fine, 0.3), base, (0.2, 0.18, 0.08))
-    col, rough, normal = wet_surface(g, base, 0.95, g.bump(fine, 0.4, 0.02), puddles=False)
+    """Grass that is not one green: clumps, clover, dry patches, worn soil, blades, a few leaves."""
+    wp = g.geometry("Position")
+    base, blades, soil = gd.grass(g, wp, _jit(rng, (0.075, 0.13, 0.03), 0.1), _jit(rng, (0.2, 0.17, 0.07), 0.1))
+    leaf, leaf_col = gd.leaves(g, wp, g.mul(g.smooth(g.noise(wp, scale=0.2, detail=2), 0.5, 0.8), 0.2))
+    base = g.mix(leaf, base, leaf_col)
+    col, rough, normal = wet_surface(g, base, 0.95, g.bump(g.add(blades, g.mul(soil, -0.5)), 0.4, 0.02),
+                                     puddles=False)
     return g.principled(base_color=col, roughness=rough, normal=normal)
 
 

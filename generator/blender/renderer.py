@@ -12,6 +12,7 @@ import numpy as np
 
 from generator.blender import actors, camera, controls, geometry, lighting, materials, motion, night, passes, session
 from generator.blender.bpy_guard import bpy
+from generator.blender.ground_tags import tag_kerbs
 from generator.spec.model import SceneSpec
 from generator.spec.render import RenderConfig
 from generator.weather import LIT_TIMES
@@ -63,6 +64,7 @@ class Renderer:
         self.device = session.configure(self.bscene, cfg)
         self.materials = materials.build_materials(spec.seed)
         self.handles = geometry.build(scene, self.materials, self.bscene.collection)
+        tag_kerbs(scene, self.handles.objects)
         self.night_lights, self.night_counts = night.build_lights(scene, self.bscene.collection)
         self.world = world
         self.actors = None

@@ -50,16 +50,20 @@ def road_wear(g: Nodes, co, base, tone: float, rng: np.random.Generator):
     def band(x, lo, hi, soft=0.004):
         return g.mul(g.smooth(x, lo - soft, lo + soft), g.math("SUBTRACT", 1.0, g.smooth(x, hi - soft, hi + soft)))
 
-    # repair patches: a rectangle in ~18% of the cells, fresher (darker) or older (greyer)
+    # repair patches: a rectangle in ~18% of the cells, fresher (darker) or older (greyer); the
+    # edges wander a few centimetres and the new asphalt feathers out over ~8 cm (soft edges)
     r, col, fx, fy = cells(PATCH_CELL_M, tuple(rng.uniform(0, 1, 3)))
+    wob = g.mul(g.math("SUBTRACT", g.noise(co, scale=2.0, detail=3), 0.5), 0.03)
+    fx, fy = g.add(fx, wob), g.add(fy, wob)
     present = g.math("LESS_THAN", r, PATCH_SHARE)
-    inside = g.mul(band(fx, 0.12, 0.82), band(fy, 0.15, 0.8))
-    seam = g.math("SUBTRACT", g.mul(band(fx, 0.11, 0.83), band(fy, 0.14, 0.81)), inside)
+    inside = g.mul(band(fx, 0.12, 0.82, 0.012), band(fy, 0.15, 0.8, 0.016))
+    seam = g.math("SUBTRACT", g.mul(band(fx, 0.11, 0.83), band(fy, 0.14, 0.81)),
+                  g.mul(band(fx, 0.12, 0.82), band(fy, 0.15, 0.8)))
     patch = g.mul(present, inside)
     patch_col = g.mix(g.math("GREATER_THAN", r, PATCH_SHARE / 2), (tone * 0.7,) * 3,
                       (tone * 1.6, tone * 1.55, tone * 1.5))
     out = g.mix(g.mul(patch, 0.85), base, patch_col)
-    out = g.mix(g.mul(g.mul(present, seam), 0.9), out, (0.012, 0.012, 0.012))
+    out = g.mix(g.mul(g.mul(present, seam), 0.6), out, (0.012, 0.012, 0.012))
     # oil and tyre stains: soft dark blotches, a little glossier
     stains = g.mul(g.smooth(g.noise(co, scale=0.35, detail=3), 0.56, 0.68),
                    g.smooth(g.noise(co, scale=2.5, detail=3), 0.3, 0.6))

@@ -31,6 +31,8 @@ WET_ROUGHNESS, PUDDLE_ROUGHNESS = 0.08, 0.02
 PUDDLE_SCALE, PUDDLE_EDGE = 0.08, (0.56, 0.6)
 #: Ripples: raindrop cells per metre, rings per metre of radius, bump strength and distance (m).
 RIPPLE_CELLS, RIPPLE_RINGS, RIPPLE_STRENGTH, RIPPLE_DISTANCE = 6.0, 9.0, 0.15, 0.01
+#: Water runs to the low parts: a ``low`` mask of 1 (a gutter) lifts the puddle noise by this much.
+LOW_BIAS = 0.25
 
 
 def _shifted_coords(g: Nodes, seed):
@@ -46,7 +48,7 @@ def _shifted_coords(g: Nodes, seed):
     return g.mapping(g.coords("Object"), location=comb.outputs[0])
 
 
-def wet_surface(g: Nodes, color, roughness, normal=None, puddles: bool = True):
+def wet_surface(g: Nodes, color, roughness, normal=None, puddles: bool = True, low=None):
     """Darken and gloss a ground surface by the scene's wetness; add puddles with ripples.
 
     Parameters
@@ -60,6 +62,8 @@ def wet_surface(g: Nodes, color, roughness, normal=None, puddles: bool = True):
     puddles : bool
         Standing water where the puddle noise is low (roads, sidewalks); off for paint,
         grass and soil, which only darken and gloss.
+    low : socket, optional
+        0..1, how low the surface lies (the gutter by the kerb): puddles form there first.
 
     Returns
     -------
@@ -70,7 +74,10 @@ def wet_surface(g: Nodes, color, roughness, normal=None, puddles: bool = True):
     mask = wet
     if puddles:
         co = _shifted_coords(g, g.attr(CONTROL["puddle_seed"], "VIEW_LAYER"))
-        water = g.smooth(g.noise(co, scale=PUDDLE_SCALE, detail=3, roughness=0.6), *PUDDLE_EDGE)
+        n = g.noise(co, scale=PUDDLE_SCALE, detail=3, roughness=0.6)
+        if low is not None:
+            n = g.add(n, g.mul(low, LOW_BIAS))
+        water = g.smooth(n, *PUDDLE_EDGE)
         pud = g.mul(water, wet)
         drop = g.voronoi(co, scale=RIPPLE_CELLS)  # distance to the nearest raindrop centre, in cell units
         rings = g.math("SINE", g.mul(drop, 2 * math.pi * RIPPLE_RINGS / RIPPLE_CELLS))

@@ -20,6 +20,7 @@ import numpy as np
 from generator.geometry import Mesh, pose
 from generator.geometry.boxes import box_of
 from generator.labels import class_table
+from generator.layout.ground.far_city import far_city
 from generator.layout.ground.intersections import intersection_road_mesh, intersection_walk_mesh
 from generator.layout.ground.roads import segment_road_mesh
 from generator.layout.ground.sidewalks import segment_walk_mesh
@@ -183,6 +184,34 @@ def verify_routes(paths: list[Path], grid: Grid, objects: list[SceneObject], lim
                 raise LayoutError(f"{path.name}: {o.name} is {d:.2f} m from the route (< {limit:.2f} m)")
 
 
+def _far_city(spec: SceneSpec, grid: Grid, prototypes: dict[str, Mesh], proxies: dict[str, Mesh],
+              objects: list[SceneObject]) -> int:
+    """Append the city beyond the town (:mod:`generator.layout.ground.far_city`) after every other object,
+    so every town object keeps its index; returns the index of the first far-city object.
+
+    Each object stands where its footprint's centre is (its transform; the mesh local to it), on no
+    lot of the town (``attrs["lot"]`` None), as stuff (instance 0). Crowns are solid double cones,
+    so their label proxy is the crowns themselves (vegetation's hull policy, without a hull that
+    would fill the gaps between the trees)."""
+    start = len(objects)
+    counters: dict[str, int] = defaultdict(int)
+    for kind, cls, world in far_city(spec.seed, grid.bounds, grid.curb_h):
+        name = f"{kind}_{counters[kind]:04d}"
+        counters[kind] += 1
+        lo, hi = world.bounds()
+        T = pose(float((lo[0] + hi[0]) / 2), float((lo[1] + hi[1]) / 2))
+        mesh = world.transformed(np.linalg.inv(T))
+        prototypes[name] = mesh
+        proxy = None
+        if cls == "vegetation":
+            proxies[name] = proxy = mesh
+            proxy = name
+        lo, hi = mesh.bounds()
+        objects.append(SceneObject(len(objects), name, kind, cls, 0, name, T, box_of(lo, hi, T), proxy,
+                                   {"lot": None}))
+    return start
+
+
 def build_scene(spec: SceneSpec) -> Town:
     """Build the town described by ``spec``.
 
@@ -218,15 +247,17 @@ def build_scene(spec: SceneSpec) -> Town:
         log.info("placed %d %s (%.2f s)", len(placer.placed) - n0, label, time.perf_counter() - t1)
     prototypes, proxies, objects = _objects(grid, lots, placer.placed, lib)
     first = len(objects) - len(placer.placed)
+    beyond = _far_city(spec, grid, prototypes, proxies, objects)
     scene = SceneModel(spec.seed, spec.spec_hash, grid.bounds, prototypes, proxies, objects, routes)
     if tmap is None:
-        verify_routes(routes, grid, objects[first:], limit - 1e-6)
+        verify_routes(routes, grid, objects[first:beyond], limit - 1e-6)
         town = Town.of(scene, grid, lib)
     else:
         verify_routes(routes, grid, [], limit)      # on the lanes (the grid's); distances in the world:
         shaped = set(range(first)) | {first + i for i, p in enumerate(placer.placed) if lib.protos[p.proto].shaped}
+        shaped |= set(range(beyond, len(objects)))          # the far city is laid out on the grid too
         world = map_scene(scene, tmap, shaped)
-        verify_world_routes(world, scene, tmap, first, shaped, limit - 1e-6)
+        verify_world_routes(world, scene, tmap, first, shaped, limit - 1e-6, beyond)
         log.info("streets cross at %.1f degrees (lean %+d): the town is mapped from its grid", tmap.angle_deg,
                  tmap.lean)
         town = Town.of(world, grid, lib, tmap, scene)

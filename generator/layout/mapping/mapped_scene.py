@@ -118,14 +118,14 @@ def map_scene(layout: SceneModel, tmap: TownMap, shaped: set[int]) -> SceneModel
 
 
 def verify_world_routes(scene: SceneModel, layout: SceneModel, tmap: TownMap, first: int, shaped: set[int],
-                        limit: float) -> None:
+                        limit: float, last: int | None = None) -> None:
     """Raise :class:`MappedLayoutError` unless every route sample of the world ``scene`` (the map
     ``tmap`` of the grid-frame ``layout``) keeps ``limit`` metres (2D) from each placed object (index
-    ``first`` on): a rigid one's box, a shaped one's mapped footprint (the parallelogram its grid box
-    becomes)."""
+    ``first`` on, up to ``last``, the far city excluded): a rigid one's box, a shaped one's mapped footprint
+    (the parallelogram its grid box becomes)."""
     for path in scene.paths:
         keep = Keepout(path.points[:, :2], limit)
-        for o in scene.objects[first:]:
+        for o in scene.objects[first:last]:
             if o.index in shaped:
                 d = keep.polygon_distance(tmap.xy(layout.objects[o.index].box.corners_xy()))
             else:

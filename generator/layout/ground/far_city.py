@@ -1,0 +1,196 @@
+"""The city beyond the town (issue 29 item 6): low-detail blocks, tree lines and a skyline.
+
+The town's ground runs flat to the horizon polygon (:mod:`generator.layout.ground.terrain`), which
+from a street showed a green plane meeting the sky. This module fills the ground ring round the
+town with a low-detail city, so the view out of town ends in more town:
+
+* a tree line (class vegetation, material ``leaves``) ``TREE_LINE_M`` beyond the town bounds, one
+  low-poly crown (an octagonal double cone, 16 triangles) every ~8 m round the whole town;
+* city blocks from ``BLOCKS_FROM_M`` to ``REACH_M`` beyond the bounds on a square ``PITCH_M`` grid
+  (streets left as open ground): each a park of a few crowns, or 1 to 4 buildings (class building),
+  boxes whose walls are ``far_facade`` (a window pattern, windows lit at night) under a flat
+  ``roof``, some with a smaller plant room on top (a roof line);
+* building heights rise with distance: 9-24 m near the town, a skyline of 35-120 m towers beyond
+  ``SKYLINE_M``, and round the ring's far edge a gapless band of 30-95 m towers, so no street of the
+  block grid opens onto the bare horizon.
+
+One object per block, park and side of the tree line, in the world frame (identity transforms), so
+Blender and the LiDAR (which reaches 120 m and rarely meets it) share the same few triangles: about
+30 k round a default town (which has about 1.3 M). The draws come from the stream
+``("layout", "far_city")`` only, so the town's own draws are untouched, and nothing stands within
+``TREE_LINE_M - 2 - CROWN_R_M[1]`` (33 m) of the town bounds.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from generator.geometry import Mesh
+from generator.labels import class_table
+from generator.materials import material_table
+from generator.rng import stream
+
+TREE_LINE_M = 40.0            #: distance of the tree line's centres beyond the town bounds
+TREE_SPACING_M = 8.0          #: mean spacing of the tree line's crowns
+CORNER_GAP_M = 10.0           #: the tree line leaves this much open at each corner
+CROWN_R_M = (3.0, 5.0)        #: crown radius range
+CROWN_H_M = (8.0, 14.0)       #: crown top height range
+BLOCKS_FROM_M = 70.0          #: the first block begins this far beyond the bounds
+REACH_M = 1200.0              #: the last block ends within this distance of the bounds
+PITCH_M, STREET_M = 90.0, 22.0  #: block grid pitch and the open street between blocks
+PARK_SHARE = 0.12             #: share of blocks that are parks
+SKYLINE_M = 550.0             #: beyond this distance from the bounds, towers appear
+TOWER_SHARE = 0.35            #: share of the blocks beyond SKYLINE_M that hold one tower
+LOW_H_M, TOWER_H_M = (9.0, 24.0), (35.0, 120.0)
+WALL_DEPTH_M, WALL_H_M = 35.0, (30.0, 95.0)  #: the gapless band of towers at the ring's far edge
+
+#: Unit box: 8 corners (x, y, z in {0, 1}) and its 10 triangles without the bottom (walls, then roof).
+_BOX_V = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]], float)
+_BOX_F = np.array([[0, 1, 5], [0, 5, 4], [1, 2, 6], [1, 6, 5], [2, 3, 7], [2, 7, 6], [3, 0, 4], [3, 4, 7],
+                   [4, 5, 6], [4, 6, 7]], np.int64)
+_WALLS = 8
+
+
+def _boxes(b: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Vertices, faces and roof flags of ``b`` (k, 6) boxes ``(x0, y0, z0, x1, y1, z1)``, no bottoms."""
+    lo, hi = b[:, None, :3], b[:, None, 3:]
+    v = (lo + _BOX_V[None] * (hi - lo)).reshape(-1, 3)
+    f = (_BOX_F[None] + 8 * np.arange(len(b))[:, None, None]).reshape(-1, 3)
+    roof = np.tile(np.arange(len(_BOX_F)) >= _WALLS, len(b))
+    return v, f, roof
+
+
+def _crowns(xy: np.ndarray, r: np.ndarray, h: np.ndarray, z0: float) -> tuple[np.ndarray, np.ndarray]:
+    """Octagonal double cones: bottom apex on the ground, widest (``r``) at 40 % of ``h``, top apex at ``h``."""
+    a = 2 * np.pi * np.arange(8) / 8
+    ring = np.stack([np.cos(a), np.sin(a)], 1)                               # (8, 2)
+    k = len(xy)
+    mid = xy[:, None, :] + r[:, None, None] * ring[None]                     # (k, 8, 2)
+    v = np.concatenate([np.c_[xy, np.full(k, z0)][:, None],
+                        np.concatenate([mid, np.full((k, 8, 1), z0) + 0.4 * h[:, None, None]], 2),
+                        np.c_[xy, z0 + h][:, None]], 1).reshape(-1, 3)         # 10 vertices per crown
+    i = np.arange(8)
+    j = (i + 1) % 8
+    one = np.concatenate([np.stack([np.zeros(8, np.int64), 1 + j, 1 + i], 1),   # lower cone, outward
+                          np.stack([np.full(8, 9), 1 + i, 1 + j], 1)])           # upper cone, outward
+    f = (one[None] + 10 * np.arange(k)[:, None, None]).reshape(-1, 3)
+    return v, f
+
+
+def _ring_cells(bounds: np.ndarray) -> np.ndarray:
+    """(n, 4) ``(x0, y0, x1, y1)`` block rectangles of the grid in the ring round ``bounds``."""
+    (bx0, by0), (bx1, by1) = bounds
+    c = np.array([(bx0 + bx1) / 2, (by0 + by1) / 2])
+    half = np.array([(bx1 - bx0) / 2, (by1 - by0) / 2])
+    n = int(np.ceil((max(half) + REACH_M) / PITCH_M))
+    k = np.arange(-n, n)
+    gx, gy = np.meshgrid(k, k, indexing="ij")
+    x0 = c[0] + gx.ravel() * PITCH_M + STREET_M / 2
+    y0 = c[1] + gy.ravel() * PITCH_M + STREET_M / 2
+    x1, y1 = x0 + PITCH_M - STREET_M, y0 + PITCH_M - STREET_M
+    # distance of each rectangle from the bounds (0 if they overlap), and its far corner's
+    gap = np.maximum(np.maximum(bx0 - x1, x0 - bx1), np.maximum(by0 - y1, y0 - by1))
+    far = np.maximum(np.maximum(bx0 - x0, x1 - bx1), np.maximum(by0 - y0, y1 - by1))
+    keep = (gap >= BLOCKS_FROM_M) & (far <= REACH_M)
+    return np.stack([x0, y0, x1, y1], 1)[keep]
+
+
+def _distance(bounds: np.ndarray, xy: np.ndarray) -> np.ndarray:
+    """(k,) distance (m) of points from the bounds rectangle (the Chebyshev gap: the ring's own measure)."""
+    (bx0, by0), (bx1, by1) = bounds
+    return np.maximum(np.maximum(bx0 - xy[:, 0], xy[:, 0] - bx1), np.maximum(by0 - xy[:, 1], xy[:, 1] - by1))
+
+
+def far_city(seed: int, bounds: np.ndarray, z0: float) -> list[tuple[str, str, Mesh]]:
+    """The blocks, parks and tree lines round a town, world frame, as ``(kind, class, mesh)``.
+
+    Parameters
+    ----------
+    seed : int
+        The spec's seed; draws come from ``stream(seed, "layout", "far_city")``.
+    bounds : (2, 2) float64
+        The town's bounds ``[[xmin, ymin], [xmax, ymax]]``, metres.
+    z0 : float
+        Ground height there (the horizon ground's, ``curb_h``), metres.
+
+    Returns
+    -------
+    list of (kind, cls, Mesh)
+        ``("far_trees", "vegetation", ...)`` per side of the tree line, then per block of the ring
+        (rows of the grid in order) ``("far_block", "building", ...)`` (walls ``far_facade``, roofs
+        ``roof``) or ``("far_park", "vegetation", ...)`` (crowns of material ``leaves``). One object
+        per block keeps every object's box the size of its block (no box encloses the town).
+    """
+    rng = stream(seed, "layout", "far_city")
+    bounds = np.asarray(bounds, np.float64)
+    (bx0, by0), (bx1, by1) = bounds
+    out = []
+    # the tree line: crowns along the rectangle TREE_LINE_M outside the bounds, jittered; each side
+    # stops CORNER_GAP_M short of the corners, so no two sides' crowns meet
+    t = TREE_LINE_M
+    corners = np.array([(bx0 - t, by0 - t), (bx1 + t, by0 - t), (bx1 + t, by1 + t), (bx0 - t, by1 + t)])
+    for a, b in zip(corners, np.roll(corners, -1, 0), strict=True):
+        length = float(np.linalg.norm(b - a))
+        u = (b - a) / length
+        n = max(int((length - 2 * CORNER_GAP_M) // TREE_SPACING_M), 1)
+        s = CORNER_GAP_M + (np.arange(n) + 0.5 + rng.uniform(-0.3, 0.3, n)) * (length - 2 * CORNER_GAP_M) / n
+        out_dir = np.array([u[1], -u[0]])                                        # away from the town
+        xy = a + s[:, None] * u + out_dir * rng.uniform(-2.0, 6.0, n)[:, None]
+        out.append(("far_trees", "vegetation", _crown_mesh(rng, xy, z0)))
+    for x0, y0, x1, y1 in _ring_cells(bounds):
+        d = float(_distance(bounds, np.array([[(x0 + x1) / 2, (y0 + y1) / 2]]))[0])
+        if rng.uniform() < PARK_SHARE:
+            m = int(rng.integers(3, 7))
+            xy = np.stack([rng.uniform(x0 + 6, x1 - 6, m), rng.uniform(y0 + 6, y1 - 6, m)], 1)
+            out.append(("far_park", "vegetation", _crown_mesh(rng, xy, z0)))
+            continue
+        blocks = []
+        if d > SKYLINE_M and rng.uniform() < TOWER_SHARE:
+            w = rng.uniform(20.0, 34.0, 2)
+            cx, cy = rng.uniform(x0 + w[0] / 2, x1 - w[0] / 2), rng.uniform(y0 + w[1] / 2, y1 - w[1] / 2)
+            h = rng.uniform(*TOWER_H_M)
+            blocks.append((cx - w[0] / 2, cy - w[1] / 2, z0, cx + w[0] / 2, cy + w[1] / 2, z0 + h))
+        else:
+            nx, ny = int(rng.integers(1, 3)), int(rng.integers(1, 3))
+            xs, ys = np.linspace(x0, x1, nx + 1), np.linspace(y0, y1, ny + 1)
+            for i in range(nx):
+                for j in range(ny):
+                    g = rng.uniform(0.0, 3.0, 4)                                 # gaps and setbacks
+                    h = rng.uniform(*LOW_H_M) * (1.0 + 0.6 * min(d / SKYLINE_M, 1.0))
+                    blocks.append((xs[i] + g[0], ys[j] + g[1], z0, xs[i + 1] - g[2], ys[j + 1] - g[3], z0 + h))
+        out.append(("far_block", "building", _block_mesh(rng, np.array(blocks, np.float64))))
+    # the skyline's far edge: a gapless wall of towers round the ring, so no street between the blocks
+    # leads the eye to the bare horizon (one object per side; the south and north sides span the corners)
+    e = REACH_M + 10.0
+    sides = [((bx0 - e - WALL_DEPTH_M, by0 - e - WALL_DEPTH_M), (bx1 + e + WALL_DEPTH_M, by0 - e), 0),
+             ((bx0 - e - WALL_DEPTH_M, by1 + e), (bx1 + e + WALL_DEPTH_M, by1 + e + WALL_DEPTH_M), 0),
+             ((bx0 - e - WALL_DEPTH_M, by0 - e), (bx0 - e, by1 + e), 1),
+             ((bx1 + e, by0 - e), (bx1 + e + WALL_DEPTH_M, by1 + e), 1)]
+    for (x0, y0), (x1, y1), axis in sides:
+        a0, a1 = (x0, x1) if axis == 0 else (y0, y1)
+        cuts = [a0]
+        while cuts[-1] < a1:
+            cuts.append(min(cuts[-1] + rng.uniform(25.0, 60.0), a1))
+        cuts = np.array(cuts)
+        h = z0 + rng.uniform(*WALL_H_M, len(cuts) - 1)
+        if axis == 0:
+            b = np.stack([cuts[:-1], np.full_like(h, y0), np.full_like(h, z0), cuts[1:], np.full_like(h, y1), h], 1)
+        else:
+            b = np.stack([np.full_like(h, x0), cuts[:-1], np.full_like(h, z0), np.full_like(h, x1), cuts[1:], h], 1)
+        out.append(("far_block", "building", _block_mesh(rng, b)))
+    return out
+
+
+def _block_mesh(rng: np.random.Generator, b: np.ndarray) -> Mesh:
+    """Buildings ``b`` (k, 6), 40 % of them with a plant room on the roof (a roof line)."""
+    top = rng.uniform(size=len(b)) < 0.4
+    inset = np.minimum(b[top, 3] - b[top, 0], b[top, 4] - b[top, 1])[:, None] * np.array([0.3, 0.3])
+    rooms = np.c_[b[top, :2] + inset, b[top, 5], b[top, 3:5] - inset, b[top, 5] + rng.uniform(2.5, 4.5, top.sum())]
+    v, f, roof = _boxes(np.vstack([b, rooms]))
+    mats = material_table()
+    return Mesh(v, f, class_table().id("building"), np.where(roof, mats.id("roof"), mats.id("far_facade")))
+
+
+def _crown_mesh(rng: np.random.Generator, xy: np.ndarray, z0: float) -> Mesh:
+    v, f = _crowns(xy, rng.uniform(*CROWN_R_M, len(xy)), rng.uniform(*CROWN_H_M, len(xy)), z0)
+    return Mesh(v, f, class_table().id("vegetation"), material_table().id("leaves"))
