@@ -6,7 +6,7 @@ Steps, per chunk ``[c0, c1)`` of a sweep (the scanner's threads run chunks in pa
    known whatever the chunking) against the town, then the actors, as the ideal scanner casts them;
    which beams may meet which actor (:meth:`generator.lidar.actors.ActorCaster.aim`) is worked out
    once here and reused by every later ray list of the chunk;
-2. the chunk's edge beams (:func:`generator.lidar.return_kernels.edge_beams`) get their probe
+2. the chunk's edge beams (:func:`generator.lidar.return_rays.edge_beams`) get their probe
    sub-rays (:func:`~generator.lidar.return_rays.probe_pairs`), and the beams the probes split
    (:func:`~generator.lidar.return_rays.split_beams`) the rest, cast against the town and the actors;
 3. rays that end on glass go on behind it, up to ``glass_layers`` panes
@@ -28,8 +28,8 @@ import numpy as np
 
 from generator.lidar.kernels import world_rays
 from generator.lidar.points import POINT_DTYPE
-from generator.lidar.return_kernels import beam_returns, edge_beams, subrays
-from generator.lidar.return_rays import absorb_interior, pane_rays, probe_pairs, split_beams
+from generator.lidar.return_kernels import beam_returns
+from generator.lidar.return_rays import absorb_interior, edge_beams, pane_rays, probe_pairs, split_beams, subrays
 
 #: how far behind a pane a continued ray starts, metres
 GLASS_STEP_M = 1e-3

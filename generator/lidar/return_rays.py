@@ -1,4 +1,5 @@
-"""Compiled passes over a chunk's ray lists (:mod:`generator.lidar.physical_chunk`): probes, splits, panes.
+"""Compiled passes over a chunk's ray lists (:mod:`generator.lidar.physical_chunk`): edge beams, sub-rays,
+probes, splits, panes.
 
 Each replaces a run of numpy expressions that held the GIL, with the same float32 arithmetic in the
 same order (no ``fastmath``, so no fused multiply-adds): the points stay byte for byte those of the
@@ -97,7 +98,7 @@ def probe_pairs(edge, side, probes, beam_out, which_out):  # pragma: no cover - 
     Parameters
     ----------
     edge, side : (e,) int64, uint8
-        :func:`generator.lidar.return_kernels.edge_beams`' output (beams ascending, neighbour bits).
+        :func:`edge_beams`' output (beams ascending, neighbour bits).
     probes : (4,) int64
         Sub-ray towards each neighbour (:func:`generator.lidar.returns.probe_index`).
     beam_out, which_out : (4 e,) int64
@@ -198,3 +199,99 @@ def split_beams(pb, pw, dist, face, inst, p_dist, p_face, p_inst, face_label, lo
                     n_rest += 1
         i = j
     return n_split, n_rest
+
+
+@njit(nogil=True, cache=True)
+def edge_beams(dist, face, inst, faces, a, c0, c1, n_l, min_range, max_range, step, out, side):  # pragma: no cover
+    """Inner beams whose footprint may straddle an edge (see :mod:`generator.lidar.returns`).
+
+    A beam is an edge beam when a neighbour in the range image (the next column either side, the
+    next ring up or down) has no return where it has one or the other way round, hits another class or
+    instance, or -- the columns either side -- lies more than ``step`` times its range nearer or farther.
+
+    Parameters
+    ----------
+    dist, face, inst : (n,) float32, int32, int32
+        Central rays of columns ``a .. b - 1`` (``inst`` -1 = the face's own instance).
+    faces : (F,) FACE_DTYPE
+    a, c0, c1 : int
+        First halo column and the chunk's columns ``[c0, c1)``.
+    n_l : int
+        Lasers.
+    step : float
+        Relative range step between neighbouring columns that counts as an edge.
+    out : (n_inner,) int64
+        Written: halo-row indices of the edge beams, ascending.
+    side : (n_inner,) uint8
+        Written beside ``out``: which neighbours differ, bits 1 = previous column, 2 = next column,
+        4 = ring above, 8 = ring below.
+
+    Returns
+    -------
+    count : int
+    """
+    n = dist.shape[0]
+    b = n // n_l + a
+    key = np.empty(n, np.int64)
+    for r in range(n):
+        f = face[r]
+        if f < 0 or dist[r] < min_range or dist[r] >= max_range:
+            key[r] = -1
+        else:
+            ins = np.int64(inst[r]) if inst[r] >= 0 else np.int64(faces[f].instance)
+            key[r] = (np.int64(faces[f]["class"]) << 16) | ins
+    k = 0
+    for c in range(c0, c1):
+        base = (c - a) * n_l
+        for j in range(n_l):
+            r = base + j
+            own = key[r]
+            bits = 0
+            if c > a:
+                rn = r - n_l
+                if key[rn] != own or (own >= 0 and abs(dist[rn] - dist[r]) > step * dist[r]):
+                    bits |= 1
+            if c + 1 < b:
+                rn = r + n_l
+                if key[rn] != own or (own >= 0 and abs(dist[rn] - dist[r]) > step * dist[r]):
+                    bits |= 2
+            if j > 0 and key[r - 1] != own:
+                bits |= 4
+            if j + 1 < n_l and key[r + 1] != own:
+                bits |= 8
+            if bits:
+                out[k] = r
+                side[k] = bits
+                k += 1
+    return k
+
+
+@njit(nogil=True, cache=True)
+def subrays(o_w, d_w, beams, which, pattern, o_out, d_out):  # pragma: no cover - compiled
+    """Sub-rays ``d + x u + y v`` (normalised; ``u`` horizontal to the left of the beam, ``v`` up across it).
+
+    Parameters
+    ----------
+    o_w, d_w : (n, 3) float32
+        Central rays (re-centred origins, world directions).
+    beams, which : (m,) int64
+        Per sub-ray: the row of its beam and its index in ``pattern``.
+    pattern : (K - 1, 2) float64
+        Angular offsets ``(x, y)``, radians.
+    o_out, d_out : (m, 3) float32
+        Written.
+    """
+    for i in range(beams.shape[0]):
+        r = beams[i]
+        dx, dy, dz = np.float64(d_w[r, 0]), np.float64(d_w[r, 1]), np.float64(d_w[r, 2])
+        h = np.sqrt(dx * dx + dy * dy)
+        if h < 1e-9:
+            ux, uy, uz = 0.0, 1.0, 0.0
+        else:
+            ux, uy, uz = -dy / h, dx / h, 0.0
+        vx, vy, vz = dy * uz - dz * uy, dz * ux - dx * uz, dx * uy - dy * ux
+        px, py = pattern[which[i], 0], pattern[which[i], 1]
+        ex, ey, ez = dx + px * ux + py * vx, dy + px * uy + py * vy, dz + px * uz + py * vz
+        n = np.sqrt(ex * ex + ey * ey + ez * ez)
+        o_out[i, 0], o_out[i, 1], o_out[i, 2] = o_w[r, 0], o_w[r, 1], o_w[r, 2]
+        d_out[i, 0], d_out[i, 1], d_out[i, 2] = ex / n, ey / n, ez / n
