@@ -70,6 +70,18 @@ def _cast_subrays(scanner, plan, cols, aimed, o_w, d_world, beam_rows, which, pa
     return {"o": o, "dw": dw, "df": d, "dist": dist, "face": face, "inst": inst, "moving": moving, "beam": beam}
 
 
+def _constants(scanner, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Read-only (n,) float32 zeros and ones and int64 ``0 .. n - 1`` (the central rays' offset, glass
+    transmission and beam), made once per scanner instead of once per chunk and sweep."""
+    c = getattr(scanner, "_chunk_constants", None)
+    if c is None or len(c[0]) < n:
+        c = (np.zeros(n, np.float32), np.ones(n, np.float32), np.arange(n, dtype=np.int64))
+        for a in c:
+            a.flags.writeable = False
+        scanner._chunk_constants = c
+    return c[0][:n], c[1][:n], c[2][:n]
+
+
 def run_physical_chunk(scanner, sweep, i: int, cols: slice) -> None:
     """Cast chunk ``i`` (columns ``cols``) of ``sweep`` and write its returns (see the module docstring)."""
     sensor, model, tables = scanner.sensor, scanner.returns, scanner._records
@@ -84,7 +96,9 @@ def run_physical_chunk(scanner, sweep, i: int, cols: slice) -> None:
         n = (b - a) * L
         o_w, d_w = np.empty((n, 3), np.float32), np.empty((n, 3), np.float32)
         world_rays(scanner._o32, scanner._d32, sweep.rot_t, sweep.trans, a, b, o_w, d_w)
-        d_world = d_w.copy()  # the actors replace the directions of their hits by local ones
+        # the actors replace the directions of their hits by local ones: sub-rays and rays behind glass
+        # start from a copy of the world directions
+        d_world = d_w.copy() if k or p.glass_layers else d_w
         dist, face = scanner.caster.intersect_local(o_w, d_w, hi_r, mark_misses=False)
         plan = sweep.get_plan()
         # which beams may meet which actor: once per chunk, for the central rays, the sub-rays and the glass
@@ -100,10 +114,10 @@ def run_physical_chunk(scanner, sweep, i: int, cols: slice) -> None:
                                 side)
             edge, side = edge[:n_edge], side[:n_edge]
         weight = np.ones(n_in, np.float32)
+        zeros, ones, rows = _constants(scanner, n_in)
         parts = {"o": [o_w[i0:i1]], "dw": [d_world[i0:i1]], "df": [d_w[i0:i1]], "dist": [dist[i0:i1]],
                  "face": [face[i0:i1]], "inst": [inst[i0:i1]], "moving": [moving[i0:i1]],
-                 "beam": [np.arange(n_in, dtype=np.int64)], "weight": [weight],
-                 "offset": [np.zeros(n_in, np.float32)], "tau": [np.ones(n_in, np.float32)]}
+                 "beam": [rows], "weight": [weight], "offset": [zeros], "tau": [ones]}
         if k and n_edge:
             share = np.float32(1.0 / (k + 1))
             # probe: the sub-ray towards each neighbour that differs

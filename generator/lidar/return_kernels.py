@@ -105,21 +105,23 @@ def beam_returns(out, n_beams, ray0, beam, weight, offset, tau, dist, face, d_f,
     # rows 0 .. n_beams - 1 are the beams' central rays, in order (beam[q] == q); only the rows after
     # them (sub-rays, rays behind glass) are gathered per beam, so a beam without extra rays costs
     # one look at its central row
-    total = np.empty(n, np.float64)
+    total = np.empty(n, np.float64)  # offset + distance: extra rows here, a central row in its beam's turn
     count = np.zeros(n_beams + 1, np.int64)
-    for r in range(n):
-        t = np.float64(offset[r]) + np.float64(dist[r])
-        total[r] = t
-        if r >= n_beams and face[r] >= 0 and t >= min_range and t < max_range:
-            count[beam[r] + 1] += 1
-    for q in range(n_beams):
-        count[q + 1] += count[q]
-    extra = np.empty(count[n_beams], np.int64)
-    fill = count[:n_beams].copy()
-    for r in range(n_beams, n):
-        if face[r] >= 0 and total[r] >= min_range and total[r] < max_range:
-            extra[fill[beam[r]]] = r
-            fill[beam[r]] += 1
+    extra = np.empty(0, np.int64)
+    if n > n_beams:
+        for r in range(n_beams, n):
+            t = np.float64(offset[r]) + np.float64(dist[r])
+            total[r] = t
+            if face[r] >= 0 and t >= min_range and t < max_range:
+                count[beam[r] + 1] += 1
+        for q in range(n_beams):
+            count[q + 1] += count[q]
+        extra = np.empty(count[n_beams], np.int64)
+        fill = count[:n_beams].copy()
+        for r in range(n_beams, n):
+            if face[r] >= 0 and total[r] >= min_range and total[r] < max_range:
+                extra[fill[beam[r]]] = r
+                fill[beam[r]] += 1
     n_l = ring_of.shape[0]
     m = 0
     cap = 64
@@ -133,7 +135,9 @@ def beam_returns(out, n_beams, ray0, beam, weight, offset, tau, dist, face, d_f,
     c_rep = np.empty(cap, np.int64)
     c_mix = np.zeros(cap, np.bool_)
     for q in range(n_beams):
-        central = face[q] >= 0 and total[q] >= min_range and total[q] < max_range
+        t = np.float64(offset[q]) + np.float64(dist[q])
+        total[q] = t
+        central = face[q] >= 0 and t >= min_range and t < max_range
         lo, hi = count[q], count[q + 1]
         ne = hi - lo + (1 if central else 0)
         if ne == 0:
