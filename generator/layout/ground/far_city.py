@@ -14,7 +14,8 @@ town with a low-detail city, so the view out of town ends in more town:
   ``SKYLINE_M``, and round the ring's far edge a gapless band of 30-95 m towers, so no street of the
   block grid opens onto the bare horizon.
 
-One object per block, park and side of the tree line, in the world frame (identity transforms), so
+One object per block, park and side of the tree line (made here in the world frame; the scene places
+each at its footprint's centre, :func:`generator.layout.assemble.build_scene`), so
 Blender and the LiDAR (which reaches 120 m and rarely meets it) share the same few triangles: about
 30 k round a default town (which has about 1.3 M). The draws come from the stream
 ``("layout", "far_city")`` only, so the town's own draws are untouched, and nothing stands within
