@@ -70,16 +70,14 @@ def _cast_subrays(scanner, plan, cols, aimed, o_w, d_world, beam_rows, which, pa
     return {"o": o, "dw": dw, "df": d, "dist": dist, "face": face, "inst": inst, "moving": moving, "beam": beam}
 
 
-def _constants(scanner, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Read-only (n,) float32 zeros and ones and int64 ``0 .. n - 1`` (the central rays' offset, glass
-    transmission and beam), made once per scanner instead of once per chunk and sweep."""
-    c = getattr(scanner, "_chunk_constants", None)
-    if c is None or len(c[0]) < n:
-        c = (np.zeros(n, np.float32), np.ones(n, np.float32), np.arange(n, dtype=np.int64))
-        for a in c:
-            a.flags.writeable = False
-        scanner._chunk_constants = c
-    return c[0][:n], c[1][:n], c[2][:n]
+def central_constants(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Read-only (n,) float32 zeros and ones and int64 ``0 .. n - 1``: the central rays' offset, glass
+    transmission and beam (:attr:`generator.lidar.scan.Scanner.central_constants`, made once per scanner
+    for its largest chunk instead of once per chunk and sweep)."""
+    c = (np.zeros(n, np.float32), np.ones(n, np.float32), np.arange(n, dtype=np.int64))
+    for a in c:
+        a.flags.writeable = False
+    return c
 
 
 def run_physical_chunk(scanner, sweep, i: int, cols: slice) -> None:
@@ -114,7 +112,7 @@ def run_physical_chunk(scanner, sweep, i: int, cols: slice) -> None:
                                 side)
             edge, side = edge[:n_edge], side[:n_edge]
         weight = np.ones(n_in, np.float32)
-        zeros, ones, rows = _constants(scanner, n_in)
+        zeros, ones, rows = (c[:n_in] for c in scanner.central_constants)
         parts = {"o": [o_w[i0:i1]], "dw": [d_world[i0:i1]], "df": [d_w[i0:i1]], "dist": [dist[i0:i1]],
                  "face": [face[i0:i1]], "inst": [inst[i0:i1]], "moving": [moving[i0:i1]],
                  "beam": [rows], "weight": [weight], "offset": [zeros], "tau": [ones]}

@@ -37,7 +37,7 @@ import numpy as np
 from generator.lidar.actors import ActorCaster
 from generator.lidar.caster import RayCaster, make_caster
 from generator.lidar.kernels import returns, world_rays
-from generator.lidar.physical_chunk import FaceLookup, run_physical_chunk
+from generator.lidar.physical_chunk import FaceLookup, central_constants, run_physical_chunk
 from generator.lidar.points import POINT_DTYPE, RecordTables
 from generator.lidar.returns import ReturnModel
 from generator.lidar.sensors import Sensor
@@ -144,6 +144,9 @@ class Scanner:
         n_chunks = min(steps, self.threads * max(1, chunks_per_thread))
         edges = np.linspace(0, steps, n_chunks + 1).round().astype(int)
         self._chunks = [slice(a, b) for a, b in itertools.pairwise(edges) if b > a]
+        #: the central rays' offsets, transmissions and beams of the largest chunk (physical returns only)
+        self.central_constants = (central_constants(max(c.stop - c.start for c in self._chunks) * sensor.n_lasers)
+                                  if self.returns is not None else None)
         self._pool = ThreadPoolExecutor(self.threads, thread_name_prefix="lidar") if self.threads > 1 else None
 
     def close(self) -> None:
