@@ -53,10 +53,12 @@ def test_seed002_processing_shows_as_the_three_differences_it_adds(pair, tmp_pat
     kept = 1 - np.array(lost["raw"])
     # 1. rays lost: a 10 % dropout of the returns adds 0.1 x (1 - loss) per ring, on average over the rings
     assert d["rays_lost_per_ring"] == pytest.approx(0.1 * kept.mean(), rel=0.1)
-    # ... at every range: near bins lose 10 % more of their rays (jittered points sharing a cell are not losses)
+    # ... at every range: near bins lose 10 % more of their rays (jittered points sharing a cell are not losses);
+    # within 5 m more than that: a 5 cm jitter there moves a point by over a column (0.17 deg) and ring
+    # (0.4 deg), out of its own cell, which then counts as lost (measured 0.15 at 0-5 m, 0.07-0.10 beyond)
     per_range = rep["metrics"]["rays_lost_per_range"]["curves"]
     added = np.array(per_range["seed002"][:6]) - np.array(per_range["raw"][:6])  # 0-30 m
-    assert np.abs(added - 0.1).max() < 0.05, added
+    assert np.abs(added[1:] - 0.1).max() < 0.05 and 0.08 < added[0] < 0.25, added
     # the dropout is uniform in range: the range distribution of the points stays the same
     assert d["points_per_range"] < 0.02
     # 2. rings: +-5 cm jitter moves points centimetres off their cone and along their ring
