@@ -372,27 +372,58 @@ def time_compare(args) -> int:
     return 0
 
 
+def _checkout(text: str) -> str:
+    """An urbangen checkout (a folder holding ``generator/``), for ``--code-root`` / ``--baseline``."""
+    if not (Path(text) / "generator" / "__init__.py").is_file():
+        raise argparse.ArgumentTypeError(f"{text}: not an urbangen checkout (no generator/ package in it)")
+    return text
+
+
+def _folder(text: str) -> str:
+    """An existing folder (the crops of a ``render`` run)."""
+    if not Path(text).is_dir():
+        raise argparse.ArgumentTypeError(f"{text}: no such folder")
+    return text
+
+
+def _positive(text: str) -> int:
+    try:
+        n = int(text)
+    except ValueError:
+        n = 0
+    if n < 1:
+        raise argparse.ArgumentTypeError(f"must be a whole number >= 1, got {text!r}")
+    return n
+
+
+def _spec_file(text: str) -> Path:
+    if not Path(text).is_file():
+        raise argparse.ArgumentTypeError(f"{text}: no such spec file")
+    return Path(text)
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     sub = ap.add_subparsers(dest="cmd", required=True)
     r = sub.add_parser("render", help="render the crops of one tree")
     r.add_argument("out", help="folder for the crops and sheet.png")
-    r.add_argument("--spec", type=Path, default=ROOT / "scenes" / "default_town.json")
-    r.add_argument("--code-root", default=None, help="the urbangen checkout to render with (default: this one)")
+    r.add_argument("--spec", type=_spec_file, default=ROOT / "scenes" / "default_town.json")
+    r.add_argument("--code-root", type=_checkout, default=None,
+                   help="the urbangen checkout to render with (default: this one)")
     r.add_argument("--size", default="640x360", help="WIDTHxHEIGHT of every crop")
-    r.add_argument("--samples", type=int, default=12, help="Cycles samples (denoised)")
+    r.add_argument("--samples", type=_positive, default=12, help="Cycles samples (denoised)")
     r.add_argument("--only", nargs="*", default=["ground", "horizon"],
                    choices=["ground", "horizon", "trees", "facades", "road"])
     r.add_argument("--shots", nargs="*", default=None, help="render only these shots (file stems)")
     c = sub.add_parser("compare", help="before | after sheets of two render runs")
-    c.add_argument("before")
-    c.add_argument("after")
+    c.add_argument("before", type=_folder)
+    c.add_argument("after", type=_folder)
     c.add_argument("out")
     t = sub.add_parser("time", help="preview-preset render time of a baseline checkout beside this tree")
-    t.add_argument("--baseline", required=True, help="the checkout to compare with (e.g. main)")
-    t.add_argument("--spec", type=Path, default=ROOT / "scenes" / "default_town.json")
-    t.add_argument("--frames", type=int, default=3)
-    t.add_argument("--rounds", type=int, default=2)
+    t.add_argument("--baseline", type=_checkout, required=True, help="the checkout to compare with (e.g. main)")
+    t.add_argument("--spec", type=_spec_file, default=ROOT / "scenes" / "default_town.json")
+    t.add_argument("--frames", type=_positive, default=3)
+    t.add_argument("--rounds", type=_positive, default=2)
     o = sub.add_parser("_time_one")
     o.add_argument("--code-root", required=True)
     o.add_argument("--spec", type=Path, required=True)

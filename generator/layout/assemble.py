@@ -204,8 +204,7 @@ def _far_city(spec: SceneSpec, grid: Grid, prototypes: dict[str, Mesh], proxies:
         prototypes[name] = mesh
         proxy = None
         if cls == "vegetation":
-            proxies[name] = proxy = mesh
-            proxy = name
+            proxies[name], proxy = mesh, name
         lo, hi = mesh.bounds()
         objects.append(SceneObject(len(objects), name, kind, cls, 0, name, T, box_of(lo, hi, T), proxy,
                                    {"lot": None}))
