@@ -12,7 +12,7 @@ import numpy as np
 
 from assets_procedural.building import building
 from assets_procedural.fence import fence
-from assets_procedural.ground_pieces import driveway_apron, gravel_patch, median_strip, traffic_island
+from assets_procedural.ground_pieces import driveway_apron, gravel_patch, median_strip, traffic_island, verge_crossing
 from assets_procedural.motorcycles import motorcycle
 from assets_procedural.person import person
 from assets_procedural.proto_cache import CACHE
@@ -75,6 +75,7 @@ BUILDERS: dict[str, Callable[..., Mesh]] = {
     "traffic_island": traffic_island,
     "median_strip": median_strip,
     "driveway_apron": driveway_apron,
+    "verge_crossing": verge_crossing,
     "gravel_patch": gravel_patch,
     "bench": bench,
     "bin": litter_bin,
@@ -117,6 +118,7 @@ MAIN_CLASS: dict[str, str] = {
     "traffic_island": "other_ground",
     "median_strip": "other_ground",
     "driveway_apron": "other_ground",
+    "verge_crossing": "other_ground",
     "gravel_patch": "other_ground",
     "bench": "street_object",
     "bin": "street_object",

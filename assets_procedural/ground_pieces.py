@@ -1,5 +1,5 @@
-"""Ground pieces labelled ``other_ground``: traffic islands, median strips, driveway aprons and
-gravel patches (SemanticKITTI other-ground 49, Cityscapes ground 6).
+"""Ground pieces labelled ``other_ground``: traffic islands, median strips, driveway aprons, verge
+crossings and gravel patches (SemanticKITTI other-ground 49, Cityscapes ground 6).
 
 Local frame: z up, the bottom at z = 0 (the layout lays them on the road or terrain surface),
 origin at the centre of the footprint. Islands and medians run along x and are raised like a
@@ -153,6 +153,38 @@ def driveway_apron(rng: np.random.Generator, width: float | None = None, depth: 
     c, mside = resolve_ids(CLS, "curb_concrete")
     _, mtop = resolve_ids(CLS, mat)
     return centred(Mesh(v, np.array(faces), c, [mtop, mtop] + [mside] * 8))
+
+
+def verge_crossing(rng: np.random.Generator, width: float | None = None, depth: float | None = None) -> Mesh:
+    """A paved crossing of a grass verge: the hard-standing a house's driveway or path lays across
+    the verge between the kerb and the sidewalk, a slab 2.5 cm thick (the layout sinks it 5 mm into
+    the grass, so it stands 2 cm proud). Width along x, depth (across the verge) along y.
+
+    Parameters
+    ----------
+    width : float, optional
+        Along x, metres (2-8); drawn (3-4.5) when omitted.
+    depth : float, optional
+        Along y, metres (0.5-6); drawn (2-3) when omitted.
+
+    Returns
+    -------
+    Mesh
+        Class ``other_ground``; the top paving (``block_paving``, ``sidewalk_concrete`` or
+        ``parking_asphalt``, drawn), the sides ``curb_concrete``.
+    """
+    W = float(rng.uniform(3.0, 4.5)) if width is None else float(width)
+    D = float(rng.uniform(2.0, 3.0)) if depth is None else float(depth)
+    if not (2.0 <= W <= 8.0 and 0.5 <= D <= 6.0):
+        raise ValueError(f"verge_crossing needs width in [2, 8] and depth in [0.5, 6] m, got {W}, {D}")
+    top = str(rng.choice(["block_paving", "sidewalk_concrete", "parking_asphalt"]))
+    outline = np.array([(-W / 2, -D / 2), (W / 2, -D / 2), (W / 2, D / 2), (-W / 2, D / 2)])
+    slab = prism(outline, 0.0, 0.025, CLS, "curb_concrete")
+    up = face_normals(slab)[:, 2] > 0.5
+    _, m = resolve_ids(CLS, top)
+    slab.face_material[up] = m
+    keep = face_normals(slab)[:, 2] > -0.5             # no bottom: it lies on the grass
+    return centred(slab.select(keep))
 
 
 def gravel_patch(rng: np.random.Generator, size: float | None = None) -> Mesh:

@@ -62,7 +62,8 @@ STEPS = (
     ("lamp posts", lambda p, s, g, lots, st: ps.place_lamps(p, s, st)),
     ("street trees", lambda p, s, g, lots, st: ps.place_street_trees(p, s, st)),
     # verges exist only in towns with a streets spec (no-ops otherwise)
-    # (residential verge hedges first: the verge trees then stand in their gaps)
+    # (paved crossings first, then residential verge hedges: the verge trees then stand in their gaps)
+    ("verge crossings", lambda p, s, g, lots, st: pv.place_verge_crossings(p, s, lots, st)),
     ("verge hedges and bushes", lambda p, s, g, lots, st: pv.place_verge_bushes(p, s, st)),
     ("verge trees", lambda p, s, g, lots, st: pv.place_verge_trees(p, s, st)),
     ("traffic signs", lambda p, s, g, lots, st: ps.place_signs(p, s, st)),
