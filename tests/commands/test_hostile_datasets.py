@@ -93,34 +93,40 @@ def _write_images(root: Path, scene, spec, n: int, width: int = 96, height: int 
         (root / "images" / f"{name}.json").write_text(json.dumps(rec))
 
 
-# session scope: each pytest-xdist worker builds its own (a few seconds), so the properties below spread over
-# both workers instead of queueing on the one that holds a module-scoped dataset
+# the dataset is made once per test run (kits.shared_build) and read on both pytest-xdist workers, so the
+# properties below spread over both instead of queueing on the one that would hold a module-scoped dataset;
+# each worker builds the scene of its spec (the same scene: same spec, same town)
 @pytest.fixture(scope="session")
 def built_kit(tmp_path_factory):
     """(the kit, the scene its spec builds); read-only."""
-    from generator.jobs.boxes import write_sequence_openlabel
-    from generator.jobs.lidar_sequence import SequenceOptions, write_sequence
     from generator.layout import assemble
     from generator.spec import load_spec
+    from kits.shared_build import SharedBuild
 
-    base = tmp_path_factory.mktemp("hostile-ds")
-    doc = load_spec(ROOT / "scenes" / "test_town.json").to_dict()
-    doc["sensors"]["lidar"]["preset"] = "vlp16"  # a quarter of the points of the HDL-64E: faster runs
-    spec_path = base / "spec" / "town.json"
-    spec_path.parent.mkdir()
-    spec_path.write_text(json.dumps(doc))
-    spec = load_spec(spec_path)
-    scene = assemble.build_scene(spec)
-    root = base / "clean"
-    _write_images(root, scene, spec, 2)
-    write_sequence(scene, spec, root / "lidar", SequenceOptions(frames=2, threads=2, bev=False), progress=False)
-    write_sequence_openlabel(spec, root, "00", scene=scene)
-    outside = base / "outside"
-    outside.mkdir()
-    (outside / "secret.txt").write_text(f"{SECRET}\n" * 4)
-    (outside / "000000.bin").write_text(SECRET)
+    def build(base: Path) -> None:
+        from generator.jobs.boxes import write_sequence_openlabel
+        from generator.jobs.lidar_sequence import SequenceOptions, write_sequence
+
+        doc = load_spec(ROOT / "scenes" / "test_town.json").to_dict()
+        doc["sensors"]["lidar"]["preset"] = "vlp16"  # a quarter of the points of the HDL-64E: faster runs
+        spec_path = base / "spec" / "town.json"
+        spec_path.parent.mkdir(parents=True)
+        spec_path.write_text(json.dumps(doc))
+        spec = load_spec(spec_path)
+        scene = assemble.build_scene(spec)
+        root = base / "clean"
+        _write_images(root, scene, spec, 2)
+        write_sequence(scene, spec, root / "lidar", SequenceOptions(frames=2, threads=2, bev=False), progress=False)
+        write_sequence_openlabel(spec, root, "00", scene=scene)
+        outside = base / "outside"
+        outside.mkdir()
+        (outside / "secret.txt").write_text(f"{SECRET}\n" * 4)
+        (outside / "000000.bin").write_text(SECRET)
+
+    base = SharedBuild(tmp_path_factory, "hostile-ds", build).path()
+    spec_path, root = base / "spec" / "town.json", base / "clean"
     files = sorted(str(p.relative_to(root)) for p in root.rglob("*"))
-    return Kit(root, spec_path, outside, files), scene
+    return Kit(root, spec_path, base / "outside", files), assemble.build_scene(load_spec(spec_path))
 
 
 @pytest.fixture
@@ -422,7 +428,7 @@ PLY_TOKENS = [MARKER, "-5", "9" * 30, "1e3", "", "list uchar int", "double", "as
               "face 3", "property", "element", "end_header"]
 
 
-@pytest.fixture(scope="session")  # per worker, as the kit above
+@pytest.fixture(scope="session")  # per worker
 def town(tmp_path_factory) -> Path:
     from kits.carla_town import make_town
 

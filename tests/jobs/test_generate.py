@@ -22,6 +22,7 @@ from generator.jobs.frameset import FrameSet
 from generator.jobs.journal import Journal, combo_mask
 from generator.jobs.plan import make_plan
 from kits.paths import ROOT
+from kits.shared_build import SharedBuild
 from kits.stand_in_run import COMBOS, run, spec_with_towns
 
 Usage = namedtuple("Usage", "total used free")
@@ -51,13 +52,14 @@ def _resume(out: Path) -> None:
     run(out, int(FRAMES), int(EVERY))
 
 
-# session scope: each pytest-xdist worker makes its own reference (a few seconds), so the kill tests below
-# spread over both workers instead of queueing on the one that holds a module-scoped reference
+# made once per test run (kits.shared_build) and read by the kill tests below on both pytest-xdist workers,
+# so they spread over both instead of queueing on the one that would hold a module-scoped reference
 @pytest.fixture(scope="session")
 def reference(tmp_path_factory):
-    out = tmp_path_factory.mktemp("standin") / "ref"
-    assert _kit(out).returncode == 0
-    return out
+    def build(folder: Path) -> None:
+        assert _kit(folder / "ref").returncode == 0
+
+    return SharedBuild(tmp_path_factory, "standin_reference", build).path() / "ref"
 
 
 def test_a_stand_in_run_records_every_item_once(reference):

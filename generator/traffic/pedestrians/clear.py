@@ -82,6 +82,20 @@ def _tiles(boxes: np.ndarray) -> np.ndarray:
     return np.concatenate(out) if out else np.zeros((0, 7))
 
 
+def _footprint_rects(scene, objects) -> np.ndarray:
+    """(m, 4) world rectangles ``(x0, y0, x1, y1)`` enclosing each object's prototype bounds under its
+    yaw-only transform: every collision band (and so every tile) of the object lies inside."""
+    bounds: dict[str, np.ndarray] = {}
+    out = np.empty((len(objects), 4))
+    for k, o in enumerate(objects):
+        if o.prototype not in bounds:
+            bounds[o.prototype] = scene.prototypes[o.prototype].bounds()
+        (x0, y0, _), (x1, y1, _) = bounds[o.prototype]
+        xy = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]]) @ o.transform[:2, :2].T + o.transform[:2, 3]
+        out[k] = (*xy.min(0), *xy.max(0))
+    return out
+
+
 class Obstacles:
     """The static obstacles a walker's box may not overlap.
 
@@ -93,14 +107,20 @@ class Obstacles:
         Bands starting at or above this height (metres, world z) are ignored (above every head).
     keep : callable, optional
         ``keep(xy) -> (n,) bool`` for (n, 2) tile centres: tiles far from every walkway can be dropped.
+    near : callable, optional
+        ``near(rects) -> (m,) bool`` for (m, 4) world rectangles ``(x0, y0, x1, y1)``, each enclosing
+        an object's footprint (its prototype's bounds under its transform): False only where ``keep``
+        is False at every point of the rectangle. Such objects (the far city) are skipped before their
+        collision bands are made and tiled: the tiles are the same, the work is not.
     """
 
-    def __init__(self, scene, top: float, keep=None):
+    def __init__(self, scene, top: float, keep=None, near=None):
         cache: dict[str, np.ndarray] = {}
         rows = []
-        for o in scene.objects:
-            if o.cls in GROUND_CLASSES:
-                continue
+        objects = [o for o in scene.objects if o.cls not in GROUND_CLASSES]
+        if near is not None and objects:
+            objects = [o for o, ok in zip(objects, near(_footprint_rects(scene, objects)), strict=True) if ok]
+        for o in objects:
             if o.prototype not in cache:
                 cache[o.prototype] = collision_boxes(scene.prototypes[o.prototype], whole=o.kind in WHOLE_BOX_KINDS)
             wb = world_boxes(cache[o.prototype], o.transform)

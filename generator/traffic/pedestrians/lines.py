@@ -100,6 +100,23 @@ def street_distance(grid: Grid, xy: np.ndarray) -> np.ndarray:
     return d
 
 
+def street_distance_bound(grid: Grid, rects: np.ndarray) -> np.ndarray:
+    """(m,) float64: a lower bound of :func:`street_distance` over each of the (m, 4) rectangles
+    ``(x0, y0, x1, y1)`` -- the least L-infinity distance from the rectangle to the street centre
+    segments (exact, as the distance is a max of one x and one y term per segment; a closed street
+    only raises :func:`street_distance`)."""
+    r = np.asarray(rects, np.float64).reshape(-1, 4)
+    xs, ys = grid.xs, grid.ys
+    zero = np.zeros(len(r))
+    out_x = np.maximum.reduce([xs[0] - r[:, 2], r[:, 0] - xs[-1], zero])
+    out_y = np.maximum.reduce([ys[0] - r[:, 3], r[:, 1] - ys[-1], zero])
+    gap_y = np.maximum(np.maximum(r[:, 1, None] - ys[None], ys[None] - r[:, 3, None]), 0.0)
+    gap_x = np.maximum(np.maximum(r[:, 0, None] - xs[None], xs[None] - r[:, 2, None]), 0.0)
+    d_ew = np.maximum(gap_y, out_x[:, None]).min(1)
+    d_ns = np.maximum(gap_x, out_y[:, None]).min(1)
+    return np.minimum(d_ew, d_ns)
+
+
 def lines(grid: Grid, offs: tuple[float, ...]) -> dict[tuple[int, int, int, int], Line]:
     """Every line, keyed ``(axis, street index, side, family)``."""
     out = {}

@@ -32,6 +32,7 @@ from generator.traffic.pedestrians.lines import (
     lane_offsets,
     lines,
     street_distance,
+    street_distance_bound,
     turns,
 )
 from generator.world.scene import Path
@@ -133,8 +134,10 @@ def _shift_rows(grid: Grid, line: Line, t: np.ndarray, offs, obstacles: wc.Obsta
 
 def obstacles_of(grid: Grid, scene, body: wc.Body) -> wc.Obstacles:
     """The static obstacles of ``scene`` a walker of ``body`` can meet on the pavement of ``grid``."""
-    return wc.Obstacles(scene, grid.curb_h + body.height + 0.1,
-                        keep=lambda xy: street_distance(grid, xy) < grid.corridor_half + 2.0)
+    reach = grid.corridor_half + 2.0
+    # near: objects wholly beyond ``reach`` (+ 1 um for the tiles' rounding) of every street need no tiles
+    return wc.Obstacles(scene, grid.curb_h + body.height + 0.1, keep=lambda xy: street_distance(grid, xy) < reach,
+                        near=lambda rects: street_distance_bound(grid, rects) < reach + 1e-6)
 
 
 def build_walkways(grid: Grid, obstacles: wc.Obstacles, body: wc.Body) -> Walkways:

@@ -192,13 +192,22 @@ def test_no_pedestrian_enters_a_static_object(town, tracks, test_scene):
             bands.append(wb)
     bands = np.concatenate(bands)            # (m, 7): cx, cy, hx, hy, yaw, z0, z1
     quads_b = _corners(bands[:, :2], bands[:, 2:4], bands[:, 4])
-    tree = cKDTree(bands[:, :2])
-    reach = np.hypot(bands[:, 2], bands[:, 3]).max() + 1.0
+    # broad phase: a pedestrian can touch a band only within the band's and its own bounding radii;
+    # small bands by a k-d tree at the largest small radius, large ones (buildings, fences, the far
+    # city's blocks and tree lines, up to ~100 m) each at its own radius
+    r_ped = max(1.0, float(np.hypot(*np.abs([lo[:, :2], hi[:, :2]]).max((0, 1)))) * 2)
+    r_band = np.hypot(bands[:, 2], bands[:, 3])
+    small, large = np.flatnonzero(r_band <= 3.0), np.flatnonzero(r_band > 3.0)
+    tree = cKDTree(bands[small, :2])
+    reach = r_band[small].max() + r_ped
     for t in range(0, xyz.shape[1], 2):
         quads, z = _footprints(xyz, yaw, lo, hi, t)
         near = tree.query_ball_point(xyz[:, t, :2], reach)
         i = np.repeat(np.arange(len(near)), [len(n) for n in near])
-        j = np.concatenate([np.asarray(n, int) for n in near])
+        j = small[np.concatenate([np.asarray(n, int) for n in near])]
+        il, jl = np.nonzero(np.linalg.norm(xyz[:, t, None, :2] - bands[None, large, :2], axis=-1)
+                            <= r_band[large] + r_ped)
+        i, j = np.r_[i, il], np.r_[j, large[jl]]
         hit = _overlap(quads[i], quads_b[j]) & (z[i, 0] < bands[j, 6]) & (bands[j, 5] < z[i, 1])
         assert not hit.any(), f"t={t * DT_S:.2f}: pedestrian {i[hit][0]} inside a static object"
 
