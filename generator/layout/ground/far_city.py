@@ -14,10 +14,15 @@ town with a low-detail city, so the view out of town ends in more town:
   ``SKYLINE_M``, and round the ring's far edge a gapless band of 30-95 m towers, so no street of the
   block grid opens onto the bare horizon.
 
-One object per block, park and side of the tree line (made here in the world frame; the scene places
-each at its footprint's centre, :func:`generator.layout.assemble.build_scene`), so
-Blender and the LiDAR (which reaches 120 m and rarely meets it) share the same few triangles: about
-30 k round a default town (which has about 1.3 M). The draws come from the stream
+Twelve objects in all (made here in the world frame; the scene places each at its footprint's
+centre, :func:`generator.layout.assemble.build_scene`): the tree line's four sides, the blocks and
+parks of the ring's four sides (south, north, west, east: rectangles of whole rows and columns of
+the block grid that meet neither each other, the tree line nor the town), and the far edge's four
+sides. Every Blender object costs the RGB and label passes (Cycles syncs and instances each), and
+a scene of one object per block held ~870 more of them; joined, the far city adds a dozen and keeps
+every triangle, class and material (each building stays its own mesh island for the facade
+shader). Blender and the LiDAR (which reaches 120 m and rarely meets it) share the same few
+triangles: about 30 k round a default town (which has about 1.3 M). The draws come from the stream
 ``("layout", "far_city")`` only, so the town's own draws are untouched, and nothing stands within
 ``TREE_LINE_M - 2 - CROWN_R_M[1]`` (33 m) of the town bounds.
 """
@@ -26,7 +31,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from generator.geometry import Mesh
+from generator.geometry import Mesh, merge
 from generator.labels import class_table
 from generator.materials import material_table
 from generator.rng import stream
@@ -78,8 +83,20 @@ def _crowns(xy: np.ndarray, r: np.ndarray, h: np.ndarray, z0: float) -> tuple[np
     return v, f
 
 
-def _ring_cells(bounds: np.ndarray) -> np.ndarray:
-    """(n, 4) ``(x0, y0, x1, y1)`` block rectangles of the grid in the ring round ``bounds``."""
+def _ring_cells(bounds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The block rectangles of the grid in the ring round ``bounds`` and the side each belongs to.
+
+    Returns
+    -------
+    cells : (n, 4) float64
+        ``(x0, y0, x1, y1)`` per block, rows of the grid in order, metres.
+    side : (n,) int64
+        0 south, 1 north, 2 west, 3 east: whole rows of blocks below the town's ``BLOCKS_FROM_M``
+        line are south, whole rows above it north, the blocks of the rows between (beside the
+        town) west or east. Each side's blocks lie in a rectangle that meets no other side's, the
+        tree line or the town (the rows between begin a street above the last south row), so a
+        side joined into one object has a footprint (even its convex hull) that touches nothing.
+    """
     (bx0, by0), (bx1, by1) = bounds
     c = np.array([(bx0 + bx1) / 2, (by0 + by1) / 2])
     half = np.array([(bx1 - bx0) / 2, (by1 - by0) / 2])
@@ -93,7 +110,8 @@ def _ring_cells(bounds: np.ndarray) -> np.ndarray:
     gap = np.maximum(np.maximum(bx0 - x1, x0 - bx1), np.maximum(by0 - y1, y0 - by1))
     far = np.maximum(np.maximum(bx0 - x0, x1 - bx1), np.maximum(by0 - y0, y1 - by1))
     keep = (gap >= BLOCKS_FROM_M) & (far <= REACH_M)
-    return np.stack([x0, y0, x1, y1], 1)[keep]
+    side = np.select([by0 - y1 >= BLOCKS_FROM_M, y0 - by1 >= BLOCKS_FROM_M, bx0 - x1 >= BLOCKS_FROM_M], [0, 1, 2], 3)
+    return np.stack([x0, y0, x1, y1], 1)[keep], side[keep]
 
 
 def _distance(bounds: np.ndarray, xy: np.ndarray) -> np.ndarray:
@@ -117,10 +135,12 @@ def far_city(seed: int, bounds: np.ndarray, z0: float) -> list[tuple[str, str, M
     Returns
     -------
     list of (kind, cls, Mesh)
-        ``("far_trees", "vegetation", ...)`` per side of the tree line, then per block of the ring
-        (rows of the grid in order) ``("far_block", "building", ...)`` (walls ``far_facade``, roofs
-        ``roof``) or ``("far_park", "vegetation", ...)`` (crowns of material ``leaves``). One object
-        per block keeps every object's box the size of its block (no box encloses the town).
+        ``("far_trees", "vegetation", ...)`` per side of the tree line (crowns of material
+        ``leaves``), then ``("far_blocks", "building", ...)`` per side of the ring that holds blocks
+        (buildings of class building, walls ``far_facade`` and roofs ``roof``; parks' crowns of
+        class vegetation, material ``leaves``), then ``("far_skyline", "building", ...)`` per side
+        of the far edge. No two of these meshes' footprints (nor their convex hulls or bounding
+        boxes) overlap, and none encloses the town.
     """
     rng = stream(seed, "layout", "far_city")
     bounds = np.asarray(bounds, np.float64)
@@ -138,12 +158,14 @@ def far_city(seed: int, bounds: np.ndarray, z0: float) -> list[tuple[str, str, M
         out_dir = np.array([u[1], -u[0]])                                        # away from the town
         xy = a + s[:, None] * u + out_dir * rng.uniform(-2.0, 6.0, n)[:, None]
         out.append(("far_trees", "vegetation", _crown_mesh(rng, xy, z0)))
-    for x0, y0, x1, y1 in _ring_cells(bounds):
+    cells, sides = _ring_cells(bounds)
+    parts: list[list[Mesh]] = [[] for _ in range(4)]
+    for (x0, y0, x1, y1), side in zip(cells, sides, strict=True):
         d = float(_distance(bounds, np.array([[(x0 + x1) / 2, (y0 + y1) / 2]]))[0])
         if rng.uniform() < PARK_SHARE:
             m = int(rng.integers(3, 7))
             xy = np.stack([rng.uniform(x0 + 6, x1 - 6, m), rng.uniform(y0 + 6, y1 - 6, m)], 1)
-            out.append(("far_park", "vegetation", _crown_mesh(rng, xy, z0)))
+            parts[side].append(_crown_mesh(rng, xy, z0))
             continue
         blocks = []
         if d > SKYLINE_M and rng.uniform() < TOWER_SHARE:
@@ -159,7 +181,8 @@ def far_city(seed: int, bounds: np.ndarray, z0: float) -> list[tuple[str, str, M
                     g = rng.uniform(0.0, 3.0, 4)                                 # gaps and setbacks
                     h = rng.uniform(*LOW_H_M) * (1.0 + 0.6 * min(d / SKYLINE_M, 1.0))
                     blocks.append((xs[i] + g[0], ys[j] + g[1], z0, xs[i + 1] - g[2], ys[j + 1] - g[3], z0 + h))
-        out.append(("far_block", "building", _block_mesh(rng, np.array(blocks, np.float64))))
+        parts[side].append(_block_mesh(rng, np.array(blocks, np.float64)))
+    out += [("far_blocks", "building", merge(p)) for p in parts if p]
     # the skyline's far edge: a gapless wall of towers round the ring, so no street between the blocks
     # leads the eye to the bare horizon (one object per side; the south and north sides span the corners)
     e = REACH_M + 10.0
@@ -178,7 +201,7 @@ def far_city(seed: int, bounds: np.ndarray, z0: float) -> list[tuple[str, str, M
             b = np.stack([cuts[:-1], np.full_like(h, y0), np.full_like(h, z0), cuts[1:], np.full_like(h, y1), h], 1)
         else:
             b = np.stack([np.full_like(h, x0), cuts[:-1], np.full_like(h, z0), np.full_like(h, x1), cuts[1:], h], 1)
-        out.append(("far_block", "building", _block_mesh(rng, b)))
+        out.append(("far_skyline", "building", _block_mesh(rng, b)))
     return out
 
 
