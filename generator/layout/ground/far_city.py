@@ -49,6 +49,7 @@ SKYLINE_M = 550.0             #: beyond this distance from the bounds, towers ap
 TOWER_SHARE = 0.35            #: share of the blocks beyond SKYLINE_M that hold one tower
 LOW_H_M, TOWER_H_M = (9.0, 24.0), (35.0, 120.0)
 WALL_DEPTH_M, WALL_H_M = 35.0, (30.0, 95.0)  #: the gapless band of towers at the ring's far edge
+SIDE_GAP_M = 2.0             #: the band's west and east sides stop this short of the south and north sides
 
 #: Unit box: 8 corners (x, y, z in {0, 1}) and its 10 triangles without the bottom (walls, then roof).
 _BOX_V = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]], float)
@@ -184,12 +185,14 @@ def far_city(seed: int, bounds: np.ndarray, z0: float) -> list[tuple[str, str, M
         parts[side].append(_block_mesh(rng, np.array(blocks, np.float64)))
     out += [("far_blocks", "building", merge(p)) for p in parts if p]
     # the skyline's far edge: a gapless wall of towers round the ring, so no street between the blocks
-    # leads the eye to the bare horizon (one object per side; the south and north sides span the corners)
-    e = REACH_M + 10.0
+    # leads the eye to the bare horizon (one object per side; the south and north sides span the
+    # corners, the west and east sides keep SIDE_GAP_M from them, so no two sides' boxes touch: a
+    # slit 35 m deep that no line of sight from the town crosses)
+    e, g = REACH_M + 10.0, SIDE_GAP_M
     sides = [((bx0 - e - WALL_DEPTH_M, by0 - e - WALL_DEPTH_M), (bx1 + e + WALL_DEPTH_M, by0 - e), 0),
              ((bx0 - e - WALL_DEPTH_M, by1 + e), (bx1 + e + WALL_DEPTH_M, by1 + e + WALL_DEPTH_M), 0),
-             ((bx0 - e - WALL_DEPTH_M, by0 - e), (bx0 - e, by1 + e), 1),
-             ((bx1 + e, by0 - e), (bx1 + e + WALL_DEPTH_M, by1 + e), 1)]
+             ((bx0 - e - WALL_DEPTH_M, by0 - e + g), (bx0 - e, by1 + e - g), 1),
+             ((bx1 + e, by0 - e + g), (bx1 + e + WALL_DEPTH_M, by1 + e - g), 1)]
     for (x0, y0), (x1, y1), axis in sides:
         a0, a1 = (x0, x1) if axis == 0 else (y0, y1)
         cuts = [a0]
