@@ -190,7 +190,7 @@ def _far_city(spec: SceneSpec, grid: Grid, prototypes: dict[str, Mesh], proxies:
     so every town object keeps its index; returns the index of the first far-city object.
 
     Each object stands where its footprint's centre is (its transform; the mesh local to it), on no
-    lot of the town (``attrs["lot"]`` None), as stuff (instance 0). Crowns are solid double cones,
+    lot of the town (``attrs["lot"]`` None), as stuff (instance 0). Crowns are closed solids,
     so the label proxy of an object with crowns (vegetation's hull policy) is its crowns themselves,
     without a hull that would fill the gaps between the trees (or cover the buildings beside a park)."""
     start = len(objects)

@@ -5,7 +5,7 @@ from a street showed a green plane meeting the sky. This module fills the ground
 town with a low-detail city, so the view out of town ends in more town:
 
 * a tree line (class vegetation, material ``leaves``) ``TREE_LINE_M`` beyond the town bounds, one
-  low-poly crown (an octagonal double cone, 16 triangles) every ~8 m round the whole town;
+  rounded low-poly crown (30 triangles) every ~8 m round the whole town;
 * city blocks from ``BLOCKS_FROM_M`` to ``REACH_M`` beyond the bounds on a square ``PITCH_M`` grid
   (streets left as open ground): each a park of a few crowns, or 1 to 4 buildings (class building),
   boxes whose walls are ``far_facade`` (a window pattern, windows lit at night) under a flat
@@ -41,6 +41,9 @@ TREE_SPACING_M = 8.0          #: mean spacing of the tree line's crowns
 CORNER_GAP_M = 10.0           #: the tree line leaves this much open at each corner
 CROWN_R_M = (3.0, 5.0)        #: crown radius range
 CROWN_H_M = (8.0, 14.0)       #: crown top height range
+#: crown shape: (share of the height, share of the radius) of each ring, bottom up
+CROWN_RINGS = ((0.06, 0.55), (0.38, 1.0), (0.74, 0.78))
+CROWN_SIDES = 5               #: vertices per ring
 BLOCKS_FROM_M = 70.0          #: the first block begins this far beyond the bounds
 REACH_M = 1200.0              #: the last block ends within this distance of the bounds
 PITCH_M, STREET_M = 90.0, 22.0  #: block grid pitch and the open street between blocks
@@ -68,20 +71,35 @@ def _boxes(b: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 def _crowns(xy: np.ndarray, r: np.ndarray, h: np.ndarray, z0: float) -> tuple[np.ndarray, np.ndarray]:
-    """Octagonal double cones: bottom apex on the ground, widest (``r``) at 40 % of ``h``, top apex at ``h``."""
-    a = 2 * np.pi * np.arange(8) / 8
-    ring = np.stack([np.cos(a), np.sin(a)], 1)                               # (8, 2)
-    k = len(xy)
-    mid = xy[:, None, :] + r[:, None, None] * ring[None]                     # (k, 8, 2)
-    v = np.concatenate([np.c_[xy, np.full(k, z0)][:, None],
-                        np.concatenate([mid, np.full((k, 8, 1), z0) + 0.4 * h[:, None, None]], 2),
-                        np.c_[xy, z0 + h][:, None]], 1).reshape(-1, 3)         # 10 vertices per crown
-    i = np.arange(8)
-    j = (i + 1) % 8
-    one = np.concatenate([np.stack([np.zeros(8, np.int64), 1 + j, 1 + i], 1),   # lower cone, outward
-                          np.stack([np.full(8, 9), 1 + i, 1 + j], 1)])           # upper cone, outward
-    f = (one[None] + 10 * np.arange(k)[:, None, None]).reshape(-1, 3)
-    return v, f
+    """Rounded low-poly crowns, 30 triangles each: a pentagon ring per ``CROWN_RINGS`` row (each turned
+    half a step from the one below, so the bands between are antiprisms), capped by a centre
+    vertex on the ground below and an apex at ``h`` above; closed, faces outward. Shaded smooth
+    (material ``leaves``), they read as round crowns rather than the spinning tops of a double cone.
+
+    Returns
+    -------
+    v : (k * 17, 3) float64
+    f : (k * 30, 3) int64
+    """
+    n, k, rows = CROWN_SIDES, len(xy), len(CROWN_RINGS)
+    rings = []
+    for i, (zs, rs) in enumerate(CROWN_RINGS):
+        a = 2 * np.pi * (np.arange(n) + 0.5 * i) / n
+        ring = np.stack([np.cos(a), np.sin(a)], 1)                                # (n, 2)
+        mid = xy[:, None, :] + rs * r[:, None, None] * ring[None]                 # (k, n, 2)
+        rings.append(np.concatenate([mid, z0 + zs * h[:, None, None] + np.zeros((k, n, 1))], 2))
+    v = np.concatenate([np.c_[xy, np.full(k, z0)][:, None], *rings, np.c_[xy, z0 + h][:, None]], 1)
+    nv = 2 + n * rows
+    i = np.arange(n)
+    j = (i + 1) % n
+    faces = [np.stack([np.zeros(n, np.int64), 1 + j, 1 + i], 1)]                  # bottom cap, facing down
+    for b in range(rows - 1):
+        lo, hi = 1 + b * n, 1 + (b + 1) * n
+        faces += [np.stack([lo + i, lo + j, hi + i], 1), np.stack([lo + j, hi + j, hi + i], 1)]
+    top = 1 + (rows - 1) * n
+    faces.append(np.stack([np.full(n, nv - 1), top + i, top + j], 1))               # top cap, facing up
+    f = (np.concatenate(faces)[None] + nv * np.arange(k)[:, None, None]).reshape(-1, 3)
+    return v.reshape(-1, 3), f
 
 
 def _ring_cells(bounds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
