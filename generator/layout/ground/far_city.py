@@ -24,7 +24,7 @@ every triangle, class and material (each building stays its own mesh island for 
 shader). Blender and the LiDAR (which reaches 120 m and rarely meets it) share the same few
 triangles: about 30 k round a default town (which has about 1.3 M). The draws come from the stream
 ``("layout", "far_city")`` only, so the town's own draws are untouched, and nothing stands within
-``TREE_LINE_M - 2 - CROWN_R_M[1]`` (33 m) of the town bounds.
+``TREE_LINE_M - 2 - CROWN_R_M[1]`` (7 m) of the town bounds.
 """
 
 from __future__ import annotations
@@ -36,15 +36,15 @@ from generator.labels import class_table
 from generator.materials import material_table
 from generator.rng import stream
 
-TREE_LINE_M = 40.0            #: distance of the tree line's centres beyond the town bounds
+TREE_LINE_M = 14.0            #: distance of the tree line's centres beyond the town bounds
 TREE_SPACING_M = 8.0          #: mean spacing of the tree line's crowns
-CORNER_GAP_M = 10.0           #: the tree line leaves this much open at each corner
+CORNER_GAP_M = 12.0           #: the tree line's east and west sides stop this short of the corners
 CROWN_R_M = (3.0, 5.0)        #: crown radius range
 CROWN_H_M = (8.0, 14.0)       #: crown top height range
 #: crown shape: (share of the height, share of the radius) of each ring, bottom up
 CROWN_RINGS = ((0.06, 0.55), (0.38, 1.0), (0.74, 0.78))
 CROWN_SIDES = 5               #: vertices per ring
-BLOCKS_FROM_M = 70.0          #: the first block begins this far beyond the bounds
+BLOCKS_FROM_M = 40.0          #: the first block begins this far beyond the bounds
 REACH_M = 1200.0              #: the last block ends within this distance of the bounds
 PITCH_M, STREET_M = 90.0, 22.0  #: block grid pitch and the open street between blocks
 PARK_SHARE = 0.12             #: share of blocks that are parks
@@ -165,15 +165,17 @@ def far_city(seed: int, bounds: np.ndarray, z0: float) -> list[tuple[str, str, M
     bounds = np.asarray(bounds, np.float64)
     (bx0, by0), (bx1, by1) = bounds
     out = []
-    # the tree line: crowns along the rectangle TREE_LINE_M outside the bounds, jittered; each side
-    # stops CORNER_GAP_M short of the corners, so no two sides' crowns meet
+    # the tree line: crowns along the rectangle TREE_LINE_M outside the bounds, jittered; the south
+    # and north sides run through the corners, the east and west sides stop CORNER_GAP_M short of
+    # them, so no two sides' crowns (nor boxes) meet
     t = TREE_LINE_M
     corners = np.array([(bx0 - t, by0 - t), (bx1 + t, by0 - t), (bx1 + t, by1 + t), (bx0 - t, by1 + t)])
-    for a, b in zip(corners, np.roll(corners, -1, 0), strict=True):
+    for k, (a, b) in enumerate(zip(corners, np.roll(corners, -1, 0), strict=True)):
         length = float(np.linalg.norm(b - a))
         u = (b - a) / length
-        n = max(int((length - 2 * CORNER_GAP_M) // TREE_SPACING_M), 1)
-        s = CORNER_GAP_M + (np.arange(n) + 0.5 + rng.uniform(-0.3, 0.3, n)) * (length - 2 * CORNER_GAP_M) / n
+        cut = CORNER_GAP_M * (k % 2)                                             # 0 south, north
+        n = max(int((length - 2 * cut) // TREE_SPACING_M), 1)
+        s = cut + (np.arange(n) + 0.5 + rng.uniform(-0.3, 0.3, n)) * (length - 2 * cut) / n
         out_dir = np.array([u[1], -u[0]])                                        # away from the town
         xy = a + s[:, None] * u + out_dir * rng.uniform(-2.0, 6.0, n)[:, None]
         out.append(("far_trees", "vegetation", _crown_mesh(rng, xy, z0)))
