@@ -5,6 +5,8 @@ cut into 0.5 m height bands, :func:`generator.layout.placement.prototypes.collis
 crown or a lamp arm above head height does not block the pavement under it while the trunk and
 the pole do. Large bands (fences, buildings) are cut into tiles of at most :data:`TILE_M`, so
 every obstacle is small and one k-d tree over tile centres finds the candidates of any query.
+Objects wholly beyond the town's bounds (the far city, hundreds of metres of blocks whose bands
+would cut into millions of tiles) are left out: every walkway lies inside the bounds.
 
 Boxes are rows ``(cx, cy, hx, hy, yaw, z0, z1)``: world-frame centre, half length along ``yaw``,
 half width, heading (radians) and the z interval, metres (the layout's collision-box format).
@@ -98,9 +100,13 @@ class Obstacles:
     def __init__(self, scene, top: float, keep=None):
         cache: dict[str, np.ndarray] = {}
         rows = []
+        (bx0, by0), (bx1, by1) = scene.bounds
         for o in scene.objects:
             if o.cls in GROUND_CLASSES:
                 continue
+            lo, hi = (c := o.box.corners_xy()).min(0), c.max(0)
+            if lo[0] > bx1 or lo[1] > by1 or hi[0] < bx0 or hi[1] < by0:
+                continue            # beyond the town's bounds (the far city): no walker meets it
             if o.prototype not in cache:
                 cache[o.prototype] = collision_boxes(scene.prototypes[o.prototype], whole=o.kind in WHOLE_BOX_KINDS)
             wb = world_boxes(cache[o.prototype], o.transform)
