@@ -191,11 +191,12 @@ def _far_city(spec: SceneSpec, grid: Grid, prototypes: dict[str, Mesh], proxies:
     so every town object keeps its index; returns the index of the first far-city object.
 
     Each object stands where its footprint's centre is (its transform; the mesh local to it), on no
-    lot of the town (``attrs["lot"]`` None), as stuff (instance 0). Crowns are solid double cones,
-    so their label proxy is the crowns themselves (vegetation's hull policy, without a hull that
-    would fill the gaps between the trees)."""
+    lot of the town (``attrs["lot"]`` None), as stuff (instance 0). Crowns are closed solids,
+    so the label proxy of an object with crowns (vegetation's hull policy) is its crowns themselves,
+    without a hull that would fill the gaps between the trees (or cover the buildings beside a park)."""
     start = len(objects)
     counters: dict[str, int] = defaultdict(int)
+    hull = class_table().hull_classes
     for kind, cls, world in far_city(spec.seed, grid.bounds, grid.curb_h):
         name = f"{kind}_{counters[kind]:04d}"
         counters[kind] += 1
@@ -204,8 +205,9 @@ def _far_city(spec: SceneSpec, grid: Grid, prototypes: dict[str, Mesh], proxies:
         mesh = world.transformed(np.linalg.inv(T))
         prototypes[name] = mesh
         proxy = None
-        if cls == "vegetation":
-            proxies[name], proxy = mesh, name
+        crowns = hull[mesh.face_class]
+        if crowns.any():
+            proxies[name], proxy = (mesh if crowns.all() else mesh.select(crowns)), name
         lo, hi = mesh.bounds()
         objects.append(SceneObject(len(objects), name, kind, cls, 0, name, T, box_of(lo, hi, T), proxy,
                                    {"lot": None}))

@@ -5,7 +5,7 @@ from a street showed a green plane meeting the sky. This module fills the ground
 town with a low-detail city, so the view out of town ends in more town:
 
 * a tree line (class vegetation, material ``leaves``) ``TREE_LINE_M`` beyond the town bounds, one
-  low-poly crown (an octagonal double cone, 16 triangles) every ~8 m round the whole town;
+  rounded low-poly crown (30 triangles) every ~8 m round the whole town;
 * city blocks from ``BLOCKS_FROM_M`` to ``REACH_M`` beyond the bounds on a square ``PITCH_M`` grid
   (streets left as open ground): each a park of a few crowns, or 1 to 4 buildings (class building),
   boxes whose walls are ``far_facade`` (a window pattern, windows lit at night) under a flat
@@ -14,29 +14,37 @@ town with a low-detail city, so the view out of town ends in more town:
   ``SKYLINE_M``, and round the ring's far edge a gapless band of 30-95 m towers, so no street of the
   block grid opens onto the bare horizon.
 
-One object per block, park and side of the tree line (made here in the world frame; the scene places
-each at its footprint's centre, :func:`generator.layout.assemble.build_scene`), so
-Blender and the LiDAR (which reaches 120 m and rarely meets it) share the same few triangles: about
-30 k round a default town (which has about 1.3 M). The draws come from the stream
+Twelve objects in all (made here in the world frame; the scene places each at its footprint's
+centre, :func:`generator.layout.assemble.build_scene`): the tree line's four sides, the blocks and
+parks of the ring's four sides (south, north, west, east: rectangles of whole rows and columns of
+the block grid that meet neither each other, the tree line nor the town), and the far edge's four
+sides. Every Blender object costs the RGB and label passes (Cycles syncs and instances each), and
+a scene of one object per block held ~870 more of them; joined, the far city adds a dozen and keeps
+every triangle, class and material (each building stays its own mesh island for the facade
+shader). Blender and the LiDAR (which reaches 120 m and rarely meets it) share the same few
+triangles: about 45 k round a default town (which has about 1.3 M). The draws come from the stream
 ``("layout", "far_city")`` only, so the town's own draws are untouched, and nothing stands within
-``TREE_LINE_M - 2 - CROWN_R_M[1]`` (33 m) of the town bounds.
+``TREE_LINE_M - 2 - CROWN_R_M[1]`` (7 m) of the town bounds.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from generator.geometry import Mesh
+from generator.geometry import Mesh, merge
 from generator.labels import class_table
 from generator.materials import material_table
 from generator.rng import stream
 
-TREE_LINE_M = 40.0            #: distance of the tree line's centres beyond the town bounds
+TREE_LINE_M = 14.0            #: distance of the tree line's centres beyond the town bounds
 TREE_SPACING_M = 8.0          #: mean spacing of the tree line's crowns
-CORNER_GAP_M = 10.0           #: the tree line leaves this much open at each corner
+CORNER_GAP_M = 12.0           #: the tree line's east and west sides stop this short of the corners
 CROWN_R_M = (3.0, 5.0)        #: crown radius range
 CROWN_H_M = (8.0, 14.0)       #: crown top height range
-BLOCKS_FROM_M = 70.0          #: the first block begins this far beyond the bounds
+#: crown shape: (share of the height, share of the radius) of each ring, bottom up
+CROWN_RINGS = ((0.06, 0.55), (0.38, 1.0), (0.74, 0.78))
+CROWN_SIDES = 5               #: vertices per ring
+BLOCKS_FROM_M = 40.0          #: the first block begins this far beyond the bounds
 REACH_M = 1200.0              #: the last block ends within this distance of the bounds
 PITCH_M, STREET_M = 90.0, 22.0  #: block grid pitch and the open street between blocks
 PARK_SHARE = 0.12             #: share of blocks that are parks
@@ -44,6 +52,7 @@ SKYLINE_M = 550.0             #: beyond this distance from the bounds, towers ap
 TOWER_SHARE = 0.35            #: share of the blocks beyond SKYLINE_M that hold one tower
 LOW_H_M, TOWER_H_M = (9.0, 24.0), (35.0, 120.0)
 WALL_DEPTH_M, WALL_H_M = 35.0, (30.0, 95.0)  #: the gapless band of towers at the ring's far edge
+SIDE_GAP_M = 2.0             #: the band's west and east sides stop this short of the south and north sides
 
 #: Unit box: 8 corners (x, y, z in {0, 1}) and its 10 triangles without the bottom (walls, then roof).
 _BOX_V = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]], float)
@@ -62,24 +71,51 @@ def _boxes(b: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 def _crowns(xy: np.ndarray, r: np.ndarray, h: np.ndarray, z0: float) -> tuple[np.ndarray, np.ndarray]:
-    """Octagonal double cones: bottom apex on the ground, widest (``r``) at 40 % of ``h``, top apex at ``h``."""
-    a = 2 * np.pi * np.arange(8) / 8
-    ring = np.stack([np.cos(a), np.sin(a)], 1)                               # (8, 2)
-    k = len(xy)
-    mid = xy[:, None, :] + r[:, None, None] * ring[None]                     # (k, 8, 2)
-    v = np.concatenate([np.c_[xy, np.full(k, z0)][:, None],
-                        np.concatenate([mid, np.full((k, 8, 1), z0) + 0.4 * h[:, None, None]], 2),
-                        np.c_[xy, z0 + h][:, None]], 1).reshape(-1, 3)         # 10 vertices per crown
-    i = np.arange(8)
-    j = (i + 1) % 8
-    one = np.concatenate([np.stack([np.zeros(8, np.int64), 1 + j, 1 + i], 1),   # lower cone, outward
-                          np.stack([np.full(8, 9), 1 + i, 1 + j], 1)])           # upper cone, outward
-    f = (one[None] + 10 * np.arange(k)[:, None, None]).reshape(-1, 3)
-    return v, f
+    """Rounded low-poly crowns, 30 triangles each: a pentagon ring per ``CROWN_RINGS`` row (each turned
+    half a step from the one below, so the bands between are antiprisms), capped by a centre
+    vertex on the ground below and an apex at ``h`` above; closed, faces outward. Shaded smooth
+    (material ``leaves``), they read as round crowns rather than the spinning tops of a double cone.
+
+    Returns
+    -------
+    v : (k * 17, 3) float64
+    f : (k * 30, 3) int64
+    """
+    n, k, rows = CROWN_SIDES, len(xy), len(CROWN_RINGS)
+    rings = []
+    for i, (zs, rs) in enumerate(CROWN_RINGS):
+        a = 2 * np.pi * (np.arange(n) + 0.5 * i) / n
+        ring = np.stack([np.cos(a), np.sin(a)], 1)                                # (n, 2)
+        mid = xy[:, None, :] + rs * r[:, None, None] * ring[None]                 # (k, n, 2)
+        rings.append(np.concatenate([mid, z0 + zs * h[:, None, None] + np.zeros((k, n, 1))], 2))
+    v = np.concatenate([np.c_[xy, np.full(k, z0)][:, None], *rings, np.c_[xy, z0 + h][:, None]], 1)
+    nv = 2 + n * rows
+    i = np.arange(n)
+    j = (i + 1) % n
+    faces = [np.stack([np.zeros(n, np.int64), 1 + j, 1 + i], 1)]                  # bottom cap, facing down
+    for b in range(rows - 1):
+        lo, hi = 1 + b * n, 1 + (b + 1) * n
+        faces += [np.stack([lo + i, lo + j, hi + i], 1), np.stack([lo + j, hi + j, hi + i], 1)]
+    top = 1 + (rows - 1) * n
+    faces.append(np.stack([np.full(n, nv - 1), top + i, top + j], 1))               # top cap, facing up
+    f = (np.concatenate(faces)[None] + nv * np.arange(k)[:, None, None]).reshape(-1, 3)
+    return v.reshape(-1, 3), f
 
 
-def _ring_cells(bounds: np.ndarray) -> np.ndarray:
-    """(n, 4) ``(x0, y0, x1, y1)`` block rectangles of the grid in the ring round ``bounds``."""
+def _ring_cells(bounds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The block rectangles of the grid in the ring round ``bounds`` and the side each belongs to.
+
+    Returns
+    -------
+    cells : (n, 4) float64
+        ``(x0, y0, x1, y1)`` per block, rows of the grid in order, metres.
+    side : (n,) int64
+        0 south, 1 north, 2 west, 3 east: whole rows of blocks below the town's ``BLOCKS_FROM_M``
+        line are south, whole rows above it north, the blocks of the rows between (beside the
+        town) west or east. Each side's blocks lie in a rectangle that meets no other side's, the
+        tree line or the town (the rows between begin a street above the last south row), so a
+        side joined into one object has a footprint (even its convex hull) that touches nothing.
+    """
     (bx0, by0), (bx1, by1) = bounds
     c = np.array([(bx0 + bx1) / 2, (by0 + by1) / 2])
     half = np.array([(bx1 - bx0) / 2, (by1 - by0) / 2])
@@ -93,7 +129,8 @@ def _ring_cells(bounds: np.ndarray) -> np.ndarray:
     gap = np.maximum(np.maximum(bx0 - x1, x0 - bx1), np.maximum(by0 - y1, y0 - by1))
     far = np.maximum(np.maximum(bx0 - x0, x1 - bx1), np.maximum(by0 - y0, y1 - by1))
     keep = (gap >= BLOCKS_FROM_M) & (far <= REACH_M)
-    return np.stack([x0, y0, x1, y1], 1)[keep]
+    side = np.select([by0 - y1 >= BLOCKS_FROM_M, y0 - by1 >= BLOCKS_FROM_M, bx0 - x1 >= BLOCKS_FROM_M], [0, 1, 2], 3)
+    return np.stack([x0, y0, x1, y1], 1)[keep], side[keep]
 
 
 def _distance(bounds: np.ndarray, xy: np.ndarray) -> np.ndarray:
@@ -117,33 +154,39 @@ def far_city(seed: int, bounds: np.ndarray, z0: float) -> list[tuple[str, str, M
     Returns
     -------
     list of (kind, cls, Mesh)
-        ``("far_trees", "vegetation", ...)`` per side of the tree line, then per block of the ring
-        (rows of the grid in order) ``("far_block", "building", ...)`` (walls ``far_facade``, roofs
-        ``roof``) or ``("far_park", "vegetation", ...)`` (crowns of material ``leaves``). One object
-        per block keeps every object's box the size of its block (no box encloses the town).
+        ``("far_trees", "vegetation", ...)`` per side of the tree line (crowns of material
+        ``leaves``), then ``("far_blocks", "building", ...)`` per side of the ring that holds blocks
+        (buildings of class building, walls ``far_facade`` and roofs ``roof``; parks' crowns of
+        class vegetation, material ``leaves``), then ``("far_skyline", "building", ...)`` per side
+        of the far edge. No two of these meshes' footprints (nor their convex hulls or bounding
+        boxes) overlap, and none encloses the town.
     """
     rng = stream(seed, "layout", "far_city")
     bounds = np.asarray(bounds, np.float64)
     (bx0, by0), (bx1, by1) = bounds
     out = []
-    # the tree line: crowns along the rectangle TREE_LINE_M outside the bounds, jittered; each side
-    # stops CORNER_GAP_M short of the corners, so no two sides' crowns meet
+    # the tree line: crowns along the rectangle TREE_LINE_M outside the bounds, jittered; the south
+    # and north sides run through the corners, the east and west sides stop CORNER_GAP_M short of
+    # them, so no two sides' crowns (nor boxes) meet
     t = TREE_LINE_M
     corners = np.array([(bx0 - t, by0 - t), (bx1 + t, by0 - t), (bx1 + t, by1 + t), (bx0 - t, by1 + t)])
-    for a, b in zip(corners, np.roll(corners, -1, 0), strict=True):
+    for k, (a, b) in enumerate(zip(corners, np.roll(corners, -1, 0), strict=True)):
         length = float(np.linalg.norm(b - a))
         u = (b - a) / length
-        n = max(int((length - 2 * CORNER_GAP_M) // TREE_SPACING_M), 1)
-        s = CORNER_GAP_M + (np.arange(n) + 0.5 + rng.uniform(-0.3, 0.3, n)) * (length - 2 * CORNER_GAP_M) / n
+        cut = CORNER_GAP_M * (k % 2)                                             # 0 south, north
+        n = max(int((length - 2 * cut) // TREE_SPACING_M), 1)
+        s = cut + (np.arange(n) + 0.5 + rng.uniform(-0.3, 0.3, n)) * (length - 2 * cut) / n
         out_dir = np.array([u[1], -u[0]])                                        # away from the town
         xy = a + s[:, None] * u + out_dir * rng.uniform(-2.0, 6.0, n)[:, None]
         out.append(("far_trees", "vegetation", _crown_mesh(rng, xy, z0)))
-    for x0, y0, x1, y1 in _ring_cells(bounds):
+    cells, sides = _ring_cells(bounds)
+    parts: list[list[Mesh]] = [[] for _ in range(4)]
+    for (x0, y0, x1, y1), side in zip(cells, sides, strict=True):
         d = float(_distance(bounds, np.array([[(x0 + x1) / 2, (y0 + y1) / 2]]))[0])
         if rng.uniform() < PARK_SHARE:
             m = int(rng.integers(3, 7))
             xy = np.stack([rng.uniform(x0 + 6, x1 - 6, m), rng.uniform(y0 + 6, y1 - 6, m)], 1)
-            out.append(("far_park", "vegetation", _crown_mesh(rng, xy, z0)))
+            parts[side].append(_crown_mesh(rng, xy, z0))
             continue
         blocks = []
         if d > SKYLINE_M and rng.uniform() < TOWER_SHARE:
@@ -159,14 +202,17 @@ def far_city(seed: int, bounds: np.ndarray, z0: float) -> list[tuple[str, str, M
                     g = rng.uniform(0.0, 3.0, 4)                                 # gaps and setbacks
                     h = rng.uniform(*LOW_H_M) * (1.0 + 0.6 * min(d / SKYLINE_M, 1.0))
                     blocks.append((xs[i] + g[0], ys[j] + g[1], z0, xs[i + 1] - g[2], ys[j + 1] - g[3], z0 + h))
-        out.append(("far_block", "building", _block_mesh(rng, np.array(blocks, np.float64))))
+        parts[side].append(_block_mesh(rng, np.array(blocks, np.float64)))
+    out += [("far_blocks", "building", merge(p)) for p in parts if p]
     # the skyline's far edge: a gapless wall of towers round the ring, so no street between the blocks
-    # leads the eye to the bare horizon (one object per side; the south and north sides span the corners)
-    e = REACH_M + 10.0
+    # leads the eye to the bare horizon (one object per side; the south and north sides span the
+    # corners, the west and east sides keep SIDE_GAP_M from them, so no two sides' boxes touch: a
+    # slit 35 m deep that no line of sight from the town crosses)
+    e, g = REACH_M + 10.0, SIDE_GAP_M
     sides = [((bx0 - e - WALL_DEPTH_M, by0 - e - WALL_DEPTH_M), (bx1 + e + WALL_DEPTH_M, by0 - e), 0),
              ((bx0 - e - WALL_DEPTH_M, by1 + e), (bx1 + e + WALL_DEPTH_M, by1 + e + WALL_DEPTH_M), 0),
-             ((bx0 - e - WALL_DEPTH_M, by0 - e), (bx0 - e, by1 + e), 1),
-             ((bx1 + e, by0 - e), (bx1 + e + WALL_DEPTH_M, by1 + e), 1)]
+             ((bx0 - e - WALL_DEPTH_M, by0 - e + g), (bx0 - e, by1 + e - g), 1),
+             ((bx1 + e, by0 - e + g), (bx1 + e + WALL_DEPTH_M, by1 + e - g), 1)]
     for (x0, y0), (x1, y1), axis in sides:
         a0, a1 = (x0, x1) if axis == 0 else (y0, y1)
         cuts = [a0]
@@ -178,7 +224,7 @@ def far_city(seed: int, bounds: np.ndarray, z0: float) -> list[tuple[str, str, M
             b = np.stack([cuts[:-1], np.full_like(h, y0), np.full_like(h, z0), cuts[1:], np.full_like(h, y1), h], 1)
         else:
             b = np.stack([np.full_like(h, x0), cuts[:-1], np.full_like(h, z0), np.full_like(h, x1), cuts[1:], h], 1)
-        out.append(("far_block", "building", _block_mesh(rng, b)))
+        out.append(("far_skyline", "building", _block_mesh(rng, b)))
     return out
 
 

@@ -7,6 +7,8 @@ import json
 
 import numpy as np
 import pytest
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 
 from generator.geometry import apply
 from generator.labels import class_table
@@ -20,6 +22,19 @@ def _far(scene):
     return [o for o in scene.objects if o.kind.startswith("far_")]
 
 
+def _islands(mesh, faces):
+    """(k, 2, 3) local AABBs ``(min, max)`` of the connected pieces of ``mesh``'s ``faces`` (bool mask)."""
+    f = mesh.faces[faces]
+    n = len(mesh.vertices)
+    g = coo_matrix((np.ones(2 * len(f)), (np.r_[f[:, 0], f[:, 1]], np.r_[f[:, 1], f[:, 2]])), shape=(n, n))
+    _, label = connected_components(g, directed=False)
+    used = np.unique(f)
+    v, lab = mesh.vertices[used], label[used]
+    order = np.argsort(lab, kind="stable")
+    cuts = np.flatnonzero(np.diff(lab[order])) + 1
+    return np.array([(p.min(0), p.max(0)) for p in np.split(v[order], cuts)])
+
+
 def test_far_city_stands_outside_the_town_with_labels(default_scene):
     far = _far(default_scene)
     first = far[0].index
@@ -27,18 +42,25 @@ def test_far_city_stands_outside_the_town_with_labels(default_scene):
     assert not any(o.kind.startswith("far_") for o in default_scene.objects[:first])
     (bx0, by0), (bx1, by1) = default_scene.bounds
     classes, mats = class_table(), material_table()
-    kinds = {"far_block": ("building", {"far_facade", "roof"}), "far_park": ("vegetation", {"leaves"}),
-             "far_trees": ("vegetation", {"leaves"})}
+    materials = {"building": {"far_facade", "roof"}, "vegetation": {"leaves"}}
+    kinds = {"far_blocks": ("building", {"building", "vegetation"}), "far_skyline": ("building", {"building"}),
+             "far_trees": ("vegetation", {"vegetation"})}
+    assert {o.kind for o in far} == set(kinds)
     for o in far:
         m = default_scene.prototypes[o.prototype]
-        cls, materials = kinds[o.kind]
+        cls, face_classes = kinds[o.kind]
         assert o.cls == cls and o.instance_id == 0 and o.attrs["lot"] is None
-        assert (m.face_class == classes.id(cls)).all()
-        assert {mats.rows[i].name for i in np.unique(m.face_material)} <= materials
+        assert {classes.names[c] for c in np.unique(m.face_class)} <= face_classes
+        for c in face_classes:
+            on = m.face_class == classes.id(c)
+            assert {mats.rows[i].name for i in np.unique(m.face_material[on])} <= materials[c]
         v = apply(o.transform, m.vertices)
         assert np.allclose(o.transform[:2, 3], (v[:, :2].min(0) + v[:, :2].max(0)) / 2), "stands where it is"
-        if cls == "vegetation":         # solid crowns: the label proxy is the crowns themselves, no hull
-            assert o.proxy == o.prototype and default_scene.proxies[o.proxy] is m
+        crowns = m.face_class == classes.id("vegetation")
+        if crowns.any():                # solid crowns: the label proxy is the crowns themselves, no hull
+            p = default_scene.proxies[o.proxy]
+            assert o.proxy == o.prototype and p.n_faces == crowns.sum()
+            assert np.array_equal(p.vertices[p.faces], m.vertices[m.faces[crowns]])
         else:
             assert o.proxy is None
         gap = np.maximum(np.maximum(bx0 - v[:, 0], v[:, 0] - bx1), np.maximum(by0 - v[:, 1], v[:, 1] - by1))
@@ -52,13 +74,35 @@ def test_far_city_stands_outside_the_town_with_labels(default_scene):
     assert 5_000 < n_far < 60_000 and n_far < 0.05 * len(default_scene.faces)
 
 
+def test_far_city_is_a_dozen_objects_whose_boxes_keep_apart(default_scene):
+    """Every Blender object costs both passes, so the far city's hundreds of buildings and parks are
+    joined into a dozen objects, and their bounding boxes (so their footprints) neither overlap nor
+    touch each other or the town: the town's no-touch invariants hold for them as for any object."""
+    far = _far(default_scene)
+    building = class_table().id("building")
+    n_buildings = sum(len(_islands(m, m.face_class == building))
+                      for m in (default_scene.prototypes[o.prototype] for o in far if o.kind == "far_blocks"))
+    assert len(far) <= 12 and n_buildings > 500, (len(far), n_buildings)
+    box = np.array([[o.box.corners_xy().min(0), o.box.corners_xy().max(0)] for o in far])    # (n, 2, 2)
+    town = default_scene.bounds
+    for i, a in enumerate(box):
+        assert (a[0] > town[1] + 1.0).any() or (a[1] < town[0] - 1.0).any(), far[i].name
+        for j in range(i + 1, len(box)):
+            b = box[j]
+            assert (a[0] > b[1] + 1.0).any() or (b[0] > a[1] + 1.0).any(), (far[i].name, far[j].name)
+
+
 def test_far_city_closes_the_horizon_all_round(default_scene):
     """From the town's centre every compass direction (0.5 degree steps) meets a far building, and
     the skyline beyond SKYLINE_M rises higher than the blocks near the town."""
-    far = [o for o in _far(default_scene) if o.kind == "far_block"]
-    verts = [apply(o.transform, default_scene.prototypes[o.prototype].vertices) for o in far]
-    lo = np.array([v.min(0) for v in verts])
-    hi = np.array([v.max(0) for v in verts])
+    building = class_table().id("building")
+    boxes = []
+    for o in _far(default_scene):
+        m = default_scene.prototypes[o.prototype]
+        if (m.face_class == building).any():
+            boxes.append(_islands(m, m.face_class == building) + o.transform[:3, 3])    # translation only
+    boxes = np.concatenate(boxes)
+    lo, hi = boxes[:, 0], boxes[:, 1]
     c = default_scene.bounds.mean(0)
     az = np.deg2rad(np.arange(0, 360, 0.5))
     d = np.stack([np.cos(az), np.sin(az)], 1)[:, None]                       # (A, 1, 2)
