@@ -25,7 +25,7 @@ BRICK_M = (0.225, 0.075)      #: brick pitch along and up: 215 x 65 mm bricks an
 BRICK_JOINT_M = 0.010
 PANEL_JOINT_M = 0.012
 SILL_M = 0.87                 #: sill height above a storey's floor (the layouts draw 0.8-0.95 m)
-STREAK_CELL_M = 0.06          #: run-off streak width scale (noise 1/scale along the wall)
+STREAK_CELL_M = 0.22          #: run-off streak width scale (noise 1/scale along the wall), metres
 
 
 def xyz(g: Nodes, v):
@@ -80,18 +80,17 @@ def brick(g: Nodes, uv, co, palette):
     """Brick wall colour and height: ``palette`` four colours (dark, mid, light, over-burnt)."""
     t, joint = cells(g, uv, BRICK_M[0], BRICK_M[1], BRICK_JOINT_M, 0.5)
     col = g.ramp(t, [(0.0, palette[0]), (0.45, palette[1]), (0.88, palette[2]), (0.93, palette[3])])
-    grain = g.noise(co, scale=45.0, detail=3)
+    grain = g.noise(co, scale=45.0, detail=1)
     col = g.mix(g.mul(g.math("ABSOLUTE", g.math("SUBTRACT", grain, 0.5)), 0.6), col, (0.06, 0.03, 0.02))
-    mortar = g.mix(g.noise(co, scale=8.0, detail=2), (0.42, 0.40, 0.36), (0.55, 0.53, 0.49))
-    col = g.mix(joint, col, mortar)
+    col = g.mix(joint, col, (0.48, 0.46, 0.42))
     height = g.add(g.mul(joint, -1.0), g.mul(grain, 0.15))
     return col, height
 
 
 def render(g: Nodes, uv, co, z, colour):
     """Rendered wall: grain, blotches, a plinth at the base on some buildings; (colour, height)."""
-    grain = g.noise(co, scale=70.0, detail=2)
-    blotch = g.noise(co, scale=0.7, detail=3)
+    grain = g.noise(co, scale=70.0, detail=1)
+    blotch = g.noise(co, scale=0.7, detail=2)
     tone = g.add(0.94, g.add(g.mul(grain, 0.06), g.mul(g.smooth(blotch, 0.3, 0.7), 0.06)))
     col = g.mix(1.0, colour, grey(g, tone), "MULTIPLY")
     plinth_h = g.add(0.4, g.mul(per_building(g, 13.0), 0.4))
@@ -104,7 +103,7 @@ def render(g: Nodes, uv, co, z, colour):
 def panels(g: Nodes, uv, co, colour, size):
     """Concrete panel wall: stack-bonded ``size`` = (w, h) metre panels, a tone each; (colour, height)."""
     t, joint = cells(g, uv, size[0], size[1], PANEL_JOINT_M, 0.0)
-    pores = g.noise(co, scale=60.0, detail=2)
+    pores = g.noise(co, scale=60.0, detail=1)
     tone = g.add(0.88, g.add(g.mul(t, 0.16), g.mul(pores, 0.05)))
     col = g.mix(1.0, colour, grey(g, tone), "MULTIPLY")
     col = g.mix(g.mul(joint, 0.85), col, (0.12, 0.12, 0.12))
@@ -112,25 +111,27 @@ def panels(g: Nodes, uv, co, colour, size):
 
 
 def weathering(g: Nodes, uv, co, z, col, amount, floor_m: float = 3.2):
-    """Run-off streaks and base grime over a wall colour ``col``; ``amount`` (0..1 socket or float)."""
+    """Age over a wall colour ``col``: a blotchy greying over metres, run-off streaks (densest in the
+    metre under each storey's sills) and base grime; ``amount`` (0..1 socket or float).
+
+    Returns (colour, stain height for the bump)."""
     u, v, _ = xyz(g, uv)
-    # streaks: noise stretched 25x downward, in patches; strongest in the metre under each storey's
-    # sills (the sill sits ~0.9 m above the floor: the band from floor - 0.1 to floor + 0.9)
+    broad = g.noise(co, scale=0.18, detail=2)               # ~5 m blotches: one noise for age and patches
+    col = g.mix(g.mul(g.smooth(broad, 0.35, 0.75), g.mul(amount, 0.45)), col,
+                g.mix(0.6, col, (0.42, 0.41, 0.39), "MULTIPLY"))
     st_vec = g.node("ShaderNodeCombineXYZ")
     g.set(st_vec.inputs[0], g.mul(u, 1.0 / STREAK_CELL_M))
-    g.set(st_vec.inputs[1], g.mul(v, 0.6))
-    streak = g.smooth(g.noise(st_vec.outputs[0], scale=1.0, detail=3, roughness=0.6), 0.52, 0.72)
-    patch = g.smooth(g.noise(co, scale=0.35, detail=2), 0.35, 0.65)
+    g.set(st_vec.inputs[1], g.mul(v, 0.35))
+    streak = g.smooth(g.noise(st_vec.outputs[0], scale=1.0, detail=2, roughness=0.6), 0.5, 0.68)
     in_storey = g.math("FRACT", g.mul(g.math("SUBTRACT", SILL_M, v), 1.0 / floor_m))  # 0 at a sill, 1 a storey down
-    fade = g.add(0.35, g.mul(inv(g, g.smooth(in_storey, 0.0, 0.32)), 0.65))
-    k = g.mul(g.mul(streak, g.add(g.mul(patch, 0.7), 0.3)), g.mul(fade, amount))
-    col = g.mix(g.mul(k, 0.7), col, g.mix(0.5, col, (0.36, 0.34, 0.3), "MULTIPLY"))
+    fade = g.add(0.3, g.mul(inv(g, g.smooth(in_storey, 0.0, 0.45)), 0.7))
+    k = g.mul(g.mul(streak, g.smooth(broad, 0.25, 0.6)), g.mul(fade, amount))
+    col = g.mix(g.math("MINIMUM", g.mul(k, 1.1), 0.85), col, g.mix(0.75, col, (0.3, 0.28, 0.25), "MULTIPLY"))
     # base grime: splash and soil up to 0.5-1.2 m, ragged
-    edge = g.add(0.5, g.mul(g.noise(co, scale=1.5, detail=3), 0.7))
+    edge = g.add(0.5, g.mul(g.noise(co, scale=1.5, detail=1), 0.7))
     low = inv(g, g.smooth(g.math("DIVIDE", z, edge), 0.0, 1.0))
-    speck = g.add(0.6, g.mul(g.noise(co, scale=25.0, detail=2), 0.4))
-    grime = g.mul(g.mul(low, speck), g.add(0.35, g.mul(amount, 0.5)))
-    col = g.mix(grime, col, g.mix(0.5, col, (0.3, 0.27, 0.22), "MULTIPLY"))
+    grime = g.mul(low, g.add(0.45, g.mul(amount, 0.5)))
+    col = g.mix(grime, col, g.mix(0.6, col, (0.28, 0.25, 0.2), "MULTIPLY"))
     return col, g.mul(k, 0.3)
 
 

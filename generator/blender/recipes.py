@@ -160,7 +160,7 @@ def _wall(g, col, height, rough, uv, co, z, weather=1.0):
 def facade_plaster(g, rng):
     """Render: grain, blotches and water stains, a plinth on some buildings, weathering."""
     uv, co, z = fd.wall_uv(g)
-    stains = g.smooth(g.noise(g.mapping(co, scale=(1, 1, 0.3)), scale=0.8, detail=4), 0.55, 0.75)
+    stains = g.smooth(g.noise(g.mapping(co, scale=(1, 1, 0.3)), scale=0.8, detail=2), 0.55, 0.75)
     base = g.mix(g.mul(stains, 0.25), (1.0, 1.0, 1.0), (0.8, 0.77, 0.72))
     col, height = fd.render(g, uv, co, z, _tint(g, base))
     return _wall(g, col, height, 0.9, uv, co, z)
@@ -190,7 +190,7 @@ def facade_concrete(g, rng):
     """Precast panels on a 1.2-1.5 m grid, a tone per panel, pores, weathering (stronger)."""
     uv, co, z = fd.wall_uv(g)
     size = (float(rng.uniform(1.2, 1.5)), float(rng.uniform(1.2, 1.5)))
-    col, height = fd.panels(g, uv, co, _jit(rng, (0.62, 0.62, 0.6), 0.05), size)
+    col, height = fd.panels(g, uv, co, _jit(rng, (0.4, 0.39, 0.37), 0.05), size)
     return _wall(g, _rel_tint(g, col, _CONCRETE_TINT), height, 0.8, uv, co, z, weather=1.2)
 
 
