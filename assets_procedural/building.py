@@ -8,7 +8,9 @@ face is closer than 2 cm to a parallel face of another material.
 
 The window rhythm, shop fronts and balconies are drawn per building
 (:mod:`assets_procedural.facade_layout`); what stands proud of the wall (balconies, sign
-bands, awnings) is drawn by :mod:`assets_procedural.facade_details`.
+boards, blade signs, awnings) is drawn by :mod:`assets_procedural.facade_details`; window
+surrounds and rainwater pipes by :mod:`assets_procedural.facade_trim`, from sub-streams of the
+building's generator of their own (the window rhythm of a seed does not depend on them).
 """
 
 from __future__ import annotations
@@ -272,9 +274,11 @@ def building(rng: np.random.Generator, footprint: np.ndarray, height: float, flo
     Mesh
         Class ``building``; anchors ``"door"`` (1, 3): bottom centre of the door in the wall
         plane, and ``"windows"`` (n, 3): centres of the glass panes (windows, balcony doors,
-        shop windows). Shop windows (material ``shop_glass``) with a sign band and, for some
-        buildings, awnings on the front's ground floor; balconies (slab and railing) on the
-        upper floors of the front and back for some buildings.
+        shop windows). Shop windows (material ``shop_glass``) with a sign board each, blade signs
+        and, for some buildings, awnings on the front's ground floor; balconies (slab and railing)
+        on the upper floors of the front and back for some buildings; window surrounds
+        (``facade_trim``) and rainwater pipes (``drainpipe``) at the corners of the front and back
+        for some; flat roofs with a coping lip.
     """
     if facade not in FACADES:
         raise ValueError(f"facade must be one of {sorted(FACADES)}, got {facade!r}")
