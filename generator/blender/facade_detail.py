@@ -82,7 +82,7 @@ def brick(g: Nodes, uv, co, palette):
     col = g.ramp(t, [(0.0, palette[0]), (0.45, palette[1]), (0.88, palette[2]), (0.93, palette[3])])
     grain = g.noise(co, scale=45.0, detail=1)
     col = g.mix(g.mul(g.math("ABSOLUTE", g.math("SUBTRACT", grain, 0.5)), 0.6), col, (0.06, 0.03, 0.02))
-    col = g.mix(joint, col, (0.48, 0.46, 0.42))
+    col = g.mix(joint, col, (0.36, 0.345, 0.32))
     height = g.add(g.mul(joint, -1.0), g.mul(grain, 0.15))
     return col, height
 

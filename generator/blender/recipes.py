@@ -179,7 +179,7 @@ def _rel_tint(g, base, tint):
 def facade_brick(g, rng):
     """Stretcher-bond brick at real size, a tone per brick, recessed mortar joints, weathering."""
     uv, co, z = fd.wall_uv(g)
-    mid = np.asarray(_jit(rng, (0.36, 0.12, 0.065), 0.15))
+    mid = np.asarray(_jit(rng, (0.3, 0.085, 0.048), 0.12))
     palette = [tuple(mid * 0.72), tuple(mid), tuple(np.clip(mid * [1.25, 1.35, 1.4], 0, 1)),
                tuple(mid * [0.45, 0.5, 0.6])]
     col, height = fd.brick(g, uv, co, palette)
