@@ -8,7 +8,9 @@ face is closer than 2 cm to a parallel face of another material.
 
 The window rhythm, shop fronts and balconies are drawn per building
 (:mod:`assets_procedural.facade_layout`); what stands proud of the wall (balconies, sign
-bands, awnings) is drawn by :mod:`assets_procedural.facade_details`.
+boards, blade signs, awnings) is drawn by :mod:`assets_procedural.facade_details`; window
+surrounds and rainwater pipes by :mod:`assets_procedural.facade_trim`, from sub-streams of the
+building's generator of their own (the window rhythm of a seed does not depend on them).
 """
 
 from __future__ import annotations
@@ -19,10 +21,12 @@ import numpy as np
 
 from assets_procedural.building_roof import flat_roof, pitched_roof, rectangle_of
 from assets_procedural.facade_details import balcony, shop_front
-from assets_procedural.facade_layout import Hole, Style, draw_style, holes, wall_rects
+from assets_procedural.facade_layout import PIER_M, Hole, Style, draw_style, holes, wall_rects
+from assets_procedural.facade_trim import TRIM_T, draw_trim, pipes, surround
 from generator.geometry import Mesh, box, merge, quads, resolve_ids
 from generator.geometry.primitives import _UNIT_BOX_FACES
 from generator.geometry.primitives import _UNIT_BOX_VERTICES as _UNIT_BOX
+from generator.rng import substream
 
 log = logging.getLogger(__name__)
 
@@ -75,7 +79,7 @@ class _Facade:
         self.facing: list[int] = []
         self._normals: list[np.ndarray] = [self.n, self._down, self.d, self._back, self._up]
         self._normal_of: dict[int, int] = {id(a): i for i, a in enumerate(self._normals)}
-        self.sills: list[tuple[Hole, str]] = []
+        self.sills: list[tuple[Hole, str, float]] = []
         self.boxes: list[tuple] = []  # boxes proud of the wall (balconies, sign bands), built in mesh()
 
     def point(self, u: float, v: float, w: float) -> tuple[float, float, float]:
@@ -114,12 +118,13 @@ class _Facade:
         self.rect(u0, u0 + width, v0 + width, v1 - width, w, material)
         self.rect(u1 - width, u1, v0 + width, v1 - width, w, material)
 
-    def reveals(self, h: Hole, depth: float, material: str) -> None:
-        """The four (three for a door) inner faces of the opening, facing into it."""
-        u0, u1, v0, v1, d = h.u0, h.u1, h.v0, h.v1, -depth
-        q = [(u0, v1, 0, u1, v1, 0, u1, v1, d, u0, v1, d),       # top, facing down
-             (u0, v0, 0, u0, v1, 0, u0, v1, d, u0, v0, d),       # left, facing along the wall
-             (u1, v0, 0, u1, v1, 0, u1, v1, d, u1, v0, d)]       # right, facing back
+    def reveals(self, h: Hole, depth: float, material: str, front: float = 0.0) -> None:
+        """The four (three for a door) inner faces of the opening, facing into it; top and sides
+        start at ``w = front`` (through a window surround proud of the wall), the bottom at the wall."""
+        u0, u1, v0, v1, d, f = h.u0, h.u1, h.v0, h.v1, -depth, front
+        q = [(u0, v1, f, u1, v1, f, u1, v1, d, u0, v1, d),       # top, facing down
+             (u0, v0, f, u0, v1, f, u0, v1, d, u0, v0, d),       # left, facing along the wall
+             (u1, v0, f, u1, v1, f, u1, v1, d, u1, v0, d)]       # right, facing back
         facing = [1, 2, 3]
         if v0 > 0:
             q.append((u0, v0, 0, u1, v0, 0, u1, v0, d, u0, v0, d))  # bottom, facing up
@@ -128,9 +133,10 @@ class _Facade:
         self.materials += [material] * len(q)
         self.facing += facing
 
-    def sill(self, h: Hole, material: str) -> None:
-        """A stone sill under a window, proud of the wall (top, front, bottom, ends); built in :meth:`mesh`."""
-        self.sills.append((h, material))
+    def sill(self, h: Hole, material: str, reach: float = 0.05) -> None:
+        """A stone sill under a window, ``reach`` past each side of it, proud of the wall (top, front,
+        bottom, ends); built in :meth:`mesh`."""
+        self.sills.append((h, material, reach))
 
     def _sill_mesh(self) -> list[Mesh]:
         """Every sill at once: one box per distinct width (the face against the wall dropped), moved
@@ -143,15 +149,15 @@ class _Facade:
         shapes: dict[tuple[float, str], int] = {}
         built = []
         which = np.empty(len(self.sills), np.int64)
-        for i, (h, material) in enumerate(self.sills):
-            w = h.u1 - h.u0 + 0.1
+        for i, (h, material, reach) in enumerate(self.sills):
+            w = h.u1 - h.u0 + 2 * reach
             if (w, material) not in shapes:
                 s = box((w, 0.07, 0.06), CLS, material, center=(0, 0, 0))
                 keep = s.vertices[s.faces].mean(1)[:, 1] < 0.035 - 1e-9  # drop the face against the wall
                 shapes[(w, material)] = len(built)
                 built.append((s.vertices @ m[:3, :3].T, s.faces[keep], s.face_class[keep], s.face_material[keep]))
             which[i] = shapes[(w, material)]
-        sills = np.array([((h.u0 + h.u1) / 2, h.v0 - 0.03) for h, _ in self.sills])
+        sills = np.array([((h.u0 + h.u1) / 2, h.v0 - 0.03) for h, _, _ in self.sills])
         # the sill centres, operation by operation as o + uc * d + 0.035 * n + (v0 - 0.03) * z
         centre = self.o + sills[:, :1] * self.d + 0.035 * self.n + sills[:, 1:] * np.array([0, 0, 1.0])
         verts = np.stack([b[0] for b in built])[which] + centre[:, None, :]
@@ -209,10 +215,17 @@ class _Facade:
         return [quads(corners, CLS, self.materials, normals)] + self._sill_mesh() + self._box_mesh()
 
 
-def _opening(fc: _Facade, h: Hole, st: Style, facade_mat: str) -> np.ndarray:
-    """Reveals, frame, glass (or door leaf) of one hole; returns the pane centre (3,)."""
+def _opening(fc: _Facade, h: Hole, st: Style, facade_mat: str, trim: float = 0.0) -> np.ndarray:
+    """Reveals, frame, glass (or door leaf) of one hole, a surround of bars ``trim`` wide round a
+    window (0: none); returns the pane centre (3,)."""
     depth = st.recess
-    fc.reveals(h, depth, facade_mat)
+    trimmed = trim > 0 and h.kind == "window" and st.pattern != "ribbon"
+    if st.paired:       # the two windows of a pair stand PIER_M apart: bars and sills keep 4 cm between them
+        trim = min(trim, PIER_M / 2 - 0.04)
+    reach = min(trim + 0.03, PIER_M / 2 - 0.02) if trimmed else 0.05
+    fc.reveals(h, depth, facade_mat, TRIM_T if trimmed else 0.0)
+    if trimmed:
+        surround(fc, h, trim, "facade_trim")
     centre = fc.point((h.u0 + h.u1) / 2, (h.v0 + h.v1) / 2, -depth)
     wf = -depth + FRAME_FROM_GLASS
     if h.kind == "door":
@@ -232,7 +245,7 @@ def _opening(fc: _Facade, h: Hole, st: Style, facade_mat: str) -> np.ndarray:
         fc.rect(a, um - 0.03, vt - 0.03, vt + 0.03, wf, "window_frame")
         fc.rect(um + 0.03, b, vt - 0.03, vt + 0.03, wf, "window_frame")
     if h.kind == "window" and st.pattern != "ribbon":
-        fc.sill(h, "facade_concrete")
+        fc.sill(h, "facade_trim" if trimmed else "facade_concrete", reach)
     return centre
 
 
@@ -261,9 +274,11 @@ def building(rng: np.random.Generator, footprint: np.ndarray, height: float, flo
     Mesh
         Class ``building``; anchors ``"door"`` (1, 3): bottom centre of the door in the wall
         plane, and ``"windows"`` (n, 3): centres of the glass panes (windows, balcony doors,
-        shop windows). Shop windows (material ``shop_glass``) with a sign band and, for some
-        buildings, awnings on the front's ground floor; balconies (slab and railing) on the
-        upper floors of the front and back for some buildings.
+        shop windows). Shop windows (material ``shop_glass``) with a sign board each, blade signs
+        and, for some buildings, awnings on the front's ground floor; balconies (slab and railing)
+        on the upper floors of the front and back for some buildings; window surrounds
+        (``facade_trim``) and rainwater pipes (``drainpipe``) at the corners of the front and back
+        for some; flat roofs with a coping lip.
     """
     if facade not in FACADES:
         raise ValueError(f"facade must be one of {sorted(FACADES)}, got {facade!r}")
@@ -273,6 +288,8 @@ def building(rng: np.random.Generator, footprint: np.ndarray, height: float, flo
         raise ValueError(f"height {height} m / floor_height {floor_height} m too small")
     poly = _clean(footprint)
     facade_mat = FACADES[facade]
+    trim = draw_trim(substream(rng, "facade_trim"), facade)
+    signs = substream(rng, "shop_signs")
     st = draw_style(rng, height, floor_height, facade)
     rect = rectangle_of(poly)
     if roof != "flat" and rect is None:
@@ -304,17 +321,20 @@ def building(rng: np.random.Generator, footprint: np.ndarray, height: float, flo
         for u0, u1, v0, v1 in wall_rects(fc.length, height, openings):
             fc.rect(u0, u1, v0, v1, 0.0, facade_mat)
         for h in openings:
-            centre = _opening(fc, h, st, facade_mat)
+            centre = _opening(fc, h, st, facade_mat, trim.surround)
             if h.kind == "door":
                 door_point = fc.pts([((h.u0 + h.u1) / 2, 0.0, 0.0)])
             else:
                 panes.append(centre)
             if h.kind == "balcony":
                 balcony(fc, h, st, facade_mat)
-        shop_front(fc, [h for h in openings if h.kind == "shop"], st, fc.length, rng)
+        shop_front(fc, [h for h in openings if h.kind == "shop"], st, fc.length, rng, signs)
+        if roles[i] != "side":
+            parts += pipes(fc, trim.pipes_front if i == front else trim.pipe_back, height - 0.1)
         parts += fc.meshes()
     if roof == "flat":
-        parts.append(flat_roof(rng, poly, height, parapet, facade_mat))
+        parts.append(flat_roof(rng, poly, height, parapet, facade_mat,
+                               "facade_concrete" if facade in ("concrete", "glass") else "facade_trim"))
     else:
         parts.append(pitched_roof(rng, rect, height, roof, facade_mat))
     out = merge(parts)

@@ -11,6 +11,8 @@ import numpy as np
 from generator.geometry import Mesh, box, merge, polygon, pose, resolve_ids, triangulate
 
 CLS = "building"
+COPING_OUT = 0.05    #: the parapet coping overhangs the walls by this much, metres
+COPING_H = 0.08      #: depth of the coping's lip, metres
 UP = np.array([0.0, 0.0, 1.0])
 
 
@@ -50,8 +52,11 @@ def _inside(poly: np.ndarray, pts: np.ndarray) -> np.ndarray:
     return (np.sum(cond & (x < xi), axis=1) % 2) == 1
 
 
-def flat_roof(rng: np.random.Generator, poly: np.ndarray, height: float, parapet: float, facade_mat: str) -> Mesh:
-    """Roof slab ``parapet`` below the wall top, parapet inner walls and cap, rooftop boxes.
+def flat_roof(rng: np.random.Generator, poly: np.ndarray, height: float, parapet: float, facade_mat: str,
+              coping: str = "facade_concrete") -> Mesh:
+    """Roof slab ``parapet`` below the wall top, parapet inner walls, a coping over the parapet that
+    overhangs the walls by ``COPING_OUT`` (a lip ``COPING_H`` deep: the roof edge reads as a line from
+    the street), rooftop boxes.
 
     Parameters
     ----------
@@ -71,7 +76,15 @@ def flat_roof(rng: np.random.Generator, poly: np.ndarray, height: float, parapet
         q0, q1, p0, p1 = inner[i], inner[j], poly[i], poly[j]
         inward = np.array([-(q1 - q0)[1], (q1 - q0)[0], 0.0])
         parts.append(polygon([[*q0, zr], [*q1, zr], [*q1, height], [*q0, height]], CLS, facade_mat, inward))
-        parts.append(polygon([[*p0, height], [*p1, height], [*q1, height], [*q0, height]], CLS, "facade_concrete", UP))
+    outer = _offset_inward(poly, -COPING_OUT)
+    zc = height - COPING_H
+    for i in range(k):
+        j = (i + 1) % k
+        q0, q1, p0, p1, o0, o1 = inner[i], inner[j], poly[i], poly[j], outer[i], outer[j]
+        out = np.array([(p1 - p0)[1], -(p1 - p0)[0], 0.0])
+        parts.append(polygon([[*o0, height], [*o1, height], [*q1, height], [*q0, height]], CLS, coping, UP))
+        parts.append(polygon([[*o0, zc], [*o1, zc], [*o1, height], [*o0, height]], CLS, coping, out))
+        parts.append(polygon([[*p0, zc], [*p1, zc], [*o1, zc], [*o0, zc]], CLS, coping, -UP))
     lo, hi = inner.min(0), inner.max(0)
     for size in ([rng.uniform(2.2, 3.2), rng.uniform(2.5, 3.5), rng.uniform(2.3, 2.8)],
                  [rng.uniform(1.0, 2.0), rng.uniform(0.8, 1.4), rng.uniform(0.8, 1.3)]):

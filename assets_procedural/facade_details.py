@@ -14,7 +14,9 @@ from assets_procedural.facade_layout import Hole, Style
 
 SLAB_T = 0.16          #: balcony slab thickness, metres
 RAIL_H = 1.0           #: railing height above the slab, metres
-FASCIA_H = 0.5         #: shop sign band height, metres
+FASCIA_H = 0.45        #: shop sign band height, metres (its top stays 4 cm under a first-floor balcony slab)
+BLADE_M = (0.65, 0.6)  #: blade sign reach from the wall and height, metres
+BLADE_P = 0.35         #: share of shops with a blade sign
 
 
 def balcony(fc, h: Hole, st: Style, facade_mat: str) -> None:
@@ -45,8 +47,10 @@ def balcony(fc, h: Hole, st: Style, facade_mat: str) -> None:
     fc.box(u1 - 2 * r, u1, top, top + RAIL_H - 0.05, 0.0, 2 * r, "balcony_metal")
 
 
-def shop_front(fc, shops: list[Hole], st: Style, length: float, rng: np.random.Generator) -> None:
-    """A fascia (sign band) over the ground floor and, for an awning style, one awning per shop window.
+def shop_front(fc, shops: list[Hole], st: Style, length: float, rng: np.random.Generator,
+               signs: np.random.Generator | None = None) -> None:
+    """Sign boards over the ground floor, blade signs (drawn from ``signs``, when given) and, for an
+    awning style, one awning per shop window.
 
     Parameters
     ----------
@@ -58,7 +62,17 @@ def shop_front(fc, shops: list[Hole], st: Style, length: float, rng: np.random.G
     if not shops:
         return
     top = max(s.v1 for s in shops)
-    fc.box(0.15, length - 0.15, top + 0.1, top + 0.1 + FASCIA_H, 0.0, 0.1, "shop_sign")
+    # one board per shop (split half-way between shop windows, 6 cm apart): each its own colour
+    shops = sorted(shops, key=lambda s: s.u0)
+    cuts = [0.15] + [(p.u1 + q.u0) / 2 for p, q in zip(shops[:-1], shops[1:], strict=True)] + [length - 0.15]
+    for k, (c0, c1) in enumerate(zip(cuts[:-1], cuts[1:], strict=True)):
+        fc.box(c0 + (0.03 if k else 0.0), c1 - (0.03 if k < len(cuts) - 2 else 0.0), top + 0.1,
+               top + 0.1 + FASCIA_H, 0.0, 0.1, "shop_sign")
+    if signs is not None:    # blade signs square to the wall at some shops, over the awnings
+        for s in shops:
+            u = s.u0 - 0.15
+            if signs.random() < BLADE_P and u > 0.4:
+                fc.box(u - 0.03, u + 0.03, top + 0.75, top + 0.75 + BLADE_M[1], 0.0, BLADE_M[0], "shop_sign")
     if not st.awning:
         return
     depth = float(rng.uniform(0.8, 1.1))

@@ -24,6 +24,8 @@ lit windows):
 * ``trees``   -- a tree of each species in the town, the camera 1.6 m up, 1.6 crown heights away;
 * ``facades`` -- the buildings with shop fronts and balconies, seen from the sidewalk across the street;
 * ``road``    -- stretches of road seen from 2.2 m up, looking down the lane.
+* ``facades_close`` -- a building of each wall material (render, brick, panels) from 8 m, and the
+  first by night (issue 29 item 5).
 
 Render settings: the ``preview`` preset (OpenImageDenoise) at ``--size`` and ``--samples``, motion blur
 and the camera model off (the crops are compared as scene radiance through one fixed tone map).
@@ -141,6 +143,37 @@ def facade_shots(scene) -> list[Shot]:
     return shots
 
 
+# -- issue 29 item 5 (facades helper): close facade crops, kept apart from the shots above ---------
+
+
+def facade_close_shots(scene) -> list[Shot]:
+    """A building of each wall material from the sidewalk opposite its front corner, ~9 m away, 1.7 m
+    up (bricks, render, panels, trim, pipes and shop signs at the scale a driving camera sees them
+    close); the first one again by night."""
+    shots = []
+    for want in ("plaster", "brick", "concrete"):
+        for o in scene.objects:
+            if o.kind != "building" or o.attrs.get("facade") != want:
+                continue
+            T = o.transform
+            lo, hi = scene.prototypes[o.prototype].bounds()
+            front = T[:3, :3] @ np.array([0.0, -1.0, 0.0])
+            corner = T[:3, :3] @ np.array([lo[0] + 1.5, lo[1], 0.0]) + T[:3, 3]
+            eye = corner + front * 8.0 + T[:3, :3] @ np.array([-3.0, 0.0, 0.0])
+            eye[2] = T[2, 3] + 1.7
+            target = corner + T[:3, :3] @ np.array([3.0, 0.0, 0.0]) + [0.0, 0.0, 3.5]
+            if _clear_eye(scene, eye, target, 6.0):
+                shots.append(Shot(f"facade_close_{want}", f"facade close: {want}, 8 m", look_at(eye, target)))
+                break
+    if shots:
+        shots.append(dataclasses.replace(shots[0], name=shots[0].name + "_night", time_of_day="night",
+                                         title=shots[0].title + ", night"))
+    return shots
+
+
+# -- end of the facades helper's block -------------------------------------------------------------
+
+
 def road_shots(scene) -> list[Shot]:
     path = max(scene.paths, key=lambda p: p.length())
     out = []
@@ -238,7 +271,7 @@ def render(args) -> int:
     cfg = dataclasses.replace(base, resolution=(w, h), samples=args.samples, camera_model=False,
                               motion_blur=dataclasses.replace(base.motion_blur, enabled=False))
     makers = {"ground": ground_shots, "horizon": horizon_shots, "trees": tree_shots, "facades": facade_shots,
-              "road": road_shots}
+              "road": road_shots, "facades_close": facade_close_shots}
     shots = [s for key in args.only for s in makers[key](town) if not args.shots or s.name in args.shots]
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -413,7 +446,7 @@ def main(argv: list[str] | None = None) -> int:
     r.add_argument("--size", default="640x360", help="WIDTHxHEIGHT of every crop")
     r.add_argument("--samples", type=_positive, default=12, help="Cycles samples (denoised)")
     r.add_argument("--only", nargs="*", default=["ground", "horizon"],
-                   choices=["ground", "horizon", "trees", "facades", "road"])
+                   choices=["ground", "horizon", "trees", "facades", "road", "facades_close"])
     r.add_argument("--shots", nargs="*", default=None, help="render only these shots (file stems)")
     c = sub.add_parser("compare", help="before | after sheets of two render runs")
     c.add_argument("before", type=_folder)

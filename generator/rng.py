@@ -45,3 +45,22 @@ def stream(seed: int, *names: str | int) -> np.random.Generator:
 def child_seed(seed: int, *names: str | int) -> int:
     """A 63-bit integer seed derived from ``seed`` and ``names`` (for other libraries)."""
     return int(stream(seed, *names).integers(0, 2**63 - 1))
+
+
+def substream(g: np.random.Generator, *names: str | int) -> np.random.Generator:
+    """A named sub-stream of the stream ``g`` was made from, without drawing from ``g``.
+
+    An asset builder receives one generator (``stream(seed, "assets", kind, i)``); a feature added
+    to it later draws from ``substream(g, "feature")`` so the builder's existing draws keep their
+    values. Depends only on ``g``'s seed sequence (not on how far ``g`` has been drawn).
+
+    Parameters
+    ----------
+    g : numpy.random.Generator
+        A generator seeded from a ``SeedSequence`` (every generator of :func:`stream` and
+        ``numpy.random.default_rng(int)``).
+    *names : str or int
+        Path of the sub-stream, e.g. ``("facade_detail",)``.
+    """
+    entropy = np.atleast_1d(np.asarray(g.bit_generator.seed_seq.entropy, dtype=object)).tolist()
+    return np.random.Generator(np.random.PCG64(np.random.SeedSequence([*map(int, entropy), *_name_words(names)])))

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from generator.blender import facade_detail as fd
 from generator.blender import ground_detail as gd
 from generator.blender.controls import CONTROL
 from generator.blender.nodes import Nodes
@@ -148,35 +149,49 @@ def _tint(g, base):
     return g.mix(1.0, base, g.object_info("Color"), "MULTIPLY")
 
 
+def _wall(g, col, height, rough, uv, co, z, weather=1.0):
+    """Weathered wall shader of a base colour and height (:mod:`generator.blender.facade_detail`)."""
+    amount = g.mul(g.add(0.35, g.mul(fd.per_building(g, 1.0), 0.65)), weather)
+    col, stain = fd.weathering(g, uv, co, z, col, amount)
+    return g.principled(base_color=col, roughness=g.add(rough, g.mul(stain, -0.1)),
+                        normal=g.bump(g.add(height, stain), 0.3, 0.004))
+
+
 def facade_plaster(g, rng):
-    uv, co = _wall_coords(g)
-    n = g.noise(co, scale=4, detail=6)
-    stains = g.smooth(g.noise(g.mapping(co, scale=(1, 1, 0.3)), scale=0.8, detail=4), 0.55, 0.75)
-    base = g.mix(g.mul(stains, 0.35), g.ramp(n, [(0.4, (0.92,) * 3), (0.6, (1.0,) * 3)]), (0.45, 0.42, 0.38),
-                 "MULTIPLY")
-    return g.principled(base_color=_tint(g, base), roughness=0.9, normal=g.bump(n, 0.15, 0.02))
+    """Render: grain, blotches and water stains, a plinth on some buildings, weathering."""
+    uv, co, z = fd.wall_uv(g)
+    stains = g.smooth(g.noise(g.mapping(co, scale=(1, 1, 0.3)), scale=0.8, detail=2), 0.55, 0.75)
+    base = g.mix(g.mul(stains, 0.25), (1.0, 1.0, 1.0), (0.8, 0.77, 0.72))
+    col, height = fd.render(g, uv, co, z, _tint(g, base))
+    return _wall(g, col, height, 0.9, uv, co, z)
+
+
+#: the base wall tints of the layout (``generator/layout/lots/lot.py``): brick and concrete walls keep
+#: only the per-building jitter of their tint (their colour is in the texture)
+_BRICK_TINT, _CONCRETE_TINT = (0.6, 0.32, 0.24), (0.65, 0.65, 0.63)
+
+
+def _rel_tint(g, base, tint):
+    rel = g.mix(1.0, g.object_info("Color"), tuple(1.0 / c for c in tint), "MULTIPLY")
+    return g.mix(1.0, base, rel, "MULTIPLY")
 
 
 def facade_brick(g, rng):
-    uv, co = _wall_coords(g)
-    c1 = _jit(rng, (0.30, 0.085, 0.045), 0.15)
-    c2 = _jit(rng, (0.22, 0.065, 0.035), 0.15)
-    bricks = g.brick(uv, color1=c1, color2=c2, mortar=(0.45, 0.43, 0.4), scale=1.0, mortar_size=0.012,
-                     brick_width=0.25, row_height=0.075)
-    mortar = g.brick(uv, color1=(1, 1, 1), color2=(1, 1, 1), mortar=(0, 0, 0), scale=1.0, mortar_size=0.012,
-                     brick_width=0.25, row_height=0.075, out="Factor")
-    n = g.noise(co, scale=30, detail=3)
-    base = g.mix(g.mul(n, 0.25), bricks, (0.1, 0.05, 0.03))
-    return g.principled(base_color=_tint(g, base), roughness=0.85, normal=g.bump(mortar, 0.3, 0.01))
+    """Stretcher-bond brick at real size, a tone per brick, recessed mortar joints, weathering."""
+    uv, co, z = fd.wall_uv(g)
+    mid = np.asarray(_jit(rng, (0.3, 0.085, 0.048), 0.12))
+    palette = [tuple(mid * 0.72), tuple(mid), tuple(np.clip(mid * [1.25, 1.35, 1.4], 0, 1)),
+               tuple(mid * [0.45, 0.5, 0.6])]
+    col, height = fd.brick(g, uv, co, palette)
+    return _wall(g, _rel_tint(g, col, _BRICK_TINT), height, 0.85, uv, co, z)
 
 
 def facade_concrete(g, rng):
-    uv, co = _wall_coords(g)
-    panels = g.brick(uv, color1=(0.95, 0.95, 0.95), color2=(0.85, 0.85, 0.85), mortar=(0.3, 0.3, 0.3), scale=1.0,
-                     mortar_size=0.01, brick_width=3.0, row_height=1.6, offset=0.0)
-    n = g.noise(co, scale=6, detail=8)
-    base = g.mix(1.0, panels, g.ramp(n, [(0.3, (0.5,) * 3), (0.7, (0.62,) * 3)]), "MULTIPLY")
-    return g.principled(base_color=_tint(g, base), roughness=0.8, normal=g.bump(n, 0.1, 0.01))
+    """Precast panels on a 1.2-1.5 m grid, a tone per panel, pores, weathering (stronger)."""
+    uv, co, z = fd.wall_uv(g)
+    size = (float(rng.uniform(1.2, 1.5)), float(rng.uniform(1.2, 1.5)))
+    col, height = fd.panels(g, uv, co, _jit(rng, (0.4, 0.39, 0.37), 0.05), size)
+    return _wall(g, _rel_tint(g, col, _CONCRETE_TINT), height, 0.8, uv, co, z, weather=1.2)
 
 
 def window_glass(g, rng):
@@ -190,7 +205,12 @@ def window_glass(g, rng):
     warm = g.ramp(kelvin, [(0.0, (1.0, 0.62, 0.32)), (0.45, (1.0, 0.74, 0.46)), (0.75, (1.0, 0.86, 0.68)),
                            (0.92, (0.92, 0.94, 1.0))])
     bright = g.math("POWER", 10.0, g.add(-1.0, g.mul(g.math("FRACT", g.mul(pane, 113.0)), 1.5)))
-    glass = g.principled(base_color=(0.02, 0.025, 0.03), roughness=0.03, metallic=0.0, ior=1.5, specular=1.0)
+    # the room behind: mostly dark, some panes with pale curtains or blinds drawn (a tone per pane)
+    curtain = g.smooth(g.math("FRACT", g.mul(pane, 7.0)), 0.7, 0.95)
+    room = g.mix(curtain, (0.012, 0.013, 0.015), g.mix(g.math("FRACT", g.mul(pane, 3.0)), (0.09, 0.08, 0.065),
+                                                           (0.06, 0.065, 0.07)))
+    glass = g.principled(base_color=room, roughness=g.add(0.015, g.mul(g.math("FRACT", g.mul(pane, 53.0)), 0.04)),
+                         metallic=0.0, ior=1.5, specular=1.0, normal=fd.wavy_normal(g))
     return _emit(g, glass, warm, 6.0, "windows", g.mul(lit, bright))
 
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from generator.blender import facade_detail as fd
 from generator.blender.controls import CONTROL
 from generator.blender.nodes import Nodes
 from generator.blender.recipes import _emit, _foliage, _jit, _tint, _wall_coords
@@ -45,7 +46,8 @@ def shop_glass(g, rng):
     """Shop windows: clear glass with a lit interior at night (the ``windows`` light group)."""
     pane = g.math("FRACT", g.add(g.geometry("Random Per Island"), g.object_info("Random")))
     lit = g.math("LESS_THAN", pane, g.add(g.attr(CONTROL["lit_windows"], "VIEW_LAYER"), 0.3))
-    glass = g.principled(base_color=(0.015, 0.02, 0.022), roughness=0.02, ior=1.5, specular=1.0)
+    glass = g.principled(base_color=(0.015, 0.02, 0.022), roughness=0.02, ior=1.5, specular=1.0,
+                         normal=fd.wavy_normal(g, 0.01))
     return _emit(g, glass, (1.0, 0.9, 0.75), 8.0, "windows", lit)
 
 
@@ -61,14 +63,39 @@ def awning(g, rng):
 
 
 def shop_sign(g, rng):
-    """A painted fascia board over the shop windows, a colour per object, faint lettering blocks."""
+    """Painted sign boards over the shop windows: a colour per board (each board is its own mesh
+    island: Random Per Island, with the object's draw), pale lettering blocks along their middle."""
     uv, co = _wall_coords(g)
+    board = g.math("FRACT", g.add(g.geometry("Random Per Island"), g.object_info("Random")))
     letters = g.brick(uv, color1=(1, 1, 1), color2=(1, 1, 1), mortar=(0, 0, 0), scale=1.0, mortar_size=0.05,
                       brick_width=0.35, row_height=0.55, out="Factor")
-    colour = g.hsv((0.05, 0.1, 0.25), hue=g.object_info("Random"), saturation=1.0, value=1.0)
+    colour = g.hsv((0.05, 0.1, 0.25), hue=board, saturation=g.add(0.5, g.mul(g.math("FRACT", g.mul(board, 7.0)), 0.6)),
+                   value=g.add(0.6, g.mul(g.math("FRACT", g.mul(board, 13.0)), 0.8)))
     base = g.mix(g.mul(g.math("SUBTRACT", 1.0, letters), 0.85), colour, (0.85, 0.82, 0.75))
     return g.principled(base_color=base, roughness=0.4)
 
 
 def balcony_metal(g, rng):
     return g.principled(base_color=_tint(g, _jit(rng, (0.12, 0.12, 0.125), 0.2)), metallic=0.6, roughness=0.45)
+
+
+# -- issue 29 item 5 (facades): window surrounds, copings, drainpipes ----------------------------
+
+
+def facade_trim(g, rng):
+    """Stone or render trim (window surrounds, string courses, parapet copings): pale, fine grain,
+    a little weathered."""
+    uv, co, z = fd.wall_uv(g)
+    grain = g.noise(co, scale=60.0, detail=2)
+    col = g.mix(g.mul(grain, 0.15), _jit(rng, (0.72, 0.7, 0.65), 0.05), (0.55, 0.53, 0.5))
+    col, stain = fd.weathering(g, uv, co, z, col, g.mul(fd.per_building(g, 1.0), 0.6))
+    return g.principled(base_color=col, roughness=0.75, normal=g.bump(g.add(grain, stain), 0.2, 0.003))
+
+
+def drainpipe(g, rng):
+    """Painted metal rainwater pipes: dark grey, black or zinc per building, a little dirty."""
+    pick = fd.per_building(g, 29.0)
+    col = g.ramp(pick, [(0.0, (0.06, 0.06, 0.065)), (0.5, (0.2, 0.21, 0.22)), (0.8, (0.42, 0.43, 0.44))])
+    dirt = g.smooth(g.noise(g.coords("Object"), scale=3.0, detail=3), 0.5, 0.7)
+    col = g.mix(g.mul(dirt, 0.4), col, (0.12, 0.1, 0.08))
+    return g.principled(base_color=col, metallic=0.4, roughness=0.5)
