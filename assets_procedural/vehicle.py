@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from assets_procedural.car_body import body_shell, draw_dimensions
+from assets_procedural.vehicle_interior import car_interior
 from generator.geometry import Mesh, box, cylinder, disc, loft, merge, on_ground, polygon, pose, prism, resolve_ids
 
 GLASS_OFFSET = 0.02  # metres: glass in front of the body surface (>= 2 cm: no z-fighting)
@@ -151,7 +152,7 @@ def car(rng: np.random.Generator, variant: str | None = None, quantile: float | 
     p = draw_dimensions(rng, variant)
     shell, info = body_shell(p, variant)
     L, W, r, tyre_w = p["L"], p["W"], p["r"], 0.2 + 0.1 * (p["r"] - 0.29)
-    parts = [shell]
+    parts = [shell, car_interior(p, info)]
     for x in (info["xr"], info["xf"]):
         for side in (1.0, -1.0):
             parts.append(car_wheel(x, W / 2 - 0.025, side, r, tyre_w))
