@@ -112,7 +112,9 @@ def wheel_rim(g: Nodes, rng):
 
 
 def licence_plate(g: Nodes, rng):
-    return g.principled(base_color=(0.78, 0.78, 0.72), roughness=0.35)
+    """White plates; about one car in eight yellow (Dutch plates, British rear plates)."""
+    yellow = g.math("GREATER_THAN", g.object_info("Random"), 0.88)
+    return g.principled(base_color=g.mix(yellow, (0.78, 0.78, 0.72), (0.8, 0.6, 0.04)), roughness=0.35)
 
 
 def clothing(g: Nodes, rng):
