@@ -12,7 +12,9 @@ from __future__ import annotations
 import numpy as np
 
 from assets_procedural.car_body import body_shell, draw_dimensions
+from assets_procedural.vehicle_interior import car_interior
 from generator.geometry import Mesh, box, cylinder, disc, loft, merge, on_ground, polygon, pose, prism, resolve_ids
+from generator.geometry.primitives import quads
 
 GLASS_OFFSET = 0.02  # metres: glass in front of the body surface (>= 2 cm: no z-fighting)
 PROUD_M = 0.025      #: how far a car's lamps and plates stand out of its nose and tail, metres
@@ -80,7 +82,8 @@ def _inset_quad(q: np.ndarray, du: float, dv: float, normal: np.ndarray, cls: st
 
 def car_wheel(x: float, y_out: float, side: float, radius: float, width: float, cls: str = "car",
               sections: int = 12) -> Mesh:
-    """A car wheel: a tyre with rounded shoulders (``rubber``), a rim face (``wheel_rim``) and a hub cap.
+    """A car wheel: a tyre with rounded shoulders (``rubber``), a rim face (``wheel_rim``) with five spokes
+    between dark openings (``rubber``) and a hub cap.
 
     Parameters
     ----------
@@ -102,7 +105,22 @@ def car_wheel(x: float, y_out: float, side: float, radius: float, width: float, 
     _, rim = resolve_ids(cls, "wheel_rim")
     tyre.face_material[-sections:] = rim                             # the outer cap: the rim face
     hub = disc((x, side * (y_out + 0.006), radius), (0, side, 0), 0.2 * radius, cls, "chrome", 6)
-    return merge([tyre, hub])
+    return merge([tyre, hub, _rim_openings(x, side * (y_out + 0.003), radius, side, cls)])
+
+
+def _rim_openings(x: float, y: float, radius: float, side: float, cls: str, spokes: int = 5) -> Mesh:
+    """The dark openings between an alloy rim's ``spokes`` (``rubber``: the brake behind, dark), 3 mm proud
+    of the rim face at ``y``: ``spokes`` quads that leave the spokes in the rim's metal between them."""
+    period = 2 * np.pi / spokes
+    mid = period * (np.arange(spokes) + 0.5)
+    t0, t1 = mid - 0.3 * period, mid + 0.3 * period
+    r0, r1 = 0.27 * radius, 0.58 * radius
+
+    def at(r, t):
+        return np.stack([x + r * np.cos(t), np.full_like(t, y), radius + r * np.sin(t)], -1)
+
+    corners = np.stack([at(r0, t0), at(r1, t0), at(r1, t1), at(r0, t1)], 1)
+    return quads(corners, cls, "rubber", np.tile([0.0, side, 0.0], (spokes, 1)))
 
 
 def _arch_wall(x: float, y: float, side: float, r: float, arch: float, cls: str) -> Mesh:
@@ -151,7 +169,7 @@ def car(rng: np.random.Generator, variant: str | None = None, quantile: float | 
     p = draw_dimensions(rng, variant)
     shell, info = body_shell(p, variant)
     L, W, r, tyre_w = p["L"], p["W"], p["r"], 0.2 + 0.1 * (p["r"] - 0.29)
-    parts = [shell]
+    parts = [shell, car_interior(p, info)]
     for x in (info["xr"], info["xf"]):
         for side in (1.0, -1.0):
             parts.append(car_wheel(x, W / 2 - 0.025, side, r, tyre_w))

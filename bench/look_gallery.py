@@ -23,9 +23,11 @@ lit windows):
   and by night (issue 29 item 6);
 * ``trees``   -- a tree of each species in the town, the camera 1.6 m up, 1.6 crown heights away;
 * ``facades`` -- the buildings with shop fronts and balconies, seen from the sidewalk across the street;
-* ``road``    -- stretches of road seen from 2.2 m up, looking down the lane.
+* ``road``    -- stretches of road seen from 2.2 m up, looking down the lane;
 * ``facades_close`` -- a building of each wall material (render, brick, panels) from 8 m, and the
-  first by night (issue 29 item 5).
+  first by night (issue 29 item 5);
+* ``cars``    -- a parked car from the sidewalk, front three-quarter by day and by night, and side-on
+  through its windows by day (issue 29 item 3).
 
 Render settings: the ``preview`` preset (OpenImageDenoise) at ``--size`` and ``--samples``, motion blur
 and the camera model off (the crops are compared as scene radiance through one fixed tone map).
@@ -252,6 +254,29 @@ def horizon_shots(town) -> list[Shot]:
     return shots
 
 
+# -- cars (issue 29 item 3, helper "cars") -------------------------------------------------------------
+def car_shots(town) -> list[Shot]:
+    """A parked car close up from the sidewalk, front three-quarter view, 1.6 m up, by day and by night;
+    and the same car side-on through its windows (issue 29 item 3)."""
+    for o in town.objects:
+        if o.cls != "car" or o.attrs.get("placement") != "parked":
+            continue
+        T = o.transform
+        lo, hi = town.prototypes[o.prototype].bounds()
+        centre = T[:3, :3] @ np.array([(lo[0] + hi[0]) / 2, 0.0, 0.9]) + T[:3, 3]
+        for side in (1.0, -1.0):
+            eye = T[:3, :3] @ np.array([hi[0] + 1.6, side * (hi[1] + 2.6), 1.6]) + T[:3, 3]
+            eye_side = T[:3, :3] @ np.array([(lo[0] + hi[0]) / 2 - 0.3, side * (hi[1] + 2.8), 1.5]) + T[:3, 3]
+            if _clear_eye(town, eye, centre, 2.0) and _clear_eye(town, eye_side, centre, 2.0):
+                return [Shot("car_day", "car: parked, front three-quarter, day", look_at(eye, centre)),
+                        Shot("car_night", "car: parked, front three-quarter, night", look_at(eye, centre),
+                             time_of_day="night"),
+                        Shot("car_side_day", "car: parked, side-on through the windows, day",
+                             look_at(eye_side, centre))]
+    return []
+# -- end of cars ---------------------------------------------------------------------------------------
+
+
 def render(args) -> int:
     sys.path.insert(0, str(Path(args.code_root).resolve() if args.code_root else ROOT))
     import generator
@@ -271,7 +296,7 @@ def render(args) -> int:
     cfg = dataclasses.replace(base, resolution=(w, h), samples=args.samples, camera_model=False,
                               motion_blur=dataclasses.replace(base.motion_blur, enabled=False))
     makers = {"ground": ground_shots, "horizon": horizon_shots, "trees": tree_shots, "facades": facade_shots,
-              "road": road_shots, "facades_close": facade_close_shots}
+              "road": road_shots, "facades_close": facade_close_shots, "cars": car_shots}
     shots = [s for key in args.only for s in makers[key](town) if not args.shots or s.name in args.shots]
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -446,7 +471,7 @@ def main(argv: list[str] | None = None) -> int:
     r.add_argument("--size", default="640x360", help="WIDTHxHEIGHT of every crop")
     r.add_argument("--samples", type=_positive, default=12, help="Cycles samples (denoised)")
     r.add_argument("--only", nargs="*", default=["ground", "horizon"],
-                   choices=["ground", "horizon", "trees", "facades", "road", "facades_close"])
+                   choices=["ground", "horizon", "trees", "facades", "road", "facades_close", "cars"])
     r.add_argument("--shots", nargs="*", default=None, help="render only these shots (file stems)")
     c = sub.add_parser("compare", help="before | after sheets of two render runs")
     c.add_argument("before", type=_folder)

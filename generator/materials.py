@@ -28,7 +28,7 @@ class MaterialInfo:
 class MaterialTable:
     """Material rows with name lookup and per-id arrays."""
 
-    def __init__(self, rows: list[MaterialInfo], cabins: tuple[str, ...] = ()):
+    def __init__(self, rows: list[MaterialInfo], cabins: tuple[str, ...] = (), interiors: tuple[str, ...] = ()):
         if [r.id for r in rows] != list(range(len(rows))):
             raise ValueError("materials.yaml: ids must be 0..N-1 in order")
         for r in rows:
@@ -38,6 +38,11 @@ class MaterialTable:
         self.rows = rows
         #: classes whose glass closes an unmodelled cabin (``cabins`` in materials.yaml)
         self.cabins = tuple(cabins)
+        #: classes whose cabin is modelled behind their glass (``interiors`` in materials.yaml)
+        self.interiors = tuple(interiors)
+        if set(self.cabins) & set(self.interiors):
+            raise ValueError(f"materials.yaml: classes both in cabins and interiors: "
+                             f"{sorted(set(self.cabins) & set(self.interiors))}")
         self.names = [r.name for r in rows]
         self._by_name = {r.name: r for r in rows}
 
@@ -94,4 +99,5 @@ def material_table() -> MaterialTable:
             for r in raw
         ],
         tuple(str(c) for c in doc.get("cabins", ())),
+        tuple(str(c) for c in doc.get("interiors", ())),
     )

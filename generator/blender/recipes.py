@@ -262,10 +262,6 @@ def truck_paint(g, rng):
     return g.principled(base_color=g.object_info("Color"), metallic=0.1, roughness=0.45)
 
 
-def car_glass(g, rng):
-    return g.principled(base_color=(0.01, 0.012, 0.015), roughness=0.02, ior=1.5, specular=1.0)
-
-
 def rubber(g, rng):
     return g.principled(base_color=(0.015, 0.015, 0.015), roughness=0.9)
 

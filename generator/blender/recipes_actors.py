@@ -5,13 +5,16 @@ hair are object properties (:mod:`generator.layout.placement.appearance` draws t
 in ``attrs``; :func:`generator.blender.geometry.new_object` writes them): ``Object.color`` holds
 the paint or the top, ``ug_<name>_color`` the others, ``ug_paint_metallic`` 0/1 and ``ug_outfit``
 1 where a person's colours were given (0: the earlier look, tones from the object's random
-number, so scenes without drawn outfits still render sensibly). Same signature as
-:mod:`generator.blender.recipes`.
+number, so scenes without drawn outfits still render sensibly); a vehicle's paint finish
+(``ug_paint_matte``, ``ug_paint_dirt``) comes from :mod:`generator.blender.vehicle_finish`. Same
+signature as :mod:`generator.blender.recipes`.
 """
 
 from __future__ import annotations
 
 from generator.blender.nodes import Nodes
+from generator.labels import class_table
+from generator.materials import material_table
 
 
 def _per_object(g: Nodes, name: str, fallback):
@@ -19,15 +22,85 @@ def _per_object(g: Nodes, name: str, fallback):
     return g.mix(g.attr("ug_outfit", "OBJECT", "Fac"), fallback, g.attr(f"ug_{name}_color", "OBJECT", "Color"))
 
 
+def _height(g: Nodes):
+    """The shading point's height in the object's frame (a vehicle's origin is on the ground), metres."""
+    sep = g.node("ShaderNodeSeparateXYZ")
+    g.set(sep.inputs[0], g.coords("Object"))
+    return sep.outputs["Z"]
+
+
 def car_paint(g: Nodes, rng):
+    """Vehicle paint of one of three finishes, with road grime toward the sills.
+
+    Object properties (:mod:`generator.blender.vehicle_finish`): ``ug_paint_metallic`` (metallic paints of
+    the palette: flakes under the clear coat), ``ug_paint_matte`` (satin, no clear coat) and
+    ``ug_paint_dirt`` (0 clean .. 1 filthy: grime rising from the sills in streaks, dust over all).
+    """
     metallic = g.attr("ug_paint_metallic", "OBJECT", "Fac")
-    return g.principled(base_color=g.object_info("Color"), metallic=g.lerp(metallic, 0.0, 0.7),
-                        roughness=g.lerp(metallic, 0.28, 0.38), coat=1.0, coat_roughness=0.04)
+    matte = g.attr("ug_paint_matte", "OBJECT", "Fac")
+    dirt = g.attr("ug_paint_dirt", "OBJECT", "Fac")
+    co = g.coords("Object")
+    # metallic flakes: sub-millimetre cells tilting the base layer's normal under a smooth coat
+    flakes = g.voronoi(co, scale=900.0, out="Distance")
+    normal = g.bump(g.mul(flakes, metallic), 0.25, 0.0004)
+    rough = g.lerp(matte, g.lerp(metallic, 0.28, 0.36), 0.62)
+    coat = g.lerp(matte, 1.0, 0.0)
+    # grime: up to ~0.25 m on a clean car, to the belt line on a filthy one, streaked vertically
+    reach = g.add(0.12, g.mul(dirt, 0.75))
+    low = g.math("SUBTRACT", 1.0, g.smooth(g.math("DIVIDE", _height(g), reach), 0.35, 1.0))
+    streaks = g.noise(g.mapping(co, scale=(6.0, 6.0, 1.5)), scale=3.0, detail=3.0)
+    grime = g.math("MINIMUM", 1.0, g.mul(g.mul(dirt, low), g.add(0.55, g.mul(streaks, 0.7))))
+    dust = g.mul(dirt, g.add(0.12, g.mul(g.noise(co, scale=2.0, detail=2.0), 0.18)))
+    base = g.mix(dust, g.object_info("Color"), (0.30, 0.27, 0.23))
+    base = g.mix(grime, base, (0.11, 0.09, 0.065))
+    rough = g.lerp(g.math("MAXIMUM", grime, dust), rough, 0.9)
+    coat = g.lerp(grime, coat, 0.05)
+    return g.principled(base_color=base, metallic=g.lerp(grime, g.lerp(metallic, 0.0, 0.7), 0.0), roughness=rough,
+                        coat=coat, coat_roughness=0.04, normal=normal)
 
 
 def car_body(g: Nodes, rng):
     """The curved shell of a car: the same paint, shaded smooth (``car_paint`` stays flat for boxy parts)."""
     return car_paint(g, rng)
+
+
+def _see_through(g: Nodes):
+    """1 on the faces of the classes whose cabin is modelled (``interiors`` in materials.yaml), else 0."""
+    classes = class_table()
+    out = 0.0
+    for name in material_table().interiors:
+        eq = g.node("ShaderNodeMath", operation="COMPARE")
+        g.set(eq.inputs[0], g.attr("class_id"))
+        eq.inputs[1].default_value, eq.inputs[2].default_value = float(classes.id(name)), 0.25
+        out = g.add(out, eq.outputs[0])
+    return g.math("MINIMUM", out, 1.0)
+
+
+def car_glass(g: Nodes, rng):
+    """Vehicle and shelter glass. On a car (a modelled cabin behind it) thin tinted glass the camera sees
+    through, reflecting by Fresnel; elsewhere (trucks, buses, shelters: nothing behind it) dark and glossy."""
+    opaque = g.principled(base_color=(0.01, 0.012, 0.015), roughness=0.02, ior=1.5, specular=1.0)
+    tint = g.node("ShaderNodeBsdfTransparent")
+    g.set(tint.inputs["Color"], (0.5, 0.56, 0.55))
+    gloss = g.node("ShaderNodeBsdfGlossy")
+    g.set(gloss.inputs["Color"], (1.0, 1.0, 1.0))
+    g.set(gloss.inputs["Roughness"], 0.03)
+    fres = g.node("ShaderNodeFresnel")
+    g.set(fres.inputs["IOR"], 1.52)
+    thin = g.mix_shader(fres.outputs[0], tint.outputs[0], gloss.outputs[0])
+    return g.mix_shader(_see_through(g), opaque, thin)
+
+
+def car_interior(g: Nodes, rng):
+    """Seats, dashboard, door cards and floor: black, grey or beige per car, a fabric grain."""
+    tone = g.ramp(g.object_info("Random"), [(0.0, (0.012, 0.012, 0.013)), (0.6, (0.035, 0.034, 0.033)),
+                                            (0.9, (0.16, 0.13, 0.095))])
+    grain = g.bump(g.noise(g.coords("Object"), scale=180.0, detail=2.0), 0.15, 0.002)
+    return g.principled(base_color=tone, roughness=0.8, normal=grain)
+
+
+def car_headliner(g: Nodes, rng):
+    return g.principled(base_color=(0.32, 0.31, 0.29), roughness=0.95)
 
 
 def car_trim(g: Nodes, rng):
@@ -39,7 +112,9 @@ def wheel_rim(g: Nodes, rng):
 
 
 def licence_plate(g: Nodes, rng):
-    return g.principled(base_color=(0.78, 0.78, 0.72), roughness=0.35)
+    """White plates; about one car in eight yellow (Dutch plates, British rear plates)."""
+    yellow = g.math("GREATER_THAN", g.object_info("Random"), 0.88)
+    return g.principled(base_color=g.mix(yellow, (0.78, 0.78, 0.72), (0.8, 0.6, 0.04)), roughness=0.35)
 
 
 def clothing(g: Nodes, rng):

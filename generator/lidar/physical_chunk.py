@@ -11,7 +11,8 @@ Steps, per chunk ``[c0, c1)`` of a sweep (the scanner's threads run chunks in pa
    (:func:`~generator.lidar.return_rays.split_beams`) the rest, cast against the town and the actors;
 3. rays that end on glass go on behind it, up to ``glass_layers`` panes
    (:func:`~generator.lidar.return_rays.pane_rays`); a continued ray that meets the object whose
-   glass it crossed (same class and instance) is absorbed in its interior
+   glass it crossed (same class and instance) is absorbed in its interior, unless the object's cabin
+   is modelled: then only its own opaque faces return it
    (:func:`~generator.lidar.return_rays.absorb_interior`);
 4. the waveform of every beam (:func:`generator.lidar.return_kernels.beam_returns`) gives its
    returns, handed to the sweep (:meth:`generator.lidar.scan._Sweep.deliver`), which places them
@@ -172,6 +173,8 @@ class FaceLookup:
         One-way transmittance of the face's material.
     label : (F + 1,) int64
         ``class << 16 | instance`` of the face (-1 in the last entry).
+    interior : (C,) bool
+        Per class id: its cabin is modelled (``Optics.interior``).
     """
 
     def __init__(self, faces: np.ndarray, optics):
@@ -180,6 +183,7 @@ class FaceLookup:
         ends = optics.room[mat] | optics.cabin[faces["class"]]
         self.glass = (self.transmittance > 0) & ~np.append(ends, False)
         self.label = np.append((faces["class"].astype(np.int64) << 16) | faces["instance"], -1).astype(np.int64)
+        self.interior = np.ascontiguousarray(optics.interior, bool)
 
 
 def _behind_glass(scanner, plan, cols, aimed, parts, lookup, layers, max_range, n_in) -> None:
@@ -213,7 +217,7 @@ def _behind_glass(scanner, plan, cols, aimed, parts, lookup, layers, max_range, 
         inst, moving = _actor_hits(scanner, plan, cols, o, d, dist, face, aimed, rows=rows, offset=offset)
         # the interior of the object whose glass the ray crossed is not modelled: absorbed there
         face = np.ascontiguousarray(face, np.int32)
-        absorb_interior(face, inst, pane, lookup.label)
+        absorb_interior(face, inst, pane, lookup.label, lookup.transmittance, lookup.interior)
         layer = {"o": o, "dw": dw, "df": d, "dist": dist, "face": face, "inst": inst, "moving": moving, "beam": beam,
                  "weight": weight, "offset": offset, "tau": tau}
         for key, v in layer.items():

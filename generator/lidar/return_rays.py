@@ -69,8 +69,13 @@ def pane_rays(face, dist, offset, tau, inst, o, dw, glass_face, face_trans, face
 
 
 @njit(nogil=True, cache=True)
-def absorb_interior(face, inst, pane, face_label):  # pragma: no cover - compiled
-    """Rays behind a pane that meet the pane's own object (same class and instance) end there: ``face`` = -1.
+def absorb_interior(face, inst, pane, face_label, face_trans, interior):  # pragma: no cover - compiled
+    """Rays behind a pane that its object absorbs end there: ``face`` = -1.
+
+    Behind the pane of a class with a modelled cabin (``interior``), the ray keeps only an opaque face
+    of the pane's own object (the cabin seen through its glass); its own glass again (the far window)
+    or any other object (a seam of the body) absorbs it, so it never leaves the vehicle. Behind any
+    other pane, a ray meeting the pane's own object (same class and instance) is absorbed.
 
     Parameters
     ----------
@@ -81,13 +86,20 @@ def absorb_interior(face, inst, pane, face_label):  # pragma: no cover - compile
     pane : (n,) int64
         Label of the pane each ray crossed (:func:`pane_rays`).
     face_label : (F + 1,) int64
+    face_trans : (F + 1,) float32
+        Per face-table row its material's one-way transmittance (> 0: glass).
+    interior : (C,) bool
+        Per class id: its cabin is modelled behind its glass.
     """
     for r in range(face.shape[0]):
         f = face[r]
         if f < 0:
             continue
         lab = (face_label[f] & ~np.int64(0xFFFF)) | np.int64(inst[r]) if inst[r] >= 0 else face_label[f]
-        if lab == pane[r]:
+        if interior[pane[r] >> 16]:
+            if lab != pane[r] or face_trans[f] > 0:
+                face[r] = -1
+        elif lab == pane[r]:
             face[r] = -1
 
 

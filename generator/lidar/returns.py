@@ -29,14 +29,19 @@ the 3 mrad column spacing that no central ray touches stays invisible (as withou
 
 Glass (materials with a ``transmittance``): the pane returns its own weak diffuse reflectance and a
 specular glint near normal incidence, and lets ``transmittance`` of the power through; the beam goes
-on (up to ``glass_layers`` panes). Behind the glass of an object lies its interior, which the scene
-does not model: a continued beam that meets the same object (same class and instance) again is
-absorbed there, and a free-standing pane (a shelter, a glass wall panel) shows what stands behind
-it. Two kinds of pane end the beam at once, without casting it on: a building's facade glass
-(``behind: room`` in ``materials.yaml``: the room absorbs the beam, and the scene's buildings have
-no floor, so a beam cast on would meet the ground under the building) and a vehicle's windows (the
-classes listed as ``cabins``: cast on, the beam could only meet its own vehicle again, or slip out
-through a seam of the body). So car windows are the holes of real scans.
+on (up to ``glass_layers`` panes). Behind the glass of most objects lies an interior the scene does
+not model: a continued beam that meets the same object (same class and instance) again is absorbed
+there, and a free-standing pane (a shelter, a glass wall panel) shows what stands behind it. A car's
+cabin is modelled (seats, dashboard, door cards, floor, headliner; the classes listed as
+``interiors``): the beam goes on into it and returns from the opaque faces of its own vehicle it
+meets there, as the camera sees them through the transparent glass; meeting its own vehicle's glass
+again (the far window) or anything else (through a seam of the body), it is absorbed, so it never
+leaves the vehicle. Two kinds of pane end the beam at once, without casting it on: a building's
+facade glass (``behind: room`` in ``materials.yaml``: the room absorbs the beam, and the scene's
+buildings have no floor, so a beam cast on would meet the ground under the building) and the windows
+of vehicles whose cabin is not modelled (the classes listed as ``cabins``: trucks, buses, trams;
+cast on, the beam could only meet its own vehicle again, or slip out through a seam of the body):
+their windows are the holes of real scans.
 
 Waveform: each beam's hits (sub-rays, panes, what lies behind them) sorted by range; hits closer
 than ``separation_m`` (half the pulse length, ``c tau / 2``) merge into one return whose range is
@@ -117,6 +122,9 @@ class Optics:
         Panes with an unmodelled room behind them (``behind: room``): the beam ends there.
     cabin : (C,) bool, indexed by class id
         Classes whose panes close an unmodelled cabin (``cabins`` in ``materials.yaml``): the beam ends there.
+    interior : (C,) bool, indexed by class id
+        Classes whose cabin is modelled (``interiors`` in ``materials.yaml``): the beam goes on into the cabin
+        and returns only from its own vehicle's opaque faces.
     reference_range_m, min_range_m : float
         ``R0`` of the normalisation and the range below which ``P`` stops growing.
     """
@@ -128,6 +136,7 @@ class Optics:
     smooth: np.ndarray
     room: np.ndarray
     cabin: np.ndarray
+    interior: np.ndarray
     reference_range_m: float = 10.0
     min_range_m: float = 1.0
 
@@ -151,8 +160,10 @@ def optics_from_materials(retro_gain: float = 20.0, retro_exponent: float = 8.0,
     classes = class_table()
     cabin = np.zeros(len(classes), bool)
     cabin[[classes.id(name) for name in mats.cabins]] = True
-    return Optics(refl, gain, expo, trans, trans > 0, mats.room_behind.copy(), cabin, float(reference_range_m),
-                  float(min_range_m))
+    interior = np.zeros(len(classes), bool)
+    interior[[classes.id(name) for name in mats.interiors]] = True
+    return Optics(refl, gain, expo, trans, trans > 0, mats.room_behind.copy(), cabin, interior,
+                  float(reference_range_m), float(min_range_m))
 
 
 def probe_index(pattern: np.ndarray, clockwise: bool) -> np.ndarray:
@@ -251,8 +262,9 @@ class ReturnModel:
                                    "second return) and second_return/first_index/*.bin (uint32 row of the same beam's "
                                    "first point in velodyne/*.bin); velodyne/ and labels/ hold one point per beam",
             "glass": "transmittance per material (materials.yaml); a beam that crossed an object's glass and meets "
-                     "the same object again is absorbed (unmodelled interior); facade glass (behind: room) ends "
-                     "the beam",
+                     "the same object again is absorbed (unmodelled interior); behind the glass of a modelled "
+                     "cabin (interiors) it returns only from its own vehicle's opaque faces; facade glass "
+                     "(behind: room) and unmodelled cabins (cabins) end the beam",
             "range_noise_sigma_m_per_laser": [round(float(s), 5) for s in self.ring_sigma[np.argsort(np.arange(
                 len(self.ring_sigma)))]],
             "randomness": "per-laser draws: stream(seed, 'lidar_sensor', ...); per frame: stream(seed, 'frame', k, "
