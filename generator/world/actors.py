@@ -105,6 +105,50 @@ class Track:
         return np.linalg.norm(self.velocity(t)[:, :2], axis=1)
 
 
+@dataclass(frozen=True)
+class Gait:
+    """A walker's gait cycle: which of its phase meshes it shows at a time, from the distance walked.
+
+    The phase at ``t`` is ``distance(t) / stride_m`` (modulo 1), ``distance`` the path length of the
+    track's positions (horizontal, linear between samples like the pose), so the feet stay planted and
+    every sensor that asks at ``t`` sees the same limbs. Phase mesh ``k`` of ``n`` holds the phase ``k / n``;
+    an instant shows the nearest one.
+
+    Attributes
+    ----------
+    keys : tuple of str
+        Keys into :attr:`World.prototypes` of the phase meshes (same faces, limbs moved), phase 0 first.
+    stride_m : float
+        Metres walked per gait cycle (two steps).
+    distance : (T,) float64
+        Metres walked at each sample of the actor's track (0 at its first sample).
+    lo, hi : (n, 3) float64
+        Local bounds of each phase mesh.
+    """
+
+    keys: tuple[str, ...]
+    stride_m: float
+    distance: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+
+    @staticmethod
+    def walked(track: Track) -> np.ndarray:
+        """(T,) float64 cumulative horizontal path length of ``track``'s samples, metres."""
+        step = np.linalg.norm(np.diff(track.xyz[:, :2], axis=0), axis=1)
+        return np.r_[0.0, np.cumsum(step)]
+
+    def index(self, track: Track, t) -> np.ndarray:
+        """(k,) int64 phase mesh shown at time(s) ``t``."""
+        if len(self.distance) == 1:
+            d = np.zeros(np.size(t))
+        else:
+            i, f = track._where(t)
+            d = self.distance[i] * (1 - f) + self.distance[i + 1] * f
+        n = len(self.keys)
+        return np.floor(np.mod(d / self.stride_m, 1.0) * n + 0.5).astype(np.int64) % n
+
+
 @dataclass
 class Actor:
     """One mover: a prototype mesh under a pose that changes with time.
@@ -132,6 +176,9 @@ class Actor:
         Key into :attr:`World.proxies`.
     attrs : dict
         Renderer parameters (``color``...).
+    gait : Gait or None
+        A walker's phase meshes (``prototype`` is then its phase-0 mesh; ``size`` and ``box_center``
+        hold every phase: the box of the union); None for a rigid actor.
     """
 
     uid: int
@@ -145,12 +192,34 @@ class Actor:
     track: Track
     proxy: str | None = None
     attrs: dict = field(default_factory=dict)
+    gait: Gait | None = None
+
+    def prototype_at(self, t: float) -> str:
+        """Key of the mesh the actor shows at time ``t`` (its gait phase mesh, or :attr:`prototype`)."""
+        if self.gait is None:
+            return self.prototype
+        return self.gait.keys[int(self.gait.index(self.track, t)[0])]
+
+    def local_box(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """(centre, size) (3,) float64 of the actor's box at ``t`` in its local frame: the extent of the
+        mesh it shows then."""
+        if self.gait is None:
+            return np.asarray(self.box_center, np.float64), np.asarray(self.size, np.float64)
+        k = int(self.gait.index(self.track, t)[0])
+        return (self.gait.lo[k] + self.gait.hi[k]) / 2, self.gait.hi[k] - self.gait.lo[k]
+
+    def rigid_center(self, t: float) -> np.ndarray:
+        """(3,) float64 world position at ``t`` of :attr:`box_center` (for a rigid actor its box's centre;
+        a walker's moves with its body, not with its limbs: what box velocities are taken of)."""
+        T = self.track.pose(t)[0]
+        return np.asarray(tuple(float(v) for v in T[:3, :3] @ np.asarray(self.box_center) + T[:3, 3]), np.float64)
 
     def box(self, t: float) -> OrientedBox:
-        """The actor's oriented box at time ``t``, world frame."""
+        """The actor's oriented box at time ``t``, world frame (a walker's: the extent of its phase mesh then)."""
         T = self.track.pose(t)[0]
-        c = T[:3, :3] @ np.asarray(self.box_center) + T[:3, 3]
-        return OrientedBox(tuple(float(v) for v in c), tuple(float(v) for v in self.size),
+        centre, size = self.local_box(t)
+        c = T[:3, :3] @ centre + T[:3, 3]
+        return OrientedBox(tuple(float(v) for v in c), tuple(float(v) for v in size),
                            float(self.track.heading(t)[0]))
 
 
