@@ -216,7 +216,7 @@ def _limbs(d: dict, phi: float | None) -> tuple[Mesh, float]:
     parts = []
     for leg in legs:
         parts += [tube(leg.hip, leg.knee, 0.05 * g, CLS, thigh, 0.037, sections=6),
-                  icosphere(0.036, CLS, thigh if garment != "shorts" else "skin", 0, center=tuple(leg.knee)),
+                  icosphere(0.036, CLS, shin, 0, center=tuple(leg.knee)),
                   tube(leg.knee, leg.ankle, 0.035, CLS, shin, 0.024, sections=6, caps=False),
                   _shoe(leg.ankle, leg.pitch)]
     for side, action, bend in zip((1.0, -1.0), d["arms"], d["bends"], strict=True):
@@ -287,6 +287,8 @@ def person(rng: np.random.Generator, height: float, pose: str = "standing", age:
     if pose == "standing":
         return _posed(body, d, None).transformed(scale)
     frames = [_posed(body, d, k / GAIT_PHASES).transformed(scale) for k in range(GAIT_PHASES)]
+    for f in frames:                                 # a planted sole lies on z = 0 (not 1e-17 below it)
+        np.maximum(f.vertices[:, 2], 0.0, out=f.vertices[:, 2])
     out = frames[0]
     out.anchors = {f"gait/{k:02d}": f.vertices for k, f in enumerate(frames)}
     out.anchors["gait/stride"] = np.array([[0.0, 0.0, 0.0], [s * gait.stride(d["amplitude"]), 0.0, 0.0]])

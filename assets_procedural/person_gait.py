@@ -28,7 +28,7 @@ THIGH, SHIN, ANKLE_Z = 0.245, 0.25, 0.05
 TOE_X, HEEL_X = 0.115, -0.045
 LEG = THIGH + SHIN
 HIP_Z = ANKLE_Z + LEG                   #: standing hip height
-LEG_REACH = 0.985                       #: hip-ankle distance of a planted leg / leg length (knee a little soft)
+LEG_REACH = 0.995                       #: hip-ankle distance of a planted leg / leg length (knee a little soft)
 LIFT = 0.045                            #: swing foot clearance at mid-swing
 ARM_SHARE = 0.8                         #: arm swing amplitude / hip swing amplitude
 HEEL_STRIKE, PUSH_OFF = np.radians(-12.0), np.radians(28.0)   #: foot pitch (+ = toe down) at those instants
