@@ -23,7 +23,9 @@ lit windows):
   and by night (issue 29 item 6);
 * ``trees``   -- a tree of each species in the town, the camera 1.6 m up, 1.6 crown heights away;
 * ``facades`` -- the buildings with shop fronts and balconies, seen from the sidewalk across the street;
-* ``road``    -- stretches of road seen from 2.2 m up, looking down the lane.
+* ``road``    -- stretches of road seen from 2.2 m up, looking down the lane;
+* ``people``  -- two walkers on a sidewalk, side on, at four gait phases each (the camera follows them), and
+  the riders the town parks, side on (issue 29 item 4).
 
 Render settings: the ``preview`` preset (OpenImageDenoise) at ``--size`` and ``--samples``, motion blur
 and the camera model off (the crops are compared as scene radiance through one fixed tone map).
@@ -70,6 +72,7 @@ class Shot:
     pose: np.ndarray
     time_of_day: str = "day"
     wetness: float = 0.0
+    time: float = 0.0          #: seconds on the world's timeline (the people block's walkers)
 
 
 def _materials_of(scene, obj) -> set[str]:
@@ -219,6 +222,95 @@ def horizon_shots(town) -> list[Shot]:
     return shots
 
 
+# -- people (issue 29 item 4): a walker through its gait, riders on their two-wheelers ------------------------------
+# A separate block: the shots need a world (the walker is an actor, posed by the timeline), so they are rendered by
+# a Renderer of their own (:func:`render_people`). With a checkout whose actors have no gait (main before the
+# people branch) the same walker is drawn as that checkout draws it: its one walking pose, moved along.
+
+PEOPLE_PHASES = (0, 2, 4, 6)      #: gait phases (of 16) shown side on: both feet down, ..., feet passing
+
+
+def people_world(town, spec):
+    """(world, shots): two walkers of the town's library on a sidewalk, each seen side on at
+    :data:`PEOPLE_PHASES` (the camera follows it), and the riders the town parks, seen side on."""
+    from generator.layout.placement.appearance import outfit
+    from generator.layout.placement.variety import person_variants
+    from generator.world.actors import Actor, Track, World
+
+    try:                                    # this tree: walkers with their gait cycle
+        from generator.traffic.build import gait_cycle
+        from generator.world.actors import Gait
+    except ImportError:                     # an older checkout: one pose
+        gait_cycle = Gait = None
+    grid = town.grid
+    streets = sorted((o for o in town.objects if o.kind == "street"), key=lambda o: -np.asarray(o.box.size)[:2].max())
+    v_walk = (grid.walk_inner + grid.corridor_half) / 2
+    walking = person_variants(town.library, spec)[len(person_variants(town.library, spec)) // 2:]
+    base = 1 + max(o.instance_id for o in town.objects)
+    protos, actors, shots = {}, [], []
+    speed, dt = 1.4, 0.05
+    for i, (o, proto) in enumerate(zip(streets[:2], (walking[0], walking[-1]), strict=False)):
+        T, L = o.transform, float(np.asarray(o.box.size)[:2].max())
+        start = _segment_point(T, 0.3 * L, v_walk, grid.curb_h)
+        d = T[:3, :3] @ np.array([1.0, 0.0, 0.0])
+        ts = np.arange(0.0, 10.0, dt)
+        track = Track(0.0, dt, start[None] + ts[:, None] * speed * d[None], np.full(len(ts), np.arctan2(d[1], d[0])))
+        key = f"walker_{i}"
+        protos[key] = proto.mesh
+        lo, hi = np.asarray(proto.lo), np.asarray(proto.hi)
+        extra = {}
+        stride = 0.75 * float(hi[2])
+        if gait_cycle is not None:
+            keys, stride, plo, phi = gait_cycle(key, proto.mesh, protos)
+            extra = {"gait": Gait(keys, stride, Gait.walked(track), plo, phi)}
+            lo, hi = plo.min(0), phi.max(0)
+        actors.append(Actor(i, f"actor_person_{i:04d}", "person", "person", base + i, key, tuple(hi - lo),
+                            tuple((lo + hi) / 2), track, None, {**outfit(np.random.default_rng(5 + i)),
+                                                                "role": "walking"}, **extra))
+        across = T[:3, :3] @ np.array([0.0, -1.0, 0.0])       # from the carriageway side
+        for k in PEOPLE_PHASES:
+            t = 2.0 + (k / 16) * stride / speed
+            p = track.position(t)[0]
+            eye = p + across * 3.2 + [0.0, 0.0, 1.0]
+            shots.append(Shot(f"people_walker{i}_phase{k:02d}", f"walker {i} ({proto.params.get('height', 0):.2f} m),"
+                              f" gait phase {k}/16", look_at(eye, p + [0.0, 0.0, 0.85]), time=t))
+    for o in town.objects:
+        if o.cls in ("bicyclist", "motorcyclist") and len([s for s in shots if s.name.startswith("people_rider")]) < 2:
+            T = o.transform
+            c = T[:3, 3]
+            side = T[:3, :3] @ np.array([0.0, 1.0, 0.0])
+            for sgn in (1.0, -1.0):
+                eye = c + sgn * side * 3.5 + [0.0, 0.0, 1.2]
+                if _clear_eye(town, eye, c, 2.5):
+                    shots.append(Shot(f"people_rider_{o.cls}", f"{o.cls} on its two-wheeler, side on",
+                                      look_at(eye, c + [0.0, 0.0, 0.9])))
+                    break
+    return World(town, actors, protos, {}, None, 10.0), shots
+
+
+def render_people(town, spec, cfg, tmp, out: Path) -> list:
+    """Render :func:`people_world`'s shots (RGB and labels); return sheet rows as :func:`render` does."""
+    from generator.blender.renderer import Renderer
+    from generator.labels import class_table
+    from generator.weather import Lighting
+
+    world, shots = people_world(town, spec)
+    r = Renderer(town, spec, cfg, Path(tmp) / "people", world)
+    r.set_conditions(Lighting(*DAY))
+    rows = []
+    for shot in shots:
+        r.set_time(shot.time)
+        t0 = time.perf_counter()
+        frame = r.render(shot.pose, spec.seed, {})
+        print(f"{shot.title:48s} {time.perf_counter() - t0:6.1f} s")
+        rgb = to_srgb(frame.rgb)
+        Image.fromarray(rgb).save(out / f"{shot.name}.png")
+        rows.append((shot.title, rgb, class_table().colors[frame.labels.class_id].astype(np.uint8)))
+    return rows
+
+# -- end of the people block -------------------------------------------------------------------------------------
+
+
 def render(args) -> int:
     sys.path.insert(0, str(Path(args.code_root).resolve() if args.code_root else ROOT))
     import generator
@@ -239,7 +331,8 @@ def render(args) -> int:
                               motion_blur=dataclasses.replace(base.motion_blur, enabled=False))
     makers = {"ground": ground_shots, "horizon": horizon_shots, "trees": tree_shots, "facades": facade_shots,
               "road": road_shots}
-    shots = [s for key in args.only for s in makers[key](town) if not args.shots or s.name in args.shots]
+    shots = [s for key in args.only if key in makers for s in makers[key](town)
+             if not args.shots or s.name in args.shots]
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     rows = []
@@ -258,6 +351,8 @@ def render(args) -> int:
             rgb = to_srgb(frame.rgb, night=shot.time_of_day == "night")
             Image.fromarray(rgb).save(out / f"{shot.name}.png")
             rows.append((shot.title, rgb, class_table().colors[frame.labels.class_id].astype(np.uint8)))
+        if "people" in args.only:
+            rows += render_people(town, spec, cfg, tmp, out)
     print(f"layout {t_layout:.1f} s, Blender scene build {t_build:.1f} s (baseline for the render seconds above); "
           f"{len(town.faces)} triangles")
     sheet = Image.new("RGB", (2 * w + 12, len(rows) * (h + 20) + 4), (240, 240, 240))
@@ -413,7 +508,7 @@ def main(argv: list[str] | None = None) -> int:
     r.add_argument("--size", default="640x360", help="WIDTHxHEIGHT of every crop")
     r.add_argument("--samples", type=_positive, default=12, help="Cycles samples (denoised)")
     r.add_argument("--only", nargs="*", default=["ground", "horizon"],
-                   choices=["ground", "horizon", "trees", "facades", "road"])
+                   choices=["ground", "horizon", "trees", "facades", "road", "people"])
     r.add_argument("--shots", nargs="*", default=None, help="render only these shots (file stems)")
     c = sub.add_parser("compare", help="before | after sheets of two render runs")
     c.add_argument("before", type=_folder)
