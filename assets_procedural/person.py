@@ -30,7 +30,7 @@ from __future__ import annotations
 import numpy as np
 
 from assets_procedural import person_gait as gait
-from generator.geometry import Mesh, box, icosphere, loft, merge, resolve_ids, tube
+from generator.geometry import Mesh, box, cylinder, icosphere, loft, merge, resolve_ids, tube
 
 CLS = "person"
 POSES = ("standing", "walking")
@@ -139,6 +139,29 @@ def _torso(girth: float, breadth: float, garment: str) -> Mesh:
     return torso
 
 
+_SIDES = 6
+_RING = np.stack([np.cos(np.linspace(0, 2 * np.pi, _SIDES, endpoint=False)),
+                  np.sin(np.linspace(0, 2 * np.pi, _SIDES, endpoint=False))], 1)
+#: faces of a 6-sided tube with and without end caps (the vertex order of :func:`generator.geometry.cylinder`)
+_TUBE_FACES = {caps: cylinder(1.0, 1.0, CLS, "skin", _SIDES, caps=caps).faces for caps in (True, False)}
+
+
+def _limb_tube(p0: np.ndarray, p1: np.ndarray, r0: float, r1: float, material: str, caps: bool = True) -> Mesh:
+    """A 6-sided tapered tube from ``p0`` to ``p1`` (as :func:`generator.geometry.tube` builds it, in a
+    fraction of its time: a walker builds ~20 per gait phase)."""
+    axis = np.asarray(p1, float) - np.asarray(p0, float)
+    length = float(np.sqrt(axis @ axis))
+    w = axis / length
+    h = (0.0, 0.0, 1.0) if abs(w[2]) < 0.9 else (1.0, 0.0, 0.0)
+    u = np.array([h[1] * w[2] - h[2] * w[1], h[2] * w[0] - h[0] * w[2], h[0] * w[1] - h[1] * w[0]])
+    u /= np.sqrt(u @ u)
+    v = np.array([w[1] * u[2] - w[2] * u[1], w[2] * u[0] - w[0] * u[2], w[0] * u[1] - w[1] * u[0]])
+    ring = _RING[:, :1] * u + _RING[:, 1:] * v
+    verts = [p0 + r0 * ring, p1 + r1 * ring] + ([np.stack([p0, p1])] if caps else [])
+    c, m = resolve_ids(CLS, material)
+    return Mesh(np.concatenate(verts), _TUBE_FACES[caps], c, m)
+
+
 def _oriented(center: np.ndarray, axes: np.ndarray, size: tuple[float, float, float], material: str) -> Mesh:
     """A box of ``size`` along the columns of ``axes`` (3x3, orthonormal) centred on ``center``."""
     b = box(size, CLS, material)
@@ -215,9 +238,9 @@ def _limbs(d: dict, phi: float | None) -> tuple[Mesh, float]:
     dz = hip_z - 0.53
     parts = []
     for leg in legs:
-        parts += [tube(leg.hip, leg.knee, 0.05 * g, CLS, thigh, 0.037, sections=6),
+        parts += [_limb_tube(leg.hip, leg.knee, 0.05 * g, 0.037, thigh),
                   icosphere(0.036, CLS, shin, 0, center=tuple(leg.knee)),
-                  tube(leg.knee, leg.ankle, 0.035, CLS, shin, 0.024, sections=6, caps=False),
+                  _limb_tube(leg.knee, leg.ankle, 0.035, 0.024, shin, caps=False),
                   _shoe(leg.ankle, leg.pitch)]
     for side, action, bend in zip((1.0, -1.0), d["arms"], d["bends"], strict=True):
         shoulder = np.array([0.0, side * 0.1 * g * d["breadth"], 0.79 + dz])
@@ -233,9 +256,9 @@ def _limbs(d: dict, phi: float | None) -> tuple[Mesh, float]:
             elbow, wrist = _limb(shoulder, swing, bend + 0.6 * max(swing, 0.0), l1, l2)
             elbow[1] += side * 0.02
             wrist[1] += side * 0.025
-        parts += [tube(shoulder, elbow, 0.032 * g, CLS, "clothing", 0.026, sections=6),
+        parts += [_limb_tube(shoulder, elbow, 0.032 * g, 0.026, "clothing"),
                   icosphere(0.026, CLS, sleeve, 0, center=tuple(elbow)),
-                  tube(elbow, wrist, 0.025, CLS, sleeve, 0.019, sections=6, caps=False), *_hand(wrist, elbow)]
+                  _limb_tube(elbow, wrist, 0.025, 0.019, sleeve, caps=False), *_hand(wrist, elbow)]
         if action == "bag":
             grip = wrist + 0.06 * (wrist - elbow) / np.linalg.norm(wrist - elbow)
             parts.append(box((0.17, 0.05, 0.19), CLS, "shoes", (grip[0], grip[1], grip[2] - 0.105)))
