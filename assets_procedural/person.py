@@ -162,22 +162,24 @@ def _limb_tube(p0: np.ndarray, p1: np.ndarray, r0: float, r1: float, material: s
     return Mesh(np.concatenate(verts), _TUBE_FACES[caps], c, m)
 
 
-def _oriented(center: np.ndarray, axes: np.ndarray, size: tuple[float, float, float], material: str) -> Mesh:
+def _oriented(center: np.ndarray, axes: np.ndarray, size: tuple[float, float, float], material: str,
+              cls: str = CLS) -> Mesh:
     """A box of ``size`` along the columns of ``axes`` (3x3, orthonormal) centred on ``center``."""
-    b = box(size, CLS, material)
+    b = box(size, cls, material)
     return Mesh(b.vertices @ axes.T + center, b.faces, b.face_class, b.face_material)
 
 
-def _hand(wrist: np.ndarray, elbow: np.ndarray) -> list[Mesh]:
-    """Palm and fingers continuing the forearm, flat across it (palm toward the body's side)."""
+def _hand(wrist: np.ndarray, elbow: np.ndarray, material: str = "skin", k: float = 1.0, cls: str = CLS) -> list[Mesh]:
+    """Palm and fingers continuing the forearm, flat across it (palm toward the body's side); ``k`` is the
+    body height (the sizes are fractions of it), ``cls`` the class of the faces (a rider's)."""
     d = (wrist - elbow) / np.linalg.norm(wrist - elbow)
     w = np.cross(d, [0.0, 1.0, 0.0])
     if np.linalg.norm(w) < 0.3:
         w = np.cross(d, [1.0, 0.0, 0.0])
     w /= np.linalg.norm(w)
     axes = np.stack([d, w, np.cross(d, w)], 1)
-    palm = _oriented(wrist + 0.03 * d, axes, (0.058, 0.046, 0.022), "skin")
-    fingers = _oriented(wrist + 0.08 * d, axes, (0.045, 0.04, 0.015), "skin")
+    palm = _oriented(wrist + 0.03 * k * d, axes, (0.058 * k, 0.046 * k, 0.022 * k), material, cls)
+    fingers = _oriented(wrist + 0.08 * k * d, axes, (0.045 * k, 0.04 * k, 0.015 * k), material, cls)
     return [palm, fingers]
 
 
