@@ -184,8 +184,12 @@ class SceneFlow:
     """
 
     def __init__(self, T_world_ego: PoseFn, T_ego_lidar: np.ndarray, actors: list, column_time: np.ndarray, dt: float,
-                 view: View | None = None, threads: int = 2):
+                 view: View | None = None, threads: int = 2, prototypes: dict | None = None):
         from generator.lidar.tracks import TrackBank
+
+        #: walkers (index into ``actors``: (actor, its gait phase meshes)), whose limbs move their points too
+        self._walkers = {i: a for i, a in enumerate(actors) if getattr(a, "gait", None) is not None and prototypes}
+        self._prototypes = prototypes
 
         self.T_world_ego, self.dt, self.view = T_world_ego, float(dt), view
         self.T_ego_lidar = np.ascontiguousarray(T_ego_lidar, np.float64)
@@ -202,11 +206,13 @@ class SceneFlow:
         self._pool = ThreadPoolExecutor(1, thread_name_prefix="scene-flow") if threads > 1 else None
 
     @classmethod
-    def for_rig(cls, rig, actors: list, sensor, motion_skew: bool, dt: float, threads: int = 2) -> SceneFlow:
+    def for_rig(cls, rig, actors: list, sensor, motion_skew: bool, dt: float, threads: int = 2,
+                prototypes: dict | None = None) -> SceneFlow:
         """The scene flow of ``sensor``'s sweeps on ``rig`` (:class:`generator.world.rig.Rig` with its drive;
-        columns at their own instants when ``motion_skew``)."""
+        columns at their own instants when ``motion_skew``); ``prototypes`` (the world's) let a walker's
+        points move with their limbs."""
         ct = sensor.column_time() if motion_skew else np.zeros(sensor.azimuth_steps)
-        return cls(rig.trajectory.T_world_ego, rig.T_ego_lidar, actors, ct, dt, View(sensor), threads)
+        return cls(rig.trajectory.T_world_ego, rig.T_ego_lidar, actors, ct, dt, View(sensor), threads, prototypes)
 
     def close(self) -> None:
         """Stop the helper thread."""
@@ -257,7 +263,40 @@ class SceneFlow:
         obj, moved = np.empty((n, 3), np.float32), np.empty((3, n), np.float32)
         _split(lambda a, b: kernels.apply_flows(xyz[:, a:b], column[a:b], which[a:b], E, L, obj[a:b], moved[:, a:b]), n,
                self._pool)
+        if self._walkers and len(rows):
+            self._limbs(xyz, np.asarray(column), np.asarray(instance), t_sweep, rows, E, obj, moved)
         return obj, moved
+
+    def _limbs(self, xyz, column, instance, t_sweep: float, rows, E, obj, moved) -> None:
+        """Add a walker's limb motion to its points' flows (in place): each point moves with its triangle of
+        the gait phase mesh shown at its firing instant to the same triangle of the one shown ``dt`` later
+        (:func:`generator.motion.articulation.limb_displacement`)."""
+        from generator.motion.articulation import limb_displacement
+
+        who = self.lookup[instance[rows].astype(np.int64)]
+        P = None
+        for i, a in self._walkers.items():
+            mine = rows[who == i]
+            if len(mine) == 0:
+                continue
+            if P is None:
+                P = self._ego_poses(t_sweep)
+            col = column[mine].astype(np.int64)
+            t = t_sweep + self.column_time[col]
+            k0, k1 = a.gait.index(a.track, t), a.gait.index(a.track, t + self.dt)
+            Tc = P[col] @ self.T_ego_lidar
+            A0 = _yaw_poses(*self.bank.position_heading(np.full(len(t), i, np.int64), t))
+            A1 = _yaw_poses(*self.bank.position_heading(np.full(len(t), i, np.int64), t + self.dt))
+            X = np.einsum("kij,kj->ki", Tc[:, :3, :3], xyz[:, mine].T.astype(np.float64)) + Tc[:, :3, 3]
+            local = np.einsum("kji,kj->ki", A0[:, :3, :3], X - A0[:, :3, 3])
+            d = np.zeros_like(local)
+            for p0, p1 in set(zip(k0.tolist(), k1.tolist(), strict=True)) - {(k, k) for k in k0.tolist()}:
+                sel = (k0 == p0) & (k1 == p1)
+                m0, m1 = (self._prototypes[a.gait.keys[p]] for p in (p0, p1))
+                d[sel] = limb_displacement(m0, m1, local[sel])
+            step = np.einsum("kji,kj->ki", Tc[:, :3, :3], np.einsum("kij,kj->ki", A1[:, :3, :3], d))  # LiDAR axes
+            obj[mine] += step.astype(np.float32)
+            moved[:, mine] += np.einsum("kij,kj->ki", E[col, :, :3], step).T.astype(np.float32)
 
     def flow(self, x: np.ndarray, y: np.ndarray, z: np.ndarray, instance: np.ndarray, column: np.ndarray,
              t_sweep: float) -> tuple[np.ndarray, np.ndarray]:
