@@ -24,8 +24,8 @@ lit windows):
 * ``trees``   -- a tree of each species in the town, the camera 1.6 m up, 1.6 crown heights away;
 * ``facades`` -- the buildings with shop fronts and balconies, seen from the sidewalk across the street;
 * ``road``    -- stretches of road seen from 2.2 m up, looking down the lane;
-* ``people``  -- two walkers on a sidewalk, side on, at four gait phases each (the camera follows them), and
-  the riders the town parks, side on (issue 29 item 4).
+* ``people``  -- two walkers on a sidewalk, side on, at four gait phases each (the camera follows them), and a
+  cyclist and a motorcyclist on their two-wheelers, side on (issue 29 item 4).
 
 Render settings: the ``preview`` preset (OpenImageDenoise) at ``--size`` and ``--samples``, motion blur
 and the camera model off (the crops are compared as scene radiance through one fixed tone map).
@@ -232,7 +232,8 @@ PEOPLE_PHASES = (0, 2, 4, 6)      #: gait phases (of 16) shown side on: both fee
 
 def people_world(town, spec):
     """(world, shots): two walkers of the town's library on a sidewalk, each seen side on at
-    :data:`PEOPLE_PHASES` (the camera follows it), and the riders the town parks, seen side on."""
+    :data:`PEOPLE_PHASES` (the camera follows it), and a cyclist and a motorcyclist on their two-wheelers
+    (built for the shots), side on."""
     from generator.layout.placement.appearance import outfit
     from generator.layout.placement.variety import person_variants
     from generator.world.actors import Actor, Track, World
@@ -268,23 +269,35 @@ def people_world(town, spec):
                             tuple((lo + hi) / 2), track, None, {**outfit(np.random.default_rng(5 + i)),
                                                                 "role": "walking"}, **extra))
         across = T[:3, :3] @ np.array([0.0, -1.0, 0.0])       # from the carriageway side
+        t_zero = np.ceil(2.0 * speed / stride) * stride / speed  # walked a whole number of strides: phase 0
         for k in PEOPLE_PHASES:
-            t = 2.0 + (k / 16) * stride / speed
+            t = t_zero + (k / 16) * stride / speed
             p = track.position(t)[0]
             eye = p + across * 3.2 + [0.0, 0.0, 1.0]
             shots.append(Shot(f"people_walker{i}_phase{k:02d}", f"walker {i} ({proto.params.get('height', 0):.2f} m),"
                               f" gait phase {k}/16", look_at(eye, p + [0.0, 0.0, 0.85]), time=t))
-    for o in town.objects:
-        if o.cls in ("bicyclist", "motorcyclist") and len([s for s in shots if s.name.startswith("people_rider")]) < 2:
-            T = o.transform
-            c = T[:3, 3]
-            side = T[:3, :3] @ np.array([0.0, 1.0, 0.0])
-            for sgn in (1.0, -1.0):
-                eye = c + sgn * side * 3.5 + [0.0, 0.0, 1.2]
-                if _clear_eye(town, eye, c, 2.5):
-                    shots.append(Shot(f"people_rider_{o.cls}", f"{o.cls} on its two-wheeler, side on",
-                                      look_at(eye, c + [0.0, 0.0, 0.9])))
-                    break
+    # a cyclist and a motorcyclist on their two-wheelers, standing on the carriageway of the first street
+    from assets_procedural.riders import ridden
+    from generator.geometry import merge
+    from generator.layout.placement.appearance import fleet_paint
+
+    T, L = streets[0].transform, float(np.asarray(streets[0].box.size)[:2].max())
+    d = T[:3, :3] @ np.array([1.0, 0.0, 0.0])
+    for j, kind in enumerate(("bicyclist", "motorcyclist")):
+        rider, vehicle = ridden(kind, np.random.default_rng(11 + j))
+        key = f"ridden_{kind}"
+        protos[key] = merge([rider, vehicle])
+        lo, hi = protos[key].bounds()
+        c = _segment_point(T, (0.55 + 0.15 * j) * L, -(grid.road_half - 1.5), 0.0)
+        track = Track(0.0, dt, np.repeat(c[None], 3, 0), np.full(3, np.arctan2(d[1], d[0])))
+        uid = len(actors)
+        actors.append(Actor(uid, f"actor_{kind}_{uid:04d}", kind, kind, base + uid, key, tuple(hi - lo),
+                            tuple((lo + hi) / 2), track, None, {**fleet_paint(np.random.default_rng(3 + j)),
+                                                                **outfit(np.random.default_rng(9 + j)),
+                                                                "role": "driving"}))
+        eye = c + (T[:3, :3] @ np.array([0.0, -1.0, 0.0])) * 3.6 + [0.0, 0.0, 1.1]
+        shots.append(Shot(f"people_{kind}", f"{kind} on its two-wheeler, side on", look_at(eye, c + [0.0, 0.0, 0.9]),
+                          time=1.0))
     return World(town, actors, protos, {}, None, 10.0), shots
 
 
