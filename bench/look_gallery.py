@@ -239,7 +239,7 @@ def people_world(town, spec):
     from generator.world.actors import Actor, Track, World
 
     try:                                    # this tree: walkers with their gait cycle
-        from generator.traffic.build import gait_cycle
+        from generator.traffic.pedestrians.gait import gait_cycle
         from generator.world.actors import Gait
     except ImportError:                     # an older checkout: one pose
         gait_cycle = Gait = None

@@ -58,3 +58,57 @@ def carry(mover, points_world: np.ndarray) -> np.ndarray:
     if mover.meshes is not None:
         local = local + limb_displacement(*mover.meshes, local)
     return local @ T1[:3, :3].T + T1[:3, 3]
+
+
+def limb_flows(walkers: dict, prototypes: dict, lookup: np.ndarray, times: np.ndarray, dt: float,
+               T_world_lidar: np.ndarray, xyz: np.ndarray, column: np.ndarray, instance: np.ndarray, rows: np.ndarray,
+               E: np.ndarray, obj: np.ndarray, moved: np.ndarray) -> None:
+    """Add the walkers' limb motion to their LiDAR points' scene flows, in place
+    (:class:`generator.motion.scene_flow.SceneFlow`): each point moves with its triangle of the gait phase mesh
+    shown at its firing instant to the same triangle of the one shown ``dt`` later.
+
+    Parameters
+    ----------
+    walkers : dict of int to Actor
+        Index into the flow's actors -> a walker (``actor.gait`` set).
+    prototypes : dict of str to Mesh
+        The world's prototypes (the phase meshes).
+    lookup : (max_id + 1,) int64
+        Instance id -> index into the flow's actors (-1 elsewhere).
+    times : (steps,) float64
+        Firing instant of each column, seconds.
+    dt : float
+        Time to the next sweep's column, seconds.
+    T_world_lidar : (steps, 4, 4) float64
+        The LiDAR's pose at each column's instant.
+    xyz : (3, n) float32
+        Points, LiDAR frame at their firing instant.
+    column, instance : (n,) integer
+    rows : (m,) int64
+        Points on actors.
+    E : (steps, 3, 4) float64
+        LiDAR frame at a column's instant -> the LiDAR frame ``dt`` later.
+    obj : (n, 3) float32
+        Object flows (LiDAR axes at the firing instant), updated.
+    moved : (3, n) float32
+        Points moved (``x + ego``), updated.
+    """
+    who = lookup[instance[rows].astype(np.int64)]
+    for i, a in walkers.items():
+        mine = rows[who == i]
+        if len(mine) == 0:
+            continue
+        col = column[mine].astype(np.int64)
+        t = times[col]
+        k0, k1 = a.gait.index(a.track, t), a.gait.index(a.track, t + dt)
+        Tc, A0, A1 = T_world_lidar[col], a.track.pose(t), a.track.pose(t + dt)
+        X = np.einsum("kij,kj->ki", Tc[:, :3, :3], xyz[:, mine].T.astype(np.float64)) + Tc[:, :3, 3]
+        local = np.einsum("kji,kj->ki", A0[:, :3, :3], X - A0[:, :3, 3])
+        d = np.zeros_like(local)
+        for p0, p1 in set(zip(k0.tolist(), k1.tolist(), strict=True)):
+            if p0 != p1:
+                sel = (k0 == p0) & (k1 == p1)
+                d[sel] = limb_displacement(prototypes[a.gait.keys[p0]], prototypes[a.gait.keys[p1]], local[sel])
+        step = np.einsum("kji,kj->ki", Tc[:, :3, :3], np.einsum("kij,kj->ki", A1[:, :3, :3], d))  # LiDAR axes
+        obj[mine] += step.astype(np.float32)
+        moved[:, mine] += np.einsum("kij,kj->ki", E[col, :, :3], step).T.astype(np.float32)

@@ -187,7 +187,7 @@ class SceneFlow:
                  view: View | None = None, threads: int = 2, prototypes: dict | None = None):
         from generator.lidar.tracks import TrackBank
 
-        #: walkers (index into ``actors``: (actor, its gait phase meshes)), whose limbs move their points too
+        #: walkers (index into ``actors``: actor), whose limbs move their points too
         self._walkers = {i: a for i, a in enumerate(actors) if getattr(a, "gait", None) is not None and prototypes}
         self._prototypes = prototypes
 
@@ -264,39 +264,12 @@ class SceneFlow:
         _split(lambda a, b: kernels.apply_flows(xyz[:, a:b], column[a:b], which[a:b], E, L, obj[a:b], moved[:, a:b]), n,
                self._pool)
         if self._walkers and len(rows):
-            self._limbs(xyz, np.asarray(column), np.asarray(instance), t_sweep, rows, E, obj, moved)
+            from generator.motion.articulation import limb_flows
+
+            limb_flows(self._walkers, self._prototypes, self.lookup, self.column_time + t_sweep, self.dt,
+                       self._ego_poses(t_sweep) @ self.T_ego_lidar, xyz, np.asarray(column), np.asarray(instance), rows,
+                       E, obj, moved)
         return obj, moved
-
-    def _limbs(self, xyz, column, instance, t_sweep: float, rows, E, obj, moved) -> None:
-        """Add a walker's limb motion to its points' flows (in place): each point moves with its triangle of
-        the gait phase mesh shown at its firing instant to the same triangle of the one shown ``dt`` later
-        (:func:`generator.motion.articulation.limb_displacement`)."""
-        from generator.motion.articulation import limb_displacement
-
-        who = self.lookup[instance[rows].astype(np.int64)]
-        P = None
-        for i, a in self._walkers.items():
-            mine = rows[who == i]
-            if len(mine) == 0:
-                continue
-            if P is None:
-                P = self._ego_poses(t_sweep)
-            col = column[mine].astype(np.int64)
-            t = t_sweep + self.column_time[col]
-            k0, k1 = a.gait.index(a.track, t), a.gait.index(a.track, t + self.dt)
-            Tc = P[col] @ self.T_ego_lidar
-            A0 = _yaw_poses(*self.bank.position_heading(np.full(len(t), i, np.int64), t))
-            A1 = _yaw_poses(*self.bank.position_heading(np.full(len(t), i, np.int64), t + self.dt))
-            X = np.einsum("kij,kj->ki", Tc[:, :3, :3], xyz[:, mine].T.astype(np.float64)) + Tc[:, :3, 3]
-            local = np.einsum("kji,kj->ki", A0[:, :3, :3], X - A0[:, :3, 3])
-            d = np.zeros_like(local)
-            for p0, p1 in set(zip(k0.tolist(), k1.tolist(), strict=True)) - {(k, k) for k in k0.tolist()}:
-                sel = (k0 == p0) & (k1 == p1)
-                m0, m1 = (self._prototypes[a.gait.keys[p]] for p in (p0, p1))
-                d[sel] = limb_displacement(m0, m1, local[sel])
-            step = np.einsum("kji,kj->ki", Tc[:, :3, :3], np.einsum("kij,kj->ki", A1[:, :3, :3], d))  # LiDAR axes
-            obj[mine] += step.astype(np.float32)
-            moved[:, mine] += np.einsum("kij,kj->ki", E[col, :, :3], step).T.astype(np.float32)
 
     def flow(self, x: np.ndarray, y: np.ndarray, z: np.ndarray, instance: np.ndarray, column: np.ndarray,
              t_sweep: float) -> tuple[np.ndarray, np.ndarray]:

@@ -21,7 +21,6 @@ import time
 import numpy as np
 
 from generator.errors import SpecError
-from generator.geometry import Mesh
 from generator.geometry.proxy import label_proxy
 from generator.layout.network.cycles import route_node_cycles
 from generator.layout.network.design_vehicle import EGO_SIZE_M
@@ -35,10 +34,11 @@ from generator.traffic.lanes.roundabouts import GIVE_WAY_CLEAR_S
 from generator.traffic.lanes.signals import CLEAR_S, Signals
 from generator.traffic.mapped_tracks import map_track
 from generator.traffic.movers import DT_S, Mover
+from generator.traffic.pedestrians.gait import walker_gait
 from generator.traffic.pedestrians.simulate import simulate_pedestrians
 from generator.traffic.vehicles.fleet import KINDS, drives, fleet_proto, how_many, n_variants, widest_half_width
 from generator.traffic.vehicles.sim import Vehicle, VehicleSim, arm_towards
-from generator.world.actors import Actor, Gait, Track, TrackTrajectory, World, frozen_world
+from generator.world.actors import Actor, Track, TrackTrajectory, World, frozen_world
 from generator.world.trajectory import EgoTrajectory
 
 log = logging.getLogger(__name__)
@@ -338,37 +338,10 @@ def _assemble(scene, movers: list[Mover], ego: TrackTrajectory, duration_s: floa
             if hull is not None:
                 proxies[key] = hull
         lo, hi = np.asarray(m.proto.lo, float), np.asarray(m.proto.hi, float)
-        gait = None
-        if m.attrs.get("role") == "walking" and key not in cycles:
-            cycles[key] = gait_cycle(key, m.proto.mesh, prototypes)
-        if m.attrs.get("role") == "walking" and cycles[key] is not None:
-            keys, stride, plo, phi = cycles[key]
-            gait = Gait(keys, stride, Gait.walked(m.track), plo, phi)
-            lo, hi = plo.min(0), phi.max(0)                     # the box of every phase
+        gait = walker_gait(key, m.proto.mesh, m.track, prototypes, cycles) if m.attrs.get("role") == "walking" else None
+        if gait is not None:
+            lo, hi = gait.lo.min(0), gait.hi.max(0)             # the box of every phase
         actors.append(Actor(uid, f"actor_{m.kind}_{uid:04d}", m.kind, m.cls, base + uid, key, tuple(hi - lo),
                             tuple((lo + hi) / 2), m.track, key if key in proxies else None, dict(m.attrs), gait))
     return World(scene, actors, prototypes, proxies, ego, duration_s)
 
-
-def gait_cycle(key: str, mesh, prototypes: dict) -> tuple | None:
-    """A walking prototype's gait cycle: its phase meshes added to ``prototypes`` (keys ``key@gNN``).
-
-    Returns
-    -------
-    (keys, stride_m, lo, hi) or None
-        Phase mesh keys, metres per cycle, (n, 3) local bounds per phase; None for a mesh without a
-        cycle (its ``gait/NN`` anchors, :mod:`assets_procedural.person`).
-    """
-    names = sorted(k for k in mesh.anchors if k.startswith("gait/") and k[5:].isdigit())
-    if not names:
-        return None
-    keys, lo, hi = [], [], []
-    for name in names:
-        v = mesh.anchors[name]
-        k = f"{key}@g{name[5:]}"
-        prototypes[k] = Mesh(v, mesh.faces, mesh.face_class, mesh.face_material)
-        keys.append(k)
-        lo.append(v.min(0))
-        hi.append(v.max(0))
-    ends = mesh.anchors["gait/stride"]
-    return tuple(keys), float(np.linalg.norm(ends[1] - ends[0])), np.array(lo), np.array(hi)

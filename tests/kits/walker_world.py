@@ -12,7 +12,7 @@ def walker(prototypes: dict, track: Track, uid: int = 0, instance_id: int = 1000
     """A walking actor of person variant ``variant`` of ``Library(seed)``; its rest and phase meshes are
     added to ``prototypes`` (keys ``walker_v<i>`` and ``walker_v<i>@gNN``), as the traffic does."""
     from generator.layout.placement.prototypes import Library
-    from generator.traffic.build import gait_cycle
+    from generator.traffic.pedestrians.gait import gait_cycle
 
     proto = Library(seed).variant("person", variant, lambda g: {"height": height, "pose": "walking"})
     key = f"walker_v{variant}"
