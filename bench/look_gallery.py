@@ -250,10 +250,13 @@ def people_world(town, spec):
     base = 1 + max(o.instance_id for o in town.objects)
     protos, actors, shots = {}, [], []
     speed, dt = 1.4, 0.05
-    for i, (o, proto) in enumerate(zip(streets[:2], (walking[0], walking[-1]), strict=False)):
+    spots = [(o, u, sv) for o in streets for sv in (1.0, -1.0) for u in np.linspace(0.12, 0.8, 18)
+             if _people_clear(town, o, u, sv * v_walk, grid.curb_h)]
+    spots = [spots[0]] + [x for x in spots if x[0] is not spots[0][0]][:1] if spots else []
+    for i, ((o, u, sv), proto) in enumerate(zip(spots, (walking[0], walking[-1]), strict=False)):
         T, L = o.transform, float(np.asarray(o.box.size)[:2].max())
-        start = _segment_point(T, 0.3 * L, v_walk, grid.curb_h)
-        d = T[:3, :3] @ np.array([1.0, 0.0, 0.0])
+        start = _segment_point(T, u * L, sv * v_walk, grid.curb_h)
+        d = T[:3, :3] @ np.array([sv, 0.0, 0.0])
         ts = np.arange(0.0, 10.0, dt)
         track = Track(0.0, dt, start[None] + ts[:, None] * speed * d[None], np.full(len(ts), np.arctan2(d[1], d[0])))
         key = f"walker_{i}"
@@ -268,7 +271,7 @@ def people_world(town, spec):
         actors.append(Actor(i, f"actor_person_{i:04d}", "person", "person", base + i, key, tuple(hi - lo),
                             tuple((lo + hi) / 2), track, None, {**outfit(np.random.default_rng(5 + i)),
                                                                 "role": "walking"}, **extra))
-        across = T[:3, :3] @ np.array([0.0, -1.0, 0.0])       # from the carriageway side
+        across = T[:3, :3] @ np.array([0.0, -sv, 0.0])        # from the carriageway side
         t_zero = np.ceil(2.0 * speed / stride) * stride / speed  # walked a whole number of strides: phase 0
         for k in PEOPLE_PHASES:
             t = t_zero + (k / 16) * stride / speed
@@ -295,10 +298,22 @@ def people_world(town, spec):
                             tuple((lo + hi) / 2), track, None, {**fleet_paint(np.random.default_rng(3 + j)),
                                                                 **outfit(np.random.default_rng(9 + j)),
                                                                 "role": "driving"}))
-        eye = c + (T[:3, :3] @ np.array([0.0, -1.0, 0.0])) * 3.6 + [0.0, 0.0, 1.1]
+        eye = c + (T[:3, :3] @ np.array([0.0, -1.0, 0.0])) * 2.6 + [0.0, 0.0, 1.1]
         shots.append(Shot(f"people_{kind}", f"{kind} on its two-wheeler, side on", look_at(eye, c + [0.0, 0.0, 0.9]),
                           time=1.0))
     return World(town, actors, protos, {}, None, 10.0), shots
+
+
+def _people_clear(town, street, u: float, v: float, z: float) -> bool:
+    """Whether a walker starting at (``u`` of the street's length, ``v``) on its sidewalk can be seen side on
+    from 3.2 m toward the carriageway over its first 4 m (nothing within 0.6 m of the camera or on the line)."""
+    T, L = street.transform, float(np.asarray(street.box.size)[:2].max())
+    for du in (2.0, 2.5, 3.0, 3.5, 4.0):
+        p = _segment_point(T, u * L + np.sign(v) * du, v, z + 1.0)
+        eye = _segment_point(T, u * L + np.sign(v) * du, v - np.sign(v) * 3.2, z + 1.0)
+        if not _clear_eye(town, eye, p, 3.0):
+            return False
+    return True
 
 
 def render_people(town, spec, cfg, tmp, out: Path) -> list:
