@@ -291,14 +291,15 @@ def people_world(town, spec):
         key = f"ridden_{kind}"
         protos[key] = merge([rider, vehicle])
         lo, hi = protos[key].bounds()
-        c = _segment_point(T, (0.55 + 0.15 * j) * L, -(grid.road_half - 1.5), 0.0)
+        c = _segment_point(T, (0.55 + 0.15 * j) * L, -0.5 * grid.lane_half, 0.0)       # in the lane
         track = Track(0.0, dt, np.repeat(c[None], 3, 0), np.full(3, np.arctan2(d[1], d[0])))
         uid = len(actors)
         actors.append(Actor(uid, f"actor_{kind}_{uid:04d}", kind, kind, base + uid, key, tuple(hi - lo),
                             tuple((lo + hi) / 2), track, None, {**fleet_paint(np.random.default_rng(3 + j)),
                                                                 **outfit(np.random.default_rng(9 + j)),
                                                                 "role": "driving"}))
-        eye = c + (T[:3, :3] @ np.array([0.0, -1.0, 0.0])) * 2.6 + [0.0, 0.0, 1.1]
+        sides = [c + (T[:3, :3] @ np.array([0.0, sgn, 0.0])) * 2.6 + [0.0, 0.0, 1.1] for sgn in (1.0, -1.0)]
+        eye = next((e for e in sides if _clear_eye(town, e, c, 2.0)), sides[0])
         shots.append(Shot(f"people_{kind}", f"{kind} on its two-wheeler, side on", look_at(eye, c + [0.0, 0.0, 0.9]),
                           time=1.0))
     return World(town, actors, protos, {}, None, 10.0), shots
