@@ -21,21 +21,9 @@ import numpy as np
 
 from assets_procedural.motorcycles import _motorcycle_parts
 from assets_procedural.parts import centring, two_link
-from assets_procedural.person import _head
+from assets_procedural.person import _hand, _head
 from assets_procedural.two_wheelers import _bicycle_parts, contact_anchors
 from generator.geometry import Mesh, box, icosphere, loft, merge, pose, resolve_ids, tube
-
-
-def _rot_to(d: np.ndarray) -> np.ndarray:
-    """3x3 rotation taking +z to the unit vector ``d``."""
-    d = d / np.linalg.norm(d)
-    z = np.array([0.0, 0.0, 1.0])
-    v = np.cross(z, d)
-    c = float(np.dot(z, d))
-    if np.linalg.norm(v) < 1e-9:
-        return np.eye(3) if c > 0 else np.diag([1.0, -1.0, -1.0])
-    vx = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
-    return np.eye(3) + vx + vx @ vx / (1 + c)
 
 
 def _rot_y(alpha: float) -> np.ndarray:
@@ -123,6 +111,7 @@ def _figure(rng: np.random.Generator, height: float, seat: np.ndarray, hip_dx: f
         ankle = shoe_c - 0.05 * h * fdir + 0.03 * h * up
         knee, ankle = two_link(hip_s, ankle, 0.245 * h, 0.25 * h, np.array([1.0, s * 0.25, 0.6]))
         parts.append(tube(hip_s, knee, 0.045 * h * g, cls, "clothing_bottom", 0.036 * h, sections=6))
+        parts.append(icosphere(0.035 * h, cls, "clothing_bottom", 0, center=tuple(knee)))
         parts.append(tube(knee, ankle, 0.034 * h, cls, "clothing_bottom", 0.024 * h, sections=6))
         shoe = box((0.15 * h, 0.055 * h, 0.045 * h), cls, "shoes")
         parts.append(shoe.transformed(pose(*shoe_c, pitch=foot_pitch)))
@@ -131,12 +120,10 @@ def _figure(rng: np.random.Generator, height: float, seat: np.ndarray, hip_dx: f
         wrist_t = grip - 0.035 * h * (grip - shoulder) / np.linalg.norm(grip - shoulder)
         elbow, wrist = two_link(shoulder, wrist_t, 0.175 * h, 0.15 * h, np.array([-0.3, s * 0.8, -1.0]))
         parts.append(tube(shoulder, elbow, 0.032 * h * g, cls, "clothing", 0.026 * h, sections=6))
-        parts.append(tube(elbow, wrist, 0.025 * h, cls, "skin" if short_sleeves else "clothing", 0.019 * h,
-                          sections=6, caps=False))
-        hand = icosphere(1.0, cls, "skin" if not helmet else "rubber", 0)
-        d = (wrist - elbow) / np.linalg.norm(wrist - elbow)
-        hand.vertices = (hand.vertices * np.array([0.022, 0.014, 0.045]) * h) @ _rot_to(d).T + wrist + d * 0.03 * h
-        parts.append(hand)
+        sleeve = "skin" if short_sleeves else "clothing"
+        parts.append(icosphere(0.026 * h, cls, sleeve, 0, center=tuple(elbow)))
+        parts.append(tube(elbow, wrist, 0.025 * h, cls, sleeve, 0.019 * h, sections=6, caps=False))
+        parts += _hand(wrist, elbow, "skin" if not helmet else "rubber", h, cls)     # gloves with a helmet
     return merge(parts)
 
 

@@ -27,7 +27,9 @@ lit windows):
 * ``facades_close`` -- a building of each wall material (render, brick, panels) from 8 m, and the
   first by night (issue 29 item 5);
 * ``cars``    -- a parked car from the sidewalk, front three-quarter by day and by night, and side-on
-  through its windows by day (issue 29 item 3).
+  through its windows by day (issue 29 item 3);
+* ``people``  -- two walkers on a sidewalk, side on, at four gait phases each (the camera follows them), and a
+  cyclist and a motorcyclist on their two-wheelers, side on (issue 29 item 4).
 
 Render settings: the ``preview`` preset (OpenImageDenoise) at ``--size`` and ``--samples``, motion blur
 and the camera model off (the crops are compared as scene radiance through one fixed tone map).
@@ -74,6 +76,7 @@ class Shot:
     pose: np.ndarray
     time_of_day: str = "day"
     wetness: float = 0.0
+    time: float = 0.0          #: seconds on the world's timeline (the people block's walkers)
 
 
 def _materials_of(scene, obj) -> set[str]:
@@ -277,6 +280,124 @@ def car_shots(town) -> list[Shot]:
 # -- end of cars ---------------------------------------------------------------------------------------
 
 
+# -- people (issue 29 item 4): a walker through its gait, riders on their two-wheelers ------------------------------
+# A separate block: the shots need a world (the walker is an actor, posed by the timeline), so they are rendered by
+# a Renderer of their own (:func:`render_people`). With a checkout whose actors have no gait (main before the
+# people branch) the same walker is drawn as that checkout draws it: its one walking pose, moved along.
+
+PEOPLE_PHASES = (0, 2, 4, 6)      #: gait phases (of 16) shown side on: both feet down, ..., feet passing
+
+
+def people_world(town, spec):
+    """(world, shots): two walkers of the town's library on a sidewalk, each seen side on at
+    :data:`PEOPLE_PHASES` (the camera follows it), and a cyclist and a motorcyclist on their two-wheelers
+    (built for the shots), side on."""
+    from generator.layout.placement.appearance import outfit
+    from generator.layout.placement.variety import person_variants
+    from generator.world.actors import Actor, Track, World
+
+    try:                                    # this tree: walkers with their gait cycle
+        from generator.traffic.pedestrians.gait import gait_cycle
+        from generator.world.actors import Gait
+    except ImportError:                     # an older checkout: one pose
+        gait_cycle = Gait = None
+    grid = town.grid
+    streets = sorted((o for o in town.objects if o.kind == "street"), key=lambda o: -np.asarray(o.box.size)[:2].max())
+    v_walk = (grid.walk_inner + grid.corridor_half) / 2
+    walking = person_variants(town.library, spec)[len(person_variants(town.library, spec)) // 2:]
+    base = 1 + max(o.instance_id for o in town.objects)
+    protos, actors, shots = {}, [], []
+    speed, dt = 1.4, 0.05
+    spots = [(o, u, sv) for o in streets for sv in (1.0, -1.0) for u in np.linspace(0.12, 0.8, 18)
+             if _people_clear(town, o, u, sv * v_walk, grid.curb_h)]
+    spots = [spots[0]] + [x for x in spots if x[0] is not spots[0][0]][:1] if spots else []
+    for i, ((o, u, sv), proto) in enumerate(zip(spots, (walking[0], walking[-1]), strict=False)):
+        T, L = o.transform, float(np.asarray(o.box.size)[:2].max())
+        start = _segment_point(T, u * L, sv * v_walk, grid.curb_h)
+        d = T[:3, :3] @ np.array([sv, 0.0, 0.0])
+        ts = np.arange(0.0, 10.0, dt)
+        track = Track(0.0, dt, start[None] + ts[:, None] * speed * d[None], np.full(len(ts), np.arctan2(d[1], d[0])))
+        key = f"walker_{i}"
+        protos[key] = proto.mesh
+        lo, hi = np.asarray(proto.lo), np.asarray(proto.hi)
+        extra = {}
+        stride = 0.75 * float(hi[2])
+        if gait_cycle is not None:
+            keys, stride, plo, phi = gait_cycle(key, proto.mesh, protos)
+            extra = {"gait": Gait(keys, stride, Gait.walked(track), plo, phi)}
+            lo, hi = plo.min(0), phi.max(0)
+        actors.append(Actor(i, f"actor_person_{i:04d}", "person", "person", base + i, key, tuple(hi - lo),
+                            tuple((lo + hi) / 2), track, None, {**outfit(np.random.default_rng(5 + i)),
+                                                                "role": "walking"}, **extra))
+        across = T[:3, :3] @ np.array([0.0, -sv, 0.0])        # from the carriageway side
+        t_zero = np.ceil(2.0 * speed / stride) * stride / speed  # walked a whole number of strides: phase 0
+        for k in PEOPLE_PHASES:
+            t = t_zero + (k / 16) * stride / speed
+            p = track.position(t)[0]
+            eye = p + across * 3.2 + [0.0, 0.0, 1.0]
+            shots.append(Shot(f"people_walker{i}_phase{k:02d}", f"walker {i} ({proto.params.get('height', 0):.2f} m),"
+                              f" gait phase {k}/16", look_at(eye, p + [0.0, 0.0, 0.85]), time=t))
+    # a cyclist and a motorcyclist on their two-wheelers, standing on the carriageway of the first street
+    from assets_procedural.riders import ridden
+    from generator.geometry import merge
+    from generator.layout.placement.appearance import fleet_paint
+
+    T, L = streets[0].transform, float(np.asarray(streets[0].box.size)[:2].max())
+    d = T[:3, :3] @ np.array([1.0, 0.0, 0.0])
+    for j, kind in enumerate(("bicyclist", "motorcyclist")):
+        rider, vehicle = ridden(kind, np.random.default_rng(11 + j))
+        key = f"ridden_{kind}"
+        protos[key] = merge([rider, vehicle])
+        lo, hi = protos[key].bounds()
+        c = _segment_point(T, (0.55 + 0.15 * j) * L, -0.5 * grid.lane_half, 0.0)       # in the lane
+        track = Track(0.0, dt, np.repeat(c[None], 3, 0), np.full(3, np.arctan2(d[1], d[0])))
+        uid = len(actors)
+        actors.append(Actor(uid, f"actor_{kind}_{uid:04d}", kind, kind, base + uid, key, tuple(hi - lo),
+                            tuple((lo + hi) / 2), track, None, {**fleet_paint(np.random.default_rng(3 + j)),
+                                                                **outfit(np.random.default_rng(9 + j)),
+                                                                "role": "driving"}))
+        sides = [c + (T[:3, :3] @ np.array([0.0, sgn, 0.0])) * 2.6 + [0.0, 0.0, 1.1] for sgn in (1.0, -1.0)]
+        eye = next((e for e in sides if _clear_eye(town, e, c, 2.0)), sides[0])
+        shots.append(Shot(f"people_{kind}", f"{kind} on its two-wheeler, side on", look_at(eye, c + [0.0, 0.0, 0.9]),
+                          time=1.0))
+    return World(town, actors, protos, {}, None, 10.0), shots
+
+
+def _people_clear(town, street, u: float, v: float, z: float) -> bool:
+    """Whether a walker starting at (``u`` of the street's length, ``v``) on its sidewalk can be seen side on
+    from 3.2 m toward the carriageway over its first 4 m (nothing within 0.6 m of the camera or on the line)."""
+    T, L = street.transform, float(np.asarray(street.box.size)[:2].max())
+    for du in (2.0, 2.5, 3.0, 3.5, 4.0):
+        p = _segment_point(T, u * L + np.sign(v) * du, v, z + 1.0)
+        eye = _segment_point(T, u * L + np.sign(v) * du, v - np.sign(v) * 3.2, z + 1.0)
+        if not _clear_eye(town, eye, p, 3.0):
+            return False
+    return True
+
+
+def render_people(town, spec, cfg, tmp, out: Path) -> list:
+    """Render :func:`people_world`'s shots (RGB and labels); return sheet rows as :func:`render` does."""
+    from generator.blender.renderer import Renderer
+    from generator.labels import class_table
+    from generator.weather import Lighting
+
+    world, shots = people_world(town, spec)
+    r = Renderer(town, spec, cfg, Path(tmp) / "people", world)
+    r.set_conditions(Lighting(*DAY))
+    rows = []
+    for shot in shots:
+        r.set_time(shot.time)
+        t0 = time.perf_counter()
+        frame = r.render(shot.pose, spec.seed, {})
+        print(f"{shot.title:48s} {time.perf_counter() - t0:6.1f} s")
+        rgb = to_srgb(frame.rgb)
+        Image.fromarray(rgb).save(out / f"{shot.name}.png")
+        rows.append((shot.title, rgb, class_table().colors[frame.labels.class_id].astype(np.uint8)))
+    return rows
+
+# -- end of the people block -------------------------------------------------------------------------------------
+
+
 def render(args) -> int:
     sys.path.insert(0, str(Path(args.code_root).resolve() if args.code_root else ROOT))
     import generator
@@ -297,7 +418,8 @@ def render(args) -> int:
                               motion_blur=dataclasses.replace(base.motion_blur, enabled=False))
     makers = {"ground": ground_shots, "horizon": horizon_shots, "trees": tree_shots, "facades": facade_shots,
               "road": road_shots, "facades_close": facade_close_shots, "cars": car_shots}
-    shots = [s for key in args.only for s in makers[key](town) if not args.shots or s.name in args.shots]
+    shots = [s for key in args.only if key in makers for s in makers[key](town)
+             if not args.shots or s.name in args.shots]
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     rows = []
@@ -316,6 +438,8 @@ def render(args) -> int:
             rgb = to_srgb(frame.rgb, night=shot.time_of_day == "night")
             Image.fromarray(rgb).save(out / f"{shot.name}.png")
             rows.append((shot.title, rgb, class_table().colors[frame.labels.class_id].astype(np.uint8)))
+        if "people" in args.only:
+            rows += render_people(town, spec, cfg, tmp, out)
     print(f"layout {t_layout:.1f} s, Blender scene build {t_build:.1f} s (baseline for the render seconds above); "
           f"{len(town.faces)} triangles")
     sheet = Image.new("RGB", (2 * w + 12, len(rows) * (h + 20) + 4), (240, 240, 240))
@@ -471,7 +595,7 @@ def main(argv: list[str] | None = None) -> int:
     r.add_argument("--size", default="640x360", help="WIDTHxHEIGHT of every crop")
     r.add_argument("--samples", type=_positive, default=12, help="Cycles samples (denoised)")
     r.add_argument("--only", nargs="*", default=["ground", "horizon"],
-                   choices=["ground", "horizon", "trees", "facades", "road", "facades_close", "cars"])
+                   choices=["ground", "horizon", "trees", "facades", "road", "facades_close", "cars", "people"])
     r.add_argument("--shots", nargs="*", default=None, help="render only these shots (file stems)")
     c = sub.add_parser("compare", help="before | after sheets of two render runs")
     c.add_argument("before", type=_folder)

@@ -37,19 +37,28 @@ class ActorObjects:
         Index into ``world.actors`` of each entry of ``keys``.
     objects : list of bpy.types.Object
         The real object of each actor, in ``world.actors`` order.
+    meshes : dict of str to bpy.types.Mesh
+        The Blender mesh of every prototype key used (a walker's gait phase meshes among them).
     """
 
     world: World
     keys: list
     owners: list
     objects: list
+    meshes: dict | None = None
 
     def pose(self, times: np.ndarray) -> None:
-        """Key every actor at ``times`` = (opening, instant, closing), seconds on the world's timeline."""
+        """Key every actor at ``times`` = (opening, instant, closing), seconds on the world's timeline; a
+        walker shows the gait phase mesh of the instant (the one the LiDAR meets then)."""
         times = np.asarray(times, np.float64)
         values = [motion.yaw_values(a.track.position(times), a.track.heading(times)) for a in self.world.actors]
         for keys, owner in zip(self.keys, self.owners, strict=False):
             keys.set(values[owner])
+        for a, ob in zip(self.world.actors, self.objects, strict=True):
+            if a.gait is not None:
+                mesh = self.meshes[a.prototype_at(float(times[len(times) // 2]))]
+                if ob.data is not mesh:
+                    ob.data = mesh
 
 
 def build(world: World, materials: list, handles: geometry.BlenderScene) -> ActorObjects:
@@ -64,7 +73,7 @@ def build(world: World, materials: list, handles: geometry.BlenderScene) -> Acto
         The static town's collections; actor hulls are appended to ``handles.proxy_objects``
         (so they are shown and hidden with the town's).
     """
-    used = sorted({a.prototype for a in world.actors})
+    used = sorted({a.prototype for a in world.actors} | {k for a in world.actors if a.gait for k in a.gait.keys})
     meshes = {key: geometry.mesh("actor:" + key, world.prototypes[key], materials) for key in used}
     hull_keys = sorted({a.proxy for a in world.actors if a.proxy is not None})
     hull_meshes = {key: geometry.mesh("actor_hull:" + key, world.proxies[key], materials) for key in hull_keys}
@@ -82,7 +91,7 @@ def build(world: World, materials: list, handles: geometry.BlenderScene) -> Acto
             keys.append(motion.Keys(hb))
             owners.append(i)
     log.info("%d actors from %d prototypes in the Blender scene", len(world.actors), len(meshes))
-    return ActorObjects(world, keys, owners, objects)
+    return ActorObjects(world, keys, owners, objects, meshes)
 
 
 def headlights(objs: ActorObjects, make_spot, collection: bpy.types.Collection) -> int:

@@ -39,11 +39,23 @@ class Part:
     transform : (4, 4) float64 or None
         ``T_world_local`` of a static part; None for an actor (pose from ``track``).
     track : generator.world.actors.Track or None
+    actor : generator.world.actors.Actor or None
+        An articulated actor (a walker) whose mesh changes with time; ``meshes`` then holds the
+        world's prototypes it picks from (:meth:`mesh_at`).
+    meshes : dict of str to Mesh or None
     """
 
     mesh: object
     transform: np.ndarray | None = None
     track: object = None
+    actor: object = None
+    meshes: dict | None = None
+
+    def mesh_at(self, t: float):
+        """The mesh at ``t`` seconds: a walker's gait phase mesh then, else :attr:`mesh`."""
+        if self.actor is None or self.actor.gait is None:
+            return self.mesh
+        return self.meshes[self.actor.prototype_at(t)]
 
     def pose(self, t: float) -> np.ndarray:
         """(4, 4) float64 ``T_world_local`` at ``t`` seconds."""
@@ -100,7 +112,7 @@ class Subject:
         if self._actor is None:
             return np.zeros(3), np.zeros(3)
         h = self._actor.track.dt
-        c = [np.asarray(self._actor.box(t + d).center, np.float64) for d in (-h, 0.0, h)]
+        c = [self._actor.rigid_center(t + d) for d in (-h, 0.0, h)]   # a walker's limbs do not move its box
         return (c[2] - c[0]) / (2 * h), (c[2] - 2 * c[1] + c[0]) / (h * h)
 
     def moving(self, t: float) -> bool:
@@ -123,9 +135,10 @@ class Subject:
         verts, faces, off = [], [], 0
         for p in self.parts:
             T = p.pose(t)
-            v = np.asarray(p.mesh.vertices, np.float64)
+            mesh = p.mesh_at(t)
+            v = np.asarray(mesh.vertices, np.float64)
             verts.append(v @ T[:3, :3].T + T[:3, 3])
-            faces.append(np.asarray(p.mesh.faces, np.int64) + off)
+            faces.append(np.asarray(mesh.faces, np.int64) + off)
             off += len(v)
         return np.concatenate(verts), np.concatenate(faces)
 
@@ -182,7 +195,7 @@ def _actor_subjects(world) -> list[Subject]:
             continue
         b = dc.boxes[cls]
         out.append(Subject(a.instance_id, (a.instance_id,), cls, a.kind, a.name, False, b.group, bool(b.parts), "",
-                           (Part(world.prototypes.get(a.prototype), None, a.track),), None, a))
+                           (Part(world.prototypes.get(a.prototype), None, a.track, a, world.prototypes),), None, a))
     return out
 
 

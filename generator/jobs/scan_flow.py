@@ -38,6 +38,7 @@ class ScanFlowWriter:
         self.seq_dir = Path(seq_dir)
         self.rig, self.sensor, self.skew = rig, sensor, motion_skew
         self.actors = list(world.actors) if world is not None else []
+        self.prototypes = world.prototypes if world is not None else None
         self._flows: SceneFlow | None = None
         self._prev: tuple[int, float, np.ndarray] | None = None
 
@@ -59,7 +60,8 @@ class ScanFlowWriter:
         if prev is None or prev[0] != j - 1:
             return
         if self._flows is None:
-            self._flows = SceneFlow.for_rig(self.rig, self.actors, self.sensor, self.skew, t_j - prev[1])
+            self._flows = SceneFlow.for_rig(self.rig, self.actors, self.sensor, self.skew, t_j - prev[1],
+                                            prototypes=self.prototypes)
         obj, flag = self._flows.sweep(prev[2], points, prev[1])
         write_scene_flow(self.seq_dir, f"{prev[0]:06d}", obj, flag)
 

@@ -61,6 +61,8 @@ class SweepPlan:
         1 where the actor's planar speed then exceeds :data:`MOVING_THRESHOLD_MPS`.
     azimuth, half, ring0, ring1, near : (P,) arrays
         The column's beams that can reach the actor (:func:`generator.lidar.windows.column_windows`).
+    proto : (P,) int64
+        The prototype the actor shows at the column's time (a walker's gait phase mesh).
     """
 
     actor: np.ndarray
@@ -76,6 +78,7 @@ class SweepPlan:
     ring0: np.ndarray
     ring1: np.ndarray
     near: np.ndarray
+    proto: np.ndarray
 
 
 def _ragged(starts: np.ndarray, lengths: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -114,18 +117,28 @@ class ActorCaster:
 
     def __init__(self, world, sensor, face_offset: int, center: np.ndarray, spread: float = 0.0):
         actors = world.actors
-        keys = list(dict.fromkeys(a.prototype for a in actors))
+        # a walker's gait phase meshes follow its rest mesh; which one a ray meets is the phase at its column's time
+        keys = list(dict.fromkeys(k for a in actors for k in ((a.prototype,) + (a.gait.keys if a.gait else ()))))
         self.protos = [world.prototypes[k] for k in keys]
         self._casters = [EmbreeCaster(m.vertices, m.faces, center=np.zeros(3)) for m in self.protos]
         sizes = np.array([m.n_faces for m in self.protos], np.int64)
         self.proto_face_offset = face_offset + np.cumsum(sizes) - sizes
         self.proto_of = np.array([keys.index(a.prototype) for a in actors], np.int64)
         self.instance = np.array([a.instance_id for a in actors], np.uint16)
+        #: (actor index, its track, its Gait, (n_phases,) prototype index per phase) of every walker
+        self._gaits = [(i, a.track, a.gait, np.array([keys.index(k) for k in a.gait.keys], np.int64))
+                       for i, a in enumerate(actors) if a.gait is not None]
+        self._gait_slot = np.full(len(actors), -1, np.int64)
+        self._gait_slot[[g[0] for g in self._gaits]] = np.arange(len(self._gaits))
         radius = np.array([np.linalg.norm(m.vertices, axis=1).max() for m in self.protos])
-        self.radius = radius[self.proto_of]
         bounds = np.array([m.bounds() for m in self.protos])  # (n_protos, 2, 3)
-        self._box_center = ((bounds[:, 0] + bounds[:, 1]) / 2)[self.proto_of]
-        self._box_half = ((bounds[:, 1] - bounds[:, 0]) / 2)[self.proto_of]
+        self.radius = radius[self.proto_of]
+        lo, hi = bounds[self.proto_of, 0], bounds[self.proto_of, 1]
+        for i, _, _, idx in self._gaits:  # bounds over every phase: the windows hold whichever is shown
+            self.radius[i] = radius[idx].max()
+            lo[i], hi[i] = bounds[idx, 0].min(0), bounds[idx, 1].max(0)
+        self._box_center = (lo + hi) / 2
+        self._box_half = (hi - lo) / 2
         self.bank = TrackBank([a.track for a in actors])
         self.center = np.asarray(center, np.float64)
         self.sensor = sensor
@@ -164,8 +177,16 @@ class ActorCaster:
         win = self._column_windows(
             self.beams, pos, yaw, self._box_center[who], self._box_half[who], P[col if skew else 0 * col]
         )
+        proto = self.proto_of[who]
+        slot = self._gait_slot[who]
+        walking = np.flatnonzero(slot >= 0)
+        for j in np.unique(slot.take(walking)):
+            m = walking[slot.take(walking) == j]
+            _, track, gait, idx = self._gaits[j]
+            proto[m] = idx[gait.index(track, t[m])]
         return SweepPlan(actor, c0, c1, np.concatenate([[0], np.cumsum(n_cols)]), pos - self.center, np.cos(yaw),
-                         np.sin(yaw), moving, win["azimuth"], win["half"], win["ring0"], win["ring1"], win["near"])
+                         np.sin(yaw), moving, win["azimuth"], win["half"], win["ring0"], win["ring1"], win["near"],
+                         proto)
 
     # -- per chunk of columns -----------------------------------------------------------------------
     def aim(self, plan: SweepPlan, cols: slice) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
@@ -275,7 +296,7 @@ class ActorCaster:
         ray, pair, cand = ray.take(keep), pair.take(keep), cand.take(keep)
         o_loc, d_loc = np.empty((len(ray), 3), np.float32), np.empty((len(ray), 3), np.float32)
         to_actor_frames(o_w, d_w, ray, pair, plan.position, plan.cos, plan.sin, o_loc, d_loc)
-        proto = self.proto_of[plan.actor[cand]]
+        proto = plan.proto.take(pair)
         bound = np.minimum(dist.take(ray), np.float32(self.sensor.max_range_m))
         hits = []
         for p in np.unique(proto):

@@ -3,7 +3,8 @@
 For every pixel of image A (exposed at ``t_a``) with a surface (finite depth), the point the
 pixel centre sees, ``X = depth * ray`` (camera A frame), is carried to time ``t_b`` by its
 object's rigid motion (the static town does not move; an actor moves with its track,
-:mod:`generator.world.kinematics`) and projected with camera B's pose and intrinsics. The flow
+:mod:`generator.world.kinematics`; a walker's limbs also with their gait,
+:mod:`generator.motion.articulation`) and projected with camera B's pose and intrinsics. The flow
 is the projection minus the pixel centre, in pixels (``u`` right, ``v`` down), as KITTI and
 Middlebury define it: pixel ``(row, col)`` of A moves to ``(col + 0.5 + u, row + 0.5 + v)`` in
 B's pixel coordinates (origin at the top-left corner).
@@ -32,6 +33,7 @@ import numpy as np
 
 from generator.fusion.projection import Projection, visible
 from generator.geometry.transforms import invert
+from generator.motion.articulation import carry
 from generator.motion.owners import pixel_owners
 from generator.world.rig import pixel_rays
 
@@ -129,6 +131,9 @@ def optical_flow(a: View, b: View, movers_ab: list) -> Flow:
     Y[...] = X @ rel[:3, :3].T + rel[:3, 3]
     for i in np.unique(owner[owner >= 0]):
         sel = owner == i
+        if movers_ab[i].meshes is not None:  # a walker whose limbs moved: each point with its limb
+            Y[sel] = carry(movers_ab[i], Xw[sel]) @ T_b_w[:3, :3].T + T_b_w[:3, 3]
+            continue
         T = T_b_w @ movers_ab[i].M @ a.T_world_camera
         Y[sel] = X[sel] @ T[:3, :3].T + T[:3, 3]
     z = Y[..., 2]

@@ -184,8 +184,12 @@ class SceneFlow:
     """
 
     def __init__(self, T_world_ego: PoseFn, T_ego_lidar: np.ndarray, actors: list, column_time: np.ndarray, dt: float,
-                 view: View | None = None, threads: int = 2):
+                 view: View | None = None, threads: int = 2, prototypes: dict | None = None):
         from generator.lidar.tracks import TrackBank
+
+        #: walkers (index into ``actors``: actor), whose limbs move their points too
+        self._walkers = {i: a for i, a in enumerate(actors) if getattr(a, "gait", None) is not None and prototypes}
+        self._prototypes = prototypes
 
         self.T_world_ego, self.dt, self.view = T_world_ego, float(dt), view
         self.T_ego_lidar = np.ascontiguousarray(T_ego_lidar, np.float64)
@@ -202,11 +206,13 @@ class SceneFlow:
         self._pool = ThreadPoolExecutor(1, thread_name_prefix="scene-flow") if threads > 1 else None
 
     @classmethod
-    def for_rig(cls, rig, actors: list, sensor, motion_skew: bool, dt: float, threads: int = 2) -> SceneFlow:
+    def for_rig(cls, rig, actors: list, sensor, motion_skew: bool, dt: float, threads: int = 2,
+                prototypes: dict | None = None) -> SceneFlow:
         """The scene flow of ``sensor``'s sweeps on ``rig`` (:class:`generator.world.rig.Rig` with its drive;
-        columns at their own instants when ``motion_skew``)."""
+        columns at their own instants when ``motion_skew``); ``prototypes`` (the world's) let a walker's
+        points move with their limbs."""
         ct = sensor.column_time() if motion_skew else np.zeros(sensor.azimuth_steps)
-        return cls(rig.trajectory.T_world_ego, rig.T_ego_lidar, actors, ct, dt, View(sensor), threads)
+        return cls(rig.trajectory.T_world_ego, rig.T_ego_lidar, actors, ct, dt, View(sensor), threads, prototypes)
 
     def close(self) -> None:
         """Stop the helper thread."""
@@ -257,6 +263,12 @@ class SceneFlow:
         obj, moved = np.empty((n, 3), np.float32), np.empty((3, n), np.float32)
         _split(lambda a, b: kernels.apply_flows(xyz[:, a:b], column[a:b], which[a:b], E, L, obj[a:b], moved[:, a:b]), n,
                self._pool)
+        if self._walkers and len(rows):
+            from generator.motion.articulation import limb_flows
+
+            limb_flows(self._walkers, self._prototypes, self.lookup, self.column_time + t_sweep, self.dt,
+                       self._ego_poses(t_sweep) @ self.T_ego_lidar, xyz, np.asarray(column), np.asarray(instance), rows,
+                       E, obj, moved)
         return obj, moved
 
     def flow(self, x: np.ndarray, y: np.ndarray, z: np.ndarray, instance: np.ndarray, column: np.ndarray,

@@ -34,6 +34,7 @@ from generator.traffic.lanes.roundabouts import GIVE_WAY_CLEAR_S
 from generator.traffic.lanes.signals import CLEAR_S, Signals
 from generator.traffic.mapped_tracks import map_track
 from generator.traffic.movers import DT_S, Mover
+from generator.traffic.pedestrians.gait import walker_gait
 from generator.traffic.pedestrians.simulate import simulate_pedestrians
 from generator.traffic.vehicles.fleet import KINDS, drives, fleet_proto, how_many, n_variants, widest_half_width
 from generator.traffic.vehicles.sim import Vehicle, VehicleSim, arm_towards
@@ -328,7 +329,7 @@ def _assemble(scene, movers: list[Mover], ego: TrackTrajectory, duration_s: floa
     base = max([o.instance_id for o in scene.objects] + [0]) + 1
     if base + len(movers) > 65535:
         raise SpecError("", "traffic", f"{len(movers)} actors exceed the instance ids left in a uint16 label")
-    prototypes, proxies, actors = {}, {}, []
+    prototypes, proxies, actors, cycles = {}, {}, [], {}
     for uid, m in enumerate(movers):
         key = f"actor_{m.proto.key}"
         if key not in prototypes:
@@ -337,6 +338,10 @@ def _assemble(scene, movers: list[Mover], ego: TrackTrajectory, duration_s: floa
             if hull is not None:
                 proxies[key] = hull
         lo, hi = np.asarray(m.proto.lo, float), np.asarray(m.proto.hi, float)
+        gait = walker_gait(key, m.proto.mesh, m.track, prototypes, cycles) if m.attrs.get("role") == "walking" else None
+        if gait is not None:
+            lo, hi = gait.lo.min(0), gait.hi.max(0)             # the box of every phase
         actors.append(Actor(uid, f"actor_{m.kind}_{uid:04d}", m.kind, m.cls, base + uid, key, tuple(hi - lo),
-                            tuple((lo + hi) / 2), m.track, key if key in proxies else None, dict(m.attrs)))
+                            tuple((lo + hi) / 2), m.track, key if key in proxies else None, dict(m.attrs), gait))
     return World(scene, actors, prototypes, proxies, ego, duration_s)
+

@@ -22,6 +22,7 @@ import numpy as np
 
 from generator.errors import UserError
 from generator.geometry import Mesh
+from generator.world.gait import Gait
 from generator.world.scene import OrientedBox, SceneModel
 
 #: An actor faster than this at an instant is *moving* there (SemanticKITTI moving-* ids,
@@ -132,6 +133,9 @@ class Actor:
         Key into :attr:`World.proxies`.
     attrs : dict
         Renderer parameters (``color``...).
+    gait : Gait or None
+        A walker's phase meshes (``prototype`` is then its phase-0 mesh; ``size`` and ``box_center``
+        hold every phase: the box of the union); None for a rigid actor.
     """
 
     uid: int
@@ -145,12 +149,34 @@ class Actor:
     track: Track
     proxy: str | None = None
     attrs: dict = field(default_factory=dict)
+    gait: Gait | None = None
+
+    def prototype_at(self, t: float) -> str:
+        """Key of the mesh the actor shows at time ``t`` (its gait phase mesh, or :attr:`prototype`)."""
+        if self.gait is None:
+            return self.prototype
+        return self.gait.keys[int(self.gait.index(self.track, t)[0])]
+
+    def local_box(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """(centre, size) (3,) float64 of the actor's box at ``t`` in its local frame: the extent of the
+        mesh it shows then."""
+        if self.gait is None:
+            return np.asarray(self.box_center, np.float64), np.asarray(self.size, np.float64)
+        k = int(self.gait.index(self.track, t)[0])
+        return (self.gait.lo[k] + self.gait.hi[k]) / 2, self.gait.hi[k] - self.gait.lo[k]
+
+    def rigid_center(self, t: float) -> np.ndarray:
+        """(3,) float64 world position at ``t`` of :attr:`box_center` (for a rigid actor its box's centre;
+        a walker's moves with its body, not with its limbs: what box velocities are taken of)."""
+        T = self.track.pose(t)[0]
+        return np.asarray(tuple(float(v) for v in T[:3, :3] @ np.asarray(self.box_center) + T[:3, 3]), np.float64)
 
     def box(self, t: float) -> OrientedBox:
-        """The actor's oriented box at time ``t``, world frame."""
+        """The actor's oriented box at time ``t``, world frame (a walker's: the extent of its phase mesh then)."""
         T = self.track.pose(t)[0]
-        c = T[:3, :3] @ np.asarray(self.box_center) + T[:3, 3]
-        return OrientedBox(tuple(float(v) for v in c), tuple(float(v) for v in self.size),
+        centre, size = self.local_box(t)
+        c = T[:3, :3] @ centre + T[:3, 3]
+        return OrientedBox(tuple(float(v) for v in c), tuple(float(v) for v in size),
                            float(self.track.heading(t)[0]))
 
 

@@ -5,8 +5,9 @@ LiDAR scene flow: :mod:`generator.motion`) and what an image's metadata says abo
 Pure numpy.
 
 A surface point ``X`` (world frame, metres) of actor ``a`` at ``t0`` is at
-``T_world_actor(t1) @ inv(T_world_actor(t0)) @ X`` at ``t1`` (actors are rigid bodies); a point of
-the static town stays where it is. Velocities are central differences over ``+-h`` seconds (by
+``T_world_actor(t1) @ inv(T_world_actor(t0)) @ X`` at ``t1`` (actors are rigid bodies, but for a
+walker's limbs, whose gait phase meshes the :class:`Mover` carries); a point of the static town stays
+where it is. Velocities are central differences over ``+-h`` seconds (by
 default the ego track's sample spacing), the same numbers :meth:`generator.world.actors.Track.velocity`
 gives for actors.
 """
@@ -34,7 +35,12 @@ class Mover:
     T0, T1 : (4, 4) float64
         ``T_world_actor`` at the two instants.
     box_center, box_size : (3,) float64
-        The actor's box in its local frame (centre; length, width, height), metres.
+        The actor's box in its local frame (centre; length, width, height), metres (a walker's: the box
+        of every gait phase, so it holds the mesh shown at either instant).
+    meshes : (Mesh, Mesh) or None
+        A walker whose gait phase differs between the instants: the phase meshes shown at ``t0`` and
+        ``t1`` (same faces), so a surface point's own limb motion can be added to :attr:`M`
+        (:func:`generator.motion.articulation.carry`); None for a rigid actor.
     """
 
     instance_id: int
@@ -42,6 +48,7 @@ class Mover:
     T1: np.ndarray
     box_center: np.ndarray
     box_size: np.ndarray
+    meshes: tuple | None = None
 
     @property
     def M(self) -> np.ndarray:
@@ -63,8 +70,17 @@ def movers(world, t0: float, t1: float) -> list[Mover]:
     if world is None or not world.actors:
         return []
     A0, A1 = world.T_world_actor(t0), world.T_world_actor(t1)
-    return [Mover(a.instance_id, A0[i], A1[i], np.asarray(a.box_center, np.float64), np.asarray(a.size, np.float64))
+    return [Mover(a.instance_id, A0[i], A1[i], np.asarray(a.box_center, np.float64), np.asarray(a.size, np.float64),
+                  _phase_meshes(world, a, t0, t1))
             for i, a in enumerate(world.actors)]
+
+
+def _phase_meshes(world, actor, t0: float, t1: float) -> tuple | None:
+    """(mesh at t0, mesh at t1) of a walker whose gait phase changes between the instants, else None."""
+    if actor.gait is None:
+        return None
+    k0, k1 = actor.prototype_at(t0), actor.prototype_at(t1)
+    return None if k0 == k1 else (world.prototypes[k0], world.prototypes[k1])
 
 
 def _step(ego, h: float | None) -> float:

@@ -189,8 +189,11 @@ def test_truck_size_wheels_and_class(seed):
 @pytest.mark.parametrize("pose", ["standing", "walking"])
 def test_person_height_materials_budget(height, pose):
     m = build("person", 3, height=height, pose=pose)
-    assert extent(m)[2] == pytest.approx(height, abs=1e-9)
-    assert 200 <= m.n_faces <= 520
+    if pose == "standing":
+        assert extent(m)[2] == pytest.approx(height, abs=1e-9)
+    else:                                    # knees never quite straight, hips lowest with both feet down
+        assert 0.95 * height < extent(m)[2] <= height
+    assert 200 <= m.n_faces <= 900
     for mat in ("skin", "hair", "clothing", "shoes"):
         assert of_material(m, mat).any(), mat
     # faces +x: the hair leaves the face (+x side of the head) uncovered

@@ -133,7 +133,8 @@ def test_town_has_walkers_and_standers(town, tracks):
         assert m.proto.key.startswith("person_v") and m.proto.params["pose"] == m.attrs["role"]
         assert len(m.attrs["color"]) == 3 and m.track.t0 == 0.0 and m.track.dt == DT_S
         assert m.track.xyz.shape == (N_STEPS, 3)
-        assert spec.heights.person_m[0] <= m.proto.hi[2] <= spec.heights.person_m[1] + 0.05
+        low = 0.95 if m.attrs["role"] == "walking" else 1.0      # a walker's knees are never quite straight
+        assert low * spec.heights.person_m[0] <= m.proto.hi[2] <= spec.heights.person_m[1] + 0.05
 
 
 def test_walkers_stay_on_sidewalks_and_crosswalks(town, tracks):
