@@ -46,6 +46,7 @@ CASES = [
     *[(f"island-{s}", "traffic_island", dict(shape=s)) for s in ("teardrop", "stadium")],
     ("median_strip", "median_strip", dict(length=12.0)),
     ("driveway_apron", "driveway_apron", dict()),
+    ("verge_crossing", "verge_crossing", dict()),
     ("gravel_patch", "gravel_patch", dict()),
     ("bench", "bench", dict()),
     ("bench-backless", "bench", dict(backrest=False)),
@@ -79,13 +80,14 @@ SIZES = {
     "advertising_column": ((1.1, 1.1, 2.5), (1.7, 1.7, 4.5)),
     "traffic_island": ((2.0, 1.0, 0.1), (20.0, 4.0, 0.16)),
     "driveway_apron": ((0.5, 2.5, 0.1), (3.0, 9.6, 0.16)),
+    "verge_crossing": ((3.0, 2.0, 0.02), (4.5, 3.0, 0.03)),
     "gravel_patch": ((1.0, 0.7, 0.03), (25.0, 20.0, 0.05)),
 }
 
 #: kind -> most triangles one asset may have (prototypes are instanced; keep them cheap)
 BUDGET = {"bicycle": 2000, "motorcycle": 2200, "bicyclist": 2500, "motorcyclist": 2700, "bus": 1200, "tram": 2100,
           "rail_track": 800, "tram_rails": 100, "trailer": 800, "box_van": 900, "construction_vehicle": 600,
-          "wall": 600, "traffic_island": 200, "median_strip": 200, "driveway_apron": 20, "gravel_patch": 100,
+          "wall": 600, "traffic_island": 200, "median_strip": 200, "driveway_apron": 20, "verge_crossing": 12, "gravel_patch": 100,
           "bench": 400, "bin": 250, "bollard": 200, "bike_rack": 1200, "bus_shelter": 400, "hydrant": 400,
           "advertising_column": 400}
 
@@ -280,7 +282,7 @@ def test_walls_run_along_x_like_fences():
 
 
 def test_ground_pieces_are_flat_and_other_ground():
-    for kind in ("traffic_island", "median_strip", "driveway_apron", "gravel_patch"):
+    for kind in ("traffic_island", "median_strip", "driveway_apron", "verge_crossing", "gravel_patch"):
         for seed in range(6):
             m = build(kind, seed)
             assert (m.face_class == T.id("other_ground")).all()
