@@ -11,25 +11,11 @@ import numpy as np
 import pytest
 from trimesh.ray.ray_pyembree import RayMeshIntersector
 
-from assets_procedural import catalog
 from assets_procedural.building_roof import COPING_H, COPING_OUT
 from assets_procedural.facade_trim import PIPE_OFF, PIPE_R, PIPE_SIDES, TRIM_T
-from generator.geometry import Mesh, face_normals
+from generator.geometry import face_normals
 from generator.labels import class_table
-from generator.materials import material_table
-
-RECT = np.array([[-8.0, -5.0], [8.0, -5.0], [8.0, 5.0], [-8.0, 5.0]])
-L_SHAPE = np.array([[-10.0, -8.0], [10.0, -8.0], [10.0, 0.0], [0.0, 0.0], [0.0, 8.0], [-10.0, 8.0]])
-FH = 3.2
-
-
-def build(seed: int, **params) -> Mesh:
-    params.setdefault("footprint", RECT)
-    return catalog.build("building", np.random.default_rng(seed), **params)
-
-
-def mat(m: Mesh, *names: str) -> np.ndarray:
-    return np.isin(m.face_material, [material_table().id(n) for n in names])
+from kits.building_kit import FH, L_SHAPE, RECT, build, mat
 
 
 def outside(points: np.ndarray, rect: np.ndarray = RECT) -> np.ndarray:

@@ -10,6 +10,7 @@ import pytest
 
 from generator.labels import class_table
 from generator.weather import Lighting
+from kits.camera_kit import look_at
 
 pytestmark = pytest.mark.blender
 
@@ -18,14 +19,6 @@ FACADE_MATERIALS = ("facade_plaster", "facade_brick", "facade_concrete", "facade
                     "shop_glass", "shop_sign")
 
 
-def _look_at(eye, target) -> np.ndarray:
-    eye, target = np.asarray(eye, float), np.asarray(target, float)
-    z = (target - eye) / np.linalg.norm(target - eye)
-    x = np.cross(z, [0.0, 0.0, 1.0])
-    x /= np.linalg.norm(x)
-    T = np.eye(4)
-    T[:3, 0], T[:3, 1], T[:3, 2], T[:3, 3] = x, np.cross(z, x), z, eye
-    return T
 
 
 @pytest.fixture(scope="module")
@@ -44,7 +37,7 @@ def facade(test_spec, test_scene, tmp_path_factory):
         centre = T[:3, :3] @ np.array([(lo[0] + hi[0]) / 2, lo[1], 0.0]) + T[:3, 3]
         front = T[:3, :3] @ np.array([0.0, -1.0, 0.0])
         eye = centre + 7.0 * front + [0.0, 0.0, 1.7]
-        r.place_camera(_look_at(eye, centre + [0.0, 0.0, 4.0]))
+        r.place_camera(look_at(eye, centre + [0.0, 0.0, 4.0]))
         labels = r.render_labels()
         wall = labels.class_id == BUILDING
         if wall.mean() > 0.6:

@@ -10,6 +10,7 @@ import pytest
 
 from generator.labels import class_table
 from generator.weather import Lighting
+from kits.camera_kit import look_at
 
 pytestmark = pytest.mark.blender
 
@@ -18,14 +19,6 @@ BUILDING, VEGETATION, SKY = (class_table().id(n) for n in ("building", "vegetati
 DAY = Lighting("day", sun_elevation_deg=88.0, sun_azimuth_deg=150.0)    # overhead: no shadow over the gutter
 
 
-def _look_at(eye, target) -> np.ndarray:
-    eye, target = np.asarray(eye, float), np.asarray(target, float)
-    z = (target - eye) / np.linalg.norm(target - eye)
-    x = np.cross(z, [0.0, 0.0, 1.0])
-    x /= np.linalg.norm(x)
-    T = np.eye(4)
-    T[:3, 0], T[:3, 1], T[:3, 2], T[:3, 3] = x, np.cross(z, x), z, eye
-    return T
 
 
 def _clear_kerb(scene, grid):
@@ -54,7 +47,7 @@ def ground(test_spec, test_scene, tmp_path_factory):
     T, u = _clear_kerb(test_scene, grid)
     centre = T[:3, :3] @ [u, -(grid.road_half - 1.5), 0.0] + T[:3, 3]
     # straight down from 5 m over the carriageway 1.5 m off the kerb; image x runs across the street
-    r.place_camera(_look_at(centre + [0, 0, 5.0], centre + T[:3, :3] @ [0.0001, 0.0, -1.0]))
+    r.place_camera(look_at(centre + [0, 0, 5.0], centre + T[:3, :3] @ [0.0001, 0.0, -1.0]))
     out = {"labels": r.render_labels()}
     for name, wet in (("dry", 0.0), ("wet", 1.0)):
         r.set_conditions(DAY, wet, 11.0)
@@ -62,7 +55,7 @@ def ground(test_spec, test_scene, tmp_path_factory):
     # out of town at the far city: 8 m up, 15 m outside the town's south-west corner, looking out level
     (bx0, by0), _ = test_scene.bounds
     eye = np.array([bx0 - 15.0, by0 - 15.0, 8.0])
-    r.place_camera(_look_at(eye, eye + [-100.0, -100.0, 0.0]))
+    r.place_camera(look_at(eye, eye + [-100.0, -100.0, 0.0]))
     out["far_labels"] = r.render_labels()
     r.set_conditions(Lighting("night", lit_windows=1.0))
     out["night_lit"] = r.render_rgb(seed=3)[0]

@@ -12,26 +12,15 @@ from generator.lidar.sensors import load_preset
 from generator.world import rig
 from generator.world.actors import World
 from kits.scene_kit import scene_of
+from kits.surface_kit import on_surface
 from kits.walker_world import straight, walker
 
 H = 1.73
 
 
 def _on_mesh(points: np.ndarray, mesh, tol: float) -> np.ndarray:
-    """(n,) bool: which local points lie on a triangle of ``mesh`` (plane distance and inside, ``tol`` m)."""
-    a, b, c = (mesh.vertices[mesh.faces[:, k]] for k in range(3))
-    n = np.cross(b - a, c - a)
-    area2 = np.linalg.norm(n, axis=1)
-    keep = area2 > 1e-12
-    a, b, c, n, area2 = a[keep], b[keep], c[keep], n[keep] / area2[keep, None], area2[keep]
-    out = np.zeros(len(points), bool)
-    for i, p in enumerate(points):
-        near = np.abs(((p - a) * n).sum(1)) < tol
-        q = p - ((p - a[near]) * n[near]).sum(1)[:, None] * n[near]
-        w = [(np.cross(v1 - q, v2 - q) * n[near]).sum(1) / area2[near]
-             for v1, v2 in ((b[near], c[near]), (c[near], a[near]), (a[near], b[near]))]
-        out[i] = len(q) > 0 and np.any(np.min(w, axis=0) > -tol)
-    return out
+    """(n,) bool: which local points lie on a triangle of ``mesh`` (``tol`` m)."""
+    return on_surface(points, mesh.vertices, mesh.faces, tol)
 
 
 def test_every_point_lies_on_the_phase_mesh_of_its_firing_time():

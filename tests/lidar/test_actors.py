@@ -21,6 +21,7 @@ from generator.materials import material_table
 from generator.world import rig
 from generator.world.actors import MOVING_THRESHOLD_MPS, Actor, Track, World
 from kits.scene_kit import scene_of
+from kits.surface_kit import on_surface
 
 H = 1.73  # KITTI mount height
 DT = 0.05
@@ -90,23 +91,6 @@ def reference_actor_hits(sensor, poses, tr: Track, t0, size=CAR):
     with np.errstate(divide="ignore", invalid="ignore"):
         t_ground = np.where(dw[..., 2] < 0, -ow[..., 2] / dw[..., 2], np.inf).reshape(-1)
     return t_box, slack, t_ground
-
-
-def on_surface(points, vertices, faces, tol):
-    """(n,) bool: each point lies within ``tol`` of the plane of a triangle and inside it (barycentric)."""
-    a, b, c = (vertices[faces[:, i]] for i in range(3))
-    n = np.cross(b - a, c - a)
-    area2 = np.linalg.norm(n, axis=1)
-    keep = area2 > 1e-12
-    a, b, c, n, area2 = a[keep], b[keep], c[keep], n[keep] / area2[keep, None], area2[keep]
-    out = np.zeros(len(points), bool)
-    for i, p in enumerate(points):
-        near = np.abs(((p - a) * n).sum(1)) < tol
-        q = p - ((p - a[near]) * n[near]).sum(1)[:, None] * n[near]  # projection onto each plane
-        w = [(np.cross(v1 - q, v2 - q) * n[near]).sum(1) / area2[near]
-             for v1, v2 in ((b[near], c[near]), (c[near], a[near]), (a[near], b[near]))]
-        out[i] = np.any(np.min(w, axis=0) > -tol)
-    return out
 
 
 def points_in_actor_frame(p, poses, tr: Track, t0, sensor):
