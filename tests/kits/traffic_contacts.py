@@ -100,7 +100,19 @@ class _Tracks:
             self.yaw[k, :n[k]], self.yaw[k, n[k]:] = a.track.yaw, a.track.yaw[-1]
         self.centre = np.array([a.box_center for a in self.actors], np.float64).reshape(-1, 3)
         self.half = np.array([a.size[:2] for a in self.actors], np.float64).reshape(-1, 2) / 2.0
+        #: walkers: their box is the extent of the gait-phase mesh they show (phase by walked distance)
+        self.walkers = [k for k, a in enumerate(self.actors) if getattr(a, "gait", None) is not None]
         self.calls = 0
+
+    def _phase_boxes(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """((n, 3) local box centres, (n, 2) half sizes) at ``t``: a walker's those of its phase mesh then."""
+        centre, half = self.centre.copy(), self.half.copy()
+        for k in self.walkers:
+            g = self.actors[k].gait
+            j = int(g.index(self.actors[k].track, t)[0])
+            centre[k] = (g.lo[j] + g.hi[j]) / 2
+            half[k] = (g.hi[j, :2] - g.lo[j, :2]) / 2
+        return centre, half
 
     def poses(self, t: float) -> tuple[np.ndarray, np.ndarray]:
         """((n, 2) box centres, (n,) yaws) of the actors at time ``t`` (s)."""
@@ -115,8 +127,9 @@ class _Tracks:
         p = self.xyz[rows, i] * (1 - f[:, None]) + self.xyz[rows, i + 1] * f[:, None]
         h = self.yaw[rows, i] * (1 - f) + self.yaw[rows, i + 1] * f
         c, s = np.cos(h), np.sin(h)
-        cx = c * self.centre[:, 0] - s * self.centre[:, 1] + p[:, 0]
-        cy = s * self.centre[:, 0] + c * self.centre[:, 1] + p[:, 1]
+        centre, self._half_t = self._phase_boxes(t) if self.walkers else (self.centre, self.half)
+        cx = c * centre[:, 0] - s * centre[:, 1] + p[:, 0]
+        cy = s * centre[:, 0] + c * centre[:, 1] + p[:, 1]
         xy, boxes = np.stack([cx, cy], -1), None
         if self.calls % self.CHECK_EVERY == 0:            # the actors' own boxes say the same
             boxes = [a.box(t) for a in self.actors]
@@ -131,7 +144,7 @@ class _Tracks:
         xy, h, boxes = self._poses(t)
         c, s = np.cos(h)[:, None], np.sin(h)[:, None]
         sx, sy = np.array([-1.0, 1.0, 1.0, -1.0]), np.array([-1.0, -1.0, 1.0, 1.0])
-        lx, ly = sx * self.half[:, :1], sy * self.half[:, 1:]                     # (n, 4) box-frame corners
+        lx, ly = sx * self._half_t[:, :1], sy * self._half_t[:, 1:]               # (n, 4) box-frame corners
         q = np.stack([xy[:, :1] + lx * c - ly * s, xy[:, 1:] + lx * s + ly * c], -1)
         if boxes is not None:                            # checked against the actors' own boxes
             err = np.abs(footprints(boxes) - q).max(initial=0.0)

@@ -38,8 +38,12 @@ def test_the_default_library_holds_dozens_of_people_children_to_tall_adults(defa
     assert all(lo <= p.params["height"] <= hi for p in adults)
     assert {p.params["sex"] for p in adults} == {"female", "male"}
     assert max(p.params["height"] for p in kids) < min(1.7, hi)
-    for p in people:                                                          # the mesh is as tall as drawn
-        assert p.hi[2] - p.lo[2] == pytest.approx(p.params["height"], abs=1e-9)
+    for p in people:    # a standing mesh is as tall as drawn; a walker at phase 0 (both feet down, knees
+        h = p.hi[2] - p.lo[2]   # bent: the lowest point of its bob) up to 5 % lower
+        if p.params["pose"] == "standing":
+            assert h == pytest.approx(p.params["height"], abs=1e-9)
+        else:
+            assert 0.95 * p.params["height"] - 1e-9 <= h <= p.params["height"] + 1e-9
     assert len({p.mesh.vertices.tobytes() for p in people}) == n             # every variant its own mesh
 
 

@@ -26,4 +26,4 @@ def test_skipping_far_objects_leaves_the_same_tiles(test_spec, test_scene):
     solid = [o for o in test_scene.objects if o.cls not in wc.GROUND_CLASSES]
     skipped = street_distance_bound(grid, wc._footprint_rects(test_scene, solid)) >= reach + 1e-6
     far = np.array([o.kind.startswith("far_") for o in solid])
-    assert far.sum() > 50 and skipped[far].mean() > 0.9
+    assert far.sum() >= 12 and skipped[far].mean() > 0.9   # the far city: 12 joined objects (4 sides x 3 kinds)
