@@ -45,6 +45,12 @@ def register(sub) -> None:
     p.add_argument("--objects", default="auto", choices=OBJECTS,
                    help="points per object from boxes (OpenLABEL), instance labels, or off (default auto: boxes "
                         "when every dataset has them, else instances when every dataset has labels)")
+    p.add_argument("--azimuth", default=None, metavar="LO:HI",
+                   help="compare only rays and points within this azimuth range, degrees (x forward, +y = left is "
+                        "+90); with --elevation, a cropped scan such as KITTI's velodyne_reduced: --azimuth=-40:40 "
+                        "--elevation=-14:90 (write the = before a negative value; default: all)")
+    p.add_argument("--elevation", default=None, metavar="LO:HI",
+                   help="compare only beams whose elevation is within this range, degrees, up positive (default: all)")
     p.set_defaults(func=run)
 
 
@@ -79,10 +85,12 @@ def run(args) -> int:
     from generator.gap.report import pairs_of, summarize
     from generator.gap.sources import open_source
     from generator.gap.text import charts, markdown
+    from generator.gap.window import parse_window
 
     if len(args.datasets) < 2:
         raise UserError("DATASET: name at least two datasets (SYNTH REAL)")
     roles = _roles(len(args.datasets))
+    window = parse_window(args.azimuth, args.elevation)
     for p, role in zip(args.datasets, roles, strict=True):
         input_dir(p, role, "dataset folder")
     names = _names(args)
@@ -96,14 +104,15 @@ def run(args) -> int:
     out = output_dir(args.out, "--out")
     profiles, records = {}, []
     for name, src, sensor in zip(names, sources, sensors, strict=True):
-        prof, rec = measure(name, src, sensor, mode)
+        prof, rec = measure(name, src, sensor, mode, window=window)
         rec["sensor"] = sensor.source
         profiles[name] = prof
         records.append(rec)
     pairs = pairs_of(names, reference, args.pairwise)
     report = {"datasets": records, "reference": None if args.pairwise else reference,
               "pairs": [f"{a} vs {b}" for a, b in pairs], "sensor": sensors[names.index(reference)].source,
-              "objects_from": mode, "metrics": summarize(profiles, pairs, mode)}
+              "objects_from": mode, "window": None if window.whole else window.to_dict(),
+              "metrics": summarize(profiles, pairs, mode)}
     pictures = charts(report)
     with staging(out, "gap") as stage:
         write_json(stage / "gap.json", report)

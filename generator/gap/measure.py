@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import os
 from collections import deque
@@ -13,6 +14,7 @@ from generator.errors import UserError
 from generator.gap.objects import instance_objects
 from generator.gap.profile import Profile
 from generator.gap.rings import RingModel
+from generator.gap.window import Window
 from generator.progress import progress
 
 log = logging.getLogger(__name__)
@@ -39,20 +41,27 @@ def objects_mode(choice: str, sources) -> str | None:
     return None if choice == "off" else choice
 
 
-def measure(name: str, source, sensor, objects: str | None, threads: int | None = None) -> tuple[Profile, dict]:
-    """(profile, JSON record) of one dataset (scans measured on ``threads`` threads, default: the cores)."""
-    prof = Profile(name, RingModel(sensor))
+def measure(name: str, source, sensor, objects: str | None, threads: int | None = None,
+            window: Window | None = None) -> tuple[Profile, dict]:
+    """(profile, JSON record) of one dataset (scans measured on ``threads`` threads, default: the cores),
+    within ``window`` when given (:mod:`generator.gap.window`)."""
+    prof = Profile(name, RingModel(sensor), window)
 
     def one(scan):
         if scan.ring is not None and scan.ring.size and int(scan.ring.max()) >= prof.rings:
             raise UserError(f"--sensor: {sensor.name} has {prof.rings} rings, {source.root} records ring "
                             f"{int(scan.ring.max())} (leave --sensor out to use the data's own)")
+        keep, fit = prof.crop(scan.xyz, scan.ring)
+        if keep is not None:
+            scan = dataclasses.replace(scan, **{k: None if v is None else v[keep] for k, v in (
+                ("xyz", scan.xyz), ("remission", scan.remission), ("learning", scan.learning),
+                ("instance", scan.instance), ("ring", scan.ring))})
         obj = None
         if objects == "boxes":
             obj = source.boxes(scan.sequence)(scan.index, scan.xyz)
         elif objects == "instances":
             obj = instance_objects(scan.xyz, scan.learning, scan.instance)
-        return prof.measure(scan.xyz, scan.remission, scan.learning, obj, scan.ring)
+        return prof.measure(scan.xyz, scan.remission, scan.learning, obj, scan.ring, fit)
 
     # numpy releases the GIL in the large array operations: scans measured in threads, merged in order,
     # a few at a time so a long sequence is never all in memory
@@ -68,7 +77,7 @@ def measure(name: str, source, sensor, objects: str | None, threads: int | None 
     centre = (np.linspace(-0.25, 0.25, len(v) + 1)[:-1] + 0.25 / len(v))
     record = {
         "name": name, "path": str(source.root), "layout": source.layout, "scans": prof.scans,
-        "points_per_scan": prof.points / max(prof.scans, 1), "rays_per_scan": prof.rings * prof.steps,
+        "points_per_scan": prof.points / max(prof.scans, 1), "rays_per_scan": int(prof.rays_per_ring.sum()),
         "labels": source.has_labels, "boxes": source.has_boxes, "sensor_recorded": recorded,
         "ring_fit": {"within_1cm_of_cone": float(v[np.abs(centre) < 0.01].sum() / max(v.sum(), 1)),
                      "cell_collisions_per_scan": prof.collisions / max(prof.scans, 1)},

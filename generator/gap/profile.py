@@ -26,7 +26,8 @@ from __future__ import annotations
 import numpy as np
 
 from generator.gap.objects import ObjectCounts
-from generator.gap.rings import RingModel
+from generator.gap.rings import RingFit, RingModel
+from generator.gap.window import Window
 
 N_LEARNING = 20
 RANGE_EDGES = np.arange(0.0, 122.0, 2.0)           # points per range bin, metres
@@ -58,12 +59,19 @@ class Profile:
     ----------
     name : str
     model : RingModel
+    window : Window, optional
+        Only the rays and points inside it are measured (:mod:`generator.gap.window`); None: all.
     """
 
-    def __init__(self, name: str, model: RingModel):
+    def __init__(self, name: str, model: RingModel, window: Window | None = None):
         self.name, self.model = name, model
         rings, nb = len(model.elev), len(RESIDUAL_EDGES) - 1
         self.rings, self.steps = rings, model.steps
+        #: (rings, steps) bool rays inside the window, or None (every ray)
+        self.cells = None if window is None or window.whole else window.cells(model)
+        #: (rings,) int64 rays per scan of each ring inside the window
+        self.rays_per_ring = (np.full(rings, model.steps, np.int64) if self.cells is None
+                              else self.cells.sum(1).astype(np.int64))
         self.scans = 0
         self.points = 0
         self.collisions = 0
@@ -78,14 +86,31 @@ class Profile:
         self.objects = np.zeros((len(OBJECT_DISTANCE_EDGES) - 1, len(LOG_POINTS_EDGES) - 1), np.int64)
         self.object_classes: dict[str, np.ndarray] = {}
 
+    def crop(self, xyz: np.ndarray, ring: np.ndarray | None = None) -> tuple[np.ndarray | None, RingFit | None]:
+        """(keep, fit): which points of ``xyz`` (n, 3) lie in a ray of the window, and the ring fit of those.
+
+        Both None without a window (every point is measured; :meth:`measure` fits them itself). ``ring``
+        (n,) replaces the fitted ring when the format records it.
+        """
+        if self.cells is None:
+            return None, None
+        fit = self.model.fit(xyz)
+        if ring is not None:
+            fit.ring = np.asarray(ring, np.int16)
+        keep = self.cells[fit.ring, fit.column]
+        return keep, RingFit(fit.ring[keep], fit.column[keep], fit.vertical_m[keep], fit.range_m[keep])
+
     def measure(self, xyz: np.ndarray, remission: np.ndarray, learning: np.ndarray | None,
-                objects: ObjectCounts | None = None, ring: np.ndarray | None = None) -> dict:
+                objects: ObjectCounts | None = None, ring: np.ndarray | None = None,
+                fit: RingFit | None = None) -> dict:
         """One scan's counts (pure: safe in a worker thread; :meth:`merge` adds them).
 
         ``xyz`` (n, 3) sensor frame, metres; ``remission`` (n,) in [0, 1]; ``learning`` (n,) SemanticKITTI
-        learning classes or None; ``ring`` (n,) when the format records it.
+        learning classes or None; ``ring`` (n,) when the format records it; ``fit`` the ring fit of ``xyz``
+        when it is known already (:meth:`crop`).
         """
-        fit = self.model.fit(xyz)
+        if fit is None:
+            fit = self.model.fit(xyz)
         if ring is not None:
             fit.ring = np.asarray(ring, np.int16)
         cls = np.zeros(len(xyz), np.int64) if learning is None else np.asarray(learning, np.int64)
@@ -136,6 +161,8 @@ class Profile:
         est = np.where(dl < dr, rl, np.where(dr < dl, rr, np.minimum(rl, rr)))
         est = np.where(np.minimum(dl, dr) <= w, est, np.inf)[:, w:-w]
         empty = ~occ & np.isfinite(est)
+        if self.cells is not None:
+            empty &= self.cells
         n = len(LOST_RANGE_EDGES) - 1
         # every point is a returned ray; one that lost its cell to a nearer point (jitter, a calibration that
         # is not the unit's own, more firings per turn than the grid) came from one of the empty cells near

@@ -25,7 +25,7 @@ def _centres(edges: np.ndarray) -> list[float]:
 
 def _rays(p: PR.Profile) -> np.ndarray:
     folded = getattr(p, "ring_rays", None)  # set by fold_rings
-    return np.full(p.rings, p.steps * p.scans, np.int64) if folded is None else folded
+    return p.rays_per_ring * p.scans if folded is None else folded
 
 
 #: Metrics whose curve is per ring: folded to a common ring count when the sensors differ.
@@ -114,7 +114,8 @@ METRICS: dict[str, Metric] = {
     "rays_lost_per_ring": Metric(
         "share of the rays of each ring without a return (rays = columns x scans; points per ring from the ring fit)",
         "ring (0 = highest beam)", lambda p: list(range(p.rings)),
-        lambda p: (1.0 - np.minimum(p.ring_points / np.maximum(_rays(p), 1), 1.0)).tolist(),
+        lambda p: [None if t == 0 else 1.0 - min(float(n) / float(t), 1.0)  # None: no ray of the ring in the window
+                   for n, t in zip(p.ring_points, _rays(p), strict=True)],
         lambda a, b: D.tv_rates(_ring_lost(a), _rays(a), _ring_lost(b), _rays(b)),
         "total variation", "share (= mean absolute difference of the per-ring loss rates)"),
     "rays_lost_per_range": Metric(

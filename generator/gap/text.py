@@ -26,7 +26,13 @@ def markdown(report: dict) -> str:
                      f"scan of {d['rays_per_scan']} rays; ring fit: {100 * d['ring_fit']['within_1cm_of_cone']:.1f} % "
                      f"of points within 1 cm of their laser's cone, {d['ring_fit']['cell_collisions_per_scan']:.0f} "
                      "points per scan share a cell")
-    lines += ["", f"Ring fit with `{report['sensor']}`; points per object from {report['objects_from'] or 'nowhere'}.",
+    win = report.get("window")
+    crop = ""
+    if win:
+        (a0, a1), (e0, e1) = win["azimuth_deg"], win["elevation_deg"]
+        crop = f" Only rays and points within azimuth {a0:g}..{a1:g}° and elevation {e0:g}..{e1:g}° are compared."
+    lines += ["", f"Ring fit with `{report['sensor']}`; points per object from "
+              f"{report['objects_from'] or 'nowhere'}." + crop,
               "", "## Distances", "", "| metric | distance | unit | " + " | ".join(pairs) + " |",
               "|---|---|---|" + "---:|" * len(pairs)]
     for key, m in report["metrics"].items():

@@ -122,3 +122,32 @@ def test_a_lidarseg_of_the_wrong_length_is_one_line_exit_2_and_nothing_written(n
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and label.name in err[0] and "lidarseg:" in err[0], err
     assert not out.exists()
+
+
+def test_a_camera_crop_compared_within_its_window_is_its_scan(pair, tmp_path):
+    """KITTI's velodyne_reduced: the raw sweeps cut to +-40 deg and -14 deg up, against the raw sweeps."""
+    from generator.gap.rings import RingModel
+    from generator.gap.window import Window
+    from generator.lidar.sensors import load_preset
+
+    raw, _ = pair
+    cells = Window(-40.0, 40.0, -14.0, 90.0).cells(RingModel(load_preset("hdl64e")))
+    crop = tmp_path / "crop" / "sequences" / "00" / "velodyne"
+    crop.mkdir(parents=True)
+    for p in sorted((raw / "lidar/sequences/00/velodyne").glob("*.bin")):
+        scan = sk.read_scan(p)
+        az = np.degrees(np.arctan2(scan[:, 1], scan[:, 0]))
+        el = np.degrees(np.arctan2(scan[:, 2], np.hypot(scan[:, 0], scan[:, 1])))
+        keep = (np.abs(az) <= 40) & (el >= -14.5)  # the points of the crop, by their own direction
+        sk.write_scan(crop / p.name, scan[keep, :3], scan[keep, 3])
+    whole = _distances(_gap(tmp_path / "whole", raw, tmp_path / "crop", extra=("--names", "raw,crop")))
+    assert whole["rays_lost_per_ring"]["raw vs crop"] > 0.5  # every ray outside the crop counts as lost
+    rep = _gap(tmp_path / "win", raw, tmp_path / "crop",
+               extra=("--names", "raw,crop", "--azimuth=-40:40", "--elevation=-14:90"))
+    d = {k: v["raw vs crop"] for k, v in _distances(rep).items()}
+    assert d["rays_lost_per_ring"] < 0.01 and d["points_per_range"] < 0.01 and d["intensity"] < 0.01, d
+    assert rep["window"] == {"azimuth_deg": [-40.0, 40.0], "elevation_deg": [-14.0, 90.0]}
+    assert {r["rays_per_scan"] for r in rep["datasets"]} == {int(cells.sum())}
+    lost = rep["metrics"]["rays_lost_per_ring"]["curves"]["raw"]
+    floor = ~cells.any(1)  # the rings under the floor hold no ray of the window: no loss rate, not 100 %
+    assert floor.sum() > 10 and all((v is None) == f for v, f in zip(lost, floor, strict=True))
