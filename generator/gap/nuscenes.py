@@ -17,6 +17,9 @@ A point is ``x, y, z, intensity, ring``: x, y, z are turned from nuScenes' LIDAR
 y forward) into urbangen's LiDAR frame (x forward, y left; :data:`generator.formats.nuscenes.R_LIDAR_NUSCENES`)
 so azimuths and columns are counted as for a KITTI scan; intensity 0-255 becomes remission / 255; the ring
 column is nuScenes' (0 = lowest beam), handed over as urbangen's ring (0 = highest) -- nothing derived.
+A nuScenes sweep holds every firing (32 x ~1084 points): a beam without a return, or one that meets the
+ego vehicle's roof, is a point by the sensor. Points within 1 m of it in x and in y are dropped, as the
+devkit's ``LidarPointCloud.remove_close(1.0)`` drops them, so they count as lost rays.
 Labels: lidarseg indices (category.json ``index``) -> SemanticKITTI learning classes through
 ``generator/labels/nuscenes_lidarseg.yaml``. Boxes: sample annotations (global frame) moved into the
 sensor frame with the sweep's ego_pose and calibrated_sensor, points counted with the devkit's
@@ -43,6 +46,8 @@ from generator.labels.nuscenes_lidarseg import lidarseg_mapping
 from generator.safeload import printable, read_array
 
 CHANNEL = "LIDAR_TOP"
+#: points within this of the sensor in x and in y are no returns of the scene (the devkit's remove_close)
+EGO_RADIUS_M = 1.0
 NEEDED = ("sensor", "calibrated_sensor", "sample", "sample_data", "scene")
 
 
@@ -224,6 +229,11 @@ class NuScenesSource:
                 learning = None
                 if self._labels is not None:
                     learning = self._learning(rec, len(pts))
+                # nuScenes writes every firing: a beam without a return and a beam on the ego vehicle's roof sit
+                # by the sensor. Those are dropped as the devkit's remove_close(1.0) drops them: no return.
+                far = ~((np.abs(pts[:, 0]) < EGO_RADIUS_M) & (np.abs(pts[:, 1]) < EGO_RADIUS_M))
+                pts, ring = pts[far], ring[far]
+                learning = None if learning is None else learning[far]
                 xyz = (pts[:, :3].astype(np.float64) @ R_LIDAR_NUSCENES.T).astype(np.float32)
                 yield ScanData(scene, i, xyz, np.clip(pts[:, 3] / 255.0, 0.0, 1.0).astype(np.float32), learning,
                                None, ((self.rings - 1) - ring).astype(np.int16))

@@ -100,3 +100,29 @@ def test_bad_nuscenes_roots_name_file_and_field(nus, tmp_path):
     label.write_bytes(label.read_bytes()[:-3])
     with pytest.raises(UserError, match=r"_lidarseg\.bin: lidarseg: \d+ labels for the \d+ points"):
         list(open_source(broken, "REAL").scans())
+
+
+def test_firings_without_a_return_written_at_the_sensor_are_dropped_as_the_devkit_drops_them(nus, tmp_path):
+    """A real nuScenes sweep holds every firing; a beam without a return (or on the ego's roof) is a point by the
+    sensor. Such points (within 1 m in x and y, the devkit's remove_close) are no returns: the scan reads as before."""
+    import json
+    import shutil
+
+    root = tmp_path / "nus"
+    shutil.copytree(nus, root)
+    before = [s.xyz for s in open_source(nus, "REAL").scans()]
+    sweep = sorted((root / "samples" / "LIDAR_TOP").glob("*.pcd.bin"))[0]
+    pts = np.fromfile(sweep, np.float32).reshape(-1, 5)
+    idle = np.zeros((50, 5), np.float32)
+    idle[:, :3] = np.random.default_rng(0).uniform(-0.9, 0.9, (50, 3))
+    idle[:, 4] = np.arange(50) % 32
+    np.concatenate([pts, idle]).tofile(sweep)
+    version = next(root.glob("v1.0-*"))
+    token = next(r["token"] for r in json.loads((version / "sample_data.json").read_text())
+                 if r["filename"].endswith(sweep.name))
+    rel = next(r["filename"] for r in json.loads((version / "lidarseg.json").read_text())
+               if r["sample_data_token"] == token)
+    lab = root / rel  # one label per point, as the lidarseg of a real sweep has
+    np.concatenate([np.fromfile(lab, np.uint8), np.zeros(50, np.uint8)]).tofile(lab)
+    after = [s.xyz for s in open_source(root, "REAL").scans()]
+    assert len(after) == len(before) and all(np.array_equal(a, b) for a, b in zip(after, before, strict=True))
