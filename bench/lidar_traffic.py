@@ -22,7 +22,8 @@ Rows, on the rays of the same HDL-64E sweeps (2083 x 64 = 133,312 rays each, mot
   beam, built up a step at a time: the power test only (received power against the threshold; no
   glass pass, no range noise), + the glass pass (rays go on behind panes), + range noise (= the
   preset without divergence, "received power only"); then the preset itself (strongest return with
-  beam divergence) and dual returns with beam divergence.
+  beam divergence) and dual returns with beam divergence; and both again with the divergence model as it
+  was before ``edge_subrays: differing`` (every sub-ray of a split beam cast: "all sub-rays").
 
 Timings: each sweep of each method is timed in each of ``--rounds`` interleaved rounds and the
 best time per sweep is kept (a burst of load from other processes spoils one sample, not a row);
@@ -55,6 +56,8 @@ from generator.spec import parse_spec  # noqa: E402
 from generator.world.actors import Actor, Track, World  # noqa: E402
 from generator.world.rig import SWEEP_PERIOD_S, Rig  # noqa: E402
 
+#: the returns block of the divergence model as it was before only the differing sub-rays were cast
+ALL_SUBRAYS = {"edge_subrays": "all"}
 TRAFFIC_X3 = {"cars_per_km": 36, "trucks_per_km": 3, "buses_per_km": 1.5, "cyclists_per_km": 6,
               "motorcyclists_per_km": 3}
 
@@ -192,7 +195,10 @@ def main(argv=None) -> int:
                               ("physical: power + glass", "strongest", {"subrays": 1, "range_noise_m": 0.0}),
                               ("physical: received power only", "strongest", {"subrays": 1}),
                               ("physical: strongest + divergence", "strongest", {}),
-                              ("physical: dual + divergence", "dual", {})):
+                              ("physical: dual + divergence", "dual", {}),
+                              # the divergence model before edge_subrays: every sub-ray of a split beam cast
+                              ("physical: strongest + divergence, all sub-rays", "strongest", ALL_SUBRAYS),
+                              ("physical: dual + divergence, all sub-rays", "dual", ALL_SUBRAYS)):
         s_mode = with_returns(sensor, mode)
         s_mode = dataclasses.replace(s_mode, returns=dataclasses.replace(s_mode.returns, **over))
         sc = Scanner(scene, s_mode, threads=args.threads, caster=static, world=world,

@@ -7,8 +7,9 @@ Steps, per chunk ``[c0, c1)`` of a sweep (the scanner's threads run chunks in pa
    which beams may meet which actor (:meth:`generator.lidar.actors.ActorCaster.aim`) is worked out
    once here and reused by every later ray list of the chunk;
 2. the chunk's edge beams (:func:`generator.lidar.return_rays.edge_beams`) get their probe
-   sub-rays (:func:`~generator.lidar.return_rays.probe_pairs`), and the beams the probes split
-   (:func:`~generator.lidar.return_rays.split_beams`) the rest, cast against the town and the actors;
+   sub-rays (:func:`~generator.lidar.return_rays.probe_pairs`), cast against the town and the actors;
+   the beams the probes split (:func:`~generator.lidar.return_rays.split_beams`) keep them, and their
+   other sub-rays either take the centre's hit (``edge_subrays: differing``) or are cast too (``all``);
 3. rays that end on glass go on behind it, up to ``glass_layers`` panes
    (:func:`~generator.lidar.return_rays.pane_rays`); a continued ray that meets the object whose
    glass it crossed (same class and instance) is absorbed in its interior, unless the object's cabin
@@ -132,9 +133,13 @@ def run_physical_chunk(scanner, sweep, i: int, cols: slice) -> None:
                                           np.float32(SPLIT_STEP_M), np.float32(SPLIT_STEP_REL), k, keep, split, rb, rw)
             split, rb, rw = split[:n_split], rb[:n_rest], rw[:n_rest]
             if n_split:
-                # the split beams' other sub-rays; their probes are kept
-                rest = _cast_subrays(scanner, plan, cols, aimed, o_w, d_world, rb, rw, model.pattern, i0, n_in, hi_r)
                 weight[split - i0] = share
+                if p.edge_subrays == "all":  # the split beams' other sub-rays; their probes are kept
+                    rest = _cast_subrays(scanner, plan, cols, aimed, o_w, d_world, rb, rw, model.pattern, i0, n_in,
+                                         hi_r)
+                else:  # towards a neighbour that sees the centre's surface, a sub-ray sees it too
+                    weight += share * np.bincount(rb - i0, minlength=n_in).astype(np.float32)
+                    rest, rb = {key: probe[key][:0] for key in probe}, rb[:0]
                 for key in parts:
                     if key in ("weight", "offset", "tau"):
                         continue

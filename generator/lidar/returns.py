@@ -25,7 +25,11 @@ but only where the footprint can straddle an edge: where the central rays of the
 neighbours in the range image do not see one continuous surface (a hit next to a miss, another class
 or instance, or a range step between neighbouring columns). Elsewhere the footprint lies on the
 surface the centre hits and every sub-ray would return the centre's range. An object thinner than
-the 3 mrad column spacing that no central ray touches stays invisible (as without divergence).
+the 3 mrad column spacing that no central ray touches stays invisible (as without divergence). The
+same holds inside an edge beam (``edge_subrays: differing``, the default): only the sub-rays towards
+the neighbours that differ are cast (the probes); a sub-ray towards a neighbour that sees the
+centre's surface is taken to see it too, and its share of the power goes to the centre's hit.
+``edge_subrays: all`` casts every sub-ray of a beam whose probes find an edge.
 
 Glass (materials with a ``transmittance``): the pane returns its own weak diffuse reflectance and a
 specular glint near normal incidence, and lets ``transmittance`` of the power through; the beam goes
@@ -95,6 +99,7 @@ class ReturnParams:
     glass_layers: int = 2
     edge_step: float = 0.05
     incidence_exponent: float = 0.25
+    edge_subrays: str = "differing"
 
     @property
     def physical(self) -> bool:

@@ -89,6 +89,27 @@ def test_sub_rays_on_a_wall_edge_give_mixed_points_between_the_two_walls(hdl64e)
     assert not walls["mixed"][np.abs(walls["y"]) > 0.1].any()  # away from the edge: clean
 
 
+def test_casting_only_the_differing_sub_rays_keeps_every_beam_and_the_mixed_points_between_the_walls(hdl64e):
+    """``edge_subrays: differing`` (the default) against ``all``: the same beams return with the same classes,
+    the beams no edge splits are the same points byte for byte (a split beam that is not mixed may differ in
+    power), and the mixed points stay between the two walls."""
+    scene = wall_edge_scene(10.5)
+    some = scan(scene, hdl64e, model_of(hdl64e, range_noise_m=0.0))
+    every = scan(scene, hdl64e, model_of(hdl64e, range_noise_m=0.0, edge_subrays="all"))
+    assert hdl64e.returns.edge_subrays == "differing"
+    key = lambda p: p["ring"].astype(np.int64) * 10_000 + p["column"]  # noqa: E731
+    assert np.array_equal(key(some), key(every))
+    clean = (some["mixed"] == 0) & (every["mixed"] == 0)
+    assert clean.mean() > 0.99 and np.array_equal(some["class"][clean], every["class"][clean])
+    assert np.abs(some["range"][clean] - every["range"][clean]).max() < 0.01
+    same = some[clean].view(np.void) == every[clean].view(np.void)  # the beams no edge split: the same bytes
+    assert same.mean() > 0.95
+    for p in (some, every):
+        xm = p[(p["mixed"] == 1) & (np.abs(p["y"]) < 2.0)]["x"]
+        assert len(xm) >= 15 and np.all(xm > 10.0 - 0.03) and np.all(xm < 10.5 + 0.03)
+    assert 0.5 < (some["mixed"] == 1).sum() / (every["mixed"] == 1).sum() < 2.0
+
+
 def test_dual_returns_are_the_strongest_and_the_last_and_ordered(hdl64e):
     scene = wall_edge_scene(20.0)
     dual = scan(scene, hdl64e, model_of(hdl64e, mode="dual", range_noise_m=0.0))
