@@ -6,7 +6,9 @@ under ``OUT``, with ``PYTHONPATH`` set to the tree, and prints per tree: wall ti
 sys of the job and every process it started), the time of each progress item, the manifest's
 figures (town products, worker set-up, seconds in Cycles); then the ratios of this tree against the
 baseline and the byte-identity check: the SHA-256 of every file of both datasets (``manifest.json``,
-which records times and the run, and the journal excepted).
+which records times and the run, and the journal excepted; an image's JSON is hashed without its
+``timings_s``, seconds measured in the run). Both jobs write to the same folder, ``OUT/dataset``
+(statistics name the folder they read), which is then renamed ``OUT/baseline`` or ``OUT/tree``.
 
 Usage::
 
@@ -62,13 +64,32 @@ def run_job(tree: Path, out: Path, workers: int | None) -> dict:
     return {"wall": wall, "cpu": cpu, "items": items, "run": runs[-1]}
 
 
+def _data(p: Path) -> bytes:
+    """The bytes of ``p`` that are data: an image's metadata without the seconds the run took."""
+    if p.suffix == ".json" and p.parent.parent.name == "images":
+        doc = json.loads(p.read_text(encoding="utf-8"))
+        doc.pop("timings_s", None)
+        return json.dumps(doc, sort_keys=True).encode()
+    return p.read_bytes()
+
+
 def digests(root: Path) -> dict[str, str]:
     """SHA-256 of every data file under ``root`` by relative path."""
     out = {}
     for p in sorted(root.rglob("*")):
         if p.is_file() and p.name not in NOT_DATA:
-            out[str(p.relative_to(root))] = hashlib.sha256(p.read_bytes()).hexdigest()
+            out[str(p.relative_to(root))] = hashlib.sha256(_data(p)).hexdigest()
     return out
+
+
+def timed(label: str, tree: Path, out: Path, workers: int | None) -> dict:
+    """Run the job of ``tree`` into ``out/dataset``, then rename that ``out/label``."""
+    r = run_job(tree.resolve(), out / "dataset", workers)
+    shutil.rmtree(out / label, ignore_errors=True)
+    (out / "dataset").rename(out / label)
+    (out / "dataset.log").rename(out / f"{label}.log")
+    report(label, r)
+    return r
 
 
 def report(label: str, r: dict) -> None:
@@ -91,10 +112,8 @@ def main(argv=None) -> int:
     log.info("load: %s", os.getloadavg())
     results = {}
     if args.baseline is not None:
-        results["baseline"] = run_job(args.baseline.resolve(), args.out / "baseline", args.workers)
-        report("baseline", results["baseline"])
-    results["tree"] = run_job(args.tree.resolve(), args.out / "tree", args.workers)
-    report("tree", results["tree"])
+        results["baseline"] = timed("baseline", args.baseline, args.out, args.workers)
+    results["tree"] = timed("tree", args.tree, args.out, args.workers)
     log.info("load: %s", os.getloadavg())
     if args.baseline is None:
         return 0
