@@ -53,6 +53,9 @@ class RenderJob:
     first : int
         Frame number at the start of the town's drive (``spec`` is that town's spec;
         :mod:`generator.jobs.towns`); 0 for the one town.
+    town : tuple
+        ``(town file, the town's image frames)``: where the town's scene and drive may be kept
+        (:mod:`generator.jobs.town_cache`); ``()``: build them.
     """
 
     spec: object
@@ -65,6 +68,7 @@ class RenderJob:
     sequence_dir: str = ""
     parent_pid: int = 0
     first: int = 0
+    town: tuple = ()
 
     @property
     def n_items(self) -> int:
@@ -81,9 +85,9 @@ def render_threads(cfg, parts: int, executor: str = "local"):
 
 def deal_render(spec, cfg, out: Path, frames: FrameSet, combos, workers: int, stereo=(),
                 sequence_dir: Path | None = None, first: int = 0, scratch_ids=None,
-                executor: str = "local") -> list[RenderJob]:
+                executor: str = "local", town: tuple = ()) -> list[RenderJob]:
     """Deal ``frames`` (image variants) and ``stereo`` (stereo pairs) round-robin to ``workers`` jobs (fewer
-    when there is less work); the frames stay ranges."""
+    when there is less work); the frames stay ranges. ``town``: :attr:`RenderJob.town` of every job."""
     stereo = sorted(set(stereo))
     parts = max(1, min(workers, len(frames) + len(stereo)))
     frame_parts = frames.deal(parts) if frames else []
@@ -99,7 +103,8 @@ def deal_render(spec, cfg, out: Path, frames: FrameSet, combos, workers: int, st
     for fp, sp in zip(frame_parts, stereo_parts, strict=True):
         if fp or sp:
             jobs.append(RenderJob(spec, cfg, str(out), tuple(fp), tuple(tuple(c) for c in combos),
-                                  str(scratch_dir(out, next(ids))), tuple(sp), str(sequence_dir or ""), first=first))
+                                  str(scratch_dir(out, next(ids))), tuple(sp), str(sequence_dir or ""), first=first,
+                                  town=town))
     return jobs
 
 

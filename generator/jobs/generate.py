@@ -75,12 +75,14 @@ class Preflight:
     need_bytes: int
     what: str
     fresh: bool
+    built: dict = dataclasses.field(default_factory=dict)  # town index -> (scene, drive) of the canary
 
 
-def _estimate(spec, cfg, out: Path, plan: Plan, towns: TownPlan, ledger: Ledger, stand_in: bool) -> tuple[int, str]:
+def _estimate(spec, cfg, out: Path, plan: Plan, towns: TownPlan, ledger: Ledger, stand_in: bool,
+              built: dict | None = None) -> tuple[int, str]:
     """Bytes the run will write and what they hold. The first town with work left is built (its route
-    checked against its frames, its drive planned); other towns' scans and stereo pairs are estimated
-    from its sweeps per frame."""
+    checked against its frames, its drive planned; kept in ``built[index]`` as ``(scene, drive)`` for the
+    town's tasks); other towns' scans and stereo pairs are estimated from its sweeps per frame."""
     from generator.jobs.journal import combo_mask
     from generator.labels import class_table
     from generator.lidar.sensors import sensor_for_spec
@@ -98,8 +100,11 @@ def _estimate(spec, cfg, out: Path, plan: Plan, towns: TownPlan, ledger: Ledger,
         if lidar is not None:
             sweeps = int(lidar.get("sweeps", 0))
         elif canary is None:
-            canary = _canary(towns.run(index))
+            scene, drive = _canary(towns.run(index))
+            canary = drive.sweeps, len(frames)
             sweeps = canary[0]
+            if built is not None:
+                built[index] = scene, drive
         else:
             sweeps = -(-canary[0] * len(frames) // canary[1])
         scans += 0 if lidar is not None else sweeps
@@ -113,16 +118,15 @@ def _estimate(spec, cfg, out: Path, plan: Plan, towns: TownPlan, ledger: Ledger,
     return need, what
 
 
-def _canary(run) -> tuple[int, int]:
-    """Build one town: its route must fit its frames; (sweeps, image frames) of its drive."""
+def _canary(run) -> tuple:
+    """Build one town: its route must fit its frames; its scene and drive."""
     from generator.jobs.drive import plan_drive
     from generator.jobs.lidar_sequence import check_frames
     from generator.layout import build_scene
 
     scene = build_scene(run.spec)
     check_frames(scene, run.spec, max(run.local_frames) + 1)
-    drive = plan_drive(run.spec, scene, run.plan.frames, run.first)
-    return drive.sweeps, len(run.plan.frames)
+    return scene, plan_drive(run.spec, scene, run.plan.frames, run.first)
 
 
 def preflight(spec, cfg, opts: GenerateOptions) -> Preflight:
@@ -145,10 +149,11 @@ def preflight(spec, cfg, opts: GenerateOptions) -> Preflight:
         sensor = sensor_for_spec(spec)  # every file the LiDAR stage reads, read now
         processing_for_spec(spec, sensor, True, intensity_fn_for_spec(spec))
     journal = read_journal(out, old, plan, towns)
-    need, what = _estimate(spec, cfg, out, plan, towns, journal.ledger, opts.stand_in)
+    built = {}
+    need, what = _estimate(spec, cfg, out, plan, towns, journal.ledger, opts.stand_in, built)
     if not opts.stand_in:
         check_free_space(out, need, what)
-    return Preflight(plan, manifest, towns, journal, need, what, old is None)
+    return Preflight(plan, manifest, towns, journal, need, what, old is None, built)
 
 
 def _clean(out: Path, pre: Preflight, sequences: list[str]) -> None:
@@ -205,6 +210,7 @@ def run_generate(spec, cfg, opts: GenerateOptions) -> dict:
 
     source = RunSource(setup, checkpoint)
     _clean(out, pre, [pre.towns.sequence(i) for i in source.pending])
+    _keep_built(out, pre)
     journal.settle()  # a dataset from before the journal gets one now
     checkpoint(source)
     try:
@@ -222,6 +228,17 @@ def run_generate(spec, cfg, opts: GenerateOptions) -> dict:
     manifest["runs"] = manifest.get("runs", []) + [run]
     mf.save(out, manifest)
     return run
+
+
+def _keep_built(out: Path, pre: Preflight) -> None:
+    """Hand the town the preflight built to the town's tasks (:mod:`generator.jobs.town_cache`), then let it go."""
+    from generator.jobs import town_cache
+
+    for index, (scene, drive) in pre.built.items():
+        run = pre.towns.run(index)
+        town_cache.save(town_cache.town_file(out, pre.towns.sequence(index)), run.spec, run.plan.frames, run.first,
+                        scene, drive)
+    pre.built.clear()
 
 
 def _summary(source) -> dict:

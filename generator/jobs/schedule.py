@@ -38,6 +38,7 @@ from generator.jobs.journal import Journal, combo_mask
 from generator.jobs.plan import Plan
 from generator.jobs.stereo import stereo_frames
 from generator.jobs.tasks import Task
+from generator.jobs.town_cache import discard, town_file
 from generator.jobs.town_job import STAGES, TownJob, products
 from generator.jobs.towns import TownPlan
 
@@ -171,8 +172,13 @@ class RunSource:
 
     def _stage_task(self, t: _Town, stage: str, attempt: int = 0) -> Task:
         run = t.run
-        job = TownJob(run.spec, self.s.cfg, str(self.s.out), run.plan, run.first, t.todo[stage], self._town_threads())
+        job = TownJob(run.spec, self.s.cfg, str(self.s.out), run.plan, run.first, t.todo[stage], self._town_threads(),
+                      self._town_file(t))
         return self._task(stage, job, t.index, attempt)
+
+    def _town_file(self, t: _Town) -> str:
+        """Where the town's tasks keep its scene and drive for each other (none for stand-ins)."""
+        return "" if self.s.stand_in else str(town_file(self.s.out, t.seq))
 
     def _advance(self, t: _Town) -> None:
         """Issue the town's next tasks: scan, else its renders, else its finishing, else it is done."""
@@ -184,7 +190,8 @@ class RunSource:
         if (frames or stereo) and t.renders_out == 0:
             seq_dir = self.s.out / "lidar" / "sequences" / t.seq
             jobs = deal_render(t.run.spec, self.s.cfg, self.s.out, frames, self.s.plan.combos, self.s.workers, stereo,
-                               seq_dir, t.run.first, self.scratch_ids, self.s.executor)
+                               seq_dir, t.run.first, self.scratch_ids, self.s.executor,
+                               (self._town_file(t), t.run.plan.frames))
             t.renders_out = len(jobs)
             self._total += len(stereo)
             self.new += [self._task("render", job, t.index) for job in jobs]
@@ -195,6 +202,7 @@ class RunSource:
             self.new.append(self._stage_task(t, "finish"))
             return
         del self.active[t.index]
+        discard(self._town_file(t))
         self.towns_done += 1
 
     def ready(self) -> list[Task]:

@@ -53,6 +53,9 @@ class TownJob:
         Names in :data:`TOWN_PRODUCTS` to make, in order.
     threads : int or None
         Threads for the LiDAR cast (None: every core).
+    town_file : str
+        Where the town's scene and drive are kept during the run (:mod:`generator.jobs.town_cache`): read
+        from there when an earlier process built them, written there when this task builds them.
     """
 
     spec: object
@@ -62,28 +65,41 @@ class TownJob:
     first: int
     products: tuple[str, ...]
     threads: int | None = None
+    town_file: str = ""
 
 
 class TownContext:
-    """What a town task's products share: the job, and the scene and drive built once on first use."""
+    """What a town task's products share: the job, and the scene and drive, read or built once on first use."""
 
     def __init__(self, job: TownJob):
         self.job, self.spec, self.cfg, self.plan, self.first = job, job.spec, job.config, job.plan, job.first
         self.out = Path(job.out)
 
     @functools.cached_property
-    def scene(self):
-        from generator.layout import build_scene
-
-        return build_scene(self.spec)
-
-    @functools.cached_property
-    def drive(self):
+    def _town(self) -> tuple:
+        """(scene, drive): kept by an earlier process of the run, else built here (and kept for the next)."""
+        from generator.jobs import town_cache
         from generator.jobs.drive import plan_drive
         from generator.jobs.lidar_sequence import check_frames
+        from generator.layout import build_scene
 
-        check_frames(self.scene, self.spec, self.plan.frames.max() - self.first + 1)  # the route fits the frames
-        return plan_drive(self.spec, self.scene, self.plan.frames, self.first)
+        kept = town_cache.load(self.job.town_file, self.spec, self.plan.frames, self.first)
+        if kept is not None:
+            return kept
+        scene = build_scene(self.spec)
+        check_frames(scene, self.spec, self.plan.frames.max() - self.first + 1)  # the route fits the frames
+        drive = plan_drive(self.spec, scene, self.plan.frames, self.first)
+        if self.job.town_file:
+            town_cache.save(self.job.town_file, self.spec, self.plan.frames, self.first, scene, drive)
+        return scene, drive
+
+    @property
+    def scene(self):
+        return self._town[0]
+
+    @property
+    def drive(self):
+        return self._town[1]
 
 
 def write_lidar(spec, cfg, out: Path, plan: Plan, scene=None, drive=None, first: int = 0,

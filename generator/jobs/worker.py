@@ -66,8 +66,12 @@ def _run(job, queue, scratch: Path) -> None:
 
     spec, cfg = job.spec, job.config  # a re-drawn town's own spec: build_scene makes that town
     t = time.perf_counter()
-    scene = build_scene(spec)
-    world = _world(spec, scene, job)
+    kept = _kept_town(job)
+    if kept is not None:  # the town's drive covers every frame and sweep of the town: this job's too
+        scene, world = kept[0], kept[1].world
+    else:
+        scene = build_scene(spec)
+        world = _world(spec, scene, job)
     rig = Rig.from_world(spec, world)
     layout_s = time.perf_counter() - t
     renderer = Renderer(scene, spec, cfg, scratch, world)
@@ -95,6 +99,17 @@ def _run(job, queue, scratch: Path) -> None:
         "rss_mb": _rss_mb(), "setup_s": layout_s + renderer.build_seconds, "frames_s": time.perf_counter() - t_start,
         "cycles_rgb_s": cycles["rgb"], "cycles_labels_s": cycles["labels"],
     }))
+
+
+def _kept_town(job):
+    """The town's (scene, drive) as an earlier process of the run kept them (:mod:`generator.jobs.town_cache`),
+    or None."""
+    if not job.town:
+        return None
+    from generator.jobs import town_cache
+
+    path, frames = job.town
+    return town_cache.load(path, job.spec, frames, job.first)
 
 
 def _world(spec, scene, job):

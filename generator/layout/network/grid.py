@@ -25,6 +25,7 @@ are :mod:`generator.layout.ground`.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -287,6 +288,12 @@ class Grid:
                 out.append((s, "median", s.rect_world(span[0], span[1], -MEDIAN_W_M / 2, MEDIAN_W_M / 2)))
         return out
 
+    @functools.cached_property
+    def _ground_areas(self) -> tuple[list, list, np.ndarray]:
+        """What :meth:`ground_height` tests points against: road AABBs, raised AABBs, islands -- made once
+        (the grid is frozen; a pedestrian walk network asks ~36k times)."""
+        return (list(self.road_rects()), [r for _, _, r in self.raised_rects()], self.islands())
+
     def ground_height(self, xy: np.ndarray) -> np.ndarray:
         """(n,) float64 height of the ground surface at world points ``xy`` ((n, 2) metres).
 
@@ -295,13 +302,14 @@ class Grid:
         sidewalks, verges, islands, lots, terrain).
         """
         xy = np.asarray(xy, np.float64).reshape(-1, 2)
+        road, raised, islands = self._ground_areas
         on_road = np.zeros(len(xy), bool)
-        for x0, y0, x1, y1 in self.road_rects():
+        for x0, y0, x1, y1 in road:
             on_road |= (xy[:, 0] > x0) & (xy[:, 0] < x1) & (xy[:, 1] > y0) & (xy[:, 1] < y1)
-        for _, _, (x0, y0, x1, y1) in self.raised_rects():
+        for x0, y0, x1, y1 in raised:
             on_road &= ~((xy[:, 0] > x0) & (xy[:, 0] < x1) & (xy[:, 1] > y0) & (xy[:, 1] < y1))
         h = np.where(on_road, 0.0, self.curb_h)
-        for x, y, r, core in self.islands():
+        for x, y, r, core in islands:
             d2 = (xy[:, 0] - x) ** 2 + (xy[:, 1] - y) ** 2
             h[d2 < r * r] = APRON_H_M
             h[d2 < core * core] = self.curb_h

@@ -92,6 +92,17 @@ class Library:
         self.protos: dict[str, Proto] = {}
         self._unique: dict[str, int] = defaultdict(int)
 
+    def __getstate__(self) -> dict:
+        """Pickled without the catalog module and the process's prototype cache (they are this process's)."""
+        return {k: v for k, v in self.__dict__.items() if k not in ("_catalog", "_cache")}
+
+    def __setstate__(self, state: dict) -> None:
+        from assets_procedural import catalog
+        from assets_procedural.proto_cache import CACHE
+
+        self.__dict__.update(state)
+        self._catalog, self._cache = catalog, CACHE
+
     def count(self, kind: str, default: int) -> int:
         """Variants of instanced ``kind`` in this library (``default`` when the spec does not say)."""
         return int(self.counts.get(kind, default))
