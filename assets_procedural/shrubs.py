@@ -13,9 +13,10 @@ import numpy as np
 
 from assets_procedural import foliage
 from generator.geometry import Mesh, icosphere, merge, on_ground
+from generator.materials import material_table
 
 #: Leaf sprays per bush cluster and per hedge clump; the hedge clumps' squeeze along x (the slits).
-BUSH_SPRAYS, HEDGE_SPRAYS, HEDGE_SQUEEZE = 14, 12, 0.88
+BUSH_SPRAYS, HEDGE_SPRAYS, HEDGE_SQUEEZE = 16, 16, 0.95
 _ICO1 = 42      #: vertices of a once-subdivided icosphere (one hedge clump)
 
 
@@ -87,7 +88,7 @@ def hedge(rng: np.random.Generator, length: float, height: float = 1.2, depth: f
     Returns
     -------
     Mesh
-        :func:`hedge_body` (material ``hedge_leaves``) with each clump squeezed to
+        :func:`hedge_body` (material ``hedge_body``: packed leaves in the shader) with each clump squeezed to
         :data:`HEDGE_SQUEEZE` along x (slits between clumps) and :data:`HEDGE_SPRAYS` sprays of
         small leaves per clump on its sides and top (material ``hedge_leaves``), all class
         ``vegetation``, within [-length/2, length/2] in x.
@@ -99,9 +100,10 @@ def hedge(rng: np.random.Generator, length: float, height: float = 1.2, depth: f
     v = v.copy()
     v[..., 0] = centres[:, None, 0] + HEDGE_SQUEEZE * (v[..., 0] - centres[:, None, 0])
     body.vertices = v.reshape(-1, 3)
+    body.face_material = np.full(body.n_faces, material_table().id("hedge_body"), body.face_material.dtype)
     at, out = foliage.shell(rng, centres, radii, np.full(len(centres), HEDGE_SPRAYS), 0.8, 0.95, 0.6)
     keep = at[:, 2] > 0.15 * height                      # no leaves on the ground side
-    leaves = foliage.sprays(rng, at[keep], out[keep], foliage.LEAVES["small"], "vegetation", "hedge_leaves", 0.8)
+    leaves = foliage.sprays(rng, at[keep], out[keep], foliage.LEAVES["small"], "vegetation", "hedge_leaves", 1.1)
     lv = leaves.vertices
     lv[:, 0] = np.clip(lv[:, 0], -length / 2, length / 2)
     lv[:, 2] = np.maximum(lv[:, 2], 0.0)

@@ -124,6 +124,35 @@ def tree_shots(scene) -> list[Shot]:
                 shots.append(Shot(f"tree_{species.split()[0]}", f"tree: {species}, {h:.1f} m", look_at(eye, target)))
                 seen.add(species)
                 break
+    return shots + _foliage_shots(scene)
+
+
+def _foliage_shots(scene) -> list[Shot]:
+    """The first broad street tree from 5 m (looking up into the crown) and from 30 m, the first hedge
+    from 3 m and the first bush from 2.5 m (issue 29 item 1: leaves, gaps, bark)."""
+    shots = []
+    wanted = (("tree", 5.0, 1.6, 0.55, "tree_at_5m"), ("tree", 30.0, 1.6, 0.45, "tree_at_30m"),
+              ("hedge", 3.0, 1.4, 0.5, "hedge"), ("bush", 2.5, 1.2, 0.45, "bush"))
+    for kind, dist, eye_z, aim, name in wanted:
+        for o in scene.objects:
+            if o.kind != kind:
+                continue
+            lo, hi = scene.prototypes[o.prototype].bounds()
+            if kind == "tree" and hi[2] < 7.0:
+                continue
+            base = o.transform[:3, 3]
+            target = base + [0.0, 0.0, aim * hi[2]]
+            found = False
+            for ang in np.linspace(0, 2 * np.pi, 16, endpoint=False):
+                side = o.transform[:3, :3] @ np.array([0.0, 1.0, 0.0]) if kind == "hedge" else np.zeros(3)
+                d = side * np.sign(np.cos(ang)) if kind == "hedge" else np.array([np.cos(ang), np.sin(ang), 0.0])
+                eye = base + d * dist + [0.0, 0.0, eye_z]
+                if _clear_eye(scene, eye, target, reach=min(3.0, dist - 1.0)):
+                    shots.append(Shot(name, f"{kind} from {dist:g} m", look_at(eye, target)))
+                    found = True
+                    break
+            if found:
+                break
     return shots
 
 
