@@ -90,8 +90,8 @@ def hedge(rng: np.random.Generator, length: float, height: float = 1.2, depth: f
     Mesh
         :func:`hedge_body` (material ``hedge_body``: packed leaves in the shader) with each clump squeezed to
         :data:`HEDGE_SQUEEZE` along x (slits between clumps) and :data:`HEDGE_SPRAYS` sprays of
-        small leaves per clump on its sides and top (material ``hedge_leaves``), all class
-        ``vegetation``, within [-length/2, length/2] in x.
+        small leaves per clump on its sides and top (material ``hedge_leaves``), clipped 3 cm outside
+        the body, all class ``vegetation``, within [-length/2, length/2] in x.
     """
     body = hedge_body(rng, length, height, depth)
     v = body.vertices.reshape(-1, _ICO1, 3)
@@ -104,9 +104,9 @@ def hedge(rng: np.random.Generator, length: float, height: float = 1.2, depth: f
     at, out = foliage.shell(rng, centres, radii, np.full(len(centres), HEDGE_SPRAYS), 0.8, 0.95, 0.6)
     keep = at[:, 2] > 0.15 * height                      # no leaves on the ground side
     leaves = foliage.sprays(rng, at[keep], out[keep], foliage.LEAVES["small"], "vegetation", "hedge_leaves", 1.1)
-    lv = leaves.vertices
-    lv[:, 0] = np.clip(lv[:, 0], -length / 2, length / 2)
-    lv[:, 2] = np.maximum(lv[:, 2], 0.0)
+    # clipped: leaves end at the shears' planes, 3 cm outside the body
+    lo, hi = body.vertices.min(0) - [0.0, 0.03, 0.0], body.vertices.max(0) + [0.0, 0.03, 0.03]
+    leaves.vertices = np.clip(leaves.vertices, [-length / 2, lo[1], 0.0], [length / 2, hi[1], hi[2]])
     return merge([body, leaves])
 
 
