@@ -60,7 +60,7 @@ def _crown(rng: np.random.Generator, sp: Species, conifer: bool, sk: Skeleton, r
 
     Cluster centres come from :func:`_clumps` (``CLUMP_GAP`` radii apart: the gaps rays pass
     through); each cluster is a dark core of 0.7 its radius (0.9 for conifer boughs) and sprays on
-    the shell between 0.75 and 1.25 of it, pointing outward. A crown whose branch tips hold fewer
+    the shell between 0.75 and 1.2 of it, pointing outward. A crown whose branch tips hold fewer
     clusters than planned grows them. Leaf sizes scale gently with the tree's height.
     """
     leaf = foliage.LEAVES[sp.leaf]
@@ -68,7 +68,7 @@ def _crown(rng: np.random.Generator, sp: Species, conifer: bool, sk: Skeleton, r
     gap = (0.65 if conifer else 1.0) * CLUMP_GAP * r
     centres = _clumps(rng, sp, sk.tips, r, base, max(3, room // per_cluster), gap)
     grow = float(np.clip((max(3, room // per_cluster) / max(1, len(centres))) ** (1 / 3), 1.0, 1.5))
-    radii = grow * r * rng.uniform(0.8, 1.15, (len(centres), 3)) * [1.0, 1.0, sp.clump_flat]
+    radii = 0.88 * grow * r * rng.uniform(0.8, 1.15, (len(centres), 3)) * [1.0, 1.0, sp.clump_flat]
     if conifer:     # boughs: long along the branch, thin across, flat; a narrow spire at the top
         spire = (np.hypot(centres[:, 0], centres[:, 1]) < 0.3) & (centres[:, 2] > 0.75 * height)
         radii = np.where(spire[:, None], r * np.array([0.5, 0.5, 1.6]), radii * [1.6, 0.9, 1.0])
@@ -78,7 +78,7 @@ def _crown(rng: np.random.Generator, sp: Species, conifer: bool, sk: Skeleton, r
     n_spray = max(0, room - core.n_faces) // leaf.per_spray
     counts = np.full(len(centres), n_spray // max(1, len(centres)))
     counts[: n_spray - counts.sum()] += 1
-    pts, out = foliage.shell(rng, centres, radii, counts, 0.75, 1.25, sp.leaf_lift)
+    pts, out = foliage.shell(rng, centres, radii, counts, 0.75, 1.2, sp.leaf_lift)
     if conifer:     # turn the shell points with their boughs
         owner = np.repeat(np.arange(len(centres)), counts)
         rel = pts - centres[owner]
