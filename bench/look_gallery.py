@@ -85,11 +85,11 @@ def _materials_of(scene, obj) -> set[str]:
     return {names[i] for i in np.unique(scene.prototypes[obj.prototype].face_material)}
 
 
-def _clear_eye(scene, eye, target, reach: float = 3.0) -> bool:
-    """True when nothing of the town stands within 0.6 m of the camera or ``reach`` m along the first
-    stretch of its sight line (object boxes, 2D)."""
+def _clear_eye(scene, eye, target, reach: float = 3.0, skip=None) -> bool:
+    """True when nothing of the town (but ``skip``) stands within 0.6 m of the camera or ``reach`` m
+    along the first stretch of its sight line (object boxes, 2D)."""
     for o in scene.objects:
-        if o.kind in GROUND_KINDS or o.box is None or o.box.center[2] - o.box.size[2] / 2 > 2.0:
+        if o is skip or o.kind in GROUND_KINDS or o.box is None or o.box.center[2] - o.box.size[2] / 2 > 2.0:
             continue
         c, size = np.asarray(o.box.center[:2]), np.asarray(o.box.size[:2])
         cs, sn = np.cos(o.box.yaw), np.sin(o.box.yaw)
@@ -147,7 +147,7 @@ def _foliage_shots(scene) -> list[Shot]:
                 side = o.transform[:3, :3] @ np.array([0.0, 1.0, 0.0]) if kind == "hedge" else np.zeros(3)
                 d = side * np.sign(np.cos(ang)) if kind == "hedge" else np.array([np.cos(ang), np.sin(ang), 0.0])
                 eye = base + d * dist + [0.0, 0.0, eye_z]
-                if _clear_eye(scene, eye, target, reach=min(3.0, dist - 1.0)):
+                if _clear_eye(scene, eye, target, reach=min(3.0, dist - 1.0), skip=o):
                     shots.append(Shot(name, f"{kind} from {dist:g} m", look_at(eye, target)))
                     found = True
                     break
