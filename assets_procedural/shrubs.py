@@ -1,8 +1,8 @@
 """Bushes and hedges: dark leaf-cluster bodies with sprays of leaf triangles on their outside.
 
 A bush is a few clusters (:func:`assets_procedural.foliage.cores`) with gaps between them; a
-hedge is a row of boxy clipped clumps (:func:`hedge_body`), squeezed along the hedge so thin
-slits open between them. Both carry leaf sprays (:func:`assets_procedural.foliage.sprays`) on
+hedge is a row of boxy clipped clumps (:func:`hedge_body`) stretched along the hedge into one
+clipped wall. Both carry leaf sprays (:func:`assets_procedural.foliage.sprays`) on
 their shell, so a close look shows leaves and LiDAR beams pass between clusters; the label pass
 covers each with its convex-hull proxy (:mod:`generator.geometry.proxy`).
 """
@@ -15,8 +15,9 @@ from assets_procedural import foliage
 from generator.geometry import Mesh, icosphere, merge, on_ground
 from generator.materials import material_table
 
-#: Leaf sprays per bush cluster and per hedge clump; the hedge clumps' squeeze along x (the slits).
-BUSH_SPRAYS, HEDGE_SPRAYS, HEDGE_SQUEEZE = 16, 16, 0.95
+#: Leaf sprays per bush cluster and per hedge clump; the hedge clumps' stretch along x (more overlap:
+#: one clipped wall rather than a row of barrels; beams still pass low between their rounded feet).
+BUSH_SPRAYS, HEDGE_SPRAYS, HEDGE_STRETCH = 16, 16, 1.1
 _ICO1 = 42      #: vertices of a once-subdivided icosphere (one hedge clump)
 
 
@@ -88,8 +89,8 @@ def hedge(rng: np.random.Generator, length: float, height: float = 1.2, depth: f
     Returns
     -------
     Mesh
-        :func:`hedge_body` (material ``hedge_body``: packed leaves in the shader) with each clump squeezed to
-        :data:`HEDGE_SQUEEZE` along x (slits between clumps) and :data:`HEDGE_SPRAYS` sprays of
+        :func:`hedge_body` (material ``hedge_body``: packed leaves in the shader) with each clump
+        stretched to :data:`HEDGE_STRETCH` along x (overlapping more) and :data:`HEDGE_SPRAYS` sprays of
         small leaves per clump on its sides and top (material ``hedge_leaves``), clipped 3 cm outside
         the body, all class ``vegetation``, within [-length/2, length/2] in x.
     """
@@ -98,10 +99,11 @@ def hedge(rng: np.random.Generator, length: float, height: float = 1.2, depth: f
     centres = v.mean(1)
     radii = np.ptp(v, 1) / 2
     v = v.copy()
-    v[..., 0] = centres[:, None, 0] + HEDGE_SQUEEZE * (v[..., 0] - centres[:, None, 0])
+    x = centres[:, None, 0] + HEDGE_STRETCH * (v[..., 0] - centres[:, None, 0])
+    v[..., 0] = np.clip(x, -length / 2, length / 2)                 # the ends cut square
     body.vertices = v.reshape(-1, 3)
     body.face_material = np.full(body.n_faces, material_table().id("hedge_body"), body.face_material.dtype)
-    at, out = foliage.shell(rng, centres, radii, np.full(len(centres), HEDGE_SPRAYS), 0.8, 0.95, 0.6)
+    at, out = foliage.shell(rng, centres, radii, np.full(len(centres), HEDGE_SPRAYS), 0.9, 1.1, 0.6)
     keep = at[:, 2] > 0.15 * height                      # no leaves on the ground side
     leaves = foliage.sprays(rng, at[keep], out[keep], foliage.LEAVES["small"], "vegetation", "hedge_leaves", 1.1)
     # clipped: leaves end at the shears' planes, 3 cm outside the body
