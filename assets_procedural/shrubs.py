@@ -99,17 +99,34 @@ def hedge(rng: np.random.Generator, length: float, height: float = 1.2, depth: f
     centres = v.mean(1)
     radii = np.ptp(v, 1) / 2
     v = v.copy()
-    x = centres[:, None, 0] + HEDGE_STRETCH * (v[..., 0] - centres[:, None, 0])
-    v[..., 0] = np.clip(x, -length / 2, length / 2)                 # the ends cut square
+    dx = v[..., 0] - centres[:, None, 0]
+    room = (length / 2 - np.abs(centres[:, 0])) / np.maximum(np.abs(dx).max(1), 1e-9)
+    v[..., 0] = centres[:, None, 0] + dx * np.minimum(HEDGE_STRETCH, np.maximum(room, 1.0))[:, None]
     body.vertices = v.reshape(-1, 3)
     body.face_material = np.full(body.n_faces, material_table().id("hedge_body"), body.face_material.dtype)
     at, out = foliage.shell(rng, centres, radii, np.full(len(centres), HEDGE_SPRAYS), 0.9, 1.1, 0.6)
     keep = at[:, 2] > 0.15 * height                      # no leaves on the ground side
     leaves = foliage.sprays(rng, at[keep], out[keep], foliage.LEAVES["small"], "vegetation", "hedge_leaves", 1.1)
-    # clipped: leaves end at the shears' planes, 3 cm outside the body
-    lo, hi = body.vertices.min(0) - [0.0, 0.03, 0.0], body.vertices.max(0) + [0.0, 0.03, 0.03]
-    leaves.vertices = np.clip(leaves.vertices, [-length / 2, lo[1], 0.0], [length / 2, hi[1], hi[2]])
-    return merge([body, leaves])
+    # clipped: a leaf reaching past the shears' planes (3 cm outside the body) is cut back toward its base
+    lo = np.array([-length / 2, body.vertices[:, 1].min() - 0.03, 0.0])
+    hi = np.array([length / 2, body.vertices[:, 1].max() + 0.03, body.vertices[:, 2].max() + 0.03])
+    return merge([body, _cut_back(leaves, lo, hi)])
+
+
+def _cut_back(leaves: Mesh, lo: np.ndarray, hi: np.ndarray) -> Mesh:
+    """``leaves`` (separate triangles: side, tip, side) shortened toward the middle of their base edge
+    until inside the box [``lo``, ``hi``] (3,); leaves whose base lies outside are dropped."""
+    t = leaves.vertices[leaves.faces]                                       # (n, 3, 3)
+    base = (t[:, 0] + t[:, 2]) / 2
+    inside = ((base > lo) & (base < hi)).all(1)
+    rel = t - base[:, None]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        room = np.where(rel > 0, (hi - base)[:, None] / rel, np.where(rel < 0, (lo - base)[:, None] / rel, np.inf))
+    f = np.clip(0.98 * room.min((1, 2)), 0.0, 1.0)[:, None, None]     # 2 % short: no tips coplanar on a plane
+    t = (base[:, None] + f * rel)[inside]
+    m = len(t)
+    return Mesh(t.reshape(-1, 3), np.arange(3 * m, dtype=np.int64).reshape(m, 3), leaves.face_class[inside],
+                leaves.face_material[inside])
 
 
 def hedge_body(rng: np.random.Generator, length: float, height: float = 1.2, depth: float = 0.8) -> Mesh:
