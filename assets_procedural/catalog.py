@@ -18,6 +18,7 @@ from assets_procedural.person import person
 from assets_procedural.proto_cache import CACHE
 from assets_procedural.riders import bicyclist, motorcyclist, ridden
 from assets_procedural.shelters import bus_shelter
+from assets_procedural.shrubs import bush, hedge
 from assets_procedural.street_furniture import lamp_post, traffic_light, traffic_sign
 from assets_procedural.street_objects import advertising_column, bench, bike_rack, bollard, hydrant
 from assets_procedural.street_objects import bin as litter_bin
@@ -25,7 +26,7 @@ from assets_procedural.tracks import rail_track, tram_rails
 from assets_procedural.transit import bus, tram
 from assets_procedural.two_wheelers import bicycle
 from assets_procedural.utility_vehicles import box_van, construction_vehicle, trailer
-from assets_procedural.vegetation import bush, hedge, tree
+from assets_procedural.vegetation import tree
 from assets_procedural.vehicle import car, truck
 from assets_procedural.walls import wall
 from generator.geometry import Mesh

@@ -35,22 +35,28 @@ class Species:
     bark: str                         #: trunk and branch material
     leaves: str                       #: leaf clump material
     droop: float = 0.0                #: how far tips hang below their branch end (fraction of length)
-    detail: int = 1                   #: icosphere subdivisions of a clump (80 triangles at 1, 20 at 0)
+    leaf: str = "ovate"               #: leaf look (:data:`assets_procedural.foliage.LEAVES`)
+    sprays: int = 16                  #: leaf sprays a cluster is planned with (sets how many clusters fit)
+    core: str = "leaf_shade"          #: material of the clusters' dark inner cores
+    leaf_lift: float = 0.3            #: how strongly sprays crowd to the sunny top of a cluster
 
 
 SPECIES: dict[str, Species] = {
     # London plane / maple: broad round crown on a stout trunk, wide-spreading limbs
-    "plane": Species((1.0, 1.3), 0.30, (4, 6), (2, 4), 2, (25, 50), 38, 0.12, 0.7, (2, 4), 0.028, "bark", "leaves"),
+    "plane": Species((1.0, 1.3), 0.30, (4, 6), (2, 4), 2, (25, 50), 38, 0.12, 0.7, (2, 4), 0.028, "bark_plane",
+                     "leaves", leaf="broad", sprays=14),
     # linden / lime: dense upright oval crown
-    "linden": Species((0.6, 0.8), 0.27, (5, 7), (2, 4), 2, (45, 65), 30, 0.12, 0.8, (2, 4), 0.024, "bark", "leaves"),
+    "linden": Species((0.6, 0.8), 0.27, (5, 7), (2, 4), 2, (45, 65), 30, 0.12, 0.8, (2, 4), 0.024, "bark", "leaves",
+                      leaf="heart", sprays=16),
     # birch: narrow, thin white trunk, steep limbs with hanging twigs, small light clumps
     "birch": Species((0.42, 0.58), 0.30, (4, 6), (2, 3), 2, (55, 72), 28, 0.1, 1.1, (2, 4), 0.016, "bark_birch",
-                     "leaves_birch", droop=0.25),
+                     "leaves_birch", droop=0.25, leaf="narrow", sprays=20, leaf_lift=0.0),
     # young street tree: staked sapling, thin trunk, a few limbs and a small sparse crown
-    "young": Species((0.55, 0.8), 0.45, (3, 5), (2, 4), 1, (40, 60), 30, 0.15, 0.85, (2, 4), 0.014, "bark", "leaves"),
+    "young": Species((0.55, 0.8), 0.45, (3, 5), (2, 4), 1, (40, 60), 30, 0.15, 0.85, (2, 4), 0.014, "bark", "leaves",
+                     leaf="ovate", sprays=18),
     # spruce / fir: a leader to the top and whorls of near-horizontal branches (conical)
-    "conifer": Species((0.45, 0.6), 0.12, (5, 7), (0, 1), 0, (-8, 8), 0, 0.22, 0.4, (2, 3), 0.022, "bark",
-                       "needles", detail=0),
+    "conifer": Species((0.45, 0.6), 0.12, (5, 7), (0, 1), 0, (-8, 8), 0, 0.22, 0.4, (3, 5), 0.022, "bark",
+                       "needles", leaf="needle", sprays=4, core="needles", leaf_lift=-0.2),
 }
 
 

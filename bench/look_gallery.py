@@ -85,11 +85,11 @@ def _materials_of(scene, obj) -> set[str]:
     return {names[i] for i in np.unique(scene.prototypes[obj.prototype].face_material)}
 
 
-def _clear_eye(scene, eye, target, reach: float = 3.0) -> bool:
-    """True when nothing of the town stands within 0.6 m of the camera or ``reach`` m along the first
-    stretch of its sight line (object boxes, 2D)."""
+def _clear_eye(scene, eye, target, reach: float = 3.0, skip=None) -> bool:
+    """True when nothing of the town (but ``skip``) stands within 0.6 m of the camera or ``reach`` m
+    along the first stretch of its sight line (object boxes, 2D)."""
     for o in scene.objects:
-        if o.kind in GROUND_KINDS or o.box is None or o.box.center[2] - o.box.size[2] / 2 > 2.0:
+        if o is skip or o.kind in GROUND_KINDS or o.box is None or o.box.center[2] - o.box.size[2] / 2 > 2.0:
             continue
         c, size = np.asarray(o.box.center[:2]), np.asarray(o.box.size[:2])
         cs, sn = np.cos(o.box.yaw), np.sin(o.box.yaw)
@@ -123,6 +123,35 @@ def tree_shots(scene) -> list[Shot]:
             if _clear_eye(scene, eye, target):
                 shots.append(Shot(f"tree_{species.split()[0]}", f"tree: {species}, {h:.1f} m", look_at(eye, target)))
                 seen.add(species)
+                break
+    return shots + _foliage_shots(scene)
+
+
+def _foliage_shots(scene) -> list[Shot]:
+    """The first broad street tree from 5 m (looking up into the crown) and from 30 m, the first hedge
+    from 3 m and the first bush from 2.5 m (issue 29 item 1: leaves, gaps, bark)."""
+    shots = []
+    wanted = (("tree", 5.0, 1.6, 0.55, "tree_at_5m"), ("tree", 30.0, 1.6, 0.45, "tree_at_30m"),
+              ("hedge", 3.0, 1.4, 0.5, "hedge"), ("bush", 2.5, 1.2, 0.45, "bush"))
+    for kind, dist, eye_z, aim, name in wanted:
+        for o in scene.objects:
+            if o.kind != kind:
+                continue
+            lo, hi = scene.prototypes[o.prototype].bounds()
+            if kind == "tree" and hi[2] < 7.0:
+                continue
+            base = o.transform[:3, 3]
+            target = base + [0.0, 0.0, aim * hi[2]]
+            found = False
+            for ang in np.linspace(0, 2 * np.pi, 16, endpoint=False):
+                side = o.transform[:3, :3] @ np.array([0.0, 1.0, 0.0]) if kind == "hedge" else np.zeros(3)
+                d = side * np.sign(np.cos(ang)) if kind == "hedge" else np.array([np.cos(ang), np.sin(ang), 0.0])
+                eye = base + d * dist + [0.0, 0.0, eye_z]
+                if _clear_eye(scene, eye, target, reach=min(3.0, dist - 1.0), skip=o):
+                    shots.append(Shot(name, f"{kind} from {dist:g} m", look_at(eye, target)))
+                    found = True
+                    break
+            if found:
                 break
     return shots
 

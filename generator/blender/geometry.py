@@ -23,8 +23,8 @@ from generator.materials import material_table
 from generator.world.scene import SceneModel
 
 #: Materials shaded smooth (organic shapes); everything else is flat (hard surfaces).
-SMOOTH_MATERIALS = frozenset({"leaves", "hedge_leaves", "bark", "skin", "hair", "clothing", "rubber", "car_body",
-                              "clothing_bottom"})
+SMOOTH_MATERIALS = frozenset({"leaves", "hedge_leaves", "hedge_body", "bark", "bark_plane", "leaf_shade",
+                              "skin", "hair", "clothing", "rubber", "car_body", "clothing_bottom"})
 
 
 @dataclass

@@ -235,19 +235,26 @@ def door(g, rng):
 
 
 def bark(g, rng):
+    """Furrowed bark: vertical plates between dark cracks, grey-brown, a green film of algae in patches."""
     co = g.coords("Object")
-    stripes = g.wave(g.mapping(co, scale=(4, 4, 0.5)), scale=3, distortion=8, detail=6, direction="X")
-    base = g.ramp(stripes, [(0.2, (0.05, 0.035, 0.025)), (0.8, (0.16, 0.12, 0.09))])
-    return g.principled(base_color=base, roughness=0.9, normal=g.bump(stripes, 0.6, 0.02))
+    crack = g.smooth(g.voronoi(g.mapping(co, scale=(7.0, 7.0, 1.4)), scale=1.0, feature="DISTANCE_TO_EDGE"), 0.0, 0.09)
+    grain = g.noise(g.mapping(co, scale=(30, 30, 6)), scale=1.0, detail=2)
+    base = g.ramp(grain, [(0.25, _jit(rng, (0.07, 0.06, 0.05), 0.1)), (0.75, _jit(rng, (0.15, 0.135, 0.115), 0.1))])
+    base = g.mix(g.mul(g.smooth(g.noise(co, scale=1.2, detail=2), 0.55, 0.75), 0.6), base, (0.06, 0.08, 0.03))
+    base = g.mix(g.math("SUBTRACT", 1.0, crack), base, (0.015, 0.012, 0.01))
+    return g.principled(base_color=base, roughness=0.92, normal=g.bump(crack, 0.8, 0.02))
 
 
 def _foliage(g, rng, color):
-    n = g.noise(g.coords("Object"), scale=3, detail=4)
-    hue = g.add(0.46, g.mul(g.object_info("Random"), 0.08))
-    base = g.hsv(g.ramp(n, [(0.3, _jit(rng, color, 0.1)), (0.7, _jit(rng, np.asarray(color) * 1.6, 0.1))]),
-                 hue=hue, value=g.add(0.8, g.mul(g.geometry("Random Per Island"), 0.4)))
-    leaf = g.principled(base_color=base, roughness=0.7, specular=0.3, normal=g.bump(g.noise(scale=40), 0.5, 0.02))
-    return g.mix_shader(0.25, leaf, g.translucent(base))
+    """Leaves: each leaf (mesh island) its own shade and a little its own hue, sunny and shaded
+    sides of a crown; light through them from behind (a quarter translucent)."""
+    leaf = g.geometry("Random Per Island")
+    n = g.noise(g.coords("Object"), scale=0.8, detail=1)
+    hue = g.add(g.add(0.46, g.mul(g.object_info("Random"), 0.06)), g.mul(leaf, 0.05))
+    base = g.ramp(n, [(0.3, _jit(rng, color, 0.1)), (0.75, _jit(rng, np.asarray(color) * 1.5, 0.1))])
+    base = g.hsv(base, hue=hue, value=g.add(0.6, g.mul(leaf, 0.8)))
+    face = g.principled(base_color=base, roughness=0.55, specular=0.35)
+    return g.mix_shader(0.25, face, g.translucent(base))
 
 
 def leaves(g, rng):

@@ -99,3 +99,34 @@ def drainpipe(g, rng):
     dirt = g.smooth(g.noise(g.coords("Object"), scale=3.0, detail=3), 0.5, 0.7)
     col = g.mix(g.mul(dirt, 0.4), col, (0.12, 0.1, 0.08))
     return g.principled(base_color=col, metallic=0.4, roughness=0.5)
+
+
+def bark_plane(g: Nodes, rng: np.random.Generator):
+    """London plane bark: smooth, flaking in patches of cream, olive and grey-brown."""
+    co = g.mapping(g.coords("Object"), scale=(3.0, 3.0, 1.6))
+    patch = g.ramp(g.voronoi(co, scale=2.2, out="Color"),
+                   [(0.25, _jit(rng, (0.16, 0.15, 0.1), 0.05)), (0.5, _jit(rng, (0.08, 0.08, 0.05), 0.05)),
+                    (0.75, _jit(rng, (0.24, 0.22, 0.16), 0.05))])
+    return g.principled(base_color=patch, roughness=0.75)
+
+
+def leaf_shade(g: Nodes, rng: np.random.Generator):
+    """The inner body of a leaf cluster: leaves in each other's shade, dark and mottled (no translucency:
+    little light gets through a cluster)."""
+    co = g.coords("Object")
+    tone = g.ramp(g.noise(co, scale=6.0, detail=1), [(0.3, _jit(rng, (0.02, 0.042, 0.011), 0.1)),
+                                                      (0.7, _jit(rng, (0.04, 0.075, 0.018), 0.1))])
+    tone = g.hsv(tone, hue=g.add(0.47, g.mul(g.object_info("Random"), 0.06)))
+    return g.principled(base_color=tone, roughness=0.7, specular=0.25)
+
+
+def hedge_body(g: Nodes, rng: np.random.Generator):
+    """The clipped face of a hedge: small leaves packed edge to edge (Voronoi cells a few centimetres
+    across, each its own shade), darker in the crevices."""
+    co = g.coords("Object")
+    cell = g.voronoi(co, scale=22.0, out="Color")
+    deep = g.smooth(g.noise(co, scale=3.0, detail=1), 0.35, 0.7)             # holes in the clipping
+    tone = g.ramp(cell, [(0.0, _jit(rng, (0.025, 0.05, 0.012), 0.1)), (1.0, _jit(rng, (0.065, 0.115, 0.028), 0.1))])
+    tone = g.mix(g.mul(deep, 0.7), tone, (0.01, 0.018, 0.006))
+    tone = g.hsv(tone, hue=g.add(0.47, g.mul(g.object_info("Random"), 0.05)))
+    return g.principled(base_color=tone, roughness=0.55, specular=0.35, normal=g.bump(deep, 0.5, 0.03))

@@ -103,6 +103,9 @@ def test_same_seed_same_bytes_other_seed_other_mesh(case):
     assert a.vertices.shape != c.vertices.shape or not np.array_equal(a.vertices, c.vertices)
 
 
+LEAF_MATERIALS = ("leaves", "leaves_birch", "needles", "hedge_leaves")
+
+
 @pytest.mark.parametrize("case", CASES, ids=[c[0] for c in CASES])
 def test_faces_seen_from_outside_are_front_faces(case):
     """Rays from above and around (never from under the ground) first meet faces whose
@@ -118,6 +121,9 @@ def test_faces_seen_from_outside_are_front_faces(case):
     tri, ray = RayMeshIntersector(m.to_trimesh()).intersects_id(origins, d, multiple_hits=False)[:2]
     back = np.einsum("ij,ij->i", face_normals(m)[tri], d[ray]) > 0
     assert len(tri) > 100
+    # a leaf is a two-sided sheet (both sensors shade and cast it from either side): its underside is real
+    leaf = np.isin(m.face_material[tri], [material_table().id(n) for n in LEAF_MATERIALS])
+    back &= ~leaf
     # thin proud glass seen at grazing angles and open limb ends may show a back face, rarely
     assert back.mean() <= (0.005 if kind in ("car", "truck", "person", "fence") else 0.0)
 
@@ -221,9 +227,9 @@ def test_tree_height_crown_base_and_budget(height):
             crown = m.vertices[np.unique(m.faces[of_class(m, "tree_crown")])]
             assert crown[:, 2].min() >= 2.2, "crown too low for people and cars under a street tree"
             trunk = of_class(m, "tree_trunk")
-            barks = [material_table().id(n) for n in ("bark", "bark_birch")]
+            barks = [material_table().id(n) for n in ("bark", "bark_birch", "bark_plane")]
             assert trunk.any() and np.isin(m.face_material[trunk], barks).all()
-            assert 400 <= m.n_faces <= 2000
+            assert 400 <= m.n_faces <= 3000
 
 
 def _crown_profile(m: Mesh) -> tuple[float, float, int]:
