@@ -1,7 +1,7 @@
 """The README's main job, timed, for this tree and a baseline tree side by side; same bytes or not.
 
 Runs ``generate scenes/first_look.json --config first_look --frames 2 --variants
-day:clear,day:rain_fog,night:wet`` (the README's command) once per tree, each into its own folder
+day:clear,day:rain_fog,night:wet --workers 2`` (the README's command) once per tree, each into its own folder
 under ``OUT``, with ``PYTHONPATH`` set to the tree, and prints per tree: wall time, CPU time (user +
 sys of the job and every process it started), the time of each progress item, the manifest's
 figures (town products, worker set-up, seconds in Cycles); then the ratios of this tree against the
@@ -37,6 +37,8 @@ log = logging.getLogger("bench.main_job")
 ROOT = Path(__file__).resolve().parents[1]
 ARGS = ["generate", "scenes/first_look.json", "--config", "first_look", "--frames", "2",
         "--variants", "day:clear,day:rain_fog,night:wet"]
+#: the README's --workers
+README_WORKERS = 2
 #: Files that record the run itself (times, the run's options), not the data.
 NOT_DATA = {"manifest.json", "journal.txt"}
 PROGRESS = re.compile(r"generate: (\d+)/(\d+) item.*elapsed (\d+) s")
@@ -105,7 +107,7 @@ def main(argv=None) -> int:
     ap.add_argument("out", type=Path, help="folder for the datasets and logs (created)")
     ap.add_argument("--tree", type=Path, default=ROOT, help="tree to time (default: this one)")
     ap.add_argument("--baseline", type=Path, default=None, help="baseline tree, run first in the same call")
-    ap.add_argument("--workers", type=int, default=None, help="--workers of the job (default: the README's)")
+    ap.add_argument("--workers", type=int, default=README_WORKERS, help="--workers of the job (default: the README's)")
     args = ap.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     args.out.mkdir(parents=True, exist_ok=True)
