@@ -63,7 +63,7 @@ def _range(text: str, option: str, lo: float, hi: float) -> tuple[float, float]:
     except ValueError:
         a = b = None
     if a is None or not (math.isfinite(a) and math.isfinite(b)):
-        raise UserError(f"{option}: {text!r} is not LO:HI in degrees (e.g. {option} {lo:g}:{hi:g})")
+        raise UserError(f"{option}: {text!r} is not LO:HI in degrees (e.g. {option}={lo:g}:{hi:g})")
     if not lo <= a < b <= hi:
         raise UserError(f"{option}: {text!r} must satisfy {lo:g} <= LO < HI <= {hi:g} degrees")
     return a, b
