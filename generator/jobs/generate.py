@@ -120,13 +120,9 @@ def _estimate(spec, cfg, out: Path, plan: Plan, towns: TownPlan, ledger: Ledger,
 
 def _canary(run) -> tuple:
     """Build one town: its route must fit its frames; its scene and drive."""
-    from generator.jobs.drive import plan_drive
-    from generator.jobs.lidar_sequence import check_frames
-    from generator.layout import build_scene
+    from generator.jobs.town_job import build_town
 
-    scene = build_scene(run.spec)
-    check_frames(scene, run.spec, max(run.local_frames) + 1)
-    return scene, plan_drive(run.spec, scene, run.plan.frames, run.first)
+    return build_town(run.spec, run.plan.frames, run.first)
 
 
 def preflight(spec, cfg, opts: GenerateOptions) -> Preflight:

@@ -68,6 +68,18 @@ class TownJob:
     town_file: str = ""
 
 
+def build_town(spec, frames, first: int) -> tuple:
+    """(scene, drive) of the town of ``spec`` whose drive starts at frame ``first`` and covers image
+    ``frames`` (a :class:`~generator.jobs.frameset.FrameSet`); raises when its route is too short for them."""
+    from generator.jobs.drive import plan_drive
+    from generator.jobs.lidar_sequence import check_frames
+    from generator.layout import build_scene
+
+    scene = build_scene(spec)
+    check_frames(scene, spec, frames.max() - first + 1)  # the route fits the frames
+    return scene, plan_drive(spec, scene, frames, first)
+
+
 class TownContext:
     """What a town task's products share: the job, and the scene and drive, read or built once on first use."""
 
@@ -79,16 +91,11 @@ class TownContext:
     def _town(self) -> tuple:
         """(scene, drive): kept by an earlier process of the run, else built here (and kept for the next)."""
         from generator.jobs import town_cache
-        from generator.jobs.drive import plan_drive
-        from generator.jobs.lidar_sequence import check_frames
-        from generator.layout import build_scene
 
         kept = town_cache.load(self.job.town_file, self.spec, self.plan.frames, self.first)
         if kept is not None:
             return kept
-        scene = build_scene(self.spec)
-        check_frames(scene, self.spec, self.plan.frames.max() - self.first + 1)  # the route fits the frames
-        drive = plan_drive(self.spec, scene, self.plan.frames, self.first)
+        scene, drive = build_town(self.spec, self.plan.frames, self.first)
         if self.job.town_file:
             town_cache.save(self.job.town_file, self.spec, self.plan.frames, self.first, scene, drive)
         return scene, drive
