@@ -79,20 +79,17 @@ def _crown(rng: np.random.Generator, sp: Species, conifer: bool, sk: Skeleton, r
     counts = np.full(len(centres), n_spray // max(1, len(centres)))
     counts[: n_spray - counts.sum()] += 1
     pts, out = foliage.shell(rng, centres, radii, counts, 0.75, 1.2, sp.leaf_lift)
-    if conifer:     # turn the shell points with their boughs
-        owner = np.repeat(np.arange(len(centres)), counts)
-        rel = pts - centres[owner]
-        pts = centres[owner] + np.c_[c[owner] * rel[:, 0] - s[owner] * rel[:, 1],
-                                     s[owner] * rel[:, 0] + c[owner] * rel[:, 1], rel[:, 2]]
-        core.vertices = _yawed(core.vertices, centres, c, s)
+    if conifer:     # turn the shell points and the cores with their boughs
+        per_core = len(core.vertices) // max(1, len(centres))
+        pts = _yawed(pts, np.repeat(np.arange(len(centres)), counts), centres, c, s)
+        core.vertices = _yawed(core.vertices, np.repeat(np.arange(len(centres)), per_core), centres, c, s)
     scale = float(np.clip(height / 10.0, 0.75, 1.15))
     keep = pts[:, 2] > base + 0.45 * scale      # no leaf hangs below the crown base
     return [core, foliage.sprays(rng, pts[keep], out[keep], leaf, "tree_crown", sp.leaves, scale)]
 
 
-def _yawed(v: np.ndarray, centres: np.ndarray, c: np.ndarray, s: np.ndarray) -> np.ndarray:
-    """(20 * n, 3) core vertices turned about their own cluster centre by the yaw (cos ``c``, sin ``s``)."""
-    owner = np.repeat(np.arange(len(centres)), len(v) // max(1, len(centres)))
+def _yawed(v: np.ndarray, owner: np.ndarray, centres: np.ndarray, c: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """(m, 3) points ``v`` turned about the centre of their cluster ``owner`` (m,) by its yaw (cos ``c``, sin ``s``)."""
     rel = v - centres[owner]
     return centres[owner] + np.c_[c[owner] * rel[:, 0] - s[owner] * rel[:, 1],
                                   s[owner] * rel[:, 0] + c[owner] * rel[:, 1], rel[:, 2]]
