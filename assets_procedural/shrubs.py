@@ -21,18 +21,6 @@ BUSH_SPRAYS, HEDGE_SPRAYS, HEDGE_STRETCH = 16, 16, 1.1
 _ICO1 = 42      #: vertices of a once-subdivided icosphere (one hedge clump)
 
 
-def _blob(rng: np.random.Generator, center: np.ndarray, radii: np.ndarray, cls: str, material: str,
-          jitter: float = 0.18, detail: int = 1, yaw: float = 0.0) -> Mesh:
-    """A leaf cluster: an ellipsoid icosphere (80 triangles, 20 at ``detail`` 0) with radial noise,
-    its x half-axis turned to ``yaw`` radians."""
-    m = icosphere(1.0, cls, material, detail)
-    r = 1.0 + rng.uniform(-jitter, jitter, len(m.vertices))
-    v = m.vertices * r[:, None] * radii
-    c, s = np.cos(yaw), np.sin(yaw)
-    m.vertices = np.c_[c * v[:, 0] - s * v[:, 1], s * v[:, 0] + c * v[:, 1], v[:, 2]] + center
-    return m
-
-
 def _scatter(rng: np.random.Generator, n: int, radii: np.ndarray, min_gap: float,
              shell: float = 0.35) -> np.ndarray:
     """(<=n, 3) float: points in the unit-ellipsoid of ``radii`` at least ``min_gap`` apart.
@@ -151,7 +139,8 @@ def hedge_body(rng: np.random.Generator, length: float, height: float = 1.2, dep
     n = max(1, int(round(length / spacing)))
     rx = length / n / 2
     xs = -length / 2 + rx + np.arange(n) * 2 * rx
-    # All clumps at once, with the draws and float operations of one _blob per clump in turn: each
+    # All clumps at once, with the draws and float operations of one jittered icosphere (an ellipsoid
+    # blob, turned by yaw 0) per clump in turn: each
     # clump takes 5 uniforms (3 radii, 2 centre offsets) then one jitter per sphere vertex, and
     # Generator.uniform(a, b) is a + (b - a) * random(), so one random((n, 5 + k)) block is the same stream.
     sphere = icosphere(1.0, "vegetation", "hedge_leaves", 1)
@@ -164,9 +153,9 @@ def hedge_body(rng: np.random.Generator, length: float, height: float = 1.2, dep
     radii = np.stack([rx * uniform(1.1, 1.3, u[:, 0]), depth / 2 * uniform(0.9, 1.0, u[:, 1]),
                       height / 2 * uniform(0.92, 1.0, u[:, 2])], 1)
     c = np.stack([xs + uniform(-0.05, 0.05, u[:, 3]) * rx, uniform(-0.04, 0.04, u[:, 4]) * depth, radii[:, 2]], 1)
-    r = 1.0 + uniform(-0.12, 0.12, u[:, 5:])                       # _blob's radial noise (jitter 0.12)
+    r = 1.0 + uniform(-0.12, 0.12, u[:, 5:])                       # each clump's radial noise (jitter 0.12)
     v = sphere.vertices[None] * r[:, :, None] * radii[:, None, :]
-    cy, sy = np.cos(0.0), np.sin(0.0)                               # _blob's yaw 0
+    cy, sy = np.cos(0.0), np.sin(0.0)                               # each clump's yaw 0
     v = np.stack([cy * v[..., 0] - sy * v[..., 1], sy * v[..., 0] + cy * v[..., 1], v[..., 2]], -1) + c[:, None, :]
     # clipped hedges are boxy: push the blob toward its bounding box (superellipsoid look)
     rel = (v - c[:, None, :]) / radii[:, None, :]

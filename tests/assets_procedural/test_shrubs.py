@@ -10,9 +10,21 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from assets_procedural.shrubs import _blob, bush, hedge, hedge_body
-from generator.geometry import merge, on_ground
+from assets_procedural.shrubs import bush, hedge, hedge_body
+from generator.geometry import Mesh, icosphere, merge, on_ground
 from generator.materials import material_table
+
+
+def _blob(rng, center, radii, cls: str, material: str, jitter: float = 0.18, detail: int = 1,
+          yaw: float = 0.0) -> Mesh:
+    """A leaf cluster: an ellipsoid icosphere (80 triangles, 20 at ``detail`` 0) with radial noise,
+    its x half-axis turned to ``yaw`` radians."""
+    m = icosphere(1.0, cls, material, detail)
+    r = 1.0 + rng.uniform(-jitter, jitter, len(m.vertices))
+    v = m.vertices * r[:, None] * radii
+    c, s = np.cos(yaw), np.sin(yaw)
+    m.vertices = np.c_[c * v[:, 0] - s * v[:, 1], s * v[:, 0] + c * v[:, 1], v[:, 2]] + center
+    return m
 
 
 def _hedge_one_clump_at_a_time(rng, length, height=1.2, depth=0.8):
