@@ -53,9 +53,9 @@ def measure(name: str, source, sensor, objects: str | None, threads: int | None 
                             f"{int(scan.ring.max())} (leave --sensor out to use the data's own)")
         keep, fit = prof.crop(scan.xyz, scan.ring)
         if keep is not None:
-            scan = dataclasses.replace(scan, **{k: None if v is None else v[keep] for k, v in (
-                ("xyz", scan.xyz), ("remission", scan.remission), ("learning", scan.learning),
-                ("instance", scan.instance), ("ring", scan.ring))})
+            per_point = ("xyz", "remission", "learning", "instance", "ring")
+            scan = dataclasses.replace(scan, **{k: None if getattr(scan, k) is None else getattr(scan, k)[keep]
+                                                for k in per_point})
         obj = None
         if objects == "boxes":
             obj = source.boxes(scan.sequence)(scan.index, scan.xyz)

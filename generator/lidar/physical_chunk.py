@@ -134,17 +134,16 @@ def run_physical_chunk(scanner, sweep, i: int, cols: slice) -> None:
             split, rb, rw = split[:n_split], rb[:n_rest], rw[:n_rest]
             if n_split:
                 weight[split - i0] = share
-                if p.edge_subrays == "all":  # the split beams' other sub-rays; their probes are kept
+                sub = {key: v[keep] for key, v in probe.items()}  # the split beams' probes are kept
+                if p.edge_subrays == "all":  # with their other sub-rays
                     rest = _cast_subrays(scanner, plan, cols, aimed, o_w, d_world, rb, rw, model.pattern, i0, n_in,
                                          hi_r)
+                    sub = {key: np.concatenate([v, rest[key]]) for key, v in sub.items()}
                 else:  # towards a neighbour that sees the centre's surface, a sub-ray sees it too
                     weight += share * np.bincount(rb - i0, minlength=n_in).astype(np.float32)
-                    rest, rb = {key: probe[key][:0] for key in probe}, rb[:0]
-                for key in parts:
-                    if key in ("weight", "offset", "tau"):
-                        continue
-                    parts[key].append(np.concatenate([probe[key][keep], rest[key]]))
-                m = int(keep.sum()) + len(rb)
+                for key, v in sub.items():
+                    parts[key].append(v)
+                m = len(sub["beam"])
                 parts["weight"].append(np.full(m, share, np.float32))
                 parts["offset"].append(np.zeros(m, np.float32))
                 parts["tau"].append(np.ones(m, np.float32))
