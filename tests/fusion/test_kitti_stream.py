@@ -17,8 +17,8 @@ pytestmark = pytest.mark.blender
 
 @pytest.fixture(scope="module")
 def sequence(tmp_path_factory, root):
-    """The stream of the test town's ``generate`` run that tests/commands/test_generate.py makes too (3 frames:
-    16 sweeps, pairs at 0 and 10), made once per test run (:mod:`kits.generated_town`); read-only."""
+    """The stream of the test town's ``generate`` run that tests/commands/test_generate.py makes too (2 frames:
+    9 sweeps, a pair at 0), made once per test run (:mod:`kits.generated_town`); read-only."""
     return reference_run(tmp_path_factory, root).path() / "lidar" / "sequences" / "00"
 
 
