@@ -147,7 +147,9 @@ def test_routes_in_a_full_mix_town_are_smooth_on_the_lanes_and_one_way_forwards(
     assert n > 0, "the routes drive no one-way street"
 
 
-@pytest.fixture(scope="module", params=[3, 5])
+# one town (seed 3): a second seed (5) of the same 4 x 4 full-mix town drove the same code for ~14 s more;
+# test_one_way_signs drives full-mix towns with traffic too, and the seeds above check the grids of more
+@pytest.fixture(scope="module", params=[3])
 def full_town(request):
     spec = full_spec(request.param, traffic=TRAFFIC)
     scene = build_scene(spec)
