@@ -186,7 +186,8 @@ def _on_crossing(grid, xy: np.ndarray) -> np.ndarray:
     return out
 
 
-@pytest.mark.parametrize("seed", [5, 11, 3, 8])
+# seed 11 once failed; seed 5 a second town of the same kind (3 and 8 drove the same code a third and fourth time)
+@pytest.mark.parametrize("seed", [5, 11])
 def test_feet_on_the_ground_under_them(seed):
     """Every sample of every person (the lead-in before t = 0 included) stands on the ground under
     its centre: kerb height on the pavement and in the closed streets' corridors (caps, corners,
