@@ -52,10 +52,7 @@ def asphalt(g: Nodes, rng, tone=0.055, wear=0.5):
     base = g.mix(grate, base, g.mix(slots, (0.07, 0.065, 0.06), (0.004, 0.004, 0.004)))
     rough = g.lerp(g.mul(snakes, 0.7), rough, 0.6)
     rough = g.lerp(grate, rough, 0.45)
-    # The bump evaluates its height graph three times per shading point: stones, patch seams, manholes and
-    # grate slots stand out; the cracks and tar snakes are colour and gloss only (in the height they cost
-    # a third of the road's shading for relief finer than a pixel; issue 29's render-time bound)
-    height = g.add(g.add(g.mul(stone, 0.6), worn), g.mul(slots, -1.5))
+    height = g.add(g.add(g.mul(stone, 0.6), worn), g.add(g.mul(snakes, 0.4), g.mul(slots, -1.5)))
     color, rough, normal = wet_surface(g, base, rough, g.bump(height, 0.25, 0.01), low=gut)
     return g.principled(base_color=color, roughness=rough, normal=normal)
 

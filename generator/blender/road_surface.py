@@ -34,7 +34,6 @@ def road_wear(g: Nodes, co, base, tone: float, rng: np.random.Generator):
     Returns
     -------
     (colour socket, roughness socket, bump height socket)
-        The height holds the patch seams and manhole covers; the cracks darken the colour only.
     """
     def cells(size, offset):
         v = g.mapping(co, scale=(1 / size[0], 1 / size[1], 0.0), location=offset)
@@ -91,4 +90,5 @@ def road_wear(g: Nodes, co, base, tone: float, rng: np.random.Generator):
     out = g.mix(disc, out, iron)
     rough = g.lerp(g.add(g.mul(stains, 0.35), g.mul(disc, 0.3)), 0.85, 0.5)
     height = g.add(g.mul(g.mul(disc, g.math("SUBTRACT", 1.0, grid)), -0.5), g.mul(g.mul(present, seam), 0.3))
+    height = g.add(height, g.mul(cracks, -0.6))
     return out, rough, height
