@@ -3,7 +3,8 @@
     python bench/look_gallery.py render OUT_DIR [--spec scenes/default_town.json] [--code-root TREE]
                                  [--size 640x360] [--samples 12] [--only ground horizon trees facades road]
     python bench/look_gallery.py compare BEFORE_DIR AFTER_DIR OUT_DIR
-    python bench/look_gallery.py time --baseline MAIN_CHECKOUT [--frames 3] [--rounds 2]
+    python bench/look_gallery.py time --baseline MAIN_CHECKOUT [--frames 3] [--rounds 2] [--config preview|paper]
+                                      [--lighting day night]
 
 ``render`` writes one PNG per shot into ``OUT_DIR`` (``<shot>.png``, RGB only) and ``sheet.png``
 (RGB beside the label view, one row per shot), and prints the render seconds of every shot beside
@@ -12,7 +13,8 @@ of urbangen (e.g. main, for the "before" crops); the default is the tree this sc
 ``compare`` pastes the crops of two ``render`` runs side by side (``<shot>.png``: before | after)
 and into one ``before_after.png``. ``time`` renders the same ego views (day and night) at the full
 ``preview`` preset with a baseline checkout and with this tree, interleaved, each in its own process, and
-prints seconds per frame side by side.
+prints seconds per frame and each process's peak memory side by side (``--config paper`` for the paper
+preset; ``--lighting day`` for day views only).
 
 Shots, all in the town the spec builds (the spec's seed; day: sun at 38 degrees, clear; night: 40 %
 lit windows):
@@ -529,9 +531,14 @@ def drive_poses(town, n: int) -> list[np.ndarray]:
 
 
 def time_one(args) -> int:
-    """Render ``--frames`` ego views at the full ``preview`` preset (label pass, camera model, motion blur
-    settings as the preset has them; a static town); print one JSON line of seconds."""
+    """Render ``--frames`` ego views at the full ``--config`` preset (label pass, camera model, motion blur
+    settings as the preset has them); print one JSON line of seconds and peak memory.
+
+    Without ``--traffic`` the views are spread along the longest route of the static town; with it they
+    are frames 0, 3, 6, ... of the spec's own drive, the town's traffic posed at each frame's time and
+    the camera exposed as ``generate`` exposes it (moving cars, people, riders in view)."""
     import json
+    import resource
     sys.path.insert(0, str(Path(args.code_root).resolve()))
     from generator.blender.renderer import Renderer
     from generator.layout import build_scene
@@ -541,18 +548,39 @@ def time_one(args) -> int:
 
     spec = load_spec(args.spec)
     town = build_scene(spec)
-    cfg = load_render_config("preview")
+    cfg = load_render_config(args.config)
+    world = poses = None
+    if args.traffic:
+        from generator.jobs.drive import MARGIN_M
+        from generator.jobs.variants import pose_for
+        from generator.traffic.build import build_world
+        from generator.world.rig import Rig
+
+        last = 3 * (args.frames - 1)
+        world = build_world(spec, town, 0.0, last * spec.paths.spacing_m + MARGIN_M)
+        rig = Rig.from_world(spec, world)
+        poses = [rig.frame(k) for k in range(0, last + 1, 3)]
     with tempfile.TemporaryDirectory() as tmp:
         t0 = time.perf_counter()
-        r = Renderer(town, spec, cfg, Path(tmp))
+        r = Renderer(town, spec, cfg, Path(tmp), world)
         build = time.perf_counter() - t0
         rows = []
-        for tod in ("day", "night"):
+        for tod in args.lighting:
             r.set_conditions(Lighting(*DAY) if tod == "day" else Lighting("night", lit_windows=0.4))
-            for T in drive_poses(town, args.frames):
-                f = r.render(T, spec.seed, {})
-                rows.append({k: round(v, 3) for k, v in f.seconds.items()})
-    print(json.dumps({"build": round(build, 3), "triangles": int(len(town.faces)), "frames": rows}))
+            if poses is None:
+                seconds = [r.render(T, spec.seed, {}).seconds for T in drive_poses(town, args.frames)]
+            else:
+                seconds = []
+                for frame in poses:
+                    pose_for(r, frame, rig)()    # actors at the frame's time, the camera exposed around it
+                    t1 = time.perf_counter()
+                    _, rgb_s = r.render_rgb(spec.seed)
+                    labels = r.render_labels()
+                    seconds.append({"rgb_pass": rgb_s, **labels.seconds, "render_total": time.perf_counter() - t1})
+            rows += [{k: round(v, 3) for k, v in secs.items()} for secs in seconds]
+    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    print(json.dumps({"build": round(build, 3), "triangles": int(len(town.faces)), "frames": rows,
+                      "max_rss_mb": round(rss)}))
     return 0
 
 
@@ -565,21 +593,26 @@ def time_compare(args) -> int:
     for _ in range(args.rounds):
         for name, tree in trees.items():
             cmd = [sys.executable, str(Path(__file__).resolve()), "_time_one", "--code-root", str(tree),
-                   "--spec", str(args.spec), "--frames", str(args.frames)]
+                   "--spec", str(args.spec), "--frames", str(args.frames), "--config", args.config,
+                   "--lighting", *args.lighting, *(["--traffic"] if args.traffic else [])]
             out = subprocess.run(cmd, capture_output=True, text=True, check=True, cwd=tree)
             runs[name].append(json.loads(out.stdout.strip().splitlines()[-1]))
-    print(f"preview preset, {args.frames} ego views x (day, night) x {args.rounds} rounds, {args.spec}")
+    views = "drive frames with traffic" if args.traffic else "ego views of the static town"
+    print(f"{args.config} preset, {args.frames} {views} x ({', '.join(args.lighting)}) x {args.rounds} rounds, "
+          f"{args.spec}")
     print(f"{'tree':12s} {'triangles':>10s} {'build s':>8s} {'rgb s/frame':>12s} {'labels s/frame':>15s} "
-          f"{'total s/frame':>14s}")
-    total = {}
+          f"{'total s/frame':>14s} {'peak MB':>8s}")
+    total, parts = {}, {}
     for name, rs in runs.items():
         fr = [f for r in rs for f in r["frames"]]
         rgb = np.mean([f["rgb_pass"] for f in fr])
         tot = np.mean([f["render_total"] for f in fr])
-        total[name] = tot
+        total[name], parts[name] = tot, (rgb, tot - rgb)
         print(f"{name:12s} {rs[0]['triangles']:10d} {np.mean([r['build'] for r in rs]):8.2f} {rgb:12.2f} "
-              f"{tot - rgb:15.2f} {tot:14.2f}")
-    print(f"ratio this tree / baseline (total per frame): {total['this tree'] / total['baseline']:.3f}")
+              f"{tot - rgb:15.2f} {tot:14.2f} {max(r['max_rss_mb'] for r in rs):8d}")
+    (rgb_b, lab_b), (rgb_t, lab_t) = parts["baseline"], parts["this tree"]
+    print(f"ratio this tree / baseline: total per frame {total['this tree'] / total['baseline']:.3f}, "
+          f"RGB {rgb_t / rgb_b:.3f}, label pass {lab_t / lab_b:.3f}")
     return 0
 
 
@@ -635,10 +668,17 @@ def main(argv: list[str] | None = None) -> int:
     t.add_argument("--spec", type=_spec_file, default=ROOT / "scenes" / "default_town.json")
     t.add_argument("--frames", type=_positive, default=3)
     t.add_argument("--rounds", type=_positive, default=2)
+    t.add_argument("--config", choices=["preview", "paper"], default="preview", help="render preset")
+    t.add_argument("--lighting", nargs="+", choices=["day", "night"], default=["day", "night"])
+    t.add_argument("--traffic", action="store_true",
+                   help="the spec's own drive with its traffic (moving cars, people) instead of a static town")
     o = sub.add_parser("_time_one")
     o.add_argument("--code-root", required=True)
     o.add_argument("--spec", type=Path, required=True)
     o.add_argument("--frames", type=int, default=3)
+    o.add_argument("--config", default="preview")
+    o.add_argument("--lighting", nargs="+", default=["day", "night"])
+    o.add_argument("--traffic", action="store_true")
     args = ap.parse_args(argv)
     return {"render": render, "compare": compare, "time": time_compare, "_time_one": time_one}[args.cmd](args)
 

@@ -17,7 +17,9 @@ LiDAR see exactly the triangles they saw before. Sizes are real (1 unit = 1 m):
 * fallen leaves: 4-7 cm leaves in 14 cm cells, a share of the cells set by a density socket;
 * grass: clumps, clover, dry straw-coloured patches and worn soil, blade-scale speckle.
 
-World coordinates (``Position``) for patterns that have no direction (grain, stains, leaves, grass),
+Patterns that lie on the ground read only x and y (2D noise and Voronoi: a 3D Voronoi searches 27
+cells, a 2D one 9, and the bump evaluates its height three times). World coordinates (``Position``)
+for patterns that have no direction (grain, stains, leaves, grass),
 so they run on across object borders without a seam; object coordinates where the pattern follows
 the street (slabs, gutter, grates).
 """
@@ -60,21 +62,21 @@ def flat(g: Nodes, v):
 
 def aggregate(g: Nodes, wp, tone: float):
     """Asphalt stones and binder: (colour, height) sockets; ``wp`` world position."""
-    chips = g.voronoi(flat(g, wp), scale=STONE_CELLS_PER_M, out="Color")
+    chips = g.voronoi(wp, scale=STONE_CELLS_PER_M, out="Color", plane=True)
     c, _, _ = rgb(g, chips)
     stone = g.ramp(c, [(0.0, (tone * 0.55,) * 3), (0.8, (tone * 1.25,) * 3), (0.97, (tone * 1.6,) * 3),
                        (1.0, (tone * 3.5, tone * 3.4, tone * 3.2))])
-    mid = g.noise(wp, scale=0.9, detail=3)
-    big = g.noise(wp, scale=0.045, detail=2)
+    mid = g.noise(wp, scale=0.9, detail=3, plane=True)
+    big = g.noise(wp, scale=0.045, detail=2, plane=True)
     tint = g.mul(g.add(0.75, g.mul(mid, 0.5)), g.add(0.8, g.mul(big, 0.4)))
     return g.mix(1.0, stone, tint, "MULTIPLY"), c
 
 
 def tar_snakes(g: Nodes, wp):
     """0..1 mask of crack-sealant lines in about a third of the road."""
-    n = g.noise(flat(g, wp), scale=SNAKE_SCALE, detail=3, distortion=0.4)
+    n = g.noise(wp, scale=SNAKE_SCALE, detail=3, distortion=0.4, plane=True)
     line = inv(g, g.smooth(g.math("ABSOLUTE", g.math("SUBTRACT", n, 0.5)), SNAKE_WIDTH * 0.4, SNAKE_WIDTH))
-    zone = g.smooth(g.noise(wp, scale=0.06, detail=1), 0.5, 0.56)
+    zone = g.smooth(g.noise(wp, scale=0.06, detail=1, plane=True), 0.5, 0.56)
     return g.mul(line, zone)
 
 
@@ -84,7 +86,7 @@ def gutter(g: Nodes, co):
     x, y, _ = xyz(g, co)
     d = g.math("SUBTRACT", kerb, g.math("ABSOLUTE", y))            # metres to the kerb face
     has = g.math("GREATER_THAN", kerb, 0.0)
-    wob = g.mul(g.noise(co, scale=1.2, detail=2), 0.25)
+    wob = g.mul(g.noise(co, scale=1.2, detail=2, plane=True), 0.25)
     gut = g.mul(has, inv(g, g.smooth(g.add(d, wob), 0.25, GUTTER_M + 0.1)))
     # gully grates: one per DRAIN_CELL_M of each kerb, present by a hash of the cell and side
     cell = g.math("FLOOR", g.math("DIVIDE", x, DRAIN_CELL_M))
@@ -110,11 +112,11 @@ def gutter(g: Nodes, co):
 
 def leaves(g: Nodes, wp, density):
     """(leaf mask 0..1, leaf colour): fallen leaves in ``density`` (socket or constant) of the cells."""
-    warp = g.mapping(g.noise(wp, scale=7.0, detail=1, out="Color"), scale=(0.08, 0.05, 0))
+    warp = g.mapping(g.noise(wp, scale=7.0, detail=1, out="Color", plane=True), scale=(0.08, 0.05, 0))
     p = g.node("ShaderNodeVectorMath", operation="ADD")
     g.set(p.inputs[0], flat(g, wp))
     g.set(p.inputs[1], warp)
-    vor = g.node("ShaderNodeTexVoronoi", feature="F1", voronoi_dimensions="3D")
+    vor = g.node("ShaderNodeTexVoronoi", feature="F1", voronoi_dimensions="2D")
     g.set(vor.inputs["Vector"], p.outputs[0])
     vor.inputs["Scale"].default_value = LEAF_CELLS_PER_M
     r, gg, b = rgb(g, vor.outputs["Color"])
@@ -146,8 +148,8 @@ def slabs(g: Nodes, co, tone: float):
 
 def stains(g: Nodes, wp):
     """(gum spots, water and rust stains) masks on paving, world coordinates."""
-    vor = g.node("ShaderNodeTexVoronoi", feature="F1", voronoi_dimensions="3D")
-    g.set(vor.inputs["Vector"], flat(g, wp))
+    vor = g.node("ShaderNodeTexVoronoi", feature="F1", voronoi_dimensions="2D")
+    g.set(vor.inputs["Vector"], wp)
     vor.inputs["Scale"].default_value = 3.0
     r, _, _ = rgb(g, vor.outputs["Color"])
     gum = g.mul(g.math("LESS_THAN", r, 0.3), inv(g, g.smooth(vor.outputs["Distance"], 0.03, 0.045)))
@@ -157,16 +159,16 @@ def stains(g: Nodes, wp):
 
 def grass(g: Nodes, wp, lush, dry):
     """Grass colour and bump height: clumps, clover, dry patches, worn soil; ``wp`` world position."""
-    clump = g.noise(wp, scale=4.0, detail=2)
-    tone = g.noise(wp, scale=0.9, detail=4)
+    clump = g.noise(wp, scale=4.0, detail=2, plane=True)
+    tone = g.noise(wp, scale=0.9, detail=4, plane=True)
     base = g.ramp(g.add(g.mul(tone, 0.7), g.mul(clump, 0.3)),
                   [(0.3, tuple(c * 0.6 for c in lush)), (0.5, lush), (0.7, tuple(c * 1.4 for c in lush))])
-    dry_zone = g.smooth(g.noise(wp, scale=0.12, detail=3), 0.55, 0.7)
+    dry_zone = g.smooth(g.noise(wp, scale=0.12, detail=3, plane=True), 0.55, 0.7)
     base = g.mix(g.mul(dry_zone, g.add(0.3, g.mul(clump, 0.6))), base, dry)
-    clover = g.mul(g.smooth(g.noise(wp, scale=2.2, detail=2), 0.62, 0.68), 0.6)
+    clover = g.mul(g.smooth(g.noise(wp, scale=2.2, detail=2, plane=True), 0.62, 0.68), 0.6)
     base = g.mix(clover, base, (0.035, 0.07, 0.012))
-    soil = g.smooth(g.noise(wp, scale=0.35, detail=4), 0.7, 0.76)
+    soil = g.smooth(g.noise(wp, scale=0.35, detail=4, plane=True), 0.7, 0.76)
     base = g.mix(g.mul(soil, 0.85), base, (0.085, 0.062, 0.04))
-    blades = g.noise(g.mapping(wp, scale=(1, 1, 0)), scale=160.0, detail=1)
+    blades = g.noise(wp, scale=160.0, detail=1, plane=True)
     base = g.mix(0.4, base, g.ramp(blades, [(0.3, (0.55,) * 3), (0.7, (1.45,) * 3)]), "MULTIPLY")
     return base, blades, soil

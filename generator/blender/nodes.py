@@ -80,14 +80,20 @@ class Nodes:
         return n.outputs[0]
 
     # -- textures --------------------------------------------------------------------
-    def noise(self, vector=None, scale=5.0, detail=2.0, roughness=0.5, distortion=0.0, out="Factor", w=None):
-        n = self.node("ShaderNodeTexNoise", noise_dimensions="4D" if w is not None else "3D")
+    def noise(self, vector=None, scale=5.0, detail=2.0, roughness=0.5, distortion=0.0, out="Factor", w=None,
+              plane=False):
+        """Perlin noise; ``plane=True`` reads only the vector's x and y (a pattern on the ground plane:
+        2D noise, about half the cost of 3D per octave)."""
+        n = self.node("ShaderNodeTexNoise", noise_dimensions="4D" if w is not None else "2D" if plane else "3D")
         self._inputs(n, {"vector": vector, "scale": scale, "detail": detail, "roughness": roughness,
                          "distortion": distortion, "w": w}, {"w": "W"})
         return n.outputs[out]
 
-    def voronoi(self, vector=None, scale=5.0, randomness=1.0, feature="F1", out="Distance", w=None):
-        n = self.node("ShaderNodeTexVoronoi", feature=feature, voronoi_dimensions="4D" if w is not None else "3D")
+    def voronoi(self, vector=None, scale=5.0, randomness=1.0, feature="F1", out="Distance", w=None, plane=False):
+        """Voronoi cells; ``plane=True`` reads only the vector's x and y (cells on the ground plane: 2D,
+        9 neighbour cells searched instead of 27)."""
+        n = self.node("ShaderNodeTexVoronoi", feature=feature,
+                      voronoi_dimensions="4D" if w is not None else "2D" if plane else "3D")
         self._inputs(n, {"vector": vector, "scale": scale, "randomness": randomness, "w": w}, {"w": "W"})
         return n.outputs[out]
 

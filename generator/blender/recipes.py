@@ -37,16 +37,16 @@ def asphalt(g: Nodes, rng, tone=0.055, wear=0.5):
     co, wp = g.coords("Object"), g.geometry("Position")
     tone = tone * rng.uniform(0.85, 1.2)
     base, stone = gd.aggregate(g, wp, tone)
-    patches = g.noise(wp, scale=0.06, detail=3)
+    patches = g.noise(wp, scale=0.06, detail=3, plane=True)
     base = g.mix(g.mul(g.smooth(patches, 0.45, 0.6), wear), base, (tone * 1.8, tone * 1.75, tone * 1.7))
     snakes = gd.tar_snakes(g, wp)
     base = g.mix(g.mul(snakes, 0.9), base, (0.012, 0.012, 0.012))
     base, rough, worn = road_wear(g, co, base, tone, rng)
     gut, grate, slots = gd.gutter(g, co)
     leaf, leaf_col = gd.leaves(g, wp, g.mul(gut, 0.6))
-    grime = g.mul(gut, g.add(0.6, g.mul(g.noise(wp, scale=3.0, detail=3), 0.4)))
+    grime = g.mul(gut, g.add(0.6, g.mul(g.noise(wp, scale=3.0, detail=3, plane=True), 0.4)))
     base = g.mix(grime, base, (tone * 3.2, tone * 2.8, tone * 2.1))         # dusty sediment
-    base = g.mix(g.mul(grime, g.smooth(g.noise(wp, scale=0.8, detail=2), 0.45, 0.6)), base,
+    base = g.mix(g.mul(grime, g.smooth(g.noise(wp, scale=0.8, detail=2, plane=True), 0.45, 0.6)), base,
                  (tone * 0.4, tone * 0.36, tone * 0.28))                     # and dark wet-dirt stains
     base = g.mix(leaf, base, leaf_col)
     base = g.mix(grate, base, g.mix(slots, (0.07, 0.065, 0.06), (0.004, 0.004, 0.004)))
@@ -119,7 +119,7 @@ def grass(g, rng):
     """Grass that is not one green: clumps, clover, dry patches, worn soil, blades, a few leaves."""
     wp = g.geometry("Position")
     base, blades, soil = gd.grass(g, wp, _jit(rng, (0.075, 0.13, 0.03), 0.1), _jit(rng, (0.2, 0.17, 0.07), 0.1))
-    leaf, leaf_col = gd.leaves(g, wp, g.mul(g.smooth(g.noise(wp, scale=0.2, detail=2), 0.5, 0.8), 0.2))
+    leaf, leaf_col = gd.leaves(g, wp, g.mul(g.smooth(g.noise(wp, scale=0.2, detail=2, plane=True), 0.5, 0.8), 0.2))
     base = g.mix(leaf, base, leaf_col)
     col, rough, normal = wet_surface(g, base, 0.95, g.bump(g.add(blades, g.mul(soil, -0.5)), 0.4, 0.02),
                                      puddles=False)

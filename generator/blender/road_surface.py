@@ -53,7 +53,7 @@ def road_wear(g: Nodes, co, base, tone: float, rng: np.random.Generator):
     # repair patches: a rectangle in ~18% of the cells, fresher (darker) or older (greyer); the
     # edges wander a few centimetres and the new asphalt feathers out over ~8 cm (soft edges)
     r, col, fx, fy = cells(PATCH_CELL_M, tuple(rng.uniform(0, 1, 3)))
-    wob = g.mul(g.math("SUBTRACT", g.noise(co, scale=2.0, detail=3), 0.5), 0.03)
+    wob = g.mul(g.math("SUBTRACT", g.noise(co, scale=2.0, detail=3, plane=True), 0.5), 0.03)
     fx, fy = g.add(fx, wob), g.add(fy, wob)
     present = g.math("LESS_THAN", r, PATCH_SHARE)
     inside = g.mul(band(fx, 0.12, 0.82, 0.012), band(fy, 0.15, 0.8, 0.016))
@@ -65,14 +65,14 @@ def road_wear(g: Nodes, co, base, tone: float, rng: np.random.Generator):
     out = g.mix(g.mul(patch, 0.85), base, patch_col)
     out = g.mix(g.mul(g.mul(present, seam), 0.6), out, (0.012, 0.012, 0.012))
     # oil and tyre stains: soft dark blotches, a little glossier
-    stains = g.mul(g.smooth(g.noise(co, scale=0.35, detail=3), 0.56, 0.68),
-                   g.smooth(g.noise(co, scale=2.5, detail=3), 0.3, 0.6))
+    stains = g.mul(g.smooth(g.noise(co, scale=0.35, detail=3, plane=True), 0.56, 0.68),
+                   g.smooth(g.noise(co, scale=2.5, detail=3, plane=True), 0.3, 0.6))
     out = g.mix(g.mul(stains, 0.75), out, (tone * 0.35,) * 3)
     # alligator cracking in worn zones: a fine cell network on noise-warped coordinates
-    warp = _vadd(g, g.mapping(co, scale=(1, 1, 0)),
-                 g.mapping(g.noise(co, scale=1.5, detail=2, out="Color"), scale=(0.6, 0.6, 0)))
-    net = g.math("SUBTRACT", 1.0, g.smooth(g.voronoi(warp, scale=1.6, feature="DISTANCE_TO_EDGE"), 0.0, 0.025))
-    zone = g.smooth(g.noise(co, scale=0.09, detail=2), 0.6, 0.66)
+    warp = _vadd(g, co, g.mapping(g.noise(co, scale=1.5, detail=2, out="Color", plane=True), scale=(0.6, 0.6, 0)))
+    net = g.math("SUBTRACT", 1.0, g.smooth(g.voronoi(warp, scale=1.6, feature="DISTANCE_TO_EDGE", plane=True),
+                                            0.0, 0.025))
+    zone = g.smooth(g.noise(co, scale=0.09, detail=2, plane=True), 0.6, 0.66)
     cracks = g.mul(net, zone)
     out = g.mix(g.mul(cracks, 0.85), out, (0.008, 0.008, 0.008))
     # manhole covers: a cast-iron disc with a grid in a concrete collar, in MANHOLE_SHARE of the cells
