@@ -138,7 +138,8 @@ class Scanner:
             np.concatenate([self.caster.face_normals, *(self.actors.face_normals() if protos else [])]))
         self._o32, self._d32 = self._records.origins, self._records.directions  # (steps, L, 3), ring order
         #: what the physical chunks read per face-table row (None without the physical model)
-        self.face_lookup = (FaceLookup(self._records._faces, self.returns.optics)
+        self.face_lookup = (FaceLookup(self._records._faces, self.returns.optics,
+                                       self.caster.triangle_corners())
                             if self.returns is not None else None)
         steps = sensor.azimuth_steps
         n_chunks = min(steps, self.threads * max(1, chunks_per_thread))
