@@ -161,7 +161,8 @@ def run_physical_chunk(scanner, sweep, i: int, cols: slice) -> None:
             split, rb, rw = split[:n_split], rb[:n_rest], rw[:n_rest]
             if n_split:
                 weight[split - i0] = share
-                sub = {key: v[keep] for key, v in probe.items()}  # the split beams' probes are kept
+                kept = np.flatnonzero(keep)  # the split beams' probes are kept
+                sub = {key: v.take(kept, axis=0) for key, v in probe.items()}
                 if p.edge_subrays == "all":  # with their other sub-rays
                     ro, rd = _subray_rays(o_w, d_world, rb, rw, model.pattern)
                     rest = _cast_subrays(scanner, plan, cols, aimed, ro, rd, rb, i0, n_in, hi_r)
