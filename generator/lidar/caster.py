@@ -41,6 +41,9 @@ class RayCaster(Protocol):
     ) -> tuple[np.ndarray, np.ndarray]:
         """First hits of rays; see :meth:`EmbreeCaster.intersect`."""
 
+    def triangle_corners(self) -> np.ndarray:
+        """(F, 3, 3) float32 corners of every face, re-centred; see :meth:`EmbreeCaster.triangle_corners`."""
+
     @property
     def face_normals(self) -> np.ndarray:
         """(F, 3) float32 unit face normals, world frame."""
@@ -82,6 +85,7 @@ class EmbreeCaster:
         self.center = (v64.min(0) + v64.max(0)) / 2.0 if center is None else np.asarray(center, np.float64)
         local = np.ascontiguousarray(v64 - self.center, np.float32)
         self.n_faces = len(f)
+        self._local, self._triangles, self._corners = local, f, None
         self._normals = _unit_normals(v64[f])
         t0 = time.perf_counter()
         self._scene = rtcore_scene.EmbreeScene()
@@ -99,6 +103,15 @@ class EmbreeCaster:
     def face_normals(self) -> np.ndarray:
         """(F, 3) float32 unit normals per face, world frame (zero for degenerate faces)."""
         return self._normals
+
+    def triangle_corners(self) -> np.ndarray:
+        """(F, 3, 3) float32 corners of every face as Embree holds them (world minus :attr:`center`, metres).
+
+        Built on the first call and kept (``12 * 3 * F`` bytes: only the physical return model asks).
+        """
+        if self._corners is None:
+            self._corners = self._local[self._triangles]
+        return self._corners
 
     def intersect_local(self, origins: np.ndarray, directions: np.ndarray,
                         max_distance: float | np.ndarray, mark_misses: bool = True) -> tuple[np.ndarray, np.ndarray]:

@@ -7,9 +7,11 @@ Steps, per chunk ``[c0, c1)`` of a sweep (the scanner's threads run chunks in pa
    which beams may meet which actor (:meth:`generator.lidar.actors.ActorCaster.aim`) is worked out
    once here and reused by every later ray list of the chunk;
 2. the chunk's edge beams (:func:`generator.lidar.return_rays.edge_beams`) get their probe
-   sub-rays (:func:`~generator.lidar.return_rays.probe_pairs`), cast against the town and the actors;
-   the beams the probes split (:func:`~generator.lidar.return_rays.split_beams`) keep them, and their
-   other sub-rays either take the centre's hit (``edge_subrays: differing``) or are cast too (``all``);
+   sub-rays (:func:`~generator.lidar.return_rays.probe_pairs`); those that land on their centre's own
+   triangle with nothing their neighbour sees in front (:func:`~generator.lidar.return_rays.probes_on_centre`)
+   are not cast, the others are, against the town and the actors; the beams the cast probes split
+   (:func:`~generator.lidar.return_rays.split_beams`) keep them, and their other sub-rays (the uncast
+   probes among them) either take the centre's hit (``edge_subrays: differing``) or are cast too (``all``);
 3. rays that end on glass go on behind it, up to ``glass_layers`` panes
    (:func:`~generator.lidar.return_rays.pane_rays`); a continued ray that meets the object whose
    glass it crossed (same class and instance) is absorbed in its interior, unless the object's cabin
@@ -31,7 +33,15 @@ import numpy as np
 from generator.lidar.kernels import world_rays
 from generator.lidar.points import POINT_DTYPE
 from generator.lidar.return_kernels import beam_returns
-from generator.lidar.return_rays import absorb_interior, edge_beams, pane_rays, probe_pairs, split_beams, subrays
+from generator.lidar.return_rays import (
+    absorb_interior,
+    edge_beams,
+    pane_rays,
+    probe_pairs,
+    probes_on_centre,
+    split_beams,
+    subrays,
+)
 
 #: how far behind a pane a continued ray starts, metres
 GLASS_STEP_M = 1e-3
@@ -58,11 +68,10 @@ def _actor_hits(scanner, plan, cols, o, d, dist, face, aimed, rows=None, offset=
     return inst, moving
 
 
-def _cast_subrays(scanner, plan, cols, aimed, o_w, d_world, beam_rows, which, pattern, i0, n_in, max_range) -> dict:
-    """Cast the sub-rays ``(beam_rows, which)`` (ordered by beam) against the town and the actors."""
+def _cast_subrays(scanner, plan, cols, aimed, o, d, beam_rows, i0, n_in, max_range) -> dict:
+    """Cast the sub-rays ``o, d`` (:func:`~generator.lidar.return_rays.subrays` of ``beam_rows``, ordered by
+    beam) against the town and the actors."""
     m = len(beam_rows)
-    o, d = np.empty((m, 3), np.float32), np.empty((m, 3), np.float32)
-    subrays(o_w, d_world, beam_rows, which, pattern, o, d)
     dw = d.copy()
     dist, face = scanner.caster.intersect_local(o, d, max_range, mark_misses=False)
     beam = beam_rows - i0
@@ -70,6 +79,14 @@ def _cast_subrays(scanner, plan, cols, aimed, o_w, d_world, beam_rows, which, pa
     ptr[1:] = np.bincount(beam, minlength=n_in)
     inst, moving = _actor_hits(scanner, plan, cols, o, d, dist, face, aimed, rows=(np.cumsum(ptr), np.arange(m)))
     return {"o": o, "dw": dw, "df": d, "dist": dist, "face": face, "inst": inst, "moving": moving, "beam": beam}
+
+
+def _subray_rays(o_w, d_world, beam_rows, which, pattern) -> tuple[np.ndarray, np.ndarray]:
+    """(m, 3) float32 origins and directions of the sub-rays ``(beam_rows, which)``."""
+    m = len(beam_rows)
+    o, d = np.empty((m, 3), np.float32), np.empty((m, 3), np.float32)
+    subrays(o_w, d_world, beam_rows, which, pattern, o, d)
+    return o, d
 
 
 def central_constants(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -124,7 +141,17 @@ def run_physical_chunk(scanner, sweep, i: int, cols: slice) -> None:
             pb, pw = np.empty(4 * n_edge, np.int64), np.empty(4 * n_edge, np.int64)
             n_probe = probe_pairs(edge, side, model.probes, pb, pw)
             pb, pw = pb[:n_probe], pw[:n_probe]
-            probe = _cast_subrays(scanner, plan, cols, aimed, o_w, d_world, pb, pw, model.pattern, i0, n_in, hi_r)
+            po, pd = _subray_rays(o_w, d_world, pb, pw, model.pattern)
+            # a probe that lands on its centre's own triangle, with nothing its neighbour sees in front of
+            # it, sees the centre's surface: not cast; if another probe splits the beam, it is one of the
+            # beam's other sub-rays (split_beams lists it with them)
+            on = np.empty(n_probe, bool)
+            if probes_on_centre(pb, pw, edge, side, model.probes, o_w, d_world, po, pd, dist, face,
+                                scanner.face_lookup.corners, lo_r, hi_r, SPLIT_STEP_M, SPLIT_STEP_REL, L, on):
+                cast = np.flatnonzero(~on)
+                pb, pw, po, pd = pb[cast], pw[cast], po[cast], pd[cast]
+                n_probe = len(pb)
+            probe = _cast_subrays(scanner, plan, cols, aimed, po, pd, pb, i0, n_in, hi_r)
             keep, split = np.empty(n_probe, bool), np.empty(n_probe, np.int64)
             rb, rw = np.empty(n_probe * k, np.int64), np.empty(n_probe * k, np.int64)
             n_split, n_rest = split_beams(pb, pw, dist, face, inst, probe["dist"],
@@ -134,10 +161,11 @@ def run_physical_chunk(scanner, sweep, i: int, cols: slice) -> None:
             split, rb, rw = split[:n_split], rb[:n_rest], rw[:n_rest]
             if n_split:
                 weight[split - i0] = share
-                sub = {key: v[keep] for key, v in probe.items()}  # the split beams' probes are kept
+                kept = np.flatnonzero(keep)  # the split beams' probes are kept
+                sub = {key: v.take(kept, axis=0) for key, v in probe.items()}
                 if p.edge_subrays == "all":  # with their other sub-rays
-                    rest = _cast_subrays(scanner, plan, cols, aimed, o_w, d_world, rb, rw, model.pattern, i0, n_in,
-                                         hi_r)
+                    ro, rd = _subray_rays(o_w, d_world, rb, rw, model.pattern)
+                    rest = _cast_subrays(scanner, plan, cols, aimed, ro, rd, rb, i0, n_in, hi_r)
                     sub = {key: np.concatenate([v, rest[key]]) for key, v in sub.items()}
                 else:  # towards a neighbour that sees the centre's surface, a sub-ray sees it too
                     weight += share * np.bincount(rb - i0, minlength=n_in).astype(np.float32)
@@ -179,15 +207,18 @@ class FaceLookup:
         ``class << 16 | instance`` of the face (-1 in the last entry).
     interior : (C,) bool
         Per class id: its cabin is modelled (``Optics.interior``).
+    corners : (F_town, 3, 3) float32
+        The town's triangles as cast (``caster.triangle_corners()``; rows from ``F_town`` on are actors').
     """
 
-    def __init__(self, faces: np.ndarray, optics):
+    def __init__(self, faces: np.ndarray, optics, corners: np.ndarray):
         mat = faces["material"]
         self.transmittance = np.append(optics.transmittance[mat], np.float32(0.0)).astype(np.float32)
         ends = optics.room[mat] | optics.cabin[faces["class"]]
         self.glass = (self.transmittance > 0) & ~np.append(ends, False)
         self.label = np.append((faces["class"].astype(np.int64) << 16) | faces["instance"], -1).astype(np.int64)
         self.interior = np.ascontiguousarray(optics.interior, bool)
+        self.corners = corners
 
 
 def _behind_glass(scanner, plan, cols, aimed, parts, lookup, layers, max_range, n_in) -> None:

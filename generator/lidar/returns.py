@@ -28,8 +28,13 @@ surface the centre hits and every sub-ray would return the centre's range. An ob
 the 3 mrad column spacing that no central ray touches stays invisible (as without divergence). The
 same holds inside an edge beam (``edge_subrays: differing``, the default): only the sub-rays towards
 the neighbours that differ are cast (the probes); a sub-ray towards a neighbour that sees the
-centre's surface is taken to see it too, and its share of the power goes to the centre's hit.
-``edge_subrays: all`` casts every sub-ray of a beam whose probes find an edge.
+centre's surface is taken to see it too, and its share of the power goes to the centre's hit. So is a
+probe whose line lands inside the centre's own triangle (a town face) at a range within the split step,
+where what the neighbour on its side sees cannot stand in front of that point (it lies behind the
+triangle's plane, or on a plane the probe's line does not cross before it; a neighbour on the same plane,
+such as parking next to road, does not count as behind): it is not cast (about a third of the probes in the
+default town; :func:`generator.lidar.return_rays.probes_on_centre`). ``edge_subrays: all`` casts every
+sub-ray of a beam whose probes find an edge.
 
 Glass (materials with a ``transmittance``): the pane returns its own weak diffuse reflectance and a
 specular glint near normal incidence, and lets ``transmittance`` of the power through; the beam goes
@@ -259,7 +264,9 @@ class ReturnModel:
             "divergence_model": f"Gaussian footprint, {p.divergence_mrad} mrad full angle (1/e^2), {p.subrays} "
                                 "sub-rays "
                                 f"(centre + {max(p.subrays - 1, 0)} at {1e3 * self.spread:.3f} mrad, equal power) cast "
-                                "where the beam and its range-image neighbours do not see one continuous surface",
+                                "where the beam and its range-image neighbours do not see one continuous surface "
+                                "(a sub-ray that lands on the centre's own triangle, with nothing the neighbour on "
+                                "its side sees able to stand in front of it, takes the centre's hit uncast)",
             "returns": "strongest: one point per beam; dual: strongest and last (second strongest when the strongest "
                        "is the last); returns nearer than separation_m merge (power-weighted range, dominant label)",
             "second_return_files": "dual only: second_return/velodyne/*.bin, second_return/labels/*.label (one point "
