@@ -8,7 +8,7 @@ Steps, per chunk ``[c0, c1)`` of a sweep (the scanner's threads run chunks in pa
    once here and reused by every later ray list of the chunk;
 2. the chunk's edge beams (:func:`generator.lidar.return_rays.edge_beams`) get their probe
    sub-rays (:func:`~generator.lidar.return_rays.probe_pairs`); those that land on their centre's own
-   triangle with nothing their neighbour sees in front (:func:`~generator.lidar.return_rays.probes_on_centre`)
+   triangle with nothing their neighbour sees in front (:func:`~generator.lidar.probe_skip.probes_on_centre`)
    are not cast, the others are, against the town and the actors; the beams the cast probes split
    (:func:`~generator.lidar.return_rays.split_beams`) keep them, and their other sub-rays (the uncast
    probes among them) either take the centre's hit (``edge_subrays: differing``) or are cast too (``all``);
@@ -32,13 +32,13 @@ import numpy as np
 
 from generator.lidar.kernels import world_rays
 from generator.lidar.points import POINT_DTYPE
+from generator.lidar.probe_skip import probes_on_centre
 from generator.lidar.return_kernels import beam_returns
 from generator.lidar.return_rays import (
     absorb_interior,
     edge_beams,
     pane_rays,
     probe_pairs,
-    probes_on_centre,
     split_beams,
     subrays,
 )

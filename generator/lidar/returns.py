@@ -33,7 +33,7 @@ probe whose line lands inside the centre's own triangle (a town face) at a range
 where what the neighbour on its side sees cannot stand in front of that point (it lies behind the
 triangle's plane, or on a plane the probe's line does not cross before it; a neighbour on the same plane,
 such as parking next to road, does not count as behind): it is not cast (about a third of the probes in the
-default town; :func:`generator.lidar.return_rays.probes_on_centre`). ``edge_subrays: all`` casts every
+default town; :func:`generator.lidar.probe_skip.probes_on_centre`). ``edge_subrays: all`` casts every
 sub-ray of a beam whose probes find an edge.
 
 Glass (materials with a ``transmittance``): the pane returns its own weak diffuse reflectance and a

@@ -1,4 +1,4 @@
-"""The compiled passes over a chunk's ray lists: which probes need not be cast (:func:`probes_on_centre`)."""
+"""Which probes need not be cast (:func:`generator.lidar.probe_skip.probes_on_centre`)."""
 
 from __future__ import annotations
 
