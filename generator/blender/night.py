@@ -16,6 +16,7 @@ scene controls (:mod:`generator.blender.controls`, :data:`EMISSION_SCALE`).
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -24,6 +25,7 @@ from generator.blender.bpy_guard import bpy, mathutils
 from generator.blender.geometry import lights_on
 from generator.blender.lighting import UNITS_PER_LUX, ensure_lamp
 from generator.blender.nodes import Nodes
+from generator.blender.sky import keep_world, kept_world
 from generator.geometry import apply
 from generator.world.scene import SceneModel
 
@@ -101,7 +103,22 @@ def ensure_moon(scene: bpy.types.Scene) -> bpy.types.Object:
 
 
 def night_world(scene: bpy.types.Scene, overcast: bool = False, cloud_seed: float = 0.0) -> dict:
-    """The night sky (city glow; an orange-grey deck when overcast) and the moon; return the parameters."""
+    """The night sky (city glow; an orange-grey deck when overcast) and the moon; return the parameters.
+
+    The world is kept when it is already the scene's and was built with the same arguments
+    (:func:`generator.blender.sky.kept_world`); the moon is set every time."""
+    params = json.dumps([overcast, cloud_seed])
+    info = kept_world(scene, "urbangen_night", params) or _build_night_world(scene, overcast, cloud_seed, params)
+    moon = ensure_moon(scene)
+    moon.rotation_euler = (math.radians(50), 0.0, math.radians(30))
+    moon.data.color = (0.7, 0.8, 1.0)
+    moon.data.angle = math.radians(0.5)
+    moon.data.energy = 0.0 if overcast else MOON_STRENGTH
+    return info
+
+
+def _build_night_world(scene: bpy.types.Scene, overcast: bool, cloud_seed: float, params: str) -> dict:
+    """Build the night world's node tree, make it the scene's and return its parameters."""
     world = bpy.data.worlds.get("urbangen_night") or bpy.data.worlds.new("urbangen_night")
     g = Nodes(world.node_tree)
     z = g.node("ShaderNodeSeparateXYZ")
@@ -121,14 +138,10 @@ def night_world(scene: bpy.types.Scene, overcast: bool = False, cloud_seed: floa
     g.set(bg.inputs["Strength"], 1.0)
     g.output(bg.outputs[0], "ShaderNodeOutputWorld")
     scene.world = world
-    moon = ensure_moon(scene)
-    moon.rotation_euler = (math.radians(50), 0.0, math.radians(30))
-    moon.data.color = (0.7, 0.8, 1.0)
-    moon.data.angle = math.radians(0.5)
-    moon.data.energy = 0.0 if overcast else MOON_STRENGTH
-    return {"sky_model": "night_city_glow_overcast" if overcast else "night_city_glow", "overcast": overcast,
-            "sky_zenith_radiance": [float(v) for v in zen], "sky_horizon_radiance": [float(v) for v in hor],
-            "moon_strength_w_m2": 0.0 if overcast else MOON_STRENGTH}
+    return keep_world(world, params, {
+        "sky_model": "night_city_glow_overcast" if overcast else "night_city_glow", "overcast": overcast,
+        "sky_zenith_radiance": [float(v) for v in zen], "sky_horizon_radiance": [float(v) for v in hor],
+        "moon_strength_w_m2": 0.0 if overcast else MOON_STRENGTH})
 
 
 def lights_record() -> dict:

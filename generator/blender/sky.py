@@ -19,6 +19,7 @@ Radiance units are those of the renders: a clear day's sunlit grey surface is ab
 
 from __future__ import annotations
 
+import json
 import math
 
 from generator.blender.bpy_guard import bpy
@@ -71,10 +72,30 @@ def overcast_zenith(horizontal_irradiance: float) -> float:
     return 9.0 * horizontal_irradiance / (7.0 * math.pi)
 
 
+def kept_world(scene: bpy.types.Scene, name: str, params: str) -> dict | None:
+    """The metadata of world ``name`` when it is the scene's world and was built from ``params``, else None.
+
+    Rebuilding a world's node tree costs Cycles 1.3-2.5 s at the next render (its shaders, the sky
+    textures' precomputation, the importance map) even when nothing changed; a world asked for again
+    with the same parameters is kept as it is.
+    """
+    world = bpy.data.worlds.get(name)
+    if world is None or scene.world != world or world.get("ug_params") != params:
+        return None
+    return json.loads(world["ug_info"])
+
+
+def keep_world(world: bpy.types.World, params: str, info: dict) -> dict:
+    """Record what ``world`` was built from (:func:`kept_world`); return ``info``."""
+    world["ug_params"], world["ug_info"] = params, json.dumps(info)
+    return info
+
+
 def daylight_world(scene: bpy.types.Scene, *, sun_elevation_deg: float, sun_azimuth_deg: float,
                    sun_rgb: tuple, cloud_cover: float, cloud_seed: float, overcast: bool,
                    overcast_irradiance: float) -> dict:
-    """Build the world of a day or dusk image and make it the scene's.
+    """Build the world of a day or dusk image and make it the scene's (kept if it already is, see
+    :func:`kept_world`).
 
     Parameters
     ----------
@@ -98,6 +119,11 @@ def daylight_world(scene: bpy.types.Scene, *, sun_elevation_deg: float, sun_azim
     dict
         The sky's parameters for the image's metadata.
     """
+    params = json.dumps([sun_elevation_deg, sun_azimuth_deg, [float(c) for c in sun_rgb], cloud_cover, cloud_seed,
+                         overcast, overcast_irradiance])
+    kept = kept_world(scene, "urbangen_sky", params)
+    if kept is not None:
+        return kept
     world = bpy.data.worlds.get("urbangen_sky") or bpy.data.worlds.new("urbangen_sky")
     g = Nodes(world.node_tree)
     d = g.coords("Generated")  # the view direction in a world shader
@@ -134,7 +160,7 @@ def daylight_world(scene: bpy.types.Scene, *, sun_elevation_deg: float, sun_azim
             info.update(sky_model="blender_multiple_scattering", cloud_cover=0.0)
             g.output(bg.outputs[0], "ShaderNodeOutputWorld")
             scene.world = world
-            return info
+            return keep_world(world, params, info)
         zen = g.node("ShaderNodeTexSky", sky_type="MULTIPLE_SCATTERING")
         for k in ("sun_disc", "sun_elevation", "sun_rotation", "altitude", "air_density", "aerosol_density"):
             setattr(zen, k, getattr(sky, k))
@@ -162,7 +188,7 @@ def daylight_world(scene: bpy.types.Scene, *, sun_elevation_deg: float, sun_azim
     g.output(_seen_detail(g, bg.outputs[0], plain), "ShaderNodeOutputWorld")
     info["cloud_detail_rays"] = "camera and glossy (diffuse and shadow rays see the smooth sky)"
     scene.world = world
-    return info
+    return keep_world(world, params, info)
 
 
 def _seen_detail(g: Nodes, detailed, plain_color):
