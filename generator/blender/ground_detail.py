@@ -114,7 +114,7 @@ def leaves(g: Nodes, wp, density):
     """(leaf mask 0..1, leaf colour): fallen leaves in ``density`` (socket or constant) of the cells."""
     warp = g.mapping(g.noise(wp, scale=7.0, detail=1, out="Color", plane=True), scale=(0.08, 0.05, 0))
     p = g.node("ShaderNodeVectorMath", operation="ADD")
-    g.set(p.inputs[0], flat(g, wp))
+    g.set(p.inputs[0], wp)  # the 2D Voronoi reads x and y only
     g.set(p.inputs[1], warp)
     vor = g.node("ShaderNodeTexVoronoi", feature="F1", voronoi_dimensions="2D")
     g.set(vor.inputs["Vector"], p.outputs[0])

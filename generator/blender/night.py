@@ -107,7 +107,7 @@ def night_world(scene: bpy.types.Scene, overcast: bool = False, cloud_seed: floa
 
     The world is kept when it is already the scene's and was built with the same arguments
     (:func:`generator.blender.sky.kept_world`); the moon is set every time."""
-    params = json.dumps([overcast, cloud_seed])
+    params = json.dumps([bool(overcast), float(cloud_seed)])
     info = kept_world(scene, "urbangen_night", params) or _build_night_world(scene, overcast, cloud_seed, params)
     moon = ensure_moon(scene)
     moon.rotation_euler = (math.radians(50), 0.0, math.radians(30))

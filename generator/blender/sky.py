@@ -119,8 +119,8 @@ def daylight_world(scene: bpy.types.Scene, *, sun_elevation_deg: float, sun_azim
     dict
         The sky's parameters for the image's metadata.
     """
-    params = json.dumps([sun_elevation_deg, sun_azimuth_deg, [float(c) for c in sun_rgb], cloud_cover, cloud_seed,
-                         overcast, overcast_irradiance])
+    params = json.dumps([float(sun_elevation_deg), float(sun_azimuth_deg), [float(c) for c in sun_rgb],
+                         float(cloud_cover), float(cloud_seed), bool(overcast), float(overcast_irradiance)])
     kept = kept_world(scene, "urbangen_sky", params)
     if kept is not None:
         return kept
