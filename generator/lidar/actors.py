@@ -30,10 +30,12 @@ this scheme with the same 120 cars moving (the sweep then takes ~23 ms on 2 thre
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
 
+from generator.lidar.actor_kernels import nearest_hits, reaching
 from generator.lidar.caster import EmbreeCaster
 from generator.lidar.kernels import to_actor_frames
 from generator.lidar.tracks import TrackBank
@@ -144,6 +146,7 @@ class ActorCaster:
         self.sensor = sensor
         self.beams = BeamTable.of(sensor, spread)  # windows widened for sub-rays (beam divergence)
         self._column_windows = column_windows
+        self._no_rows = np.zeros(1, np.int64)  # what reaching() reads for ptr and ids without rows
 
     def face_normals(self) -> list[np.ndarray]:
         """Each prototype's (F_p, 3) float32 unit face normals, local frame."""
@@ -280,43 +283,26 @@ class ActorCaster:
         if aimed is None:
             return None
         ray, pair, cand = aimed
-        if rows is not None:  # beams -> their rays
+        if rows is not None:  # beams -> their rays (most beams have no sub-ray or ray behind glass)
             ptr, ids = rows
-            n_r = ptr[ray + 1] - ptr[ray]
-            some = np.flatnonzero(n_r)  # most beams have no sub-ray or ray behind glass
-            ray, pair, cand, n_r = ray.take(some), pair.take(some), cand.take(some), n_r.take(some)
-            owner, at = _ragged(ptr[ray], n_r)
-            ray, pair, cand = ids.take(at), pair.take(owner), cand.take(owner)
-            reach = dist.take(ray) if offset is None else dist.take(ray) + offset.take(ray)
-            keep = np.flatnonzero(reach > plan.near.take(pair))
         else:
-            keep = np.flatnonzero(dist.take(ray) > plan.near.take(pair))
-        if len(keep) == 0:
+            ptr = ids = self._no_rows
+        ray, pair, cand = reaching(ray, pair, cand, ptr, ids, dist, dist if offset is None else offset, plan.near,
+                                   rows is not None, offset is not None)
+        if len(ray) == 0:
             return None
-        ray, pair, cand = ray.take(keep), pair.take(keep), cand.take(keep)
         o_loc, d_loc = np.empty((len(ray), 3), np.float32), np.empty((len(ray), 3), np.float32)
         to_actor_frames(o_w, d_w, ray, pair, plan.position, plan.cos, plan.sin, o_loc, d_loc)
         proto = plan.proto.take(pair)
         bound = np.minimum(dist.take(ray), np.float32(self.sensor.max_range_m))
-        hits = []
-        for p in np.unique(proto):
-            j = np.flatnonzero(proto == p)
-            t, prim = self._casters[p].intersect_local(o_loc[j], d_loc[j], bound[j])
-            h = np.flatnonzero(prim >= 0)
-            hits.append((j[h], t[h], prim[h] + self.proto_face_offset[p]))
-        j = np.concatenate([h[0] for h in hits])
-        if len(j) == 0:
-            return None
-        t = np.concatenate([h[1] for h in hits])
-        prim = np.concatenate([h[2] for h in hits])
-        order = np.lexsort((t, ray[j]))  # nearest actor first on every ray
-        j, t, prim = j[order], t[order], prim[order]
-        first = np.r_[True, ray[j][1:] != ray[j][:-1]]
-        j, t, prim = j[first], t[first], prim[first]
-        r = ray[j]
-        dist[r], face[r], d_w[r] = t, prim, d_loc[j]
-        actor = np.full(len(dist), -1, np.int32)
-        moving = np.zeros(len(dist), np.uint8)
-        actor[r] = plan.actor[cand[j]]
-        moving[r] = plan.moving[pair[j]]
-        return actor, moving
+        # one Embree run per prototype, on its entries in order (a stable sort groups them)
+        order = np.argsort(proto, kind="stable")
+        proto = proto.take(order)
+        o_s, d_s, bound = o_loc.take(order, axis=0), d_loc.take(order, axis=0), bound.take(order)
+        t, prim = np.empty(len(order), np.float32), np.empty(len(order), np.int32)
+        ends = np.flatnonzero(np.diff(proto)) + 1
+        for a, b in itertools.pairwise([0, *ends.tolist(), len(proto)]):
+            t[a:b], prim[a:b] = self._casters[proto[a]].intersect_local(o_s[a:b], d_s[a:b], bound[a:b])
+        count, actor, moving = nearest_hits(order, ray, pair, cand, t, prim, proto, self.proto_face_offset, d_loc,
+                                            plan.actor, plan.moving, dist, face, d_w)
+        return (actor, moving) if count else None

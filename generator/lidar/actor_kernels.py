@@ -1,0 +1,114 @@
+"""Compiled passes of :meth:`generator.lidar.actors.ActorCaster.cast` around its Embree calls (GIL released).
+
+``cast`` runs up to three times per chunk of a physical sweep (central rays, sub-rays, rays behind
+glass) on the ~10-40k (beam, actor) entries of the chunk's actor windows. As numpy expressions its
+culls and its nearest-hit pick (a lexsort) were a dozen short passes holding the GIL, ~7 ms of CPU per
+sweep of the default town with 120 moving actors (one thread); here they are two passes. The
+comparisons are those of the numpy expressions, in float32 (``dist + offset`` added in float32, then
+compared with the float32 ``near``), and a ray's nearest hit is picked with ties going to the first
+entry in prototype then entry order, as the stable lexsort did: the bytes are the same.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(nogil=True, cache=True)
+def reaching(ray, pair, cand, ptr, ids, dist, offset, near, use_rows, use_offset):  # pragma: no cover - compiled
+    """The (ray, pair, candidate) entries whose ray reaches beyond the actor's nearest distance.
+
+    Parameters
+    ----------
+    ray, pair, cand : (m,) int64
+        :meth:`~generator.lidar.actors.ActorCaster.aim`'s entries: beam, (candidate, column) pair, candidate.
+    ptr, ids : (beams + 1,) int64, (n,) int64
+        With ``use_rows``: beam ``q``'s rays are ``ids[ptr[q]:ptr[q + 1]]`` (entries are expanded to
+        them, beam by beam, in that order); otherwise ``ray`` names the rays and these are unused.
+    dist, offset : (n,) float32
+        Static hit distance per ray; with ``use_offset``, the distance of its origin along its beam.
+    near : (P,) float32
+        Nearest distance of the pair's actor from the sensor.
+
+    Returns
+    -------
+    ray, pair, cand : (k,) int64
+        The entries (rays, not beams) with ``dist (+ offset) > near``, in entry order.
+    """
+    m = ray.shape[0]
+    total = 0
+    if use_rows:
+        for i in range(m):
+            total += ptr[ray[i] + 1] - ptr[ray[i]]
+    else:
+        total = m
+    r_out, p_out, c_out = np.empty(total, np.int64), np.empty(total, np.int64), np.empty(total, np.int64)
+    k = 0
+    for i in range(m):
+        p = pair[i]
+        lo, hi = (ptr[ray[i]], ptr[ray[i] + 1]) if use_rows else (i, i + 1)
+        for e in range(lo, hi):
+            r = ids[e] if use_rows else ray[i]
+            reach = dist[r] + offset[r] if use_offset else dist[r]
+            if reach > near[p]:
+                r_out[k], p_out[k], c_out[k] = r, p, cand[i]
+                k += 1
+    return r_out[:k], p_out[:k], c_out[:k]
+
+
+@njit(nogil=True, cache=True)
+def nearest_hits(order, ray, pair, cand, t, prim, proto_sorted, proto_face_offset, d_loc, plan_actor, plan_moving,
+                 dist, face, d_w):  # pragma: no cover - compiled
+    """Each ray's nearest actor hit replaces its static one (arrays updated in place).
+
+    Parameters
+    ----------
+    order : (k,) int64
+        Entries by prototype (stable): the order in which they were cast.
+    ray, pair, cand : (k,) int64
+        Per entry (unsorted): its ray, (candidate, column) pair and candidate.
+    t, prim : (k,) float32, int32
+        Per cast entry (sorted): hit distance and the prototype's face (-1: none).
+    proto_sorted : (k,) int64
+        Prototype per cast entry (sorted).
+    proto_face_offset : (n_protos,) int64
+    d_loc : (k, 3) float32
+        Per entry (unsorted): the direction in its actor's frame.
+    plan_actor, plan_moving : (K,) int64, (P,) uint8
+        :class:`~generator.lidar.actors.SweepPlan`'s ``actor`` and ``moving``.
+    dist, face, d_w : (n,) float32, (n,) int32, (n, 3) float32
+        The rays' hits, updated where an actor is hit.
+
+    Returns
+    -------
+    count : int
+        Rays that hit an actor.
+    actor, moving : (n,) int32, uint8
+        Actor index per ray (-1: the town) and its moving flag.
+    """
+    n = dist.shape[0]
+    best = np.full(n, np.inf, np.float32)
+    win = np.full(n, -1, np.int64)
+    for s in range(order.shape[0]):
+        if prim[s] < 0:
+            continue
+        r = ray[order[s]]
+        if t[s] < best[r]:  # strictly nearer: of equal hits the first cast wins (the stable lexsort's pick)
+            best[r] = t[s]
+            win[r] = s
+    actor = np.full(n, -1, np.int32)
+    moving = np.zeros(n, np.uint8)
+    count = 0
+    for r in range(n):
+        s = win[r]
+        if s < 0:
+            continue
+        j = order[s]
+        dist[r] = t[s]
+        face[r] = prim[s] + proto_face_offset[proto_sorted[s]]
+        d_w[r, 0], d_w[r, 1], d_w[r, 2] = d_loc[j, 0], d_loc[j, 1], d_loc[j, 2]
+        actor[r] = plan_actor[cand[j]]
+        moving[r] = plan_moving[pair[j]]
+        count += 1
+    return count, actor, moving
