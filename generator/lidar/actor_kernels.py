@@ -1,4 +1,6 @@
-"""Compiled passes of :meth:`generator.lidar.actors.ActorCaster.cast` around its Embree calls (GIL released).
+"""Compiled passes of :class:`generator.lidar.actors.ActorCaster` per chunk (GIL released): the beams a
+chunk aims at the actors (:func:`aim_entries`), and around ``cast``'s Embree calls (:func:`reaching`,
+:func:`nearest_hits`).
 
 ``cast`` runs up to three times per chunk of a physical sweep (central rays, sub-rays, rays behind
 glass) on the ~10-40k (beam, actor) entries of the chunk's actor windows. As numpy expressions its
@@ -112,3 +114,43 @@ def nearest_hits(order, ray, pair, cand, t, prim, proto_sorted, proto_face_offse
         moving[r] = plan_moving[pair[j]]
         count += 1
     return count, actor, moving
+
+
+@njit(nogil=True, cache=True)
+def aim_entries(c0, c1, pair_off, ring0, ring1, azimuth, half, psi, rot, start, stop, n_l):  # pragma: no cover
+    """:meth:`~generator.lidar.actors.ActorCaster.aim`'s entries in one pass (its numpy arithmetic, float64).
+
+    Parameters
+    ----------
+    c0, c1, pair_off, ring0, ring1, azimuth, half
+        :class:`~generator.lidar.actors.SweepPlan`'s arrays.
+    psi, rot : (steps,) float64, (L,) float64
+        :class:`~generator.lidar.windows.BeamTable`'s encoder azimuth per column and rotation per ring.
+    start, stop : int
+        The chunk's firing columns ``[start, stop)``.
+    n_l : int
+        Lasers.
+
+    Returns
+    -------
+    beam, pair, cand : (m,) int64
+        Chunk beam ``(column - start) * n_l + ring``, (candidate, column) pair and candidate of every
+        beam whose azimuth lies within the pair's window, by candidate, column, ring.
+    """
+    total = 0
+    for k in range(c0.shape[0]):
+        for col in range(max(c0[k], start), min(c1[k], stop)):
+            p = pair_off[k] + (col - c0[k])
+            total += max(ring1[p] - ring0[p], 0)
+    beam, pair, cand = np.empty(total, np.int64), np.empty(total, np.int64), np.empty(total, np.int64)
+    two_pi = 2 * np.pi
+    m = 0
+    for k in range(c0.shape[0]):
+        for col in range(max(c0[k], start), min(c1[k], stop)):
+            p = pair_off[k] + (col - c0[k])
+            for ring in range(ring0[p], ring1[p]):
+                off = psi[col] + rot[ring] - azimuth[p]  # this laser's beam vs the actor's direction
+                if abs(np.mod(off + np.pi, two_pi) - np.pi) <= half[p]:
+                    beam[m], pair[m], cand[m] = (col - start) * n_l + ring, p, k
+                    m += 1
+    return beam[:m], pair[:m], cand[:m]

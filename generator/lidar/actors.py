@@ -35,7 +35,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from generator.lidar.actor_kernels import nearest_hits, reaching
+from generator.lidar.actor_kernels import aim_entries, nearest_hits, reaching
 from generator.lidar.caster import EmbreeCaster
 from generator.lidar.kernels import to_actor_frames
 from generator.lidar.tracks import TrackBank
@@ -208,24 +208,10 @@ class ActorCaster:
             candidate; ordered by candidate, column, ring. :meth:`cast` takes it (or :meth:`inner` of it)
             so that the sub-rays and the rays behind glass of a chunk reuse its central rays' list.
         """
-        L = self.sensor.n_lasers
-        k = np.flatnonzero((plan.c0 < cols.stop) & (plan.c1 > cols.start))
-        if len(k) == 0:
-            return None
-        cs, ce = np.maximum(plan.c0[k], cols.start), np.minimum(plan.c1[k], cols.stop)
-        owner, col = _ragged(cs, ce - cs)
-        cand = k[owner]
-        pair = plan.pair_off[cand] + (col - plan.c0[cand])
-        live = np.flatnonzero(plan.ring1.take(pair) > plan.ring0.take(pair))
-        pair, col, cand = pair.take(live), col.take(live), cand.take(live)
-        row, ring = _ragged(plan.ring0.take(pair), plan.ring1.take(pair) - plan.ring0.take(pair))
-        pair, col, cand = pair.take(row), col.take(row), cand.take(row)
-        off = self.beams.psi.take(col) + self.beams.rot.take(ring) - plan.azimuth.take(pair)
-        off = np.abs(np.mod(off + np.pi, 2 * np.pi) - np.pi)  # this laser's beam vs the actor's direction
-        aim = np.flatnonzero(off <= plan.half.take(pair))
-        if len(aim) == 0:
-            return None
-        return ((col.take(aim) - cols.start) * L + ring.take(aim)), pair.take(aim), cand.take(aim)
+        beam, pair, cand = aim_entries(plan.c0, plan.c1, plan.pair_off, plan.ring0, plan.ring1, plan.azimuth,
+                                       plan.half, self.beams.psi, self.beams.rot, cols.start, cols.stop,
+                                       self.sensor.n_lasers)
+        return (beam, pair, cand) if len(beam) else None
 
     @staticmethod
     def inner(aimed, first: int, count: int):
