@@ -4,8 +4,10 @@ The town's ground runs flat to the horizon polygon (:mod:`generator.layout.groun
 from a street showed a green plane meeting the sky. This module fills the ground ring round the
 town with a low-detail city, so the view out of town ends in more town:
 
-* a tree line (class vegetation, material ``leaves``) ``TREE_LINE_M`` beyond the town bounds, one
-  rounded low-poly crown (30 triangles) every ~8 m round the whole town;
+* a tree line ``TREE_LINE_M`` beyond the town bounds, a tree every ~8 m round the whole town: a
+  trunk (class tree_trunk, material ``bark``) under a crown of ``LOBES`` overlapping rounded low-poly
+  lobes (class vegetation, material ``leaves``; 30 triangles each), so the line reads as trees on
+  trunks with ragged outlines rather than a row of green eggs on the ground;
 * city blocks from ``BLOCKS_FROM_M`` to ``REACH_M`` beyond the bounds on a square ``PITCH_M`` grid
   (streets left as open ground): each a park of a few crowns, or 1 to 4 buildings (class building),
   boxes whose walls are ``far_facade`` (a window pattern, windows lit at night) under a flat
@@ -22,7 +24,7 @@ sides. Every Blender object costs the RGB and label passes (Cycles syncs and ins
 a scene of one object per block held ~870 more of them; joined, the far city adds a dozen and keeps
 every triangle, class and material (each building stays its own mesh island for the facade
 shader). Blender and the LiDAR (which reaches 120 m and rarely meets it) share the same few
-triangles: about 45 k round a default town (which has about 1.3 M). The draws come from the stream
+triangles: about 59 k round a default town (which has about 1.3 M). The draws come from the stream
 ``("layout", "far_city")`` only, so the town's own draws are untouched, and nothing stands within
 ``TREE_LINE_M - 2 - CROWN_R_M[1]`` (7 m) of the town bounds.
 """
@@ -44,6 +46,10 @@ CROWN_H_M = (8.0, 14.0)       #: crown top height range
 #: crown shape: (share of the height, share of the radius) of each ring, bottom up
 CROWN_RINGS = ((0.06, 0.55), (0.38, 1.0), (0.74, 0.78))
 CROWN_SIDES = 5               #: vertices per ring
+LOBES = 3                     #: lobes of a tree line crown: the main one and two beside it
+CROWN_BASE = 0.32             #: a tree line crown starts at this share of the tree's height (the trunk below)
+TRUNK_R_M = (0.16, 0.3)       #: tree line trunk radius range
+TRUNK_SIDES = 6               #: sides of a trunk prism
 BLOCKS_FROM_M = 40.0          #: the first block begins this far beyond the bounds
 REACH_M = 1200.0              #: the last block ends within this distance of the bounds
 PITCH_M, STREET_M = 90.0, 22.0  #: block grid pitch and the open street between blocks
@@ -70,11 +76,12 @@ def _boxes(b: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return v, f, roof
 
 
-def _crowns(xy: np.ndarray, r: np.ndarray, h: np.ndarray, z0: float) -> tuple[np.ndarray, np.ndarray]:
+def _crowns(xy: np.ndarray, r: np.ndarray, h: np.ndarray, z0) -> tuple[np.ndarray, np.ndarray]:
     """Rounded low-poly crowns, 30 triangles each: a pentagon ring per ``CROWN_RINGS`` row (each turned
     half a step from the one below, so the bands between are antiprisms), capped by a centre
-    vertex on the ground below and an apex at ``h`` above; closed, faces outward. Shaded smooth
-    (material ``leaves``), they read as round crowns rather than the spinning tops of a double cone.
+    vertex at the crown's base ``z0`` (a float, or (k,) per crown) and an apex ``h`` above; closed,
+    faces outward. Shaded smooth (material ``leaves``), they read as round crowns rather than the
+    spinning tops of a double cone.
 
     Returns
     -------
@@ -82,13 +89,14 @@ def _crowns(xy: np.ndarray, r: np.ndarray, h: np.ndarray, z0: float) -> tuple[np
     f : (k * 30, 3) int64
     """
     n, k, rows = CROWN_SIDES, len(xy), len(CROWN_RINGS)
+    z0 = np.broadcast_to(np.asarray(z0, np.float64), (k,))
     rings = []
     for i, (zs, rs) in enumerate(CROWN_RINGS):
         a = 2 * np.pi * (np.arange(n) + 0.5 * i) / n
         ring = np.stack([np.cos(a), np.sin(a)], 1)                                # (n, 2)
         mid = xy[:, None, :] + rs * r[:, None, None] * ring[None]                 # (k, n, 2)
-        rings.append(np.concatenate([mid, z0 + zs * h[:, None, None] + np.zeros((k, n, 1))], 2))
-    v = np.concatenate([np.c_[xy, np.full(k, z0)][:, None], *rings, np.c_[xy, z0 + h][:, None]], 1)
+        rings.append(np.concatenate([mid, z0[:, None, None] + zs * h[:, None, None] + np.zeros((k, n, 1))], 2))
+    v = np.concatenate([np.c_[xy, z0][:, None], *rings, np.c_[xy, z0 + h][:, None]], 1)
     nv = 2 + n * rows
     i = np.arange(n)
     j = (i + 1) % n
@@ -145,7 +153,8 @@ def far_city(seed: int, bounds: np.ndarray, z0: float) -> list[tuple[str, str, M
     Parameters
     ----------
     seed : int
-        The spec's seed; draws come from ``stream(seed, "layout", "far_city")``.
+        The spec's seed; draws come from ``stream(seed, "layout", "far_city")`` (and the tree
+        line's trunks and lobes from ``stream(seed, "layout", "far_city", "tree_line")``).
     bounds : (2, 2) float64
         The town's bounds ``[[xmin, ymin], [xmax, ymax]]``, metres.
     z0 : float
@@ -154,14 +163,15 @@ def far_city(seed: int, bounds: np.ndarray, z0: float) -> list[tuple[str, str, M
     Returns
     -------
     list of (kind, cls, Mesh)
-        ``("far_trees", "vegetation", ...)`` per side of the tree line (crowns of material
-        ``leaves``), then ``("far_blocks", "building", ...)`` per side of the ring that holds blocks
+        ``("far_trees", "vegetation", ...)`` per side of the tree line (trunks of class tree_trunk,
+        material ``bark``, under crowns of class vegetation, material ``leaves``), then ``("far_blocks", "building", ...)`` per side of the ring that holds blocks
         (buildings of class building, walls ``far_facade`` and roofs ``roof``; parks' crowns of
         class vegetation, material ``leaves``), then ``("far_skyline", "building", ...)`` per side
         of the far edge. No two of these meshes' footprints (nor their convex hulls or bounding
         boxes) overlap, and none encloses the town.
     """
     rng = stream(seed, "layout", "far_city")
+    shape = stream(seed, "layout", "far_city", "tree_line")
     bounds = np.asarray(bounds, np.float64)
     (bx0, by0), (bx1, by1) = bounds
     out = []
@@ -178,7 +188,7 @@ def far_city(seed: int, bounds: np.ndarray, z0: float) -> list[tuple[str, str, M
         s = cut + (np.arange(n) + 0.5 + rng.uniform(-0.3, 0.3, n)) * (length - 2 * cut) / n
         out_dir = np.array([u[1], -u[0]])                                        # away from the town
         xy = a + s[:, None] * u + out_dir * rng.uniform(-2.0, 6.0, n)[:, None]
-        out.append(("far_trees", "vegetation", _crown_mesh(rng, xy, z0)))
+        out.append(("far_trees", "vegetation", _tree_mesh(rng, shape, xy, z0)))
     cells, sides = _ring_cells(bounds)
     parts: list[list[Mesh]] = [[] for _ in range(4)]
     for (x0, y0, x1, y1), side in zip(cells, sides, strict=True):
@@ -241,3 +251,59 @@ def _block_mesh(rng: np.random.Generator, b: np.ndarray) -> Mesh:
 def _crown_mesh(rng: np.random.Generator, xy: np.ndarray, z0: float) -> Mesh:
     v, f = _crowns(xy, rng.uniform(*CROWN_R_M, len(xy)), rng.uniform(*CROWN_H_M, len(xy)), z0)
     return Mesh(v, f, class_table().id("vegetation"), material_table().id("leaves"))
+
+
+def _prisms(xy: np.ndarray, r: np.ndarray, z0: float, z1: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Open ``TRUNK_SIDES``-sided prisms (no caps: their ends are in the ground and the crown), faces outward.
+
+    Returns
+    -------
+    v : (k * 2 * TRUNK_SIDES, 3) float64
+    f : (k * 2 * TRUNK_SIDES, 3) int64
+    """
+    n, k = TRUNK_SIDES, len(xy)
+    a = 2 * np.pi * np.arange(n) / n
+    ring = xy[:, None, :] + r[:, None, None] * np.stack([np.cos(a), np.sin(a)], 1)[None]          # (k, n, 2)
+    lo = np.concatenate([ring, np.full((k, n, 1), z0)], 2)
+    hi = np.concatenate([ring, np.broadcast_to(z1[:, None, None], (k, n, 1))], 2)
+    v = np.concatenate([lo, hi], 1)                                                           # (k, 2n, 3)
+    i = np.arange(n)
+    j = (i + 1) % n
+    f = np.concatenate([np.stack([i, j, n + j], 1), np.stack([i, n + j, n + i], 1)])
+    return v.reshape(-1, 3), (f[None] + 2 * n * np.arange(k)[:, None, None]).reshape(-1, 3)
+
+
+def _tree_mesh(rng: np.random.Generator, shape: np.random.Generator, xy: np.ndarray, z0: float) -> Mesh:
+    """Trees of the tree line at ``xy`` (k, 2): a trunk up into a crown of ``LOBES`` lobes.
+
+    The main lobe spans ``CROWN_BASE`` of the tree's height to its top; each side lobe, turned a
+    random way and pushed out by 0.4 of the crown radius, is smaller and lower, so crowns differ in
+    outline and each lobe (a mesh island) takes its own shade of the ``leaves`` material. The crown
+    radius and tree height come from ``rng`` (as the single crowns of parks draw theirs), the trunk
+    and lobes from ``shape``, so the rest of the far city draws what it drew before the lobes.
+    """
+    k = len(xy)
+    r, h = rng.uniform(*CROWN_R_M, k), rng.uniform(*CROWN_H_M, k)
+    base = z0 + CROWN_BASE * h
+    parts_v, parts_f, parts_c = [], [], []
+    nv = 0
+
+    def add(v, f, cls):
+        nonlocal nv
+        parts_v.append(v)
+        parts_f.append(f + nv)
+        parts_c.append(np.full(len(f), class_table().id(cls)))
+        nv += len(v)
+
+    ch = (1.0 - CROWN_BASE) * h                                                  # crown height
+    add(*_prisms(xy, shape.uniform(*TRUNK_R_M, k), z0, base + 0.3 * ch), "tree_trunk")
+    add(*_crowns(xy, 0.85 * r, ch, base), "vegetation")
+    for _ in range(LOBES - 1):   # side lobes reach at most 0.4 r + 0.6 r from the trunk: the 7 m gap holds
+        a = shape.uniform(0, 2 * np.pi, k)
+        d = 0.4 * r[:, None] * np.stack([np.cos(a), np.sin(a)], 1)
+        s = shape.uniform(0.45, 0.6, k)
+        add(*_crowns(xy + d, s * r, s * ch, base + shape.uniform(0.0, 0.2, k) * ch), "vegetation")
+    cls = np.concatenate(parts_c)
+    mats = material_table()
+    mat = np.where(cls == class_table().id("tree_trunk"), mats.id("bark"), mats.id("leaves"))
+    return Mesh(np.concatenate(parts_v), np.concatenate(parts_f), cls, mat)
