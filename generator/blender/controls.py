@@ -17,6 +17,10 @@ CONTROL = {
     "light_traffic_lights": "ug_light_traffic_lights",
 }
 
+#: The label switch: 0 in the RGB pass, 1 in the label passes (every material then emits its
+#: label, see :mod:`generator.blender.materials`); set by :mod:`generator.blender.session`.
+LABEL = "ug_label"
+
 #: Values for a dry, clear day.
 DAY_DEFAULTS = {
     "wetness": 0.0, "puddle_seed": 0.0, "lit_windows": 0.0, "light_windows": 0.0,

@@ -1,17 +1,24 @@
-"""Blender materials: one procedural material per row of the material table, and the
-label-pass override (sky needs no label world: it is where the Z pass reports no hit).
+"""Blender materials: one procedural material per row of the material table, each carrying the
+label pass inside it (sky needs no label world: it is where the Z pass reports no hit).
 
-The label override is one emission material for every object: colour
-``(class_id, instance_id, 0)`` from the per-face ``class_id`` attribute and the object
-pass index, strength 1, no light sampling. Rendered with 1 sample and a box filter of
-minimal width, each pixel holds exactly those integers (float32 is exact below 2**24).
+The label surface is an emission of colour ``(class_id, instance_id, 0)`` from the per-face
+``class_id`` attribute and the object pass index, strength 1, no light sampling. Every
+material ends in a Mix Shader between its own surface (factor 0) and that label emission
+(factor 1), the factor read from the scene switch :data:`generator.blender.controls.LABEL`.
+Rendered with 1 sample and a box filter of minimal width, each label pixel holds exactly those
+integers (float32 is exact below 2**24); with the switch at 0 the RGB pass renders the same
+bytes as the recipe alone. A switch rather than the view layer's material override: Cycles
+recompiles every shader and re-syncs every mesh when the override changes (about 0.5 s a
+switch at the preview preset, twice a frame), while a view-layer attribute only re-evaluates.
+:func:`label_material` is the same label surface as a material of its own (benches compare
+against the override).
 """
 
 from __future__ import annotations
 
 import logging
 
-from generator.blender import recipes, recipes_actors, recipes_far, recipes_look, recipes_street
+from generator.blender import controls, recipes, recipes_actors, recipes_far, recipes_look, recipes_street
 from generator.blender.bpy_guard import bpy
 from generator.blender.nodes import Nodes
 from generator.materials import material_table
@@ -38,26 +45,32 @@ def build_materials(seed: int) -> list[bpy.types.Material]:
             raise RuntimeError(f"no Blender recipe for material {row.name!r} (generator/blender/recipes*.py)")
         mat = bpy.data.materials.new(row.name)
         g = Nodes(mat.node_tree)
-        g.output(recipe(g, stream(seed, "materials", row.name)))
-        if row.emissive is not None:
-            # Emission strength follows scene switches (day/night); Cycles would estimate it for
-            # its light tree once and keep the estimate with persistent data, so a render would
-            # depend on the renders before it. Lamps light the scene through real lights instead.
-            mat.cycles.emission_sampling = "NONE"
+        g.output(g.mix_shader(g.attr(controls.LABEL, "VIEW_LAYER"), recipe(g, stream(seed, "materials", row.name)),
+                              label_surface(g)))
+        # Emission strength follows scene switches (day/night, the label switch); Cycles would
+        # estimate it for its light tree once and keep the estimate with persistent data, so a
+        # render would depend on the renders before it (and every label emission would be a
+        # mesh light). Lamps light the scene through real lights instead.
+        mat.cycles.emission_sampling = "NONE"
         out.append(mat)
     return out
 
 
+def label_surface(g: Nodes):
+    """The label emission: colour (class_id, instance id, 0), strength 1 (a shader socket)."""
+    comb = g.node("ShaderNodeCombineXYZ")
+    g.set(comb.inputs[0], g.attr("class_id"))
+    g.set(comb.inputs[1], g.object_info("Object Index"))
+    return g.emission(comb.outputs[0], 1.0)
+
+
 def label_material() -> bpy.types.Material:
-    """The label-pass override material (created once)."""
+    """The label surface as a material of its own, for a view-layer override (created once)."""
     mat = bpy.data.materials.get(LABEL_MATERIAL)
     if mat is not None:
         return mat
     mat = bpy.data.materials.new(LABEL_MATERIAL)
     g = Nodes(mat.node_tree)
-    comb = g.node("ShaderNodeCombineXYZ")
-    g.set(comb.inputs[0], g.attr("class_id"))
-    g.set(comb.inputs[1], g.object_info("Object Index"))
-    g.output(g.emission(comb.outputs[0], 1.0))
+    g.output(label_surface(g))
     mat.cycles.emission_sampling = "NONE"
     return mat

@@ -10,11 +10,11 @@
   camera moves, and every pixel still holds one exact class id. The real pass (depth, the
   class a ray through the pixel centre hits) stays at 1x: depth is never voted or blended.
 
-The label state differs from the RGB state in the view layer's material override, Cycles'
-sampling, filter, bounce and seed settings, motion blur (off), the proxies' ray visibility and
-the resolution; the world stays (sky is where the Z pass reports no hit). Turning the override on and off makes Cycles
-recompile every shader, so :func:`render_label_batch` renders the label passes of several
-images behind one switch.
+The label state differs from the RGB state in the label switch (every material emits its
+label, :mod:`generator.blender.materials`), Cycles' sampling, filter, bounce and seed settings,
+motion blur (off), the proxies' ray visibility and the resolution; the world stays (sky is where
+the Z pass reports no hit). Switching states costs Cycles a re-sync (motion blur, visibility), so
+:func:`render_label_batch` renders the label passes of several images behind one switch.
 
 Depth is converted from Cycles' planar Z to the distance along the pixel's ray
 (range, metres) so it compares directly with LiDAR range; sky pixels get +inf.
@@ -34,7 +34,6 @@ import OpenEXR
 
 from generator.blender import geometry, session
 from generator.blender.bpy_guard import bpy
-from generator.blender.materials import label_material
 from generator.labels import class_table
 from generator.labels.supersample import majority_labels
 from generator.world import rig
@@ -130,9 +129,8 @@ def render_label_batch(scene, bs: geometry.BlenderScene, k: np.ndarray, scratch:
                        poses: Sequence[Callable[[], object]], supersample: int = 1) -> list[LabelPasses]:
     """Render the real and label passes of several camera poses with one switch into the label state.
 
-    Switching the scene between the RGB and the label state costs Cycles a re-sync of every
-    shader (the material override on, then off again before the next RGB render), which costs
-    more than the label renders themselves; a batch pays it once. The RGB world stays in
+    Switching the scene between the RGB and the label state costs Cycles a re-sync (motion blur
+    off, then on again before the next RGB render); a batch pays it once. The RGB world stays in
     place: sky is where the Z pass reports no hit, so the sky model's precomputation is never
     redone for labels.
 
@@ -157,7 +155,7 @@ def render_label_batch(scene, bs: geometry.BlenderScene, k: np.ndarray, scratch:
         back inside the next RGB render.
     """
     t0 = time.perf_counter()
-    session.label_state(scene, label_material())
+    session.label_state(scene)
     geometry.set_proxies_visible(bs, False)
     reals, secs = [], [{} for _ in poses]
     for place, sec in zip(poses, secs, strict=False):

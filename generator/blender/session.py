@@ -2,9 +2,10 @@
 
 Two render states share one scene: the RGB pass (the config's samples, bounces,
 filter, denoiser, motion blur) and the label pass (1 sample, no bounces, a box filter of
-minimal width, no denoising, no motion blur, the label material as the view layer's
-material override). A state only writes the override when it changes: Cycles re-syncs every
-shader on each write, even of the same value.
+minimal width, no denoising, no motion blur, the label switch :data:`controls.LABEL` at 1: every
+material emits its label). A state only writes the switch when it changes. The switch replaced
+the view layer's material override, which made Cycles recompile every shader and re-sync every
+mesh on each write, in the label pass and again in the next RGB pass.
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ from __future__ import annotations
 import logging
 from contextlib import contextmanager
 
-from generator.blender import motion
+from generator.blender import controls, motion
 from generator.blender.bpy_guard import bpy
 from generator.spec.render import RenderConfig
 
@@ -101,6 +102,7 @@ def configure(scene: bpy.types.Scene, cfg: RenderConfig) -> str:
     s.color_depth = "32"
     s.exr_codec = "NONE"
     scene.view_layers[0].use_pass_z = True
+    scene[controls.LABEL] = 0.0
     return device
 
 
@@ -135,12 +137,23 @@ def rgb_state(scene: bpy.types.Scene, cfg: RenderConfig, seed: int) -> None:
     vl = scene.view_layers[0]
     if vl.material_override is not None:
         vl.material_override = None
+    _switch(scene, 0.0)
 
 
-def label_state(scene: bpy.types.Scene, material) -> None:
-    """Settings of the label pass: exact integers per pixel (``material`` emits them).
+def _switch(scene: bpy.types.Scene, value: float) -> None:
+    """Set the label switch (and tag the scene) only when it changes."""
+    if scene.get(controls.LABEL) != value:
+        scene[controls.LABEL] = value
+        scene.update_tag()
+
+
+def label_state(scene: bpy.types.Scene, material=None) -> None:
+    """Settings of the label pass: exact integers per pixel (every material emits them with the
+    label switch on).
 
     The world is left as it is: what the camera sees of it is sky, told apart by the Z pass.
+    ``material``: a label material to set as the view layer's override instead (the old way,
+    for benches that compare against it).
     """
     c = scene.cycles
     c.samples = 1
@@ -155,6 +168,7 @@ def label_state(scene: bpy.types.Scene, material) -> None:
     vl = scene.view_layers[0]
     if vl.material_override != material:
         vl.material_override = material
+    _switch(scene, 1.0)
 
 
 @contextmanager
