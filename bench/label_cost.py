@@ -83,14 +83,23 @@ def main() -> None:
     inside = {"before": 0.0, "batched": 0.0}
 
     def before():
-        for f in frames:
-            t = time.perf_counter()
-            pose_for(r, f, rig)()
-            vl.material_override = label_material()
-            vl.world_override = _legacy_label_world()
-            r.render_labels()
-            inside["before"] += time.perf_counter() - t
-            rgb(f, True)
+        # the passes now switch every material's own label branch (generator.blender.materials); the
+        # old way set the label material as the view layer's override, so ``before`` asks for it
+        from generator.blender import session
+
+        own = session.label_state
+        session.label_state = lambda scene, material=None: own(scene, label_material())
+        try:
+            for f in frames:
+                t = time.perf_counter()
+                pose_for(r, f, rig)()
+                vl.material_override = label_material()
+                vl.world_override = _legacy_label_world()
+                r.render_labels()
+                inside["before"] += time.perf_counter() - t
+                rgb(f, True)
+        finally:
+            session.label_state = own
 
     def batched():
         n = label_batch_size(cfg)
