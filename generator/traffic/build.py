@@ -124,7 +124,7 @@ def _pedestrians(spec, grid, scene, signals, lib, n_steps: int, network: dict | 
 
 #: answers of :attr:`LaneGraph.memo` that hang on the lanes' and connectors' paths and the scene
 #: only, not on the pruning a drive does: a new graph of the same grid may keep them
-_GEOMETRY_MEMOS = ("blocked_lanes", "_blocked_turn_memo", "_swept_poses")
+_GEOMETRY_MEMOS = ("blocked_lanes", "_blocked_turn_memo", "_swept_poses", "_crosswalk_sweep")
 
 
 def _fresh_graph(grid, old: LaneGraph) -> LaneGraph:

@@ -9,7 +9,8 @@ Modules import downward only, in this order (each may use those above it)::
     roundabouts       the same at a roundabout; its give-way rules' distances and times
     one_way           one-way streets in the graph (lanes turned round, connectors rebuilt)
     graph             :class:`~generator.traffic.lanes.graph.LaneGraph`
-    signals, speed_caps, clearance, ring_clearance, turn_clearance
+    signals, speed_caps, clearance, ring_clearance, turn_clearance, crosswalks
                       signal phases; speed limits per edge; lanes and turns static objects block;
-                      where vehicles wait so turning long vehicles clear them
+                      where vehicles wait so turning long vehicles clear them; which crosswalks a
+                      vehicle's box passes over on a connector (it waits until nobody is on them)
 """

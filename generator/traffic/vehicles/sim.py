@@ -12,7 +12,8 @@ planned edges of the :class:`~generator.traffic.lanes.graph.LaneGraph`, with
   its connector: the node's signal lets vehicles in (:mod:`generator.traffic.lanes.signals`), no
   vehicle holds a conflicting connector (:func:`generator.traffic.lanes.conflicts`; a bus or
   truck longer than 6 m holds the whole node), the exit lane has room for it to clear the
-  far crosswalk, and no pedestrian is on or about to step onto a crosswalk it crosses. It
+  far crosswalk, and no pedestrian is on or about to step onto a crosswalk its box passes over
+  (:mod:`generator.traffic.lanes.crosswalks`). It
   holds the grant until its rear is past the far crosswalk. Vehicles wait clear of where a long
   vehicle turning through the node (or on a roundabout's ring) swings over their stop or give-way
   line, and it is granted only while nobody sits there (:mod:`generator.traffic.lanes.turn_clearance`);
@@ -30,6 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from generator.layout.network.measures import ARM_DIRS
+from generator.traffic.lanes.crosswalks import swept_arms
 from generator.traffic.lanes.graph import LaneGraph
 from generator.traffic.lanes.roundabouts import GIVE_WAY_CLEAR_S, GIVE_WAY_REQUEST_M
 from generator.traffic.lanes.signals import CLEAR_S
@@ -220,10 +222,12 @@ class VehicleSim:
                                               and not waiting_clear(self, veh, conn, occ, B_COMF)):
             return
         # the signals keep vehicles from entering CLEAR_S before a walk phase: only people on (or
-        # stepping onto) the crosswalks within that time can meet this vehicle
+        # stepping onto) the crosswalks within that time can meet this vehicle -- on every crosswalk
+        # its box passes over, not only those it enters and leaves by (a bus swings its overhangs
+        # over the crosswalks of the arms a roundabout's ring passes: lanes.crosswalks)
         window = GIVE_WAY_CLEAR_S if give_way else CLEAR_S
-        if self.crossing is not None and (self.crossing(node, conn.arms[0], t, t + window)
-                                          or self.crossing(node, conn.arms[1], t, t + window)):
+        if self.crossing is not None and any(self.crossing(node, arm, t, t + window)
+                                             for arm in swept_arms(self.g, conn, (veh.length, veh.width))):
             return
         veh.grant = conn.index
         self.holders.setdefault(node, {})[veh.index] = conn.index
