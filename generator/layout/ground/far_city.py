@@ -164,9 +164,10 @@ def far_city(seed: int, bounds: np.ndarray, z0: float) -> list[tuple[str, str, M
     -------
     list of (kind, cls, Mesh)
         ``("far_trees", "vegetation", ...)`` per side of the tree line (trunks of class tree_trunk,
-        material ``bark``, under crowns of class vegetation, material ``leaves``), then ``("far_blocks", "building", ...)`` per side of the ring that holds blocks
-        (buildings of class building, walls ``far_facade`` and roofs ``roof``; parks' crowns of
-        class vegetation, material ``leaves``), then ``("far_skyline", "building", ...)`` per side
+        material ``bark``, under crowns of class vegetation, material ``leaves``), then
+        ``("far_blocks", "building", ...)`` per side of the ring that holds blocks (buildings of class
+        building, walls ``far_facade`` and roofs ``roof``; parks' crowns of class vegetation, material
+        ``leaves``), then ``("far_skyline", "building", ...)`` per side
         of the far edge. No two of these meshes' footprints (nor their convex hulls or bounding
         boxes) overlap, and none encloses the town.
     """
