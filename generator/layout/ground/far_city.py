@@ -286,25 +286,15 @@ def _tree_mesh(rng: np.random.Generator, shape: np.random.Generator, xy: np.ndar
     k = len(xy)
     r, h = rng.uniform(*CROWN_R_M, k), rng.uniform(*CROWN_H_M, k)
     base = z0 + CROWN_BASE * h
-    parts_v, parts_f, parts_c = [], [], []
-    nv = 0
-
-    def add(v, f, cls):
-        nonlocal nv
-        parts_v.append(v)
-        parts_f.append(f + nv)
-        parts_c.append(np.full(len(f), class_table().id(cls)))
-        nv += len(v)
-
     ch = (1.0 - CROWN_BASE) * h                                                  # crown height
-    add(*_prisms(xy, shape.uniform(*TRUNK_R_M, k), z0, base + 0.3 * ch), "tree_trunk")
-    add(*_crowns(xy, 0.85 * r, ch, base), "vegetation")
+    classes, mats = class_table(), material_table()
+    parts = [Mesh(*_prisms(xy, shape.uniform(*TRUNK_R_M, k), z0, base + 0.3 * ch), classes.id("tree_trunk"),
+                  mats.id("bark")),
+             Mesh(*_crowns(xy, 0.85 * r, ch, base), classes.id("vegetation"), mats.id("leaves"))]
     for _ in range(LOBES - 1):   # side lobes reach at most 0.4 r + 0.6 r from the trunk: the 7 m gap holds
         a = shape.uniform(0, 2 * np.pi, k)
         d = 0.4 * r[:, None] * np.stack([np.cos(a), np.sin(a)], 1)
         s = shape.uniform(0.45, 0.6, k)
-        add(*_crowns(xy + d, s * r, s * ch, base + shape.uniform(0.0, 0.2, k) * ch), "vegetation")
-    cls = np.concatenate(parts_c)
-    mats = material_table()
-    mat = np.where(cls == class_table().id("tree_trunk"), mats.id("bark"), mats.id("leaves"))
-    return Mesh(np.concatenate(parts_v), np.concatenate(parts_f), cls, mat)
+        parts.append(Mesh(*_crowns(xy + d, s * r, s * ch, base + shape.uniform(0.0, 0.2, k) * ch),
+                          classes.id("vegetation"), mats.id("leaves")))
+    return merge(parts)
