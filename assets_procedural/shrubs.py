@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from assets_procedural import foliage
+from assets_procedural.leaf_cover import leaf_cover
 from generator.geometry import Mesh, icosphere, merge, on_ground
 from generator.materials import material_table
 
@@ -77,24 +78,24 @@ def hedge(rng: np.random.Generator, length: float, height: float = 1.2, depth: f
     Returns
     -------
     Mesh
-        :func:`hedge_body` (material ``hedge_body``: packed leaves in the shader) with each clump
-        stretched to :data:`HEDGE_STRETCH` along x (overlapping more) and :data:`HEDGE_SPRAYS` sprays of
-        small leaves per clump on its sides and top (material ``hedge_leaves``), clipped 3 cm outside
-        the body, all class ``vegetation``, within [-length/2, length/2] in x.
+        :func:`hedge_body` (material ``hedge_body``: the shaded inside, packed leaves in the shader)
+        with each clump stretched to :data:`HEDGE_STRETCH` along x (overlapping more), under a skin of
+        separate small leaves (:func:`assets_procedural.leaf_cover.leaf_cover`, material
+        ``hedge_leaves``) on its sides and top, clipped 3 cm outside the body, all class ``vegetation``,
+        within [-length/2, length/2] in x.
     """
     body = hedge_body(rng, length, height, depth)
     v = body.vertices.reshape(-1, _ICO1, 3)
     centres = v.mean(1)
-    radii = np.ptp(v, 1) / 2
     v = v.copy()
     dx = v[..., 0] - centres[:, None, 0]
     room = (length / 2 - np.abs(centres[:, 0])) / np.maximum(np.abs(dx).max(1), 1e-9)
     v[..., 0] = centres[:, None, 0] + dx * np.minimum(HEDGE_STRETCH, np.maximum(room, 1.0))[:, None]
     body.vertices = v.reshape(-1, 3)
+    radii = np.ptp(v, 1) / 2
     body.face_material = np.full(body.n_faces, material_table().id("hedge_body"), body.face_material.dtype)
-    at, out = foliage.shell(rng, centres, radii, np.full(len(centres), HEDGE_SPRAYS), 0.9, 1.1, 0.6)
-    keep = at[:, 2] > 0.15 * height                      # no leaves on the ground side
-    leaves = foliage.sprays(rng, at[keep], out[keep], foliage.LEAVES["small"], "vegetation", "hedge_leaves", 1.1)
+    owner = np.arange(body.n_faces) // (body.n_faces // len(centres))
+    leaves = leaf_cover(rng, body, owner, centres, radii, 2 / 0.6, "vegetation", "hedge_leaves", 0.15 * height)
     # clipped: a leaf reaching past the shears' planes (3 cm outside the body) is cut back toward its base
     lo = np.array([-length / 2, body.vertices[:, 1].min() - 0.03, 0.0])
     hi = np.array([length / 2, body.vertices[:, 1].max() + 0.03, body.vertices[:, 2].max() + 0.03])
