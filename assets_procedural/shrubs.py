@@ -18,7 +18,7 @@ from generator.materials import material_table
 
 #: Leaf sprays per bush cluster and per hedge clump; the hedge clumps' stretch along x (more overlap:
 #: one clipped wall rather than a row of barrels; beams still pass low between their rounded feet).
-BUSH_SPRAYS, HEDGE_SPRAYS, HEDGE_STRETCH = 16, 16, 1.1
+BUSH_SPRAYS, HEDGE_SPRAYS, HEDGE_STRETCH = 16, 16, 1.3
 _ICO1 = 42      #: vertices of a once-subdivided icosphere (one hedge clump)
 
 

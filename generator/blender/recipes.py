@@ -261,10 +261,6 @@ def leaves(g, rng):
     return _foliage(g, rng, (0.045, 0.09, 0.02))
 
 
-def hedge_leaves(g, rng):
-    return _foliage(g, rng, (0.03, 0.07, 0.018))
-
-
 def truck_paint(g, rng):
     return g.principled(base_color=g.object_info("Color"), metallic=0.1, roughness=0.45)
 

@@ -110,23 +110,41 @@ def bark_plane(g: Nodes, rng: np.random.Generator):
     return g.principled(base_color=patch, roughness=0.75)
 
 
+def hedge_leaves(g: Nodes, rng: np.random.Generator):
+    """Clipped-hedge leaves: dark glossy old leaves, each its own shade (Random Per Island), and about
+    one in eight tinged toward a light yellow-green new shoot; a soft per-hedge hue (Object Info > Random)."""
+    leaf = g.geometry("Random Per Island")
+    n = g.noise(g.coords("Object"), scale=1.5, detail=1)
+    old = g.ramp(n, [(0.3, _jit(rng, (0.025, 0.06, 0.016), 0.1)), (0.75, _jit(rng, (0.045, 0.095, 0.025), 0.1))])
+    old = g.hsv(old, hue=g.add(g.add(0.47, g.mul(g.object_info("Random"), 0.05)), g.mul(leaf, 0.04)),
+                value=g.add(0.55, g.mul(leaf, 0.9)))
+    young = g.mul(g.smooth(g.math("FRACT", g.mul(leaf, 7.0)), 0.84, 0.9), 0.7)
+    base = g.mix(young, old, _jit(rng, (0.075, 0.12, 0.028), 0.1))
+    face = g.principled(base_color=base, roughness=0.45, specular=0.45)
+    return g.mix_shader(0.2, face, g.translucent(base))
+
+
 def leaf_shade(g: Nodes, rng: np.random.Generator):
-    """The inner body of a leaf cluster: leaves in each other's shade, dark and mottled (no translucency:
-    little light gets through a cluster)."""
+    """The inner body of a leaf cluster: leaves in each other's shade, dark and mottled leaf by leaf
+    (Voronoi cells a leaf across, each domed by a bump, so the low-poly core shows leaves, not facets;
+    no translucency: little light gets through a cluster)."""
     co = g.coords("Object")
-    tone = g.ramp(g.noise(co, scale=6.0, detail=1), [(0.3, _jit(rng, (0.02, 0.042, 0.011), 0.1)),
-                                                      (0.7, _jit(rng, (0.04, 0.075, 0.018), 0.1))])
+    cell = g.voronoi(co, scale=9.0, out="Color")
+    dome = cell.node.outputs["Distance"]                                       # the same cells' F1 distance
+    tone = g.ramp(cell, [(0.0, _jit(rng, (0.02, 0.042, 0.011), 0.1)), (1.0, _jit(rng, (0.05, 0.09, 0.022), 0.1))])
+    tone = g.mix(g.mul(g.noise(co, scale=2.0, detail=1), 0.5), tone, (0.015, 0.03, 0.008))
     tone = g.hsv(tone, hue=g.add(0.47, g.mul(g.object_info("Random"), 0.06)))
-    return g.principled(base_color=tone, roughness=0.7, specular=0.25)
+    bump = g.bump(g.math("SUBTRACT", 1.0, dome), 0.5, 0.02)
+    return g.principled(base_color=tone, roughness=0.7, specular=0.25, normal=bump)
 
 
 def hedge_body(g: Nodes, rng: np.random.Generator):
-    """The clipped face of a hedge: small leaves packed edge to edge (Voronoi cells a few centimetres
-    across, each its own shade), darker in the crevices."""
+    """The inside of a hedge behind its leaf skin: small leaves packed edge to edge in deep shade
+    (Voronoi cells a few centimetres across, each its own shade), darker still in the holes."""
     co = g.coords("Object")
     cell = g.voronoi(co, scale=22.0, out="Color")
     deep = g.smooth(g.noise(co, scale=3.0, detail=1), 0.35, 0.7)             # holes in the clipping
-    tone = g.ramp(cell, [(0.0, _jit(rng, (0.025, 0.05, 0.012), 0.1)), (1.0, _jit(rng, (0.065, 0.115, 0.028), 0.1))])
-    tone = g.mix(g.mul(deep, 0.7), tone, (0.01, 0.018, 0.006))
+    tone = g.ramp(cell, [(0.0, _jit(rng, (0.012, 0.026, 0.007), 0.1)), (1.0, _jit(rng, (0.035, 0.07, 0.018), 0.1))])
+    tone = g.mix(g.mul(deep, 0.7), tone, (0.006, 0.011, 0.004))
     tone = g.hsv(tone, hue=g.add(0.47, g.mul(g.object_info("Random"), 0.05)))
-    return g.principled(base_color=tone, roughness=0.55, specular=0.35, normal=g.bump(deep, 0.5, 0.03))
+    return g.principled(base_color=tone, roughness=0.6, specular=0.3, normal=g.bump(deep, 0.5, 0.03))
