@@ -81,16 +81,20 @@ def sprays(rng: np.random.Generator, centre: np.ndarray, outward: np.ndarray, le
     side = _unit(side)
     up = np.cross(d, side)
     fan = np.radians(leaf.fan)
-    theta = np.linspace(-fan / 2, fan / 2, k)[None] + rng.uniform(-0.2, 0.2, (n, k))   # (n, k)
+    theta = np.linspace(-fan / 2, fan / 2, k)[None] + rng.uniform(-0.35, 0.35, (n, k))   # (n, k)
     length = rng.uniform(*leaf.length, (n, k)) * scale
     c, s = np.cos(theta)[..., None], np.sin(theta)[..., None]
     x = c * d[:, None] + s * side[:, None]                  # (n, k, 3) leaf axes
-    y = c * side[:, None] - s * d[:, None]                  # across the blade, in the spray plane
-    z = up[:, None]
+    y = c * side[:, None] - s * d[:, None]                  # across the blade, near the spray plane
+    y = _unit(y + 0.45 * rng.normal(size=(n, k, 3)))        # each blade rolled its own way: no flat star
+    y = _unit(y - (y * x).sum(-1, keepdims=True) * x)
+    y = np.where((np.cross(x, y) * up[:, None]).sum(-1, keepdims=True) < 0, -y, y)   # upper side toward ``up``
+    z = np.cross(x, y)
     lw = (leaf.width * length)[..., None]
     lb = (leaf.base * length)[..., None]
     tip = x * length[..., None] - z * (leaf.droop * length)[..., None]
-    base = centre[:, None] + 0.15 * x * length[..., None]
+    # leaves stand along the twig (0-0.2 leaf lengths out), not all from one point
+    base = centre[:, None] + (0.15 * x + 0.2 * rng.random((n, k, 1)) * d[:, None]) * length[..., None]
     v = np.stack([base + lb * x - lw * y, base + tip, base + lb * x + lw * y], 2)   # (n, k, 3, 3)
     m = n * k
     cid, mid = resolve_ids(cls, material)

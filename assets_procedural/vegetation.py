@@ -18,6 +18,7 @@ CROWN_BASE_MIN = 2.4  # metres: pedestrians and cars fit under a street tree
 
 TRI_BUDGET = 3000   #: most triangles one tree may have (branches first, then leaf clusters as fit)
 CLUMP_GAP = 1.75    #: leaf clump centres stay this many clump radii apart: the gaps rays pass through
+CORE = 0.58         #: a broadleaf cluster's shaded core / its radius: small enough that its leaves hide its facets
 
 
 def pick_species(rng: np.random.Generator, height: float) -> str:
@@ -59,9 +60,9 @@ def _crown(rng: np.random.Generator, sp: Species, conifer: bool, sk: Skeleton, r
     """Leaf clusters round the branch tips in at most ``room`` triangles: cores, then leaf sprays.
 
     Cluster centres come from :func:`_clumps` (``CLUMP_GAP`` radii apart: the gaps rays pass
-    through); each cluster is a dark core of 0.7 its radius (0.9 for conifer boughs) and sprays on
-    the shell between 0.75 and 1.2 of it, pointing outward. A crown whose branch tips hold fewer
-    clusters than planned grows them. Leaf sizes scale gently with the tree's height.
+    through); each cluster is a shaded core of :data:`CORE` its radius (0.9 for conifer boughs) and
+    sprays on the shell between 0.65 (0.75 for conifers) and 1.15 of it, pointing outward. A crown
+    whose branch tips hold fewer clusters than planned grows them. Leaf sizes scale gently with the tree's height.
     """
     leaf = foliage.LEAVES[sp.leaf]
     per_cluster = 20 + sp.sprays * leaf.per_spray
@@ -74,11 +75,11 @@ def _crown(rng: np.random.Generator, sp: Species, conifer: bool, sk: Skeleton, r
         radii = np.where(spire[:, None], r * np.array([0.5, 0.5, 1.6]), radii * [1.6, 0.9, 1.0])
         yaw = np.arctan2(centres[:, 1], centres[:, 0])
         c, s = np.cos(yaw), np.sin(yaw)
-    core = foliage.cores(rng, centres, (0.9 if conifer else 0.7) * radii, "tree_crown", sp.core)
+    core = foliage.cores(rng, centres, (0.9 if conifer else CORE) * radii, "tree_crown", sp.core)
     n_spray = max(0, room - core.n_faces) // leaf.per_spray
     counts = np.full(len(centres), n_spray // max(1, len(centres)))
     counts[: n_spray - counts.sum()] += 1
-    pts, out = foliage.shell(rng, centres, radii, counts, 0.75, 1.2, sp.leaf_lift)
+    pts, out = foliage.shell(rng, centres, radii, counts, 0.65 if not conifer else 0.75, 1.15, sp.leaf_lift)
     if conifer:     # turn the shell points and the cores with their boughs
         per_core = len(core.vertices) // max(1, len(centres))
         pts = _yawed(pts, np.repeat(np.arange(len(centres)), counts), centres, c, s)
