@@ -1,10 +1,10 @@
-"""Bushes and hedges: dark leaf-cluster bodies with sprays of leaf triangles on their outside.
+"""Bushes and hedges: shaded leaf-cluster bodies under a skin of separate leaf triangles.
 
 A bush is a few clusters (:func:`assets_procedural.foliage.cores`) with gaps between them; a
 hedge is a row of boxy clipped clumps (:func:`hedge_body`) stretched along the hedge into one
-clipped wall. Both carry leaf sprays (:func:`assets_procedural.foliage.sprays`) on
-their shell, so a close look shows leaves and LiDAR beams pass between clusters; the label pass
-covers each with its convex-hull proxy (:mod:`generator.geometry.proxy`).
+clipped wall. Both carry a leaf skin (:func:`assets_procedural.leaf_cover.leaf_cover`) on their
+outside, so a close look shows leaves, and LiDAR beams end on leaves at varied depths or pass
+between clusters; the label pass covers each with its convex-hull proxy (:mod:`generator.geometry.proxy`).
 """
 
 from __future__ import annotations
@@ -16,9 +16,9 @@ from assets_procedural.leaf_cover import leaf_cover
 from generator.geometry import Mesh, icosphere, merge, on_ground
 from generator.materials import material_table
 
-#: Leaf sprays per bush cluster and per hedge clump; the hedge clumps' stretch along x (more overlap:
-#: one clipped wall rather than a row of barrels; beams still pass low between their rounded feet).
-BUSH_SPRAYS, HEDGE_SPRAYS, HEDGE_STRETCH = 16, 16, 1.3
+#: The hedge clumps' stretch along x (more overlap: one clipped wall rather than a row of barrels;
+#: beams still pass low between their rounded feet).
+HEDGE_STRETCH = 1.3
 _ICO1 = 42      #: vertices of a once-subdivided icosphere (one hedge clump)
 
 
@@ -48,8 +48,9 @@ def bush(rng: np.random.Generator, size: float) -> Mesh:
     -------
     Mesh
         5-8 leaf clusters (class ``vegetation``): each a 20-triangle core (material
-        ``leaf_shade``) under :data:`BUSH_SPRAYS` sprays of small leaves (material
-        ``hedge_leaves``), with gaps between clusters, resting on the ground.
+        ``leaf_shade``) under a skin of separate small leaves
+        (:func:`assets_procedural.leaf_cover.leaf_cover`, material ``hedge_leaves``), with gaps
+        between clusters, resting on the ground.
     """
     if not 0.3 <= size <= 3.0:
         raise ValueError(f"bush size must be in [0.3, 3] m, got {size}")
@@ -61,9 +62,9 @@ def bush(rng: np.random.Generator, size: float) -> Mesh:
     centres = pts + [0, 0, 0.375 * size]
     radii = r * rng.uniform(0.8, 1.1, (len(centres), 3)) * [1, 1, 0.85]
     core = foliage.cores(rng, centres, 0.75 * radii, "vegetation", "leaf_shade")
-    at, out = foliage.shell(rng, centres, radii, np.full(len(centres), BUSH_SPRAYS), 0.75, 1.0, 0.4)
-    leaves = foliage.sprays(rng, at, out, foliage.LEAVES["small"], "vegetation", "hedge_leaves",
-                            float(np.clip(size / 1.2, 0.6, 1.2)))
+    owner = np.arange(core.n_faces) // 20
+    leaves = leaf_cover(rng, core, owner, centres, 0.75 * radii, 2.0, "vegetation", "hedge_leaves",
+                        float(core.vertices[:, 2].min()) + 0.1 * size)
     return on_ground(merge([core, leaves]))
 
 
