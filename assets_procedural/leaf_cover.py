@@ -35,9 +35,13 @@ def outside(points: np.ndarray, owner: np.ndarray, centres: np.ndarray, radii: n
     clumps still counts as outside.
     """
     keep = np.ones(len(points), bool)
-    for j in range(len(centres)):
-        q = np.abs((points - centres[j]) / radii[j]) ** power
-        keep &= (q.sum(1) >= margin) | (owner == j)
+    order = np.argsort(points[:, 0], kind="stable")
+    xs = points[order, 0]
+    for j in range(len(centres)):      # only the points within the clump's x extent can be inside it
+        lo, hi = np.searchsorted(xs, [centres[j, 0] - radii[j, 0], centres[j, 0] + radii[j, 0]], side="left")
+        i = order[lo:hi]
+        q = np.abs((points[i] - centres[j]) / radii[j]) ** power
+        keep[i] &= (q.sum(1) >= margin) | (owner[i] == j)
     return keep
 
 
