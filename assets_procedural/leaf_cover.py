@@ -19,7 +19,7 @@ from generator.geometry.primitives import resolve_ids
 
 #: Leaves per square metre of hedge face; leaf length range (m); half-width / length;
 #: how far a leaf sits out of (+) or into (-) the body's face (m); tilt of a leaf off the face (0 flat).
-DENSITY, LENGTH, WIDTH, DEPTH, TILT = 280.0, (0.07, 0.12), 0.38, (0.0, 0.06), 0.5
+DENSITY, LENGTH, WIDTH, DEPTH, TILT = 160.0, (0.08, 0.14), 0.4, (0.0, 0.06), 0.5
 
 
 def _unit(v: np.ndarray) -> np.ndarray:

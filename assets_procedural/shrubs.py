@@ -105,7 +105,8 @@ def hedge(rng: np.random.Generator, length: float, height: float = 1.2, depth: f
 
 def _cut_back(leaves: Mesh, lo: np.ndarray, hi: np.ndarray) -> Mesh:
     """``leaves`` (separate triangles: side, tip, side) shortened toward the middle of their base edge
-    until inside the box [``lo``, ``hi``] (3,); leaves whose base lies outside are dropped."""
+    until inside the box [``lo``, ``hi``] (3,); leaves whose base lies outside, or that would keep less
+    than 30 % of their size (slivers), are dropped."""
     t = leaves.vertices[leaves.faces]                                       # (n, 3, 3)
     base = (t[:, 0] + t[:, 2]) / 2
     inside = ((base > lo) & (base < hi)).all(1)
@@ -113,6 +114,7 @@ def _cut_back(leaves: Mesh, lo: np.ndarray, hi: np.ndarray) -> Mesh:
     with np.errstate(divide="ignore", invalid="ignore"):
         room = np.where(rel > 0, (hi - base)[:, None] / rel, np.where(rel < 0, (lo - base)[:, None] / rel, np.inf))
     f = np.clip(0.98 * room.min((1, 2)), 0.0, 1.0)[:, None, None]     # 2 % short: no tips coplanar on a plane
+    inside &= f[:, 0, 0] > 0.3                                          # a stub cut to a sliver is dropped
     t = (base[:, None] + f * rel)[inside]
     m = len(t)
     return Mesh(t.reshape(-1, 3), np.arange(3 * m, dtype=np.int64).reshape(m, 3), leaves.face_class[inside],
