@@ -19,6 +19,9 @@ from generator.materials import material_table
 #: The hedge clumps' stretch along x (more overlap: one clipped wall rather than a row of barrels;
 #: beams still pass low between their rounded feet).
 HEDGE_STRETCH = 1.3
+#: A bush cluster's core / its radius: its leaf skin then reaches about the cluster's radius (the bush is
+#: ``size`` across; a 20-triangle core's faces lie at 0.8 of its vertices' radius).
+BUSH_CORE = 1.1
 _ICO1 = 42      #: vertices of a once-subdivided icosphere (one hedge clump)
 
 
@@ -61,9 +64,9 @@ def bush(rng: np.random.Generator, size: float) -> Mesh:
     pts[:, 2] = np.maximum(pts[:, 2], -0.3 * half[2])
     centres = pts + [0, 0, 0.375 * size]
     radii = r * rng.uniform(0.8, 1.1, (len(centres), 3)) * [1, 1, 0.85]
-    core = foliage.cores(rng, centres, 0.75 * radii, "vegetation", "leaf_shade")
+    core = foliage.cores(rng, centres, BUSH_CORE * radii, "vegetation", "leaf_shade")
     owner = np.arange(core.n_faces) // 20
-    leaves = leaf_cover(rng, core, owner, centres, 0.75 * radii, 2.0, "vegetation", "hedge_leaves",
+    leaves = leaf_cover(rng, core, owner, centres, BUSH_CORE * radii, 2.0, "vegetation", "hedge_leaves",
                         float(core.vertices[:, 2].min()) + 0.1 * size)
     return on_ground(merge([core, leaves]))
 
