@@ -276,13 +276,17 @@ def test_rendered_depth_equals_lidar_range_on_shared_rays(rendered_dataset):
         # a ray through a gap of a porous (hull-labelled) crown or hedge, or past the edge of a building's
         # thin part (balcony rail, awning) in front of its wall: same class, another surface a sub-pixel away
         thin = T.hull_classes[frame.class_id] | (frame.class_id == T.id("building"))
-        shared &= ~(thin & _depth_edges(frame.depth))
+        porous_edge = thin & _depth_edges(frame.depth)
+        shared &= ~porous_edge
         assert shared.sum() > 0.3 * h * w  # (facades with balconies have many depth edges at 96 x 64)
         err = np.abs(dist[shared].astype(np.float64) - frame.depth[shared])
         assert np.percentile(err, 99) < 0.003, np.percentile(err, 99)
         # the few larger ones are grazing rays on the road far away (float32 ray directions)
         assert np.all(err < 0.005 + 2e-4 * frame.depth[shared]), err.max()
-        assert np.array_equal(cls == T.id("sky"), ~np.isfinite(frame.depth))
+        # sky where the centre ray meets nothing; on a porous edge Cycles' depth sample (jittered in the pixel)
+        # may pass a leaf the centre ray hits, so those pixels are left out, as above
+        keep = ~porous_edge
+        assert np.array_equal((cls == T.id("sky"))[keep], ~np.isfinite(frame.depth)[keep])
 
 
 @pytest.mark.blender
