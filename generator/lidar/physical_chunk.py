@@ -32,7 +32,7 @@ import numpy as np
 
 from generator.lidar.kernels import world_rays
 from generator.lidar.points import POINT_DTYPE
-from generator.lidar.probe_skip import probes_on_centre
+from generator.lidar.probe_skip import drop_on_centre, probes_on_centre
 from generator.lidar.return_kernels import beam_returns
 from generator.lidar.return_rays import (
     absorb_interior,
@@ -148,9 +148,8 @@ def run_physical_chunk(scanner, sweep, i: int, cols: slice) -> None:
             on = np.empty(n_probe, bool)
             if probes_on_centre(pb, pw, edge, side, model.probes, o_w, d_world, po, pd, dist, face,
                                 scanner.face_lookup.corners, lo_r, hi_r, SPLIT_STEP_M, SPLIT_STEP_REL, L, on):
-                cast = np.flatnonzero(~on)
-                pb, pw, po, pd = pb[cast], pw[cast], po[cast], pd[cast]
-                n_probe = len(pb)
+                n_probe = drop_on_centre(on, pb, pw, po, pd)
+                pb, pw, po, pd = pb[:n_probe], pw[:n_probe], po[:n_probe], pd[:n_probe]
             probe = _cast_subrays(scanner, plan, cols, aimed, po, pd, pb, i0, n_in, hi_r)
             keep, split = np.empty(n_probe, bool), np.empty(n_probe, np.int64)
             rb, rw = np.empty(n_probe * k, np.int64), np.empty(n_probe * k, np.int64)

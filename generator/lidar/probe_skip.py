@@ -141,3 +141,34 @@ def probes_on_centre(pb, pw, edge, side, probes, o_w, d_w, p_o, p_d, dist, face,
         if ok:
             count += 1
     return count
+
+
+@njit(nogil=True, cache=True)
+def drop_on_centre(on, pb, pw, p_o, p_d):  # pragma: no cover - compiled
+    """Move the probes to cast (``on`` False) to the front of ``pb, pw, p_o, p_d``, in order, in place.
+
+    One pass instead of four numpy gathers (``x[flatnonzero(~on)]``), which held the GIL.
+
+    Parameters
+    ----------
+    on : (m,) bool
+        :func:`probes_on_centre`'s output.
+    pb, pw : (m,) int64
+    p_o, p_d : (m, 3) float32
+        Updated in place: rows ``[:count]`` are the probes to cast.
+
+    Returns
+    -------
+    count : int
+    """
+    k = 0
+    for i in range(on.shape[0]):
+        if on[i]:
+            continue
+        if k != i:
+            pb[k], pw[k] = pb[i], pw[i]
+            for c in range(3):
+                p_o[k, c] = p_o[i, c]
+                p_d[k, c] = p_d[i, c]
+        k += 1
+    return k
