@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from generator.geometry import box
+from generator.labels import class_table
 from generator.lidar import physical_chunk
 from generator.lidar.physical_chunk import SPLIT_STEP_M, SPLIT_STEP_REL
 from generator.lidar.returns import ReturnModel, optics_from_materials
@@ -53,7 +54,10 @@ def test_a_probe_left_uncast_would_have_agreed_with_its_centre(hdl64e, test_scen
     un = p["uncast"]
     assert len(un) > 5000 and 0.2 < un.mean() < 0.7
     assert agree[un].mean() >= 0.995
-    assert np.mean(face[un] == p["face"][un]) >= 0.99  # mostly the very triangle the centre hit
+    # mostly the very triangle the centre hit; on foliage (leaf skins of hedges, bushes and crowns: many small
+    # triangles of one class and instance) a neighbouring leaf
+    leafy = class_table().hull_classes[label[p["face"]] >> 16]
+    assert np.mean(face[un & ~leafy] == p["face"][un & ~leafy]) >= 0.99
     assert agree[~un].mean() < 0.95  # the cast ones include every probe that splits its beam
 
 
