@@ -4,10 +4,11 @@ The town's ground runs flat to the horizon polygon (:mod:`generator.layout.groun
 from a street showed a green plane meeting the sky. This module fills the ground ring round the
 town with a low-detail city, so the view out of town ends in more town:
 
-* a tree line ``TREE_LINE_M`` beyond the town bounds, a tree every ~8 m round the whole town: a
-  trunk (class tree_trunk, material ``bark``) under a crown of ``LOBES`` overlapping rounded low-poly
-  lobes (class vegetation, material ``leaves``; 30 triangles each), so the line reads as trees on
-  trunks with ragged outlines rather than a row of green eggs on the ground;
+* a tree line ``TREE_LINE_M`` beyond the town bounds, a tree every ~4 m round the whole town (closer
+  than a crown is wide, so the crowns merge into one canopy band): a trunk (class tree_trunk,
+  material ``bark``) under a crown of ``LOBES`` overlapping rounded low-poly lobes of mixed sizes at
+  staggered heights (class vegetation, material ``leaves``; 30 triangles each), so the line reads as
+  a belt of trees with a ragged top rather than a row of lollipops;
 * city blocks from ``BLOCKS_FROM_M`` to ``REACH_M`` beyond the bounds on a square ``PITCH_M`` grid
   (streets left as open ground): each a park of a few crowns, or 1 to 4 buildings (class building),
   boxes whose walls are ``far_facade`` (a window pattern, windows lit at night) under a flat
@@ -24,7 +25,7 @@ sides. Every Blender object costs the RGB and label passes (Cycles syncs and ins
 a scene of one object per block held ~870 more of them; joined, the far city adds a dozen and keeps
 every triangle, class and material (each building stays its own mesh island for the facade
 shader). Blender and the LiDAR (which reaches 120 m and rarely meets it) share the same few
-triangles: about 59 k round a default town (which has about 1.3 M). The draws come from the stream
+triangles: about 90 k round a default town (which has about 1.9 M). The draws come from the stream
 ``("layout", "far_city")`` only, so the town's own draws are untouched, and nothing stands within
 ``TREE_LINE_M - 2 - CROWN_R_M[1]`` (7 m) of the town bounds.
 """
@@ -46,8 +47,8 @@ CROWN_H_M = (8.0, 14.0)       #: crown top height range
 #: crown shape: (share of the height, share of the radius) of each ring, bottom up
 CROWN_RINGS = ((0.06, 0.55), (0.38, 1.0), (0.74, 0.78))
 CROWN_SIDES = 5               #: vertices per ring
-LOBES = 3                     #: lobes of a tree line crown: the main one and two beside it
-CROWN_BASE = 0.32             #: a tree line crown starts at this share of the tree's height (the trunk below)
+LOBES = 6                     #: lobes of a tree line crown: the main one and five round it
+CROWN_BASE = 0.22             #: a tree line crown starts at this share of the tree's height (the trunk below)
 TRUNK_R_M = (0.16, 0.3)       #: tree line trunk radius range
 TRUNK_SIDES = 6               #: sides of a trunk prism
 BLOCKS_FROM_M = 40.0          #: the first block begins this far beyond the bounds
@@ -275,26 +276,36 @@ def _prisms(xy: np.ndarray, r: np.ndarray, z0: float, z1: np.ndarray) -> tuple[n
 
 
 def _tree_mesh(rng: np.random.Generator, shape: np.random.Generator, xy: np.ndarray, z0: float) -> Mesh:
-    """Trees of the tree line at ``xy`` (k, 2): a trunk up into a crown of ``LOBES`` lobes.
+    """Trees of the tree line at ``xy`` (k, 2), and one more between each two neighbours.
 
-    The main lobe spans ``CROWN_BASE`` of the tree's height to its top; each side lobe, turned a
-    random way and pushed out by 0.4 of the crown radius, is smaller and lower, so crowns differ in
-    outline and each lobe (a mesh island) takes its own shade of the ``leaves`` material. The crown
-    radius and tree height come from ``rng`` (as the single crowns of parks draw theirs), the trunk
-    and lobes from ``shape``, so the rest of the far city draws what it drew before the lobes.
+    Each is a trunk up into a crown of ``LOBES`` lobes. The main lobe spans ``CROWN_BASE`` of the
+    tree's height to its top; each other lobe, turned a random way and pushed out by up to 0.4 of the
+    crown radius, is smaller (0.4-0.65 of the crown) and starts anywhere in the crown's lower half,
+    so crowns differ in outline and each lobe (a mesh island) takes its own shade of the ``leaves``
+    material. The trees at ``xy`` take their crown radius and height from ``rng`` (as the single
+    crowns of parks draw theirs); the trees between them (somewhere in the middle third of the gap,
+    heights 0.7-1.3x of their neighbours' mean), the trunks and the lobes come from ``shape``, so the
+    rest of the far city draws what it drew before. No lobe reaches further than the crown radius
+    from its trunk.
     """
     k = len(xy)
     r, h = rng.uniform(*CROWN_R_M, k), rng.uniform(*CROWN_H_M, k)
+    if k > 1:
+        t = shape.uniform(0.35, 0.65, k - 1)[:, None]
+        xy = np.concatenate([xy, xy[:-1] + t * (xy[1:] - xy[:-1])])
+        r = np.concatenate([r, shape.uniform(0.8, 1.0, k - 1) * (r[:-1] + r[1:]) / 2])
+        h = np.concatenate([h, shape.uniform(0.7, 1.3, k - 1) * (h[:-1] + h[1:]) / 2])
+        k = len(xy)
     base = z0 + CROWN_BASE * h
     ch = (1.0 - CROWN_BASE) * h                                                  # crown height
     classes, mats = class_table(), material_table()
     parts = [Mesh(*_prisms(xy, shape.uniform(*TRUNK_R_M, k), z0, base + 0.3 * ch), classes.id("tree_trunk"),
                   mats.id("bark")),
-             Mesh(*_crowns(xy, 0.85 * r, ch, base), classes.id("vegetation"), mats.id("leaves"))]
-    for _ in range(LOBES - 1):   # side lobes reach at most 0.4 r + 0.6 r from the trunk: the 7 m gap holds
+             Mesh(*_crowns(xy, 0.8 * r, ch, base), classes.id("vegetation"), mats.id("leaves"))]
+    for _ in range(LOBES - 1):   # a lobe reaches at most 0.4 r + 0.6 r from the trunk: the 7 m gap holds
         a = shape.uniform(0, 2 * np.pi, k)
-        d = 0.4 * r[:, None] * np.stack([np.cos(a), np.sin(a)], 1)
-        s = shape.uniform(0.45, 0.6, k)
-        parts.append(Mesh(*_crowns(xy + d, s * r, s * ch, base + shape.uniform(0.0, 0.2, k) * ch),
+        d = shape.uniform(0.2, 0.4, k)[:, None] * r[:, None] * np.stack([np.cos(a), np.sin(a)], 1)
+        s = shape.uniform(0.4, 0.6, k)
+        parts.append(Mesh(*_crowns(xy + d, s * r, s * ch, base + shape.uniform(0.0, 0.5, k) * ch),
                           classes.id("vegetation"), mats.id("leaves")))
     return merge(parts)
