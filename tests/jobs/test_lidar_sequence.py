@@ -20,7 +20,7 @@ from kits.sensor_kit import with_lidar
 #: and for the far city joined into 12 objects nearer the town, the cars' cabins, the walkers' gait phases;
 #: and for the far tree line's trunks and three-lobed crowns (new triangles 80-100 m out); and for issue 29
 #: item 1's foliage (hedges and bushes under a skin of leaf triangles, trees' sprays and cores reshaped)
-IDEAL_TEST_TOWN = "167acf27f39ffdb1cab8bb1a7673a97a335eceb4337ed5b120b076085c08bae8"
+IDEAL_TEST_TOWN = "2d72ba5c80b435e2894b6075653fe4742a2493672685bcde6c09124c11950711"
 
 
 def _with_returns(spec, returns):

@@ -25,7 +25,7 @@ sides. Every Blender object costs the RGB and label passes (Cycles syncs and ins
 a scene of one object per block held ~870 more of them; joined, the far city adds a dozen and keeps
 every triangle, class and material (each building stays its own mesh island for the facade
 shader). Blender and the LiDAR (which reaches 120 m and rarely meets it) share the same few
-triangles: about 90 k round a default town (which has about 1.9 M). The draws come from the stream
+triangles: about 113 k round a default town (which has about 1.9 M). The draws come from the stream
 ``("layout", "far_city")`` only, so the town's own draws are untouched, and nothing stands within
 ``TREE_LINE_M - 2 - CROWN_R_M[1]`` (7 m) of the town bounds.
 """

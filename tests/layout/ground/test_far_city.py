@@ -71,7 +71,8 @@ def test_far_city_stands_outside_the_town_with_labels(default_scene):
                                    for o in far])).max()
     assert reach < max(bx1, by1) + fc.REACH_M + 10.0 + fc.WALL_DEPTH_M + 1.0
     n_far = sum(default_scene.prototypes[o.prototype].n_faces for o in far)
-    assert 5_000 < n_far < 60_000 and n_far < 0.05 * len(default_scene.faces)
+    # (113 k round the default town: the tree line's belt of 6-lobed crowns, a tree every ~4 m, is most of it)
+    assert 5_000 < n_far < 130_000 and n_far < 0.07 * len(default_scene.faces)
 
 
 def test_far_city_is_a_dozen_objects_whose_boxes_keep_apart(default_scene):
