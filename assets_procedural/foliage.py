@@ -45,7 +45,8 @@ LEAVES: dict[str, Leaf] = {
 }
 
 
-def _unit(v: np.ndarray) -> np.ndarray:
+def unit(v: np.ndarray) -> np.ndarray:
+    """``v`` (..., 3) scaled to unit length along its last axis (a zero vector stays zero)."""
     return v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-12)
 
 
@@ -74,11 +75,11 @@ def sprays(rng: np.random.Generator, centre: np.ndarray, outward: np.ndarray, le
     """
     centre = np.asarray(centre, np.float64).reshape(-1, 3)
     n, k = len(centre), leaf.per_spray
-    d = _unit(np.asarray(outward, np.float64).reshape(-1, 3) + 0.35 * rng.normal(size=(n, 3)))
-    up = _unit(np.array([0.0, 0.0, 1.0]) + 0.6 * d + 0.5 * rng.normal(size=(n, 3)))
+    d = unit(np.asarray(outward, np.float64).reshape(-1, 3) + 0.35 * rng.normal(size=(n, 3)))
+    up = unit(np.array([0.0, 0.0, 1.0]) + 0.6 * d + 0.5 * rng.normal(size=(n, 3)))
     side = np.cross(up, d)
     side = np.where(np.linalg.norm(side, axis=1, keepdims=True) < 1e-6, [1.0, 0.0, 0.0], side)
-    side = _unit(side)
+    side = unit(side)
     up = np.cross(d, side)
     fan = np.radians(leaf.fan)
     theta = np.linspace(-fan / 2, fan / 2, k)[None] + rng.uniform(-0.35, 0.35, (n, k))   # (n, k)
@@ -86,8 +87,8 @@ def sprays(rng: np.random.Generator, centre: np.ndarray, outward: np.ndarray, le
     c, s = np.cos(theta)[..., None], np.sin(theta)[..., None]
     x = c * d[:, None] + s * side[:, None]                  # (n, k, 3) leaf axes
     y = c * side[:, None] - s * d[:, None]                  # across the blade, near the spray plane
-    y = _unit(y + 0.45 * rng.normal(size=(n, k, 3)))        # each blade rolled its own way: no flat star
-    y = _unit(y - (y * x).sum(-1, keepdims=True) * x)
+    y = unit(y + 0.45 * rng.normal(size=(n, k, 3)))        # each blade rolled its own way: no flat star
+    y = unit(y - (y * x).sum(-1, keepdims=True) * x)
     y = np.where((np.cross(x, y) * up[:, None]).sum(-1, keepdims=True) < 0, -y, y)   # upper side toward ``up``
     z = np.cross(x, y)
     lw = (leaf.width * length)[..., None]
@@ -122,10 +123,10 @@ def shell(rng: np.random.Generator, centres: np.ndarray, radii: np.ndarray, coun
         ``outward`` is unit.
     """
     owner = np.repeat(np.arange(len(centres)), counts)
-    d = _unit(rng.normal(size=(len(owner), 3)) + [0.0, 0.0, lift])
+    d = unit(rng.normal(size=(len(owner), 3)) + [0.0, 0.0, lift])
     r = rng.uniform(inner, outer, len(owner))
     local = d * r[:, None] * radii[owner]
-    return centres[owner] + local, _unit(local / np.maximum(radii[owner], 1e-9) ** 2)
+    return centres[owner] + local, unit(local / np.maximum(radii[owner], 1e-9) ** 2)
 
 
 def cores(rng: np.random.Generator, centres: np.ndarray, radii: np.ndarray, cls: str, material: str,

@@ -14,16 +14,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from assets_procedural.foliage import unit
 from generator.geometry import Mesh, face_normals
 from generator.geometry.primitives import resolve_ids
 
 #: Leaves per square metre of hedge face; leaf length range (m); half-width / length;
 #: how far a leaf sits out of (+) or into (-) the body's face (m); tilt of a leaf off the face (0 flat).
 DENSITY, LENGTH, WIDTH, DEPTH, TILT = 160.0, (0.08, 0.14), 0.4, (0.0, 0.06), 0.5
-
-
-def _unit(v: np.ndarray) -> np.ndarray:
-    return v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-12)
 
 
 def outside(points: np.ndarray, owner: np.ndarray, centres: np.ndarray, radii: np.ndarray,
@@ -79,12 +76,12 @@ def leaf_cover(rng: np.random.Generator, body: Mesh, owner: np.ndarray, centres:
     a, b = np.where(flip, 1.0 - a, a), np.where(flip, 1.0 - b, b)
     t = tri[face]
     p = t[:, 0] + a[:, None] * (t[:, 1] - t[:, 0]) + b[:, None] * (t[:, 2] - t[:, 0])
-    up = _unit(n[face] + TILT * rng.normal(size=(count, 3)))         # each leaf faces out at its own angle
+    up = unit(n[face] + TILT * rng.normal(size=(count, 3)))         # each leaf faces out at its own angle
     p = p + n[face] * rng.uniform(*DEPTH, (count, 1))
     keep = outside(p, owner[face], centres, radii, power) & (p[:, 2] > floor)
     p, up = p[keep], up[keep]
     m = len(p)
-    axis = _unit(np.cross(up, rng.normal(size=(m, 3))))               # the blade's direction in its plane
+    axis = unit(np.cross(up, rng.normal(size=(m, 3))))               # the blade's direction in its plane
     across = np.cross(up, axis)
     length = rng.uniform(*LENGTH, (m, 1))
     base = p - 0.45 * length * axis                                   # the leaf's middle on the sample point

@@ -65,7 +65,7 @@ def bush(rng: np.random.Generator, size: float) -> Mesh:
     centres = pts + [0, 0, 0.375 * size]
     radii = r * rng.uniform(0.8, 1.1, (len(centres), 3)) * [1, 1, 0.85]
     core = foliage.cores(rng, centres, BUSH_CORE * radii, "vegetation", "leaf_shade")
-    owner = np.arange(core.n_faces) // 20
+    owner = np.arange(core.n_faces) // (core.n_faces // len(centres))   # each core's faces in a block
     leaves = leaf_cover(rng, core, owner, centres, BUSH_CORE * radii, 2.0, "vegetation", "hedge_leaves",
                         float(core.vertices[:, 2].min()) + 0.1 * size)
     return on_ground(merge([core, leaves]))

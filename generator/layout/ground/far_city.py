@@ -280,7 +280,7 @@ def _tree_mesh(rng: np.random.Generator, shape: np.random.Generator, xy: np.ndar
 
     Each is a trunk up into a crown of ``LOBES`` lobes. The main lobe spans ``CROWN_BASE`` of the
     tree's height to its top; each other lobe, turned a random way and pushed out by up to 0.4 of the
-    crown radius, is smaller (0.4-0.65 of the crown) and starts anywhere in the crown's lower half,
+    crown radius, is smaller (0.4-0.6 of the crown) and starts anywhere in the crown's lower half,
     so crowns differ in outline and each lobe (a mesh island) takes its own shade of the ``leaves``
     material. The trees at ``xy`` take their crown radius and height from ``rng`` (as the single
     crowns of parks draw theirs); the trees between them (somewhere in the middle third of the gap,
