@@ -13,7 +13,8 @@ the most its lanes hold), then one of two worlds:
 
 Rows, on the rays of the same HDL-64E sweeps (2083 x 64 = 133,312 rays each, motion skew on):
 
-* raw embreex ``run(output=1)`` on the already-transformed float32 rays, 1 and 2 threads
+* raw casts on the already-transformed float32 rays through each backend (Embree called directly,
+  :mod:`generator.lidar.embree_native`, and embreex's ``run(output=1)``), 1 and 2 threads
   (contiguous chunks, as many as the scanner's), against the static town and against the town
   with every actor frozen into it at the first sweep's start (the same triangles, no motion);
 * ours: ``Scanner.scan`` -- rays -> labelled points -- static town only, then with the world's
@@ -24,6 +25,8 @@ Rows, on the rays of the same HDL-64E sweeps (2083 x 64 = 133,312 rays each, mot
   preset without divergence, "received power only"); then the preset itself (strongest return with
   beam divergence) and dual returns with beam divergence; and both again with the divergence model as it
   was before ``edge_subrays: differing`` (every sub-ray of a split beam cast: "all sub-rays").
+  The ideal scanner and the two divergence rows run once more through embreex's ``run``
+  ("embreex" rows: the backend before Embree was called directly; the same points).
 
 Timings: each sweep of each method is timed in each of ``--rounds`` interleaved rounds and the
 best time per sweep is kept (a burst of load from other processes spoils one sample, not a row);
@@ -154,6 +157,9 @@ def main(argv=None) -> int:
     poses = [rig.sweep_poses(float(x), sensor.column_time()) for x in times]
     static = EmbreeCaster.from_scene(scene)
     t = time.perf_counter()
+    static_x = EmbreeCaster(scene.vertices, scene.faces, native=False)
+    build_x = time.perf_counter() - t
+    t = time.perf_counter()
     frozen = frozen_caster(scene, world, float(times[0]), static.center)
     build_frozen = time.perf_counter() - t
     t = time.perf_counter()
@@ -180,14 +186,19 @@ def main(argv=None) -> int:
     scanners = {(w, th): Scanner(scene, sensor, threads=th, caster=static, world=world if w else None)
                 for w in (False, True) for th in (1, args.threads)}
     methods = {
-        ("raw embreex, static town", 1): raw(static, 1),
-        ("raw embreex, static town", args.threads): raw(static, args.threads),
-        ("raw embreex, town + actors frozen", 1): raw(frozen, 1),
-        ("raw embreex, town + actors frozen", args.threads): raw(frozen, args.threads),
+        ("raw embree, static town", 1): raw(static, 1),
+        ("raw embree, static town", args.threads): raw(static, args.threads),
+        ("raw embreex, static town", 1): raw(static_x, 1),
+        ("raw embreex, static town", args.threads): raw(static_x, args.threads),
+        ("raw embree, town + actors frozen", 1): raw(frozen, 1),
+        ("raw embree, town + actors frozen", args.threads): raw(frozen, args.threads),
     }
-    for (w, th), sc in scanners.items():
+    for (w, th), sc in list(scanners.items()):
         name = "ours: Scanner.scan, actors moving" if w else "ours: Scanner.scan, static town"
         methods[(name, th)] = lambda i, sc=sc: sc.scan(poses[i], t0=float(times[i]))
+    scanners["x"] = Scanner(scene, sensor, threads=args.threads, caster=static_x, world=world)
+    methods[("embreex: Scanner.scan, actors moving", args.threads)] = \
+        lambda i: scanners["x"].scan(poses[i], t0=float(times[i]))
     physical = {}
     # the physical rows: (label, return mode, overrides of the preset's returns block)
     for label, mode, over in (("physical: power test only", "strongest",
@@ -198,11 +209,13 @@ def main(argv=None) -> int:
                               ("physical: dual + divergence", "dual", {}),
                               # the divergence model before edge_subrays: every sub-ray of a split beam cast
                               ("physical: strongest + divergence, all sub-rays", "strongest", ALL_SUBRAYS),
-                              ("physical: dual + divergence, all sub-rays", "dual", ALL_SUBRAYS)):
+                              ("physical: dual + divergence, all sub-rays", "dual", ALL_SUBRAYS),
+                              ("embreex: strongest + divergence", "strongest", {}),
+                              ("embreex: dual + divergence", "dual", {})):
         s_mode = with_returns(sensor, mode)
         s_mode = dataclasses.replace(s_mode, returns=dataclasses.replace(s_mode.returns, **over))
-        sc = Scanner(scene, s_mode, threads=args.threads, caster=static, world=world,
-                     returns=return_model(s_mode, spec.seed))
+        sc = Scanner(scene, s_mode, threads=args.threads, caster=static_x if label.startswith("embreex") else static,
+                     world=world, returns=return_model(s_mode, spec.seed))
         physical[label] = sc
         scanners[(label, args.threads)] = sc
         methods[(label, args.threads)] = lambda i, sc=sc: sc.scan(poses[i], t0=float(times[i]), noise_key=i)
@@ -231,18 +244,22 @@ def main(argv=None) -> int:
     for (name, th), (wall, cpu) in best.items():
         print(f"{name:44s} {th:3d} {sensor.rays_per_sweep * n / wall:12,.0f} {n / wall:9.1f} {1000 * wall / n:9.2f} "
               f"{1000 * cpu / n:13.2f}")
-    raw_s = best[("raw embreex, static town", args.threads)]
+    raw_s = best[("raw embree, static town", args.threads)]
     ours_s = best[("ours: Scanner.scan, static town", args.threads)]
     ours_a = best[("ours: Scanner.scan, actors moving", args.threads)]
-    raw_f = best[("raw embreex, town + actors frozen", args.threads)]
+    raw_f = best[("raw embree, town + actors frozen", args.threads)]
     cpu = {k: v[1] for k, v in best.items()}
     cpu_static, cpu_moving = cpu[("ours: Scanner.scan, static town", 1)], cpu[("ours: Scanner.scan, actors moving", 1)]
-    print(f"\nstatic: ours / raw embreex, {args.threads} threads: {raw_s[0] / ours_s[0]:.2f}x (target >= 0.95x); "
-          f"CPU per sweep, raw / ours, 1 thread: {cpu[('raw embreex, static town', 1)] / cpu_static:.2f}x")
+    print(f"\nstatic: ours / raw embree, {args.threads} threads: {raw_s[0] / ours_s[0]:.2f}x (target >= 0.95x); "
+          f"CPU per sweep, raw / ours, 1 thread: {cpu[('raw embree, static town', 1)] / cpu_static:.2f}x")
+    x_s = best[("raw embreex, static town", args.threads)]
+    print(f"backends: Embree called directly / embreex run, raw casts on {args.threads} threads: "
+          f"{x_s[0] / raw_s[0]:.2f}x faster; town BVH build {build_x / static.build_seconds:.2f}x faster "
+          f"({static.build_seconds:.2f} s against {build_x:.2f} s)")
     print(f"moving actors: ours {n / ours_a[0]:.1f} sweeps/s = "
           f"{sensor.rays_per_sweep * n / ours_a[0] / 1e6:.2f} M rays/s "
           f"on {args.threads} threads (target >= 30 sweeps/s, 4 M rays/s); "
-          f"{raw_f[0] / ours_a[0]:.2f}x raw embreex on the "
+          f"{raw_f[0] / ours_a[0]:.2f}x raw embree on the "
           f"town with the actors frozen; CPU over static-only: "
           f"+{1000 * (cpu_moving - cpu_static) / n:.2f} ms/sweep")
     on_actor = np.array([(s.points["instance"] >= 60000).sum() if args.traffic == "lanes" else
@@ -267,6 +284,13 @@ def main(argv=None) -> int:
               f"{kept[k]:,.0f} points per sweep ({100 * kept[k] / sensor.rays_per_sweep:.1f} % of the rays; "
               f"ideal {ideal_pts:,.0f})")
     print(f"ideal, actors moving: {n / base:.1f} sweeps/s = {n / base / sensor.rotation_hz:.2f}x real time")
+    for k in ("ideal", "strongest + divergence", "dual + divergence"):
+        new = best[("ours: Scanner.scan, actors moving", args.threads)] if k == "ideal" else best[(f"physical: {k}",
+                                                                                                    args.threads)]
+        old = best[("embreex: Scanner.scan, actors moving", args.threads)] if k == "ideal" else best[(f"embreex: {k}",
+                                                                                                    args.threads)]
+        print(f"{k}, actors moving: {n / new[0] / sensor.rotation_hz:.2f}x real time (embreex run: "
+              f"{n / old[0] / sensor.rotation_hz:.2f}x), {old[0] / new[0]:.2f}x faster")
     print(f"per sweep: {np.mean(seen):.0f} actors in range, {np.mean(cand):,.0f} rays in their column windows (before "
           f"the per-laser azimuth and static-distance culls), {on_actor.mean():,.0f} points on actors "
           f"({mov.mean():,.0f} moving)")

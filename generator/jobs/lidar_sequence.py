@@ -301,6 +301,8 @@ def write_dataset_label_config(out: str | Path, split: str | None = None, sequen
 def _metadata(scene, spec, sensor: Sensor, options: SequenceOptions, intensity_fn, n_points, counts) -> dict:
     import embreex
 
+    from generator.lidar import embree_native
+
     remission = dict(getattr(intensity_fn, "description", {"model": getattr(intensity_fn, "__name__", "custom")}))
     if remission.get("placeholder"):
         remission["note"] = ("placeholder: every point has the same remission until an intensity model "
@@ -333,5 +335,7 @@ def _metadata(scene, spec, sensor: Sensor, options: SequenceOptions, intensity_f
         "points_per_scan": n_points,
         "rays_per_scan": sensor.rays_per_sweep,
         "raw_id_counts": {str(k): v for k, v in sorted(counts.items())},
-        "software": {"numpy": np.__version__, "embreex": getattr(embreex, "__version__", "unknown")},
+        "software": {"numpy": np.__version__, "embreex": getattr(embreex, "__version__", "unknown"),
+                     "embree": embree_native.version() or "through embreex.run",
+                     "ray_casts": "Embree called directly" if embree_native.available() else "embreex.run"},
     }

@@ -102,6 +102,11 @@ class ActorCaster:
         Row of the first prototype face in the scanner's face tables (the static face count).
     center : (3,) float64
         The static caster's re-centring point (rays arrive as ``world - center``).
+    spread : float
+        Beam divergence margin added to the windows, radians (0 for the ideal sensor).
+    native : bool, optional
+        Backend of the prototypes' casters (:class:`generator.lidar.caster.EmbreeCaster`; the
+        scanner passes its static caster's, so one sweep casts through one backend).
 
     Attributes
     ----------
@@ -117,12 +122,13 @@ class ActorCaster:
         Every actor's track, evaluated in bulk.
     """
 
-    def __init__(self, world, sensor, face_offset: int, center: np.ndarray, spread: float = 0.0):
+    def __init__(self, world, sensor, face_offset: int, center: np.ndarray, spread: float = 0.0,
+                 native: bool | None = None):
         actors = world.actors
         # a walker's gait phase meshes follow its rest mesh; which one a ray meets is the phase at its column's time
         keys = list(dict.fromkeys(k for a in actors for k in ((a.prototype,) + (a.gait.keys if a.gait else ()))))
         self.protos = [world.prototypes[k] for k in keys]
-        self._casters = [EmbreeCaster(m.vertices, m.faces, center=np.zeros(3)) for m in self.protos]
+        self._casters = [EmbreeCaster(m.vertices, m.faces, center=np.zeros(3), native=native) for m in self.protos]
         sizes = np.array([m.n_faces for m in self.protos], np.int64)
         self.proto_face_offset = face_offset + np.cumsum(sizes) - sizes
         self.proto_of = np.array([keys.index(a.prototype) for a in actors], np.int64)

@@ -130,7 +130,8 @@ class Scanner:
         self.returns = returns if returns is not None and returns.params.physical else None
         n_static = len(self.caster.face_normals)
         spread = self.returns.spread if self.returns is not None else 0.0
-        self.actors = (ActorCaster(world, sensor, n_static, self.caster.center, spread)
+        self.actors = (ActorCaster(world, sensor, n_static, self.caster.center, spread,
+                                   getattr(self.caster, "native", None))
                        if world is not None and world.actors else None)
         # face-table rows: the town's faces, then each prototype's (instance filled per hit)
         protos = self.actors.protos if self.actors is not None else []

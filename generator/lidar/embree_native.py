@@ -1,0 +1,209 @@
+"""Embree 4 called directly: the library ``embreex`` ships, bound with ``ctypes``, cast from a compiled loop.
+
+Why
+---
+``embreex`` (4.4) wraps one call, ``EmbreeScene.run``, and pays for it: on the default town
+(1.9 M triangles, one HDL-64E sweep of 133,312 rays, one thread) its ``run`` takes ~1.4x the
+time of the same ``rtcIntersect1`` calls made from a compiled loop, and its scene build ~5x
+the time of a plain ``rtcCommitScene`` (``bench/lidar_traffic.py`` prints both backends side
+by side). The LiDAR spends most of a sweep in Embree, so this module binds the handful of
+Embree functions the caster needs against the very library ``embreex`` installs (no other
+download, no compiler): a device, a scene of one shared triangle buffer, ``rtcIntersect1``.
+
+Same hits
+---------
+The scene is built with ``RTC_SCENE_FLAG_ROBUST`` and Embree's default (medium) build
+quality, as ``embreex``'s scene is: the hit triangle and the ``tfar`` of every ray are the
+same bits as ``embreex``'s (a test casts a town through both). Without the robust flag about
+4 % of the distances differ in the last bit.
+
+Threads
+-------
+:func:`cast` is compiled with the GIL released and each call owns its ray record, so callers
+cast from several threads at once (:mod:`generator.lidar.scan` splits the rays). The kernel
+calls a ``ctypes`` function, so numba cannot cache it on disk: it is compiled once per process
+(~0.3 s), the first time a scene is built.
+
+Where the library is not found (a platform whose ``embreex`` wheel lays its files out
+differently), :func:`available` is False and :class:`generator.lidar.caster.EmbreeCaster` uses
+``embreex.run`` itself: same hits, slower.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import glob
+import logging
+import os
+from functools import cache
+
+import numpy as np
+
+log = logging.getLogger(__name__)
+
+_TRIANGLE, _INDEX, _VERTEX = 0, 0, 1  # RTC_GEOMETRY_TYPE_TRIANGLE, RTC_BUFFER_TYPE_INDEX / _VERTEX
+_UINT3, _FLOAT3 = 0x5003, 0x9003  # RTC_FORMAT_UINT3, RTC_FORMAT_FLOAT3
+_ROBUST = 4  # RTC_SCENE_FLAG_ROBUST
+_VERSION = 0  # RTC_DEVICE_PROPERTY_VERSION
+#: file names of the Embree 4 library inside an embreex install (Linux, macOS, Windows wheels)
+_PATTERNS = ("embreex.libs/libembree4*.so*", "embreex/.dylibs/libembree4*.dylib", "embreex.libs/embree4*.dll",
+             "embreex/embree4*.dll")
+
+
+@cache
+def _library() -> ctypes.CDLL | None:
+    try:
+        import embreex
+    except ImportError:
+        return None
+    root = os.path.dirname(os.path.dirname(embreex.__file__))
+    for pattern in _PATTERNS:
+        for path in sorted(glob.glob(os.path.join(root, pattern))):
+            try:
+                lib = ctypes.CDLL(path)
+            except OSError as e:
+                log.debug("cannot load %s: %s", path, e)
+                continue
+            _declare(lib)
+            return lib
+    return None
+
+
+def _declare(lib: ctypes.CDLL) -> None:
+    p, s, u = ctypes.c_void_p, ctypes.c_size_t, ctypes.c_uint
+    for name, res, args in (
+        ("rtcNewDevice", p, [ctypes.c_char_p]), ("rtcGetDeviceError", u, [p]),
+        ("rtcGetDeviceProperty", ctypes.c_ssize_t, [p, u]),
+        ("rtcNewScene", p, [p]), ("rtcSetSceneFlags", None, [p, u]), ("rtcCommitScene", None, [p]),
+        ("rtcReleaseScene", None, [p]), ("rtcNewGeometry", p, [p, u]),
+        ("rtcSetSharedGeometryBuffer", None, [p, u, u, u, p, s, s, s]), ("rtcCommitGeometry", None, [p]),
+        ("rtcAttachGeometry", u, [p, p]), ("rtcReleaseGeometry", None, [p]),
+    ):
+        fn = getattr(lib, name)
+        fn.restype, fn.argtypes = res, args
+
+
+def available() -> bool:
+    """True when the Embree library of the ``embreex`` install could be loaded."""
+    return _library() is not None
+
+
+@cache
+def _device() -> int:
+    lib = _library()
+    dev = lib.rtcNewDevice(None)
+    if not dev:
+        raise RuntimeError("Embree could not create a device")
+    return dev
+
+
+def version() -> str | None:
+    """Embree's version (e.g. ``"4.4.0"``), or None when the library is not available."""
+    if not available():
+        return None
+    v = _library().rtcGetDeviceProperty(_device(), _VERSION)
+    return f"{v // 10000}.{v // 100 % 100}.{v % 100}"
+
+
+@cache
+def _kernel():
+    """The compiled cast loop, bound to this process's ``rtcIntersect1``."""
+    from numba import njit
+
+    size = ctypes.c_size_t
+    intersect1 = ctypes.CFUNCTYPE(None, size, size, size)(("rtcIntersect1", _library()))
+
+    @njit(nogil=True, boundscheck=False)
+    def cast(scene, o, d, tfar, rec, rec_u, dist, prim):  # pragma: no cover - compiled
+        p = rec.ctypes.data
+        one = tfar.shape[0] == 1
+        for k in range(o.shape[0]):
+            # RTCRayHit: org, tnear, dir, time, tfar, mask, id, flags | Ng, u, v, primID, geomID, instID
+            rec[0] = o[k, 0]
+            rec[1] = o[k, 1]
+            rec[2] = o[k, 2]
+            rec[3] = 0.0
+            rec[4] = d[k, 0]
+            rec[5] = d[k, 1]
+            rec[6] = d[k, 2]
+            rec[7] = 0.0
+            rec[8] = tfar[0] if one else tfar[k]
+            rec_u[9] = 0xFFFFFFFF
+            rec_u[10] = 0
+            rec_u[11] = 0
+            rec_u[17] = 0xFFFFFFFF
+            rec_u[18] = 0xFFFFFFFF
+            intersect1(scene, p, 0)
+            dist[k] = rec[8]
+            prim[k] = np.int32(rec_u[17]) if rec_u[18] != 0xFFFFFFFF else np.int32(-1)
+
+    return cast
+
+
+def _record() -> tuple[np.ndarray, np.ndarray]:
+    """A 64-byte aligned RTCRayHit (room for 32 four-byte fields) as float32 and uint32 views."""
+    raw = np.zeros(48, np.float32)
+    off = (-raw.ctypes.data % 64) // 4
+    rec = raw[off:off + 32]
+    return rec, rec.view(np.uint32)
+
+
+class Scene:
+    """One Embree scene over one triangle soup, robust flag, default build quality.
+
+    Parameters
+    ----------
+    vertices : (V, 3) float32
+        Vertex positions in the caster's frame, metres. Shared with Embree (kept alive here).
+    faces : (F, 3) int
+        Vertex indices; the primitive id of a hit is the row.
+    """
+
+    def __init__(self, vertices: np.ndarray, faces: np.ndarray):
+        lib = _library()
+        self._cast = _kernel()
+        # Embree reads the last float3 with a 16-byte load: one float of padding past the end
+        self._v = np.zeros(3 * len(vertices) + 1, np.float32)
+        self._v[:-1] = np.asarray(vertices, np.float32).ravel()
+        self._f = np.ascontiguousarray(faces, np.uint32)
+        dev = _device()
+        self._lib, self._ptr = lib, lib.rtcNewScene(dev)
+        lib.rtcSetSceneFlags(self._ptr, _ROBUST)
+        geom = lib.rtcNewGeometry(dev, _TRIANGLE)
+        lib.rtcSetSharedGeometryBuffer(geom, _VERTEX, 0, _FLOAT3, self._v.ctypes.data, 0, 12, len(vertices))
+        lib.rtcSetSharedGeometryBuffer(geom, _INDEX, 0, _UINT3, self._f.ctypes.data, 0, 12, len(self._f))
+        lib.rtcCommitGeometry(geom)
+        lib.rtcAttachGeometry(self._ptr, geom)
+        lib.rtcReleaseGeometry(geom)
+        lib.rtcCommitScene(self._ptr)
+        err = lib.rtcGetDeviceError(dev)
+        if err:
+            raise RuntimeError(f"Embree failed to build the scene (error code {err})")
+
+    def __del__(self):
+        ptr, self._ptr = getattr(self, "_ptr", None), None
+        if ptr:
+            self._lib.rtcReleaseScene(ptr)
+
+    def intersect(self, origins: np.ndarray, directions: np.ndarray, tfar: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """First hits of rays (GIL released during the cast).
+
+        Parameters
+        ----------
+        origins, directions : (n, 3) float32, C-contiguous
+            Ray origins in the scene's frame and unit directions, metres.
+        tfar : (1,) or (n,) float32
+            Farthest distance to report, one for all rays or one per ray, metres.
+
+        Returns
+        -------
+        distance : (n,) float32
+            Distance of the hit; ``tfar`` where nothing was hit.
+        prim : (n,) int32
+            Face row of the hit, -1 where nothing was hit.
+        """
+        dist = np.empty(len(origins), np.float32)
+        prim = np.empty(len(origins), np.int32)
+        rec, rec_u = _record()
+        self._cast(self._ptr, origins, directions, tfar, rec, rec_u, dist, prim)
+        return dist, prim

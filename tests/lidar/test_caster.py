@@ -1,0 +1,87 @@
+"""The ray caster: Embree called directly gives embreex's hits, bit for bit, and is the backend in use."""
+
+from __future__ import annotations
+
+import sys
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+import pytest
+
+from generator.lidar import embree_native
+from generator.lidar.caster import EmbreeCaster
+from generator.lidar.sensors import load_preset
+
+
+def _terrain(n: int = 120, cell: float = 0.5) -> tuple[np.ndarray, np.ndarray]:
+    """A rolling height field with walls: many shared edges and grazing angles, (V, 3) and (F, 3)."""
+    x, y = np.meshgrid(np.arange(n + 1) * cell - n * cell / 2, np.arange(n + 1) * cell - n * cell / 2)
+    z = 0.4 * np.sin(x / 3.0) * np.cos(y / 4.0) + np.where(np.abs(x) > n * cell * 0.4, 3.0, 0.0)
+    v = np.stack([x, y, z], -1).reshape(-1, 3)
+    i = np.arange(n * (n + 1)).reshape(n, n + 1)[:, :n].ravel()
+    quads = np.stack([i, i + 1, i + n + 2, i + n + 1], 1)
+    return v, np.concatenate([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]])
+
+
+@pytest.fixture(scope="module")
+def rays():
+    o_l, d_l, _ = load_preset("hdl64e").local_rays()
+    d = np.ascontiguousarray(d_l.reshape(-1, 3), np.float32)
+    o = np.ascontiguousarray(o_l.reshape(-1, 3) + [3.3, -1.7, 1.73], np.float32)
+    return o, d
+
+
+@pytest.fixture(scope="module")
+def casters():
+    v, f = _terrain()
+    return EmbreeCaster(v, f, center=np.zeros(3)), EmbreeCaster(v, f, center=np.zeros(3), native=False)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the embreex wheel layout is checked on Linux")
+def test_embree_is_called_directly_on_linux():
+    assert embree_native.available()
+    assert embree_native.version().startswith("4.")
+    assert EmbreeCaster(*_terrain(4)).native
+
+
+@pytest.mark.parametrize("max_distance", [60.0, "per ray"])
+def test_direct_calls_hit_what_embreex_hits_bit_for_bit(casters, rays, max_distance):
+    native, x = casters
+    o, d = rays
+    if max_distance == "per ray":
+        max_distance = np.random.default_rng(0).uniform(2.0, 40.0, len(o)).astype(np.float32)
+    a, b = native.intersect_local(o, d, max_distance), x.intersect_local(o, d, max_distance)
+    assert np.isfinite(a[0]).sum() > len(o) // 3  # the terrain is hit, not missed
+    np.testing.assert_array_equal(a[1], b[1])
+    np.testing.assert_array_equal(a[0].view(np.uint32), b[0].view(np.uint32))
+
+
+def test_a_miss_keeps_its_max_distance_unless_marked(casters, rays):
+    native, _ = casters
+    o, d = rays
+    up = d[:, 2] > 0.01  # nothing above the sensor within 15 m (the walls stand 20 m away)
+    dist, prim = native.intersect_local(o[up], d[up], 15.0, mark_misses=False)
+    assert up.sum() > 1000 and (prim == -1).all() and (dist == np.float32(15.0)).all()
+    dist, _ = native.intersect_local(o[up], d[up], 15.0)
+    assert np.isinf(dist).all()
+
+
+def test_hits_beyond_max_distance_are_misses(casters, rays):
+    native, _ = casters
+    o, d = rays
+    full, prim = native.intersect_local(o, d, 200.0)
+    near, near_prim = native.intersect_local(o, d, 10.0)
+    hit = prim >= 0
+    np.testing.assert_array_equal(near_prim >= 0, hit & (full < 10.0))
+    np.testing.assert_array_equal(near[near_prim >= 0], full[near_prim >= 0])
+
+
+def test_threads_cast_at_once_give_the_same_hits(casters, rays):
+    native, _ = casters
+    o, d = rays
+    one = native.intersect_local(o, d, 120.0)
+    parts = np.array_split(np.arange(len(o)), 8)
+    with ThreadPoolExecutor(4) as pool:
+        got = list(pool.map(lambda i: native.intersect_local(o[i], d[i], 120.0), parts))
+    np.testing.assert_array_equal(np.concatenate([g[1] for g in got]), one[1])
+    np.testing.assert_array_equal(np.concatenate([g[0] for g in got]), one[0])
