@@ -3,10 +3,10 @@
 Why
 ---
 ``embreex`` (4.4) wraps one call, ``EmbreeScene.run``, and pays for it: on the default town
-(1.9 M triangles, one HDL-64E sweep of 133,312 rays, one thread) its ``run`` takes ~1.4x the
-time of the same ``rtcIntersect1`` calls made from a compiled loop, and its scene build ~5x
-the time of a plain ``rtcCommitScene`` (``bench/lidar_traffic.py`` prints both backends side
-by side). The LiDAR spends most of a sweep in Embree, so this module binds the handful of
+(1.9 M triangles, 120 moving cars) its scene build takes ~8x the time of a plain
+``rtcCommitScene`` (4.95 s against 0.63 s) and a sweep with beam divergence up to ~1.2x the
+time of the same ``rtcIntersect1`` calls made from a compiled loop (``bench/lidar_traffic.py``
+prints both backends side by side). The LiDAR spends most of a sweep in Embree, so this module binds the handful of
 Embree functions the caster needs against the very library ``embreex`` installs (no other
 download, no compiler): a device, a scene of one shared triangle buffer, ``rtcIntersect1``.
 
@@ -22,7 +22,7 @@ Threads
 :func:`cast` is compiled with the GIL released and each call owns its ray record, so callers
 cast from several threads at once (:mod:`generator.lidar.scan` splits the rays). The kernel
 calls a ``ctypes`` function, so numba cannot cache it on disk: it is compiled once per process
-(~0.3 s), the first time a scene is built.
+(~0.3 s with the library's loading), the first time a scene is built.
 
 Where the library is not found (a platform whose ``embreex`` wheel lays its files out
 differently), :func:`available` is False and :class:`generator.lidar.caster.EmbreeCaster` uses
