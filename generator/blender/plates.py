@@ -182,12 +182,14 @@ def _band() -> np.ndarray:
 def glyph_atlas() -> np.ndarray:
     """(CELL_PX[0], CELL_PX[1] * (len(CHARSET) + 1), 4) float32 RGBA, row 0 at the top: one cell per
     character of :data:`CHARSET` (near-black ink, alpha its coverage; FE-Schrift proportions: 75 mm
-    high, 9 mm strokes in a :data:`CELL_MM` cell) and the EU band (:data:`BAND_CODE`, opaque)."""
+    high, 9 mm strokes, letters 34 mm and digits 30 mm wide in a :data:`CELL_MM` cell) and the EU band
+    (:data:`BAND_CODE`, opaque)."""
     h, w = CELL_PX
     bh = INNER_MM[1] - INNER_MM[0]
     cells = []
     for ch in CHARSET:
-        cov = glyph_coverage(ch, CELL_PX, (CELL_MM, bh), (6.4, (bh - 75) / 2, CELL_MM - 6.4, (bh + 75) / 2), 9.0)
+        m = 6.4 + 2.0 * ch.isdigit()           # digits narrower than letters (FE-Schrift: 0 is not O)
+        cov = glyph_coverage(ch, CELL_PX, (CELL_MM, bh), (m, (bh - 75) / 2, CELL_MM - m, (bh + 75) / 2), 9.0)
         cell = np.zeros((h, w, 4), np.float32)
         cell[..., :3] = 0.012
         cell[..., 3] = cov
