@@ -12,7 +12,8 @@ and whose widths come from a plan-view curve:
 
 Glass is part of the same shell: the faces of the greenhouse rows between the pillars take
 ``car_glass`` (side windows, windscreen, rear window), so the glass follows the body's curves
-and nothing z-fights. The lowest row (sills, under-body) is ``car_trim`` (black plastic).
+and nothing z-fights. The lowest row (sills, under-body) and the pillars between side windows are
+``car_trim`` (black plastic: the glass reads as one band, as on most cars since the 2000s).
 
 Local frame: +x forward, z up, the body's lowest point at ``clearance``; wheels are added by
 :mod:`assets_procedural.vehicle`.
@@ -126,10 +127,10 @@ def top_line(p: dict, k: dict, tail: str) -> np.ndarray:
     cowl = belt + 0.03
     deck = {"notch": belt + 0.02, "hatch": belt - 0.04, "box": belt - 0.06, "bed": belt + 0.02}[tail]
     tail_top = {"notch": deck - 0.05, "hatch": deck - 0.1, "box": deck - 0.12, "bed": deck}[tail]
-    roof_back = {"notch": 0.3, "hatch": 0.15, "box": 0.07, "bed": 0.05}[tail]
+    roof_back = {"notch": 0.3, "hatch": 0.18, "box": 0.14, "bed": 0.05}[tail]
     pts = [(-L / 2, tail_top - 0.1), (-L / 2 + 0.02, tail_top), (k["xd"], deck), (k["xc"], H), (k["xb"], H),
            (k["xa"], cowl), (L / 2 - 0.1, hood_front), (L / 2, nose)]
-    radii = [0, 0.02, 0.06 if tail == "box" else 0.15, roof_back, 0.35, 0.2, 0.1, 0]
+    radii = [0, 0.02, 0.1 if tail == "box" else 0.15, roof_back, 0.35, 0.2, 0.1, 0]
     if tail == "bed":                         # vertical cab back wall, then the bed rail
         pts = [(-L / 2, deck - 0.08), (-L / 2 + 0.02, deck), (k["xd"] - 0.04, deck), (k["xd"], H - 0.05),
                (k["xc"], H), (k["xb"], H), (k["xa"], cowl), (L / 2 - 0.1, hood_front), (L / 2, nose)]
@@ -170,8 +171,9 @@ def body_shell(p: dict, body: str, cls: str = "car") -> tuple[Mesh, dict]:
         Class ``cls``; materials ``car_body`` (paint, shaded smooth), ``car_glass``, ``car_trim``;
         closed (end caps).
     info : dict
-        ``xs`` (s,) stations, ``top``/``shoulder``/``bottom``/``half_w`` (s,) per station, the
-        landmarks of :func:`key_points`.
+        ``xs`` (s,) stations, ``top``/``shoulder``/``bottom``/``half_w`` (s,) per station, ``rings``
+        (s, 15, 3) the lofted sections (points 0-7 the +y side, bottom to crown), the landmarks of
+        :func:`key_points`.
     """
     t = BODY_TYPES[body]
     tail = t["tail"]
@@ -191,22 +193,33 @@ def body_shell(p: dict, body: str, cls: str = "car") -> tuple[Mesh, dict]:
     zb = zb + np.interp(end_d, [0.0, 0.06, 0.2], [0.1, 0.04, 0.0])   # bumpers curve up underneath
     half = W / 2 * np.interp(end_d, *zip(*_PLAN, strict=False))
     g = np.clip((U - S) / max(p["H"] - belt, 1e-6), 0, 1)        # 0 on hood/deck, 1 under the roof
-    w_top = half * (0.93 - 0.2 * g)
+    w_top = half * (0.92 - 0.22 * g)             # the greenhouse leans in (tumblehome)
     rings = []
+    # the roof domes fore and aft: its ends (and the roof rails) sit up to 2 cm below its middle
+    roof = (xs < k["xb"]) & (xs > k["xc"])
+    mid, half_run = (k["xb"] + k["xc"]) / 2, max((k["xb"] - k["xc"]) / 2, 1e-6)
+    U = U - np.where(roof, 0.02 * ((xs - mid) / half_run) ** 2, 0.0) * g_roof(U, S, H, belt)
     for x, b, s_, u, w, wt in zip(xs, zb, S, U, half, w_top, strict=False):
         ws = 0.975 * w
+        gg = g_roof(u, s_, H, belt)
         z4 = s_ + 0.55 * (u - s_)
-        zr = u - min(0.05, 0.25 * (u - s_))
-        w4 = ws - 0.45 * (ws - wt)
+        zr = u - min(0.05 + 0.03 * gg, 0.3 * (u - s_))            # a rounder roof edge over the cabin
+        w4 = ws - 0.42 * (ws - wt)
         side = [(0.93 * w, b), (0.985 * w, b + min(0.1, 0.3 * (s_ - b))), (w, b + 0.5 * (s_ - b)), (ws, s_),
-                (w4, z4), (wt, zr), (0.7 * wt, u)]
+                (w4, z4), (wt, zr), (0.7 * wt, u - 0.012 * gg)]
         crown = u + 0.012 + 0.03 * (u - s_) / max(H - belt, 1e-6)
         ring = side + [(0.0, crown)] + [(-y, z) for y, z in side[::-1]]
         rings.append([(x, y, z) for y, z in ring])
     shell = loft(np.array(rings), cls, "car_body")
     _paint_regions(shell, xs, t, k, len(rings[0]))
-    info = dict(k, xs=xs, top=U, shoulder=S, bottom=zb, half_w=half, tail=tail)
+    info = dict(k, xs=xs, top=U, shoulder=S, bottom=zb, half_w=half, tail=tail, rings=np.array(rings))
     return shell, info
+
+
+def g_roof(u, s, H: float, belt: float):
+    """0 where the top line runs at the shoulder (hood, deck), 1 under the roof: how much of the cabin's
+    rounding a section takes."""
+    return np.clip((u - s) / max(H - belt, 1e-6), 0, 1)
 
 
 def _paint_regions(shell: Mesh, xs: np.ndarray, t: dict, k: dict, n_ring: int) -> None:
@@ -224,12 +237,14 @@ def _paint_regions(shell: Mesh, xs: np.ndarray, t: dict, k: dict, n_ring: int) -
     side_rows = np.isin(edge, [3, 4, 9, 10])
     top_rows = np.isin(edge, [6, 7])
     side_glass = side_rows & (xm < k["glass_front"]) & (xm > k["glass_back"])
+    pillar = np.zeros_like(side_glass)
     for xp in k["pillars"]:
-        side_glass &= np.abs(xm - xp) > PILLAR_M / 2
+        pillar |= side_glass & (np.abs(xm - xp) <= PILLAR_M / 2)
+    side_glass &= ~pillar
     windscreen = top_rows & (xm < k["xa"] - 0.05) & (xm > k["xb"] + 0.03)
     rear = top_rows & (xm < k["xc"] - 0.03) & (xm > k["xd"] + 0.03)
     mats = shell.face_material
     mats[:len(f)][side_glass | windscreen | rear] = glass
-    mats[:len(f)][np.isin(edge, [0, 13, 14])] = trim
+    mats[:len(f)][np.isin(edge, [0, 13, 14]) | pillar] = trim     # sills, under-body, black B/C-pillars
     if t["tail"] == "bed":                    # the bed's tonneau cover
         mats[:len(f)][np.isin(edge, [5, 6, 7, 8]) & (xm < k["xd"] - 0.06)] = trim

@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from assets_procedural.car_body import body_shell, draw_dimensions
+from assets_procedural.car_lamps import lamp
 from assets_procedural.vehicle_interior import car_interior
 from generator.geometry import Mesh, box, cylinder, disc, loft, merge, on_ground, polygon, pose, prism, resolve_ids
 from generator.geometry.primitives import quads
@@ -178,12 +179,10 @@ def car(rng: np.random.Generator, variant: str | None = None, quantile: float | 
     nose, tail_top = float(top[-1]), float(top[0])
     hw_end = float(half[-1])
     yl, yt = hw_end - 0.24, hw_end - 0.17
-    head = np.array([[L / 2 + PROUD_M, s * yl, nose - 0.05] for s in (1, -1)])
-    tail = np.array([[-L / 2 - PROUD_M, s * yt, tail_top - 0.05] for s in (1, -1)])
-    for c in head:
-        parts.append(box((0.16, 0.36, 0.08), "car", "headlight", (c[0] - 0.08, c[1], c[2])))
-    for c in tail:
-        parts.append(box((0.14, 0.28, 0.1), "car", "taillight", (c[0] + 0.07, c[1], c[2])))
+    head = np.array([[L / 2 + PROUD_M, s * yl, nose - 0.0625] for s in (1, -1)])
+    tail = np.array([[-L / 2 - PROUD_M, s * yt, tail_top - 0.0975] for s in (1, -1)])
+    parts.append(lamp(info, True, yl - 0.18, nose - 0.1, nose - 0.025, 0.2, "headlight"))    # lenses on the shell
+    parts.append(lamp(info, False, yt - 0.12, tail_top - 0.15, tail_top - 0.045, 0.13, "taillight"))
     bottom_f, bottom_r = float(info["bottom"][-1]), float(info["bottom"][0])
     parts.append(box((0.08, 2 * yl - 0.42, 0.13), "car", "car_trim", (L / 2 - 0.035, 0, nose - 0.12)))  # grille
     parts.append(box((0.03, 0.52, 0.11), "car", "licence_plate", (L / 2 + PROUD_M - 0.015, 0, bottom_f + 0.1)))

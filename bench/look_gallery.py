@@ -28,8 +28,9 @@ lit windows):
 * ``road``    -- stretches of road seen from 2.2 m up, looking down the lane;
 * ``facades_close`` -- a building of each wall material (render, brick, panels) from 8 m, and the
   first by night (issue 29 item 5);
-* ``cars``    -- a parked car from the sidewalk, front three-quarter by day and by night, and side-on
-  through its windows by day (issue 29 item 3);
+* ``cars``    -- a parked car from the sidewalk, front three-quarter by day and by night, rear
+  three-quarter and its tail (rear plate) from 2.6 m by day, and side-on through its windows by day
+  (issue 29 item 3);
 * ``people``  -- two walkers on a sidewalk, side on, at four gait phases each (the camera follows them), and a
   cyclist and a motorcyclist on their two-wheelers, side on (issue 29 item 4).
 
@@ -290,8 +291,9 @@ def horizon_shots(town) -> list[Shot]:
 
 # -- cars (issue 29 item 3, helper "cars") -------------------------------------------------------------
 def car_shots(town) -> list[Shot]:
-    """A parked car close up from the sidewalk, front three-quarter view, 1.6 m up, by day and by night;
-    and the same car side-on through its windows (issue 29 item 3)."""
+    """A parked car close up from the sidewalk, front three-quarter view, 1.6 m up, by day and by night; the
+    rear three-quarter view and its tail (the rear plate) from 2.6 m by day; and the same car side-on through
+    its windows (issue 29 item 3)."""
     for o in town.objects:
         if o.cls != "car" or o.attrs.get("placement") != "parked":
             continue
@@ -302,7 +304,12 @@ def car_shots(town) -> list[Shot]:
             eye = T[:3, :3] @ np.array([hi[0] + 1.6, side * (hi[1] + 2.6), 1.6]) + T[:3, 3]
             eye_side = T[:3, :3] @ np.array([(lo[0] + hi[0]) / 2 - 0.3, side * (hi[1] + 2.8), 1.5]) + T[:3, 3]
             if _clear_eye(town, eye, centre, 2.0) and _clear_eye(town, eye_side, centre, 2.0):
+                eye_rear = T[:3, :3] @ np.array([lo[0] - 1.6, side * (hi[1] + 2.6), 1.6]) + T[:3, 3]
+                eye_tail = T[:3, :3] @ np.array([lo[0] - 2.6, side * 0.9, 1.1]) + T[:3, 3]
+                tail = T[:3, :3] @ np.array([lo[0], 0.0, 0.7]) + T[:3, 3]
                 return [Shot("car_day", "car: parked, front three-quarter, day", look_at(eye, centre)),
+                        Shot("car_rear_day", "car: parked, rear three-quarter, day", look_at(eye_rear, centre)),
+                        Shot("car_tail_day", "car: parked, its tail from 2.6 m, day", look_at(eye_tail, tail)),
                         Shot("car_night", "car: parked, front three-quarter, night", look_at(eye, centre),
                              time_of_day="night"),
                         Shot("car_side_day", "car: parked, side-on through the windows, day",

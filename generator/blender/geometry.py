@@ -3,6 +3,7 @@
 One mesh datablock per prototype (repeated assets are linked duplicates: instancing),
 built with ``foreach_set`` from the very arrays the LiDAR casts against. Every mesh
 carries the per-face ``class_id`` (INT) attribute;
+meshes with licence plates a UV map ``ug_plate`` (:mod:`generator.blender.plates`);
 every object carries its instance id as ``pass_index``, its colour (``attrs["color"]`` or
 ``attrs["facade_color"]``) in ``color``, ``attrs["roof_color"]`` as the custom
 property ``ug_roof_color``, every other ``attrs["<name>_color"]`` as ``ug_<name>_color``,
@@ -18,11 +19,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from generator.blender.bpy_guard import bpy, mathutils
+from generator.blender.plates import plate_uv
 from generator.geometry import Mesh
 from generator.materials import material_table
 from generator.world.scene import SceneModel
 
 #: Materials shaded smooth (organic shapes); everything else is flat (hard surfaces).
+PLATE_UV = "ug_plate"  #: UV map of meshes with licence plates (:func:`generator.blender.plates.plate_uv`)
 SMOOTH_MATERIALS = frozenset({"leaves", "hedge_leaves", "hedge_body", "bark", "bark_plane", "leaf_shade",
                               "skin", "hair", "clothing", "rubber", "car_body", "clothing_bottom"})
 
@@ -57,6 +60,9 @@ def mesh(name: str, m: Mesh, materials: list) -> bpy.types.Mesh:
     smooth = np.isin(m.face_material, [table.id(n) for n in SMOOTH_MATERIALS])
     me.attributes.new("sharp_face", "BOOLEAN", "FACE").data.foreach_set("value", ~smooth)
     me.attributes.new("class_id", "INT", "FACE").data.foreach_set("value", m.face_class.astype(np.int32))
+    plate = m.face_material == table.id("licence_plate")
+    if plate.any():                                   # where on its plate each corner lies (the registration)
+        me.uv_layers.new(name=PLATE_UV).data.foreach_set("uv", plate_uv(m.vertices, m.faces, plate).ravel())
     me.update()
     return me
 

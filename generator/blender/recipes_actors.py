@@ -13,6 +13,7 @@ signature as :mod:`generator.blender.recipes`.
 from __future__ import annotations
 
 from generator.blender.nodes import Nodes
+from generator.blender.plate_shader import plate_surface
 from generator.labels import class_table
 from generator.materials import material_table
 
@@ -112,9 +113,10 @@ def wheel_rim(g: Nodes, rng):
 
 
 def licence_plate(g: Nodes, rng):
-    """White plates; about one car in eight yellow (Dutch plates, British rear plates)."""
+    """White plates; about one car in eight yellow (Dutch plates, British rear plates); a frame, the EU band
+    and the car's own registration (:mod:`generator.blender.plate_shader`)."""
     yellow = g.math("GREATER_THAN", g.object_info("Random"), 0.88)
-    return g.principled(base_color=g.mix(yellow, (0.78, 0.78, 0.72), (0.8, 0.6, 0.04)), roughness=0.35)
+    return plate_surface(g, g.mix(yellow, (0.78, 0.78, 0.72), (0.8, 0.6, 0.04)))
 
 
 def clothing(g: Nodes, rng):

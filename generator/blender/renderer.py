@@ -13,6 +13,7 @@ import numpy as np
 from generator.blender import actors, camera, controls, geometry, lighting, materials, motion, night, passes, session
 from generator.blender.bpy_guard import bpy
 from generator.blender.ground_tags import tag_kerbs
+from generator.blender.plates import apply_plates
 from generator.blender.vehicle_finish import apply_finishes
 from generator.spec.model import SceneSpec
 from generator.spec.render import RenderConfig
@@ -72,7 +73,9 @@ class Renderer:
         if world is not None and world.actors:
             self.actors = actors.build(world, self.materials, self.handles)
             self.night_counts["headlights"] += actors.headlights(self.actors, night.headlight, self.night_lights)
-        apply_finishes(self.handles.objects + (self.actors.objects if self.actors else []), spec.seed)
+        vehicles = self.handles.objects + (self.actors.objects if self.actors else [])
+        apply_finishes(vehicles, spec.seed)
+        apply_plates(vehicles, spec.seed)
         # Every light and world exists from the start: a render must not depend on earlier renders.
         lighting.ensure_sun(self.bscene)
         night.ensure_moon(self.bscene)

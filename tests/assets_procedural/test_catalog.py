@@ -161,7 +161,7 @@ def test_car_size_budget_and_lights(seed):
     L, W, H = extent(m)
     # mirrors included in W; the longest is a double-cab pickup
     assert 3.8 <= L <= 5.45 and 1.8 <= W <= 2.08 and 1.38 <= H <= 1.9
-    assert 900 <= m.n_faces <= 1700
+    assert 900 <= m.n_faces <= 1800     # ~1 670 with lamp lenses wrapping the corners (~1 620 with box lamps)
     lo, hi = m.bounds()
     assert np.allclose((lo[:2] + hi[:2]) / 2, 0, atol=0.1)
     assert m.anchors["headlight"].shape == (2, 3) and m.anchors["taillight"].shape == (2, 3)
