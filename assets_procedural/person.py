@@ -74,6 +74,8 @@ TORSO = np.array([(0.468, 0.058, 0.044, -0.004), (0.5, 0.094, 0.062, -0.008), (0
                   (0.6, 0.082, 0.056, 0.0), (0.65, 0.086, 0.059, 0.004), (0.705, 0.093, 0.065, 0.008),
                   (0.76, 0.099, 0.062, 0.004), (0.8, 0.106, 0.053, -0.004), (0.826, 0.094, 0.046, -0.006),
                   (0.842, 0.046, 0.038, -0.004), (0.862, 0.032, 0.033, 0.008), (0.888, 0.029, 0.031, 0.02)])
+#: half the distance between the hip joints (the thighs touch at the crotch, not below it)
+HIP_Y = 0.053
 #: the trousers' (shorts', skirt's) waistband: torso bands below this height are ``clothing_bottom``
 WAIST_Z = 0.6
 #: sex -> width factor of the hips, the waist and the shoulders; extra chest depth
@@ -202,7 +204,7 @@ def _limbs(d: dict, phi: float | None) -> tuple[Mesh, float]:
     """Legs and arms at gait phase ``phi`` (None: standing), and the pelvis lift ``dz`` they need."""
     g, garment = d["girth"], d["garment"]
     phase = None if phi is None else (phi + d["lead"]) % 1.0
-    legs, hip_z = gait.legs(phase, d["amplitude"], 0.05 * g)
+    legs, hip_z = gait.legs(phase, d["amplitude"], HIP_Y * g)
     dz = hip_z - 0.53
     leg_t, leg_m = _legs_table(garment)
     leg_t = leg_t * [1.0, g, g, g]

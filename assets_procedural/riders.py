@@ -21,7 +21,7 @@ import numpy as np
 
 from assets_procedural.motorcycles import _motorcycle_parts
 from assets_procedural.parts import centring, two_link
-from assets_procedural.person import _arms_table, _head, _legs_table, torso_sections
+from assets_procedural.person import HIP_Y, _arms_table, _head, _legs_table, torso_sections
 from assets_procedural.person_shape import hand, limb, shoe, skin
 from assets_procedural.two_wheelers import _bicycle_parts, contact_anchors
 from generator.geometry import Mesh, icosphere, merge, pose, resolve_ids
@@ -101,7 +101,7 @@ def _figure(rng: np.random.Generator, height: float, seat: np.ndarray, hip_dx: f
     leg_t[:, 2] *= np.interp(leg_t[:, 0], [0.3, 0.7], [0.8, 1.0])   # a seated thigh flattens on the saddle
     y = np.array([0.0, 1.0, 0.0])
     for k, s in enumerate((-1.0, 1.0)):
-        hip_s = hip + np.array([0.0, s * 0.05 * h * g, 0.0])
+        hip_s = hip + np.array([0.0, s * HIP_Y * h * g, 0.0])
         # foot: the ball of the foot on the support, toes forward, heel behind and above it
         fdir = np.array([np.cos(foot_pitch), 0.0, -np.sin(foot_pitch)])
         up = np.array([np.sin(foot_pitch), 0.0, np.cos(foot_pitch)])
