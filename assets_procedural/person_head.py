@@ -49,8 +49,8 @@ def shape(p: np.ndarray) -> np.ndarray:
     x, y, z = p[..., 0].copy(), p[..., 1].copy(), p[..., 2].copy()
     jaw = _smooth(-z, 0.2, 1.0)                                      # 0 above the cheekbones, 1 at the chin
     y *= 1.0 - 0.25 * jaw
-    z = np.where(z < 0, z * (1.0 - 0.35 * np.clip(-x, 0, 1)), z)     # the jaw's underside rises toward the nape
-    x = x + 0.4 * jaw                                                # the chin ahead, the nape under the skull
+    z = np.where(z < 0, z * (1.0 - 0.22 * np.clip(-x, 0, 1)), z)     # the jaw's underside rises toward the nape
+    x = x + 0.28 * jaw + 0.06 * _smooth(z, 0.05, 0.45) * (x > 0)    # chin and forehead ahead, the nape under the skull
     x = np.where(x > 0.66, 0.66 + 0.55 * (x - 0.66), x)             # a flat face
     x = x - 0.1 * np.exp(-((z - 0.2) / 0.45) ** 2) * (p[..., 0] < -0.2)   # the occiput
     if_front = (p[..., 0] > 0.5).astype(float)

@@ -142,9 +142,10 @@ def skin(g: Nodes, rng):
 
 
 def hair(g: Nodes, rng):
-    """Hair colour over strands: noise stretched 12x along the person's height, darkening and bumping."""
+    """Hair colour over strands: noise stretched 12x along the person's height, darkening and bumping (no sheen:
+    it greys dark hair under a bright sky)."""
     fallback = g.mix(g.object_info("Random"), (0.02, 0.015, 0.01), (0.25, 0.17, 0.08))
     strands = g.noise(g.mapping(g.coords("Object"), scale=(1.0, 1.0, 0.08)), scale=240.0, detail=2.0)
     tone = g.mix(g.smooth(strands, 0.3, 0.7), g.hsv(_per_object(g, "hair", fallback), value=0.6),
                  _per_object(g, "hair", fallback))
-    return g.principled(base_color=tone, roughness=0.45, sheen=0.4, normal=g.bump(strands, 0.35, 0.002))
+    return g.principled(base_color=tone, roughness=0.6, normal=g.bump(strands, 0.35, 0.002))
