@@ -19,8 +19,9 @@ from kits.sensor_kit import with_lidar
 #: (facades: window surrounds, corner drainpipes, coping lips and blade signs are new building triangles);
 #: and for the far city joined into 12 objects nearer the town, the cars' cabins, the walkers' gait phases;
 #: and for the far tree line's trunks and three-lobed crowns (new triangles 80-100 m out); and for issue 29
-#: item 1's foliage (hedges and bushes under a skin of leaf triangles, trees' sprays and cores reshaped)
-IDEAL_TEST_TOWN = "2d72ba5c80b435e2894b6075653fe4742a2493672685bcde6c09124c11950711"
+#: item 1's foliage (hedges and bushes under a skin of leaf triangles, trees' sprays and cores reshaped); and
+#: for issue 29 item 4 (people shaped, not tubes: the test town's people and walkers changed shape)
+IDEAL_TEST_TOWN = "d1a15674a200aa89b01f5f83f83186ad3862d95d55f55c2ebac29c089386149e"
 
 
 def _with_returns(spec, returns):
