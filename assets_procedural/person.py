@@ -1,19 +1,27 @@
-"""Pedestrians: an articulated low-poly figure (~600-750 triangles) facing +x.
+"""Pedestrians: an articulated, shaped figure (~1 800-2 100 triangles) facing +x.
 
 Proportions follow standard anthropometric ratios of body height (shoulders at 0.8 h, hips at
-0.545 h, knees at 0.3 h). The body is parts joined at joints: head (with hair or a hat), neck,
-torso, upper arms, elbows, forearms, hands (palm and fingers), thighs, knees, shins and shoes (heel
-and toe); a walking figure's limbs follow the gait cycle of :mod:`assets_procedural.person_gait`.
+0.545 h, knees at 0.3 h) and breadths (:data:`TORSO`). The body is parts joined at joints, each a
+skin of shaped cross-sections rather than a cylinder (:mod:`assets_procedural.person_shape`,
+:mod:`assets_procedural.person_head`): a torso from the crotch over hips, waist, chest and shoulders
+into the neck (women's hips wider and waist narrower, men's shoulders broader); legs whose thighs
+taper to the knee and whose calves bulge behind the shin; arms with a deltoid over the shoulder and a
+flat wrist; hands with a palm and curled fingers; shoes with a heel, an instep and a toe; a head with
+a skull, a jaw narrowing to the chin, a nose, a brow and ears, under hair that is a volume. A walking
+figure's limbs follow the gait cycle of :mod:`assets_procedural.person_gait`.
 Every face is class ``person``. Each garment has its own material, so each can take its own
 colour per object (:mod:`generator.layout.placement.appearance`): ``clothing`` (the top: torso,
-sleeves, a coat, a beanie), ``clothing_bottom`` (trousers, shorts, a skirt), ``shoes`` (shoes, a cap,
-a carried bag or a backpack), ``skin`` (face, hands, bare arms and legs) and ``hair``.
+sleeves, a jacket, a coat, a beanie), ``clothing_bottom`` (trousers, shorts, a skirt), ``shoes`` (shoes,
+a cap, a carried bag or a backpack), ``skin`` (face, neck, hands, bare arms and legs) and ``hair``.
+Garments have their own silhouettes: trousers looser than the leg with a hem over the shoe, shorts
+ending above the knee with a hem, a skirt flaring from the waist, a hip-length jacket whose hem stands
+proud of the trousers, a coat to mid-thigh, short sleeves with a hem over the biceps.
 
 Drawn per prototype from its generator: the build (girth 0.88-1.12, shoulder breadth 0.94-1.05), the
 garments (trousers, shorts, skirt, long coat; short sleeves), what the arms do (hang, hold a phone to
 the ear, hands in the pockets, carry a bag), a walker's hip swing (20-25 degrees) and leading leg,
 then (drawn last, after everything the figure drew before) the hair style (:data:`HAIR`), headwear
-(:data:`HEADWEAR`) and a backpack.
+(:data:`HEADWEAR`), a backpack and (last of all) a jacket over trousers or shorts (:data:`JACKET_P`).
 
 Given by the caller: the height, the ``age`` and the ``sex``. A child's head is a larger part of
 its height (head height about 1/5.5 of stature at 4 years, 1/6.5 at 10, 1/7.5 for adults:
@@ -30,7 +38,9 @@ from __future__ import annotations
 import numpy as np
 
 from assets_procedural import person_gait as gait
-from generator.geometry import Mesh, box, cylinder, icosphere, loft, merge, resolve_ids, tube
+from assets_procedural import person_head as head
+from assets_procedural import person_shape as shape
+from generator.geometry import Mesh, box, merge
 
 CLS = "person"
 POSES = ("standing", "walking")
@@ -50,13 +60,29 @@ HAIR: tuple[dict[str, float], dict[str, float]] = ({"long": 0.5, "ponytail": 0.2
                                                    {"short": 0.7, "buzz": 0.3})
 HEADWEAR: dict[str, float] = {"none": 0.8, "cap": 0.1, "beanie": 0.1}
 BACKPACK_P = 0.15
+#: a hip-length jacket over trousers or shorts, how often (drawn after everything else)
+JACKET_P = 0.35
 #: the standing model's hips lie this much higher than the constants of the torso and head below
 DZ_STANDING = gait.HIP_Z - 0.53
 
 
-def _ring(z: float, half_w: float, half_d: float, x: float = 0.0, k: int = 8) -> np.ndarray:
-    a = np.linspace(0, 2 * np.pi, k, endpoint=False)
-    return np.stack([x + half_d * np.cos(a), half_w * np.sin(a), np.full(k, z)], 1)
+#: torso sections (z, half width, half depth, forward offset of the centre), unit body height, hips at
+#: 0.53: crotch, hips over the buttocks, iliac crest, waist, lower ribs, chest, upper chest, shoulders,
+#: shoulder tops, trapezius, neck, the neck's top inside the head (adult breadths: hips 0.35 m, waist
+#: 0.29 m, chest 0.32 m, biacromial 0.39 m at 1.75 m stature)
+TORSO = np.array([(0.468, 0.058, 0.044, -0.004), (0.5, 0.094, 0.062, -0.008), (0.545, 0.092, 0.06, -0.005),
+                  (0.6, 0.082, 0.056, 0.0), (0.65, 0.086, 0.059, 0.004), (0.705, 0.093, 0.065, 0.008),
+                  (0.76, 0.099, 0.062, 0.004), (0.8, 0.106, 0.053, -0.004), (0.826, 0.094, 0.046, -0.006),
+                  (0.842, 0.046, 0.038, -0.004), (0.862, 0.032, 0.033, 0.008), (0.888, 0.029, 0.031, 0.02)])
+#: half the distance between the hip joints (the thighs touch at the crotch, not below it)
+HIP_Y = 0.053
+#: the trousers' (shorts', skirt's) waistband: torso bands below this height are ``clothing_bottom``
+WAIST_Z = 0.6
+#: sex -> width factor of the hips, the waist and the shoulders; extra chest depth
+SEX_SHAPE = {"female": (1.07, 0.93, 0.96, 0.007), "male": (0.97, 1.03, 1.03, 0.0), None: (1.0, 1.0, 1.0, 0.003)}
+TORSO_SIDES = 12
+_TA = np.linspace(0.0, 2.0 * np.pi, TORSO_SIDES, endpoint=False)
+_TX, _TY = np.sign(np.cos(_TA)) * np.abs(np.cos(_TA)) ** 0.8, np.sign(np.sin(_TA)) * np.abs(np.sin(_TA)) ** 0.8
 
 
 def _limb(top: np.ndarray, angle: float, bend: float, l0: float, l1: float) -> tuple[np.ndarray, np.ndarray]:
@@ -71,128 +97,70 @@ def _pick(rng: np.random.Generator, table: dict[str, float]) -> str:
     return names[int(rng.choice(len(names), p=np.array(list(table.values()))))]
 
 
-def _hair_shell(style: str, centre: np.ndarray, radii: np.ndarray) -> list[Mesh]:
-    """Hair of ``style`` over a head of ``radii`` at ``centre`` (the face, +x, left bare)."""
-    hair = icosphere(1.0, CLS, "hair", 1)
-    rel = hair.vertices[hair.faces].mean(1)
-    low = {"long": -0.6, "buzz": 0.1}.get(style, -0.15)
-    keep = (rel[:, 2] > low) & ~((rel[:, 0] > 0.35) & (rel[:, 2] < 0.5))
-    if style == "long":
-        keep &= ~((rel[:, 0] > 0.1) & (rel[:, 2] < 0.1))
-    grow = 1.03 if style == "buzz" else 1.08
-    out = [Mesh(hair.vertices * radii * grow + centre, hair.faces[keep], hair.face_class[keep],
-                hair.face_material[keep])]
-    if style == "ponytail":
-        top = centre + radii * np.array([-0.95, 0.0, 0.2])
-        out.append(tube(top, top + radii * np.array([-0.45, 0.0, -1.5]), 0.28 * radii[1], CLS, "hair", 0.14 * radii[1],
-                        sections=5))
-    elif style == "bun":
-        out.append(icosphere(0.45 * radii[1], CLS, "hair", 0, center=centre + radii * np.array([-0.95, 0.0, 0.5])))
-    return out
+def _head_parts(h: float, k: float = 1.0, style: str = "short", headwear: str = "none", cls: str = CLS) -> list[Mesh]:
+    """Head, hair and headwear (hips at 0.53 h); ``k`` scales the head about its chin."""
+    centre = np.array([0.012, 0.0, 0.859 + 0.066 * k]) * h
+    return [head.head(centre, k * h, cls), *head.hair(style, centre, k * h, cls),
+            *head.headwear(headwear, centre, k * h, cls)]
 
 
-def _headwear(kind: str, centre: np.ndarray, radii: np.ndarray) -> list[Mesh]:
-    """A cap (crown and brim, ``shoes`` material) or a beanie (``clothing``) over the head."""
-    if kind == "none":
-        return []
-    shell = icosphere(1.0, CLS, "shoes" if kind == "cap" else "clothing", 1)
-    rel = shell.vertices[shell.faces].mean(1)
-    keep = rel[:, 2] > (0.15 if kind == "cap" else 0.0)
-    out = [Mesh(shell.vertices * radii * 1.12 + centre, shell.faces[keep], shell.face_class[keep],
-                shell.face_material[keep])]
-    if kind == "cap":
-        brim = centre + radii * np.array([1.2, 0.0, 0.3])
-        out.append(box((0.9 * radii[0], 1.5 * radii[1], 0.08 * radii[2]), CLS, "shoes", tuple(brim)))
-    return out
+def _head(h: float, rng: np.random.Generator, k: float = 1.0, cls: str = CLS) -> list[Mesh]:
+    """Head and hair with long or short hair drawn from ``rng`` (one draw; riders use it)."""
+    return _head_parts(h, k, "long" if rng.random() < 0.4 else "short", cls=cls)
 
 
-def _head_parts(h: float, k: float = 1.0, style: str = "short", headwear: str = "none") -> list[Mesh]:
-    """Head, hair, headwear and neck (hips at 0.53 h); ``k`` scales the head about its chin."""
-    centre = np.array([0.01 * h, 0.0, (0.859 + 0.066 * k) * h])
-    radii = np.array([0.056, 0.05, 0.066]) * h * k
-    head = icosphere(1.0, CLS, "skin", 1)
-    head.vertices = head.vertices * radii + centre
-    neck = tube((0, 0, 0.82 * h), (0.005 * h, 0, 0.88 * h), 0.028 * h, CLS, "skin", sections=6, caps=False)
-    return [head, *_hair_shell(style, centre, radii), *_headwear(headwear, centre, radii), neck]
+def torso_sections(girth: float, breadth: float, sex: str | None, garment: str,
+                   jacket: bool = False) -> tuple[np.ndarray, list[str]]:
+    """Torso rings (s, 12, 3) bottom to top (hips at 0.53, unit height) and each band's material:
+    the waistband down in ``clothing_bottom`` (a coat or a jacket covering it in ``clothing``), a skirt
+    flaring to above the knees, a coat's hem at mid-thigh, the neck in ``skin``."""
+    hips, waist, shoulders, bust = SEX_SHAPE[sex]
+    t = TORSO.copy()
+    t[:, 1] *= np.interp(t[:, 0], [0.5, 0.545, 0.6, 0.65, 0.76, 0.826], [hips, hips, waist, 1.0, 1.0, shoulders])
+    t[:, 1] *= np.interp(t[:, 0], [0.65, 0.705, 0.826, 0.842], [1.0, breadth, breadth, 1.0])
+    t[:, 1:3] *= np.interp(t[:, 0], [0.826, 0.862], [girth, 1.0])[:, None]
+    t[5, 2:4] += bust
+    rows = [tuple(r) for r in t]
+    top_from = WAIST_Z
+    if garment == "coat":                        # hem at mid-thigh, hanging straight from the hips
+        rows = [(0.36, 0.108 * girth, 0.08 * girth, -0.006), (0.43, 0.104 * girth, 0.074 * girth, -0.006)] + rows[1:]
+        top_from = 0.0
+    elif garment == "skirt":
+        rows = [(0.35, 0.118 * girth, 0.095 * girth, 0.0), (0.43, 0.104 * girth, 0.077 * girth, -0.004)] + rows[1:]
+    elif jacket:                                 # a hip-length jacket: its hem a lip over the trousers
+        z, w, d, x = rows[0]
+        rows[1:1] = [(0.487, 0.085 * girth, 0.058 * girth, x), (0.49, 0.1 * girth, 0.068 * girth, -0.007)]
+        top_from = 0.486
+    rows = np.array(rows)
+    if garment == "coat" or jacket:              # the top garment's ease over the chest and waist
+        rows[(rows[:, 0] >= top_from) & (rows[:, 0] < 0.82), 1:3] += 0.005
+    rings = np.stack([rows[:, 3:4] + rows[:, 2:3] * _TX, rows[:, 1:2] * _TY,
+                      np.broadcast_to(rows[:, :1], (len(rows), TORSO_SIDES))], -1)
+    mats = ["skin" if lo >= 0.842 else "clothing" if lo >= top_from else "clothing_bottom" for lo in rows[:-1, 0]]
+    return rings, mats
 
 
-def _head(h: float, rng: np.random.Generator, k: float = 1.0) -> list[Mesh]:
-    """Head, hair and neck with long or short hair drawn from ``rng`` (one draw; riders use it)."""
-    return _head_parts(h, k, "long" if rng.random() < 0.4 else "short")
+def _legs_table(garment: str) -> tuple[np.ndarray, list[str]]:
+    """Leg sections and band materials: trousers to the ankle, shorts above the knee, bare under a skirt."""
+    bare = shape.LEG
+    if garment == "skirt":
+        return bare, ["skin"] * (len(bare) - 1)
+    if garment == "shorts":
+        t, at = shape.hem(shape.eased(bare, 0.008, 0.4), 0.62, 0.008)
+        t = np.concatenate([t[: at + 2], bare[bare[:, 0] > 0.63]])
+        return t, ["clothing_bottom"] * (at + 1) + ["skin"] * (len(t) - at - 2)
+    t, at = shape.hem(shape.eased(bare, 0.007, 0.35), 1.9, 0.004)
+    t = np.concatenate([t[: at + 2], bare[bare[:, 0] > 1.91]])
+    return t, ["clothing_bottom"] * (at + 1) + ["skin"] * (len(t) - at - 2)
 
 
-def _torso(girth: float, breadth: float, garment: str) -> Mesh:
-    """Hips to neck base (unit height), the waistband down in ``clothing_bottom`` (the top in a coat)."""
-    g = girth
-    rings = [_ring(0.48, 0.088 * g, 0.06 * g), _ring(0.555, 0.082 * g, 0.058 * g), _ring(0.62, 0.078 * g, 0.058 * g),
-             _ring(0.72, 0.095 * g * breadth, 0.066 * g), _ring(0.795, 0.11 * g * breadth, 0.058 * g),
-             _ring(0.835, 0.045, 0.04)]
-    hem = {"coat": _ring(0.36, 0.1 * g, 0.075 * g), "skirt": _ring(0.35, 0.118 * g, 0.092 * g)}.get(garment)
-    if hem is not None:
-        rings.insert(0, hem)
-    torso = loft(np.array(rings), CLS, "clothing")
-    n_bottom = {"coat": 0, "skirt": 2}.get(garment, 1)            # ring gaps below the waistband
-    _, bottom = resolve_ids(CLS, "clothing_bottom")
-    torso.face_material[: 2 * 8 * n_bottom] = bottom
-    if n_bottom:
-        torso.face_material[-16:-8] = bottom                        # the cap under the hips
-    return torso
-
-
-_SIDES = 6
-_RING = np.stack([np.cos(np.linspace(0, 2 * np.pi, _SIDES, endpoint=False)),
-                  np.sin(np.linspace(0, 2 * np.pi, _SIDES, endpoint=False))], 1)
-#: faces of a 6-sided tube with and without end caps (the vertex order of :func:`generator.geometry.cylinder`)
-_TUBE_FACES = {caps: cylinder(1.0, 1.0, CLS, "skin", _SIDES, caps=caps).faces for caps in (True, False)}
-
-
-def _limb_tube(p0: np.ndarray, p1: np.ndarray, r0: float, r1: float, material: str, caps: bool = True) -> Mesh:
-    """A 6-sided tapered tube from ``p0`` to ``p1`` (as :func:`generator.geometry.tube` builds it, in a
-    fraction of its time: a walker builds ~20 per gait phase)."""
-    axis = np.asarray(p1, float) - np.asarray(p0, float)
-    length = float(np.sqrt(axis @ axis))
-    w = axis / length
-    h = (0.0, 0.0, 1.0) if abs(w[2]) < 0.9 else (1.0, 0.0, 0.0)
-    u = np.array([h[1] * w[2] - h[2] * w[1], h[2] * w[0] - h[0] * w[2], h[0] * w[1] - h[1] * w[0]])
-    u /= np.sqrt(u @ u)
-    v = np.array([w[1] * u[2] - w[2] * u[1], w[2] * u[0] - w[0] * u[2], w[0] * u[1] - w[1] * u[0]])
-    ring = _RING[:, :1] * u + _RING[:, 1:] * v
-    verts = [p0 + r0 * ring, p1 + r1 * ring] + ([np.stack([p0, p1])] if caps else [])
-    c, m = resolve_ids(CLS, material)
-    return Mesh(np.concatenate(verts), _TUBE_FACES[caps], c, m)
-
-
-def _oriented(center: np.ndarray, axes: np.ndarray, size: tuple[float, float, float], material: str,
-              cls: str = CLS) -> Mesh:
-    """A box of ``size`` along the columns of ``axes`` (3x3, orthonormal) centred on ``center``."""
-    b = box(size, cls, material)
-    return Mesh(b.vertices @ axes.T + center, b.faces, b.face_class, b.face_material)
-
-
-def _hand(wrist: np.ndarray, elbow: np.ndarray, material: str = "skin", k: float = 1.0, cls: str = CLS) -> list[Mesh]:
-    """Palm and fingers continuing the forearm, flat across it (palm toward the body's side); ``k`` is the
-    body height (the sizes are fractions of it), ``cls`` the class of the faces (a rider's)."""
-    d = (wrist - elbow) / np.linalg.norm(wrist - elbow)
-    w = np.cross(d, [0.0, 1.0, 0.0])
-    if np.linalg.norm(w) < 0.3:
-        w = np.cross(d, [1.0, 0.0, 0.0])
-    w /= np.linalg.norm(w)
-    axes = np.stack([d, w, np.cross(d, w)], 1)
-    palm = _oriented(wrist + 0.03 * k * d, axes, (0.058 * k, 0.046 * k, 0.022 * k), material, cls)
-    fingers = _oriented(wrist + 0.08 * k * d, axes, (0.045 * k, 0.04 * k, 0.015 * k), material, cls)
-    return [palm, fingers]
-
-
-def _shoe(ankle: np.ndarray, pitch: float) -> Mesh:
-    """A shoe under ``ankle``: heel to toe, the toe box lower than the instep, pitched (+ = toe down)."""
-    b = box((gait.TOE_X - gait.HEEL_X, 0.056, gait.ANKLE_Z - 0.004), CLS, "shoes",
-            ((gait.TOE_X + gait.HEEL_X) / 2, 0.0, -(gait.ANKLE_Z + 0.004) / 2))
-    v = b.vertices.copy()
-    toe_top = (v[:, 0] > 0) & (v[:, 2] > -0.02)
-    v[toe_top, 2] = -0.028
-    c, s = np.cos(pitch), np.sin(pitch)
-    v = v @ np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]]).T
-    return Mesh(v + ankle, b.faces, b.face_class, b.face_material)
+def _arms_table(short_sleeves: bool, coat: bool) -> tuple[np.ndarray, list[str]]:
+    """Arm sections and band materials: a short sleeve's hem above the biceps, a long one's cuff."""
+    bare = shape.ARM
+    s, ease = (0.45, 0.006) if short_sleeves else (1.86, 0.009 if coat else 0.005)
+    t, at = shape.hem(shape.eased(bare, ease, 0.4), s, 0.006)
+    t = np.concatenate([t[: at + 2], bare[bare[:, 0] > s + 0.01]])
+    return t, ["clothing"] * (at + 1) + ["skin"] * (len(t) - at - 2)
 
 
 def _draw(rng: np.random.Generator, pose: str, sex: str | None) -> dict:
@@ -215,14 +183,18 @@ def _draw(rng: np.random.Generator, pose: str, sex: str | None) -> dict:
     style = _pick(rng, HAIR[0 if long_hair else 1])
     headwear = _pick(rng, HEADWEAR)
     backpack = "bag" not in arms and rng.random() < BACKPACK_P
-    return dict(girth=girth, breadth=breadth, garment=garment, short_sleeves=short_sleeves, arms=arms,
-                amplitude=amplitude, lead=lead, style=style, headwear=headwear, backpack=backpack, bends=bends)
+    jacket = garment in ("trousers", "shorts") and rng.random() < JACKET_P
+    return dict(girth=girth, breadth=breadth, garment=garment, short_sleeves=short_sleeves and not jacket,
+                arms=arms, amplitude=amplitude, lead=lead, style=style, headwear=headwear, backpack=backpack,
+                bends=bends, jacket=jacket, sex=sex)
 
 
 def _body(d: dict, head_k: float) -> Mesh:
-    """The parts that do not articulate (torso, head, neck, a backpack), hips at 0.53, unit height."""
+    """The parts that do not articulate (torso and neck, head, hair, a backpack), hips at 0.53, unit height."""
     g = d["girth"]
-    parts = [_torso(g, d["breadth"], d["garment"]), *_head_parts(1.0, head_k, d["style"], d["headwear"])]
+    rings, mats = torso_sections(g, d["breadth"], d["sex"], d["garment"], d["jacket"])
+    torso = shape.skin(rings, CLS, mats, rings[0].mean(0) - [0.0, 0.0, 0.01], rings[-1].mean(0) + [0.0, 0.0, 0.01])
+    parts = [torso, *_head_parts(1.0, head_k, d["style"], d["headwear"])]
     if d["backpack"]:
         parts.append(box((0.11, 0.22 * g, 0.27), CLS, "shoes", (-0.066 * g - 0.052, 0.0, 0.66)))
     return merge(parts)
@@ -230,25 +202,24 @@ def _body(d: dict, head_k: float) -> Mesh:
 
 def _limbs(d: dict, phi: float | None) -> tuple[Mesh, float]:
     """Legs and arms at gait phase ``phi`` (None: standing), and the pelvis lift ``dz`` they need."""
-    g = d["girth"]
-    garment = d["garment"]
-    thigh = "skin" if garment == "skirt" else "clothing_bottom"
-    shin = "skin" if garment in ("skirt", "shorts") else "clothing_bottom"
-    sleeve = "skin" if d["short_sleeves"] else "clothing"
+    g, garment = d["girth"], d["garment"]
     phase = None if phi is None else (phi + d["lead"]) % 1.0
-    legs, hip_z = gait.legs(phase, d["amplitude"], 0.052 * g)
+    legs, hip_z = gait.legs(phase, d["amplitude"], HIP_Y * g)
     dz = hip_z - 0.53
+    leg_t, leg_m = _legs_table(garment)
+    leg_t = leg_t * [1.0, g, g, g]
+    arm_t, arm_m = _arms_table(d["short_sleeves"], garment == "coat")
+    arm_t = arm_t * [1.0, g, g, g]
+    y = np.array([0.0, 1.0, 0.0])
     parts = []
     for leg in legs:
-        parts += [_limb_tube(leg.hip, leg.knee, 0.05 * g, 0.037, thigh),
-                  icosphere(0.036, CLS, shin, 0, center=tuple(leg.knee)),
-                  _limb_tube(leg.knee, leg.ankle, 0.035, 0.024, shin, caps=False),
-                  _shoe(leg.ankle, leg.pitch)]
+        parts += [shape.limb(np.stack([leg.hip, leg.knee, leg.ankle]), leg_t, y, CLS, leg_m),
+                  shape.shoe(leg.ankle, leg.pitch, CLS, "shoes")]
     for side, action, bend in zip((1.0, -1.0), d["arms"], d["bends"], strict=True):
         shoulder = np.array([0.0, side * 0.1 * g * d["breadth"], 0.79 + dz])
         l1, l2 = 0.175, 0.15
         if action == "phone":
-            elbow, wrist = gait.two_link(shoulder, np.array([0.03, side * 0.075, 0.9 + dz]), l1, l2,
+            elbow, wrist = gait.two_link(shoulder, np.array([0.03, side * 0.085, 0.9 + dz]), l1, l2,
                                          np.array([0.35, side * 0.3, -1.0]))
         elif action == "pockets":
             elbow, wrist = gait.two_link(shoulder, np.array([0.03, side * 0.095, 0.5 + dz]), l1, l2,
@@ -258,9 +229,9 @@ def _limbs(d: dict, phi: float | None) -> tuple[Mesh, float]:
             elbow, wrist = _limb(shoulder, swing, bend + 0.6 * max(swing, 0.0), l1, l2)
             elbow[1] += side * 0.02
             wrist[1] += side * 0.025
-        parts += [_limb_tube(shoulder, elbow, 0.032 * g, 0.026, "clothing"),
-                  icosphere(0.026, CLS, sleeve, 0, center=tuple(elbow)),
-                  _limb_tube(elbow, wrist, 0.025, 0.019, sleeve, caps=False), *_hand(wrist, elbow)]
+        pocket = "clothing" if garment == "coat" else "clothing_bottom"    # a hand in a pocket: the pocket's bulge
+        parts += [shape.limb(np.stack([shoulder, elbow, wrist]), arm_t, y, CLS, arm_m),
+                  shape.hand(wrist, elbow, side, CLS, pocket if action == "pockets" else "skin")]
         if action == "bag":
             grip = wrist + 0.06 * (wrist - elbow) / np.linalg.norm(wrist - elbow)
             parts.append(box((0.17, 0.05, 0.19), CLS, "shoes", (grip[0], grip[1], grip[2] - 0.105)))

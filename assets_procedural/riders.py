@@ -21,9 +21,10 @@ import numpy as np
 
 from assets_procedural.motorcycles import _motorcycle_parts
 from assets_procedural.parts import centring, two_link
-from assets_procedural.person import _hand, _head
+from assets_procedural.person import HIP_Y, _arms_table, _head, _legs_table, torso_sections
+from assets_procedural.person_shape import hand, limb, shoe, skin
 from assets_procedural.two_wheelers import _bicycle_parts, contact_anchors
-from generator.geometry import Mesh, box, icosphere, loft, merge, pose, resolve_ids, tube
+from generator.geometry import Mesh, icosphere, merge, pose, resolve_ids
 
 
 def _rot_y(alpha: float) -> np.ndarray:
@@ -48,82 +49,72 @@ def _lean_for_reach(hip: np.ndarray, shoulder_local: np.ndarray, grip: np.ndarra
     return (lo + hi) / 2
 
 
-#: torso rings of the seated figure: (height along the torso above the hip, half width, half depth) / body height
-TORSO = ((-0.035, 0.095, 0.06), (0.09, 0.078, 0.058), (0.19, 0.095, 0.066), (0.265, 0.11, 0.058), (0.305, 0.045, 0.04))
-
-
 def _figure(rng: np.random.Generator, height: float, seat: np.ndarray, hip_dx: float, grips: list[np.ndarray],
             feet: list[np.ndarray], foot_pitch: float, cls: str, helmet: bool) -> Mesh:
     """A seated person on the seat whose top centre is ``seat``: the pelvis rests on it (hip
     joints ``hip_dx`` ahead of it), hands on ``grips`` (right, left), the balls of the feet on
     ``feet`` (pedal or peg tops, right, left). The torso leans forward just enough for the arms
-    to reach the grips.
+    to reach the grips; body, limbs, hands and shoes are the pedestrian's shaped parts.
     """
     h = height
     g = float(rng.uniform(0.92, 1.12))
     short_sleeves = rng.random() < 0.3
     arm_reach = 0.9 * (0.175 + 0.15) * h + 0.035 * h
     sh_local = [np.array([0.0, s * 0.1 * h * g, 0.26 * h]) for s in (-1.0, 1.0)]
-    a = np.linspace(0, 2 * np.pi, 8, endpoint=False)
+    rings, mats = torso_sections(g, 1.0, None, "trousers")
+    rings = (rings - [0.0, 0.0, 0.53]) * h                       # hip-relative, metres
     hip = np.asarray(seat, float) + np.array([hip_dx, 0.0, 0.06 * h])
     for _ in range(3):
         # lean for the reach, then sit the lowest point of pelvis and thighs 3 mm above the seat
         alpha = _lean_for_reach(hip, sh_local[1], grips[1], arm_reach)
-        z0, hw0, hd0 = TORSO[0]
-        pelvis = np.stack([hd0 * g * h * np.cos(a), hw0 * g * h * np.sin(a), np.full(8, z0 * h)], 1) @ _rot_y(alpha).T
-        low = min(float(pelvis[:, 2].min()), -0.045 * h * g)
+        pelvis = np.concatenate([rings[:2].reshape(-1, 3), rings[:1].mean(1) - [0.0, 0.0, 0.01 * h]]) @ _rot_y(alpha).T
+        low = min(float(pelvis[:, 2].min()), -0.053 * h * g)           # the thighs' undersides near the hips
         hip[2] = seat[2] + 0.003 - low
     R = _rot_y(alpha)
-    rot = _rot_y
-    rings = []
-    for z, hw, hd in TORSO:
-        gw = g if z < 0.3 else 1.0
-        ring = np.stack([hd * gw * h * np.cos(a), hw * gw * h * np.sin(a), np.full(8, z * h)], 1)
-        rings.append(ring @ R.T + hip)
-    parts = [loft(np.array(rings), cls, "clothing")]
-    # head: person's head (built standing) moved onto the neck, tilted less than the torso
     neck_base = hip + R @ np.array([0.0, 0.0, 0.29 * h])
-    head_parts = _head(h, rng)
-    t = pose(*neck_base, pitch=0.3 * alpha) @ pose(z=-0.82 * h)
+    t = pose(*neck_base, pitch=0.3 * alpha) @ pose(z=-0.82 * h)      # the head's frame: tilted less than the torso
+    neck = rings[:, 0, 2] >= 0.31 * h
+    rings[~neck] = rings[~neck] @ R.T + hip
+    rings[neck] = (rings[neck] + [0.0, 0.0, 0.53 * h]) @ t[:3, :3].T + t[:3, 3]
+    parts = [skin(rings, cls, mats, rings[0].mean(0) - R @ [0.0, 0.0, 0.01 * h],
+                  rings[-1].mean(0) + [0.0, 0.0, 0.01 * h])]
     cid, _ = resolve_ids(cls, "skin")
-    head_parts = [Mesh(m.transformed(t).vertices, m.faces, cid, m.face_material) for m in head_parts]
+    head_parts = [Mesh(m.transformed(t).vertices, m.faces, cid, m.face_material) for m in _head(h, rng)]
     if helmet:
-        centre = neck_base + rot(0.3 * alpha) @ np.array([0.01 * h, 0.0, 0.105 * h])
+        centre = neck_base + _rot_y(0.3 * alpha) @ np.array([0.01 * h, 0.0, 0.105 * h])
         shell = icosphere(1.0, cls, "car_paint", 1)
         rel = shell.vertices[shell.faces].mean(1)
         keep = rel[:, 2] > -0.45
         visor = keep & (rel[:, 0] > 0.55) & (rel[:, 2] < 0.45) & (rel[:, 2] > -0.2)
         _, glass = resolve_ids(cls, "car_glass")
-        mats = shell.face_material.copy()
-        mats[visor] = glass
+        mats_h = shell.face_material.copy()
+        mats_h[visor] = glass
         shell = Mesh(shell.vertices * np.array([0.075, 0.066, 0.082]) * h, shell.faces[keep], shell.face_class[keep],
-                     mats[keep])
+                     mats_h[keep])
         shell = shell.transformed(pose(*centre, pitch=0.3 * alpha))
         _, hair_id = resolve_ids(cls, "hair")
         head_parts = [m for m in head_parts if not (m.face_material == hair_id).all()] + [shell]
     parts += head_parts
+    leg_t, leg_m = _legs_table("trousers")
+    arm_t, arm_m = _arms_table(short_sleeves, False)
+    leg_t, arm_t = leg_t * [1.0, g * h, g * h, g * h], arm_t * [1.0, g * h, g * h, g * h]
+    leg_t[:, 2] *= np.interp(leg_t[:, 0], [0.3, 0.7], [0.8, 1.0])   # a seated thigh flattens on the saddle
+    y = np.array([0.0, 1.0, 0.0])
     for k, s in enumerate((-1.0, 1.0)):
-        hip_s = hip + np.array([0.0, s * 0.062 * h * g, 0.0])
+        hip_s = hip + np.array([0.0, s * HIP_Y * h * g, 0.0])
         # foot: the ball of the foot on the support, toes forward, heel behind and above it
         fdir = np.array([np.cos(foot_pitch), 0.0, -np.sin(foot_pitch)])
         up = np.array([np.sin(foot_pitch), 0.0, np.cos(foot_pitch)])
-        shoe_c = feet[k] + 0.02 * h * fdir + 0.025 * h * up + np.array([0.0, 0.0, 0.01])
-        ankle = shoe_c - 0.05 * h * fdir + 0.03 * h * up
+        ankle = feet[k] - 0.03 * h * fdir + 0.055 * h * up + np.array([0.0, 0.0, 0.01])
         knee, ankle = two_link(hip_s, ankle, 0.245 * h, 0.25 * h, np.array([1.0, s * 0.25, 0.6]))
-        parts.append(tube(hip_s, knee, 0.045 * h * g, cls, "clothing_bottom", 0.036 * h, sections=6))
-        parts.append(icosphere(0.035 * h, cls, "clothing_bottom", 0, center=tuple(knee)))
-        parts.append(tube(knee, ankle, 0.034 * h, cls, "clothing_bottom", 0.024 * h, sections=6))
-        shoe = box((0.15 * h, 0.055 * h, 0.045 * h), cls, "shoes")
-        parts.append(shoe.transformed(pose(*shoe_c, pitch=foot_pitch)))
+        parts += [limb(np.stack([hip_s, knee, ankle]), leg_t, y, cls, leg_m),
+                  shoe(ankle, foot_pitch, cls, "shoes", h)]
         shoulder = hip + R @ sh_local[k]
         grip = grips[k]
         wrist_t = grip - 0.035 * h * (grip - shoulder) / np.linalg.norm(grip - shoulder)
         elbow, wrist = two_link(shoulder, wrist_t, 0.175 * h, 0.15 * h, np.array([-0.3, s * 0.8, -1.0]))
-        parts.append(tube(shoulder, elbow, 0.032 * h * g, cls, "clothing", 0.026 * h, sections=6))
-        sleeve = "skin" if short_sleeves else "clothing"
-        parts.append(icosphere(0.026 * h, cls, sleeve, 0, center=tuple(elbow)))
-        parts.append(tube(elbow, wrist, 0.025 * h, cls, sleeve, 0.019 * h, sections=6, caps=False))
-        parts += _hand(wrist, elbow, "skin" if not helmet else "rubber", h, cls)     # gloves with a helmet
+        parts += [limb(np.stack([shoulder, elbow, wrist]), arm_t, y, cls, arm_m),
+                  hand(wrist, elbow, s, cls, "skin" if not helmet else "rubber", 0.5, h)]   # gloves with a helmet
     return merge(parts)
 
 

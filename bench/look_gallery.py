@@ -375,6 +375,13 @@ def people_world(town, spec):
             eye = p + across * 3.2 + [0.0, 0.0, 1.0]
             shots.append(Shot(f"people_walker{i}_phase{k:02d}", f"walker {i} ({proto.params.get('height', 0):.2f} m),"
                               f" gait phase {k}/16", look_at(eye, p + [0.0, 0.0, 0.85]), time=t))
+        if i == 0:      # closer looks at mid-swing: 4 m side on, 4 m and 10 m three-quarter from ahead
+            t = t_zero + (4 / 16) * stride / speed
+            p = track.position(t)[0]
+            for name, dist, ahead in (("side4m", 4.0, 0.0), ("front34_4m", 4.0, 1.0), ("front34_10m", 10.0, 1.0)):
+                eye = p + (across + d * ahead) / np.hypot(1.0, ahead) * dist + [0.0, 0.0, 1.5]
+                shots.append(Shot(f"people_walker0_{name}", f"walker 0, {name}", look_at(eye, p + [0.0, 0.0, 0.9]),
+                                  time=t))
     # a cyclist and a motorcyclist on their two-wheelers, standing on the carriageway of the first street
     from assets_procedural.riders import ridden
     from generator.geometry import merge

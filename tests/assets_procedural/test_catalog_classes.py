@@ -85,7 +85,7 @@ SIZES = {
 }
 
 #: kind -> most triangles one asset may have (prototypes are instanced; keep them cheap)
-BUDGET = {"bicycle": 2000, "motorcycle": 2200, "bicyclist": 2500, "motorcyclist": 2700, "bus": 1200, "tram": 2100,
+BUDGET = {"bicycle": 2000, "motorcycle": 2200, "bicyclist": 4300, "motorcyclist": 4500, "bus": 1200, "tram": 2100,
           "rail_track": 800, "tram_rails": 100, "trailer": 800, "box_van": 900, "construction_vehicle": 600,
           "wall": 600, "traffic_island": 200, "median_strip": 200, "driveway_apron": 20, "verge_crossing": 12,
           "gravel_patch": 100,

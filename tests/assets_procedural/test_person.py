@@ -42,9 +42,9 @@ def test_a_child_has_a_bigger_head_for_its_height_than_an_adult():
 
 
 def _bare_thighs(m) -> bool:
-    """Skin on the thighs (between 0.34 and 0.48 of the height, above the knees, near the middle): a skirt."""
+    """Skin on the upper thighs (between 0.4 and 0.48 of the height, above a short's hem, near the middle): a skirt."""
     c = m.vertices[m.faces].mean(1) / m.vertices[:, 2].max()
-    return int((_of(m, "skin") & (c[:, 2] > 0.34) & (c[:, 2] < 0.48) & (np.abs(c[:, 1]) < 0.07)).sum()) > 10
+    return int((_of(m, "skin") & (c[:, 2] > 0.4) & (c[:, 2] < 0.48) & (np.abs(c[:, 1]) < 0.07)).sum()) > 10
 
 
 def _shoulders(m) -> float:
