@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from generator.geometry import Mesh, icosphere
+from generator.geometry import Mesh, icosphere, unit
 from generator.geometry.primitives import resolve_ids
 
 
@@ -43,11 +43,6 @@ LEAVES: dict[str, Leaf] = {
     "small": Leaf((0.1, 0.14), 0.38, 0.3, 4, 240.0, 0.1),
     "needle": Leaf((0.4, 0.55), 0.08, 0.1, 6, 150.0, 0.3),
 }
-
-
-def unit(v: np.ndarray) -> np.ndarray:
-    """``v`` (..., 3) scaled to unit length along its last axis (a zero vector stays zero)."""
-    return v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-12)
 
 
 def sprays(rng: np.random.Generator, centre: np.ndarray, outward: np.ndarray, leaf: Leaf, cls: str,

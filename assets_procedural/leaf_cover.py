@@ -14,8 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from assets_procedural.foliage import unit
-from generator.geometry import Mesh, face_normals
+from generator.geometry import Mesh, face_normals, unit
 from generator.geometry.primitives import resolve_ids
 
 #: Leaves per square metre of hedge face; leaf length range (m); half-width / length;

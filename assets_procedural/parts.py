@@ -10,12 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from generator.geometry import Mesh, cylinder, disc, merge, pose, resolve_ids, tube
-
-
-def _unit(v: np.ndarray) -> np.ndarray:
-    v = np.asarray(v, float)
-    return v / np.linalg.norm(v, axis=-1, keepdims=True)
+from generator.geometry import Mesh, cylinder, disc, merge, pose, resolve_ids, tube, unit
 
 
 def sweep(path: np.ndarray, radius: float | tuple[float, float], cls: str | int, material: str | int,
@@ -43,23 +38,23 @@ def sweep(path: np.ndarray, radius: float | tuple[float, float], cls: str | int,
     n = len(p)
     a, b = (radius, radius) if np.isscalar(radius) else radius
     if closed:
-        t = _unit(np.roll(p, -1, 0) - np.roll(p, 1, 0))
+        t = unit(np.roll(p, -1, 0) - np.roll(p, 1, 0))
     else:
         d = np.diff(p, axis=0)
         t = np.empty_like(p)
         t[0], t[-1] = d[0], d[-1]
-        t[1:-1] = _unit(d[:-1]) + _unit(d[1:])
-        t = _unit(t)
+        t[1:-1] = unit(d[:-1]) + unit(d[1:])
+        t = unit(t)
     if binormal is not None:
-        v = np.tile(_unit(binormal), (n, 1))
-        u = _unit(np.cross(v, t))
+        v = np.tile(unit(binormal), (n, 1))
+        u = unit(np.cross(v, t))
     else:
         u = np.empty_like(p)
         helper = np.array([0.0, 0.0, 1.0]) if abs(t[0, 2]) < 0.9 else np.array([1.0, 0.0, 0.0])
-        u[0] = _unit(np.cross(helper, t[0]))
+        u[0] = unit(np.cross(helper, t[0]))
         for i in range(1, n):
             w = u[i - 1] - np.dot(u[i - 1], t[i]) * t[i]
-            u[i] = _unit(w)
+            u[i] = unit(w)
         v = np.cross(t, u)
     ang = np.linspace(0, 2 * np.pi, sides, endpoint=False)
     ca, sa = np.cos(ang), np.sin(ang)
@@ -96,9 +91,9 @@ def arc(center, u, v, radius: float, a0: float, a1: float, n: int) -> np.ndarray
 def torus(center, axis, major: float, minor: float | tuple[float, float], cls: str | int, material: str | int,
           segments: int = 24, sides: int = 6) -> Mesh:
     """A ring (tyre, rim, hoop) around ``axis`` through ``center``; ``minor`` may be (radial, axial)."""
-    axis = _unit(axis)
+    axis = unit(axis)
     helper = np.array([0.0, 0.0, 1.0]) if abs(axis[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
-    e1 = _unit(np.cross(helper, axis))
+    e1 = unit(np.cross(helper, axis))
     e2 = np.cross(axis, e1)
     path = arc(center, e1, e2, major, 0.0, 2 * np.pi, segments + 1)[:-1]
     return sweep(path, minor, cls, material, sides, closed=True, binormal=axis)
@@ -159,9 +154,9 @@ def disc_wheel(center, radius: float, tyre: float, cls: str, spokes: int = 5, ri
 def ring_plate(center, normal, r_in: float, r_out: float, cls: str | int, material: str | int,
                segments: int = 20, thickness: float = 0.005) -> Mesh:
     """A flat annulus (brake disc, chainring) of ``thickness``, both faces and both edges closed."""
-    n = _unit(normal)
+    n = unit(normal)
     helper = np.array([0.0, 0.0, 1.0]) if abs(n[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
-    e1 = _unit(np.cross(helper, n))
+    e1 = unit(np.cross(helper, n))
     e2 = np.cross(n, e1)
     a = np.linspace(0, 2 * np.pi, segments, endpoint=False)
     ring = np.cos(a)[:, None] * e1 + np.sin(a)[:, None] * e2

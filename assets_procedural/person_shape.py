@@ -20,7 +20,7 @@ import functools
 import numpy as np
 
 from assets_procedural import person_gait as gait
-from generator.geometry import Mesh, resolve_ids
+from generator.geometry import Mesh, resolve_ids, unit
 
 #: sides of a limb section
 SIDES = 8
@@ -92,10 +92,6 @@ def skin(rings: np.ndarray, cls: str, materials, start=None, end=None) -> Mesh:
                 np.concatenate(mats))
 
 
-def _unit(v: np.ndarray) -> np.ndarray:
-    return v / np.linalg.norm(v, axis=-1, keepdims=True)
-
-
 def chain_rings(joints: np.ndarray, table: np.ndarray, lateral: np.ndarray) -> np.ndarray:
     """Sections of ``table`` along the two bones ``joints`` (3, 3): (rows, SIDES, 3) ring points.
 
@@ -104,18 +100,18 @@ def chain_rings(joints: np.ndarray, table: np.ndarray, lateral: np.ndarray) -> n
     down). Sections within 0.15 of the joint turn with the bisector of the bones.
     """
     p0, p1, p2 = (np.asarray(p, float) for p in joints)
-    d1, d2 = _unit(p1 - p0), _unit(p2 - p1)
+    d1, d2 = unit(p1 - p0), unit(p2 - p1)
     s = table[:, 0]
     centre = np.where((s <= 1.0)[:, None], p0 + s[:, None] * (p1 - p0), p1 + (s[:, None] - 1.0) * (p2 - p1))
     w = np.clip((s - 0.85) / 0.3, 0.0, 1.0)[:, None]
-    t = _unit((1.0 - w) * d1 + w * d2)
+    t = unit((1.0 - w) * d1 + w * d2)
     lat = np.asarray(lateral, float)
     u = lat - (t @ lat)[:, None] * t
     weak = np.linalg.norm(u, axis=1) < 0.3
     if weak.any():                       # a bone along the lateral axis: fall back to the forward one
         fwd = np.array([1.0, 0.0, 0.0])
         u[weak] = fwd - (t[weak] @ fwd)[:, None] * t[weak]
-    u = _unit(u)
+    u = unit(u)
     v = np.cross(t, u)
     c = centre + table[:, 3:4] * v
     return (c[:, None] + table[:, 1, None, None] * np.cos(_ANG)[None, :, None] * u[:, None]
@@ -128,7 +124,7 @@ def limb(joints: np.ndarray, table: np.ndarray, lateral, cls: str, materials) ->
     c0, c1 = rings[0].mean(0), rings[-1].mean(0)
     d0, d1 = c0 - rings[1].mean(0), c1 - rings[-2].mean(0)
     r0, r1 = table[0, 1:3].mean(), table[-1, 1:3].mean()
-    return skin(rings, cls, materials, c0 + 0.6 * r0 * _unit(d0), c1 + 0.6 * r1 * _unit(d1))
+    return skin(rings, cls, materials, c0 + 0.6 * r0 * unit(d0), c1 + 0.6 * r1 * unit(d1))
 
 
 def eased(table: np.ndarray, ease: float, bulge: float = 0.5) -> np.ndarray:
@@ -153,10 +149,10 @@ def hand(wrist: np.ndarray, elbow: np.ndarray, side: float, cls: str, material: 
          scale: float = 1.0) -> Mesh:
     """A hand continuing the forearm: a flat palm (wide front to back, thin across) tapering into
     fingers that curl ``curl`` radians toward the palm (the body's side ``-side``); ``scale`` the body height."""
-    d = _unit(np.asarray(wrist, float) - np.asarray(elbow, float))
+    d = unit(np.asarray(wrist, float) - np.asarray(elbow, float))
     lateral = np.array([0.0, side, 0.0])         # out of the body (the curl's sign); the frame uses +y
     knuckle = wrist + 0.058 * scale * d
-    tip = knuckle + 0.05 * scale * _unit(d * np.cos(curl) - lateral * np.sin(curl))    # toward the palm (the body)
+    tip = knuckle + 0.05 * scale * unit(d * np.cos(curl) - lateral * np.sin(curl))    # toward the palm (the body)
     table = np.array([(-0.05, 0.010, 0.016, 0.0), (0.35, 0.013, 0.025, 0.0), (0.95, 0.011, 0.026, 0.0),
                       (1.5, 0.009, 0.021, 0.0), (2.0, 0.006, 0.015, 0.0)]) * [1.0, scale, scale, scale]
     return limb(np.stack([wrist, knuckle, tip]), table, np.array([0.0, 1.0, 0.0]), cls, material)

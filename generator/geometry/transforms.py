@@ -11,6 +11,17 @@ import math
 import numpy as np
 
 
+def unit(v) -> np.ndarray:
+    """Vectors ``v`` (..., 3) scaled to unit length along the last axis; a zero vector stays zero.
+
+    Float input keeps its dtype (float32 stays float32); anything else becomes float64.
+    """
+    v = np.asarray(v)
+    if v.dtype.kind != "f":
+        v = v.astype(np.float64)
+    return v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-12)
+
+
 def apply(matrix: np.ndarray, points: np.ndarray) -> np.ndarray:
     """Map (n, 3) points by a 4x4 homogeneous ``matrix``."""
     points = np.asarray(points, np.float64).reshape(-1, 3)

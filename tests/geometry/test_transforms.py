@@ -1,0 +1,24 @@
+"""Unit vectors: the one normaliser every asset builder uses (``generator.geometry.unit``)."""
+
+import numpy as np
+
+from generator.geometry import unit
+
+
+def test_unit_vectors_have_length_one_and_keep_their_direction():
+    v = np.array([[3.0, 4.0, 0.0], [0.0, -2.0, 0.0], [1e-6, 0.0, 1e-6]])
+    u = unit(v)
+    np.testing.assert_allclose(np.linalg.norm(u, axis=-1), 1.0, rtol=1e-12)
+    np.testing.assert_allclose(u[0], [0.6, 0.8, 0.0])
+    assert np.all(np.sign(u) == np.sign(v))
+
+
+def test_a_zero_vector_stays_zero_instead_of_nan():
+    u = unit(np.zeros((2, 3)))
+    assert np.all(u == 0.0)
+
+
+def test_float32_stays_float32_and_integers_become_float64():
+    assert unit(np.ones(3, np.float32)).dtype == np.float32
+    u = unit((0, 0, 2))
+    assert u.dtype == np.float64 and u.tolist() == [0.0, 0.0, 1.0]
