@@ -191,6 +191,7 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
     actors = world.actors if world is not None else []
     flows = ScanFlowWriter(seq, rig, world, sensor, skew)  # scene_flow/ of each sweep, once the next is cast
     with Scanner(scene, sensor, threads=options.threads, world=world, returns=returns) as scanner, flows:
+        direct = getattr(scanner.caster, "native", None)  # which backend this scanner's caster casts through
         for j in progress_bar(range(options.frames), desc=f"lidar {name}", unit="scan", enabled=progress):
             t_j = times[j]
             if returns is None:
@@ -232,6 +233,7 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
     sk.write_poses(seq / "poses.txt", kitti_calib.camera_poses(np.array(starts), tr))
     sk.write_times(seq / "times.txt", times)
     meta = _metadata(scene, spec, sensor, options, intensity_fn, n_points, counts)
+    meta["software"]["ray_casts"] = _RAY_CASTS[direct]
     meta["sweep_period_s"] = SWEEP_PERIOD_S
     meta["traffic"] = {"actors": len(actors), "moving_threshold_mps": MOVING_THRESHOLD_MPS,
                        "duration_s": float(world.duration_s) if actors else 0.0,
@@ -298,6 +300,10 @@ def write_dataset_label_config(out: str | Path, split: str | None = None, sequen
     return write_label_config(path, total, merge_split(seqs, assigned, read_split(path)))
 
 
+#: ``lidar_meta.json`` ``software.ray_casts``: the backend of the scanner's caster (None: not an Embree caster)
+_RAY_CASTS = {True: "Embree called directly", False: "embreex.run", None: "not Embree"}
+
+
 def _metadata(scene, spec, sensor: Sensor, options: SequenceOptions, intensity_fn, n_points, counts) -> dict:
     import embreex
 
@@ -337,5 +343,5 @@ def _metadata(scene, spec, sensor: Sensor, options: SequenceOptions, intensity_f
         "raw_id_counts": {str(k): v for k, v in sorted(counts.items())},
         "software": {"numpy": np.__version__, "embreex": getattr(embreex, "__version__", "unknown"),
                      "embree": embree_native.version() or "through embreex.run",
-                     "ray_casts": "Embree called directly" if embree_native.available() else "embreex.run"},
+                     "ray_casts": _RAY_CASTS[embree_native.available()]},
     }

@@ -98,6 +98,7 @@ class EmbreeCaster:
         t0 = time.perf_counter()
         if self.native:
             self._scene = embree_native.Scene(local, f)
+            self._local = self._scene.vertices  # Embree's padded copy serves us too: one copy, not two
         else:
             from embreex import rtcore_scene
             from embreex.mesh_construction import TriangleMesh

@@ -165,7 +165,9 @@ class Scene:
         # Embree reads the last float3 with a 16-byte load: one float of padding past the end
         self._v = np.zeros(3 * len(vertices) + 1, np.float32)
         self._v[:-1] = np.asarray(vertices, np.float32).ravel()
-        self._f = np.ascontiguousarray(faces, np.uint32)
+        faces = np.ascontiguousarray(faces)
+        # non-negative int32 rows are the same bytes as uint32: a view, not a second index buffer
+        self._f = faces.view(np.uint32) if faces.dtype == np.int32 else faces.astype(np.uint32)
         dev = _device()
         self._lib, self._ptr = lib, lib.rtcNewScene(dev)
         lib.rtcSetSceneFlags(self._ptr, _ROBUST)
@@ -179,6 +181,11 @@ class Scene:
         err = lib.rtcGetDeviceError(dev)
         if err:
             raise RuntimeError(f"Embree failed to build the scene (error code {err})")
+
+    @property
+    def vertices(self) -> np.ndarray:
+        """(V, 3) float32 view of the vertices Embree reads (without the padding float); do not write."""
+        return self._v[:-1].reshape(-1, 3)
 
     def __del__(self):
         ptr, self._ptr = getattr(self, "_ptr", None), None

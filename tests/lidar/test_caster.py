@@ -85,3 +85,12 @@ def test_threads_cast_at_once_give_the_same_hits(casters, rays):
         got = list(pool.map(lambda i: native.intersect_local(o[i], d[i], 120.0), parts))
     np.testing.assert_array_equal(np.concatenate([g[1] for g in got]), one[1])
     np.testing.assert_array_equal(np.concatenate([g[0] for g in got]), one[0])
+
+
+@pytest.mark.skipif(not embree_native.available(), reason="needs Embree called directly")
+def test_the_corners_the_return_model_reads_are_the_vertices_embree_casts_against():
+    v, f = _terrain(20)
+    caster = EmbreeCaster(v, f, native=True)
+    corners = caster.triangle_corners()
+    np.testing.assert_array_equal(corners, (v - caster.center).astype(np.float32)[f])
+    assert np.shares_memory(caster._local, caster._scene._v)  # one copy of the vertices, not two
