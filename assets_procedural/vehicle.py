@@ -13,6 +13,7 @@ import numpy as np
 
 from assets_procedural.car_body import body_shell, draw_dimensions
 from assets_procedural.car_lamps import lamp
+from assets_procedural.car_seams import seam_anchors
 from assets_procedural.vehicle_interior import car_interior
 from generator.geometry import Mesh, box, cylinder, disc, loft, merge, on_ground, polygon, pose, prism, resolve_ids
 from generator.geometry.primitives import quads
@@ -194,7 +195,7 @@ def car(rng: np.random.Generator, variant: str | None = None, quantile: float | 
         parts.append(box((0.09, 0.12, 0.1), "car", "car_paint", (info["xa"], side * (hw_a + 0.02),
                                                                  p["belt_z"] + 0.09)))
     body = merge(parts)
-    body.anchors = {"headlight": head, "taillight": tail}
+    body.anchors = {"headlight": head, "taillight": tail, **seam_anchors(p, info)}  # seams: drawn by the paint
     return on_ground(body)
 
 

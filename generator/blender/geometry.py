@@ -3,7 +3,8 @@
 One mesh datablock per prototype (repeated assets are linked duplicates: instancing),
 built with ``foreach_set`` from the very arrays the LiDAR casts against. Every mesh
 carries the per-face ``class_id`` (INT) attribute;
-meshes with licence plates a UV map ``ug_plate`` (:mod:`generator.blender.plates`);
+meshes with licence plates a UV map ``ug_plate`` (:mod:`generator.blender.plates`), car bodies their seam
+properties ``ug_seam_*`` (:mod:`generator.blender.car_seam_shader`);
 every object carries its instance id as ``pass_index``, its colour (``attrs["color"]`` or
 ``attrs["facade_color"]``) in ``color``, ``attrs["roof_color"]`` as the custom
 property ``ug_roof_color``, every other ``attrs["<name>_color"]`` as ``ug_<name>_color``,
@@ -19,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from generator.blender.bpy_guard import bpy, mathutils
+from generator.blender.car_seam_shader import seam_properties
 from generator.blender.plates import plate_uv
 from generator.geometry import Mesh
 from generator.materials import material_table
@@ -63,6 +65,8 @@ def mesh(name: str, m: Mesh, materials: list) -> bpy.types.Mesh:
     plate = m.face_material == table.id("licence_plate")
     if plate.any():                                   # where on its plate each corner lies (the registration)
         me.uv_layers.new(name=PLATE_UV).data.foreach_set("uv", plate_uv(m.vertices, m.faces, plate).ravel())
+    for key, value in seam_properties(m.anchors).items():  # a car body's panel gaps, read by its paint
+        me[key] = list(value) if len(value) > 1 else value[0]
     me.update()
     return me
 

@@ -12,6 +12,7 @@ signature as :mod:`generator.blender.recipes`.
 
 from __future__ import annotations
 
+from generator.blender.car_seam_shader import seam_gaps
 from generator.blender.nodes import Nodes
 from generator.blender.plate_shader import plate_surface
 from generator.labels import class_table
@@ -30,12 +31,13 @@ def _height(g: Nodes):
     return sep.outputs["Z"]
 
 
-def car_paint(g: Nodes, rng):
+def car_paint(g: Nodes, rng, seams: bool = False):
     """Vehicle paint of one of three finishes, with road grime toward the sills.
 
     Object properties (:mod:`generator.blender.vehicle_finish`): ``ug_paint_metallic`` (metallic paints of
     the palette: flakes under the clear coat), ``ug_paint_matte`` (satin, no clear coat) and
     ``ug_paint_dirt`` (0 clean .. 1 filthy: grime rising from the sills in streaks, dust over all).
+    With ``seams`` (the body shell) the panel gaps and door handles of :mod:`generator.blender.car_seam_shader`.
     """
     metallic = g.attr("ug_paint_metallic", "OBJECT", "Fac")
     matte = g.attr("ug_paint_matte", "OBJECT", "Fac")
@@ -56,13 +58,19 @@ def car_paint(g: Nodes, rng):
     base = g.mix(grime, base, (0.11, 0.09, 0.065))
     rough = g.lerp(g.math("MAXIMUM", grime, dust), rough, 0.9)
     coat = g.lerp(grime, coat, 0.05)
+    if seams:                                   # panel gaps: dark, matte grooves; handles in a shadowed recess
+        gap, handle = seam_gaps(g)
+        base = g.mix(g.math("MAXIMUM", gap, g.mul(handle, 0.8)), base, (0.012, 0.012, 0.012))
+        rough, coat = g.lerp(gap, rough, 0.7), g.lerp(gap, coat, 0.0)
+        normal = g.bump(g.math("SUBTRACT", 1.0, gap), 0.6, 0.002, normal=normal)
     return g.principled(base_color=base, metallic=g.lerp(grime, g.lerp(metallic, 0.0, 0.7), 0.0), roughness=rough,
                         coat=coat, coat_roughness=0.04, normal=normal)
 
 
 def car_body(g: Nodes, rng):
-    """The curved shell of a car: the same paint, shaded smooth (``car_paint`` stays flat for boxy parts)."""
-    return car_paint(g, rng)
+    """The curved shell of a car: the same paint, shaded smooth (``car_paint`` stays flat for boxy parts), with
+    its panel gaps and door handles."""
+    return car_paint(g, rng, seams=True)
 
 
 def _see_through(g: Nodes):

@@ -1,0 +1,74 @@
+"""Panel gaps and door handles (issue 29 item 3): a car body's paint draws dark 4 mm seams where its builder marks
+the doors, only there, and the labels do not change."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from assets_procedural.car_seams import SEAM_ANCHORS
+from assets_procedural.vehicle import car
+from generator.geometry import Mesh
+from generator.labels import class_table
+
+
+def test_only_car_bodies_get_seam_properties():
+    from generator.blender.car_seam_shader import seam_properties
+
+    m = car(np.random.default_rng(2), variant="sedan")
+    props = seam_properties(m.anchors)
+    assert props["ug_seam_on"] == (1.0,)
+    doors = props["ug_seam_doors"]
+    assert doors[:3] == tuple(m.anchors["seam/doors"][:, 0]) and doors[3] == m.anchors["seam/band"][0, 2]
+    assert all(len(v) == 4 for k, v in props.items() if k != "ug_seam_on")
+    assert seam_properties({"headlight": m.anchors["headlight"]}) == {}
+
+
+@pytest.fixture(scope="module")
+def side_views(tmp_path_factory, test_spec):
+    """One sedan twice, side on from 0.8 m at the seam between its doors (handle height): with its seams, and the
+    same mesh without the seam anchors; 640 x 360, 4 samples, by day."""
+    from generator.blender.renderer import Renderer
+    from generator.geometry import pose, rect
+    from generator.spec.render import load_render_config
+    from generator.weather import Lighting
+    from generator.world import rig
+    from kits.scene_kit import make_scene
+
+    m = car(np.random.default_rng(2), variant="sedan")
+    plain = Mesh(m.vertices, m.faces, m.face_class, m.face_material,
+                 {k: v for k, v in m.anchors.items() if k not in SEAM_ANCHORS})
+    x_mid, z = m.anchors["seam/doors"][1, 0], m.anchors["seam/handles"][0, 2] + 0.1
+    half = m.bounds()[1][1]
+    ground = ("ground", rect(-5, -20, 10, 60, 0.0, "road", "asphalt"), np.eye(4), 0)
+    # yaw 90 degrees: the car's right side (+y) faces the camera at the origin looking along +x; its x runs along +y
+    parts = [ground] + [(f"car{i}", mesh, pose(0.8 + half, y - x_mid, 0.0, yaw=np.pi / 2), i)
+                        for i, mesh, y in ((4, m, 0.0), (9, plain, 20.0))]
+    cfg = dataclasses.replace(load_render_config("test"), resolution=(640, 360), samples=4)
+    r = Renderer(make_scene(parts, kind=None), test_spec, cfg, tmp_path_factory.mktemp("scratch"))
+    r.set_conditions(Lighting("day", sun_elevation_deg=40.0, sun_azimuth_deg=200.0))
+    k = rig.intrinsics(test_spec.sensors.camera.hfov_deg, 640, 360)
+    frames = [r.render(rig.camera_extrinsics((0.0, y, z), (0, 0, 0)), seed=0, light_info={}) for y in (0.0, 20.0)]
+    return frames, k, m
+
+
+@pytest.mark.blender
+def test_the_seam_between_the_doors_is_a_dark_line_and_nothing_else_changes(side_views):
+    (seamed, plain), k, m = side_views
+    cx, cy, f = int(round(k[0, 2])), k[1, 2], k[1, 1]
+    z_eye = m.anchors["seam/handles"][0, 2] + 0.1
+    row = [int(cy + f * (z_eye - z) / 0.8) for z in (m.anchors["seam/handles"][0, 2] - 0.05,
+                                                     m.anchors["seam/band"][0, 2] + 0.1)]
+    rows = slice(row[0], min(row[1], 359))                        # below the handle, above the sill: door skin only
+    assert rows.stop - rows.start > 40
+    assert (seamed.labels.class_id[rows, cx - 40:cx + 40] == class_table().id("car")).all()
+    lum_s, lum_p = seamed.rgb[rows].mean(-1), plain.rgb[rows].mean(-1)
+    # the seam: image column cx (its world x is the camera's), a few pixels wide at 0.8 m
+    col_s = lum_s[:, cx - 2:cx + 3].min(1).mean()
+    col_p = lum_p[:, cx - 2:cx + 3].min(1).mean()
+    assert col_s < 0.5 * col_p                                   # a dark groove where the doors meet
+    away = np.r_[cx - 40:cx - 10, cx + 10:cx + 40]
+    np.testing.assert_allclose(lum_s[:, away].mean(), lum_p[:, away].mean(), rtol=0.03)   # the door skin as before
+    assert (seamed.labels.class_id == plain.labels.class_id).all()   # labels: the same pixels, seams or not
