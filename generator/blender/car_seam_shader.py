@@ -114,3 +114,21 @@ def seam_gaps(g: Nodes) -> tuple:
     handle = g.math("SUBTRACT", outer, g.mul(inner, 0.5))
     on = g.attr("ug_seam_on", "OBJECT", "Fac")
     return g.mul(gap, on), g.mul(handle, on)
+
+
+GRILLE_PITCH_M = 0.022   #: slat pitch of the radiator grille, metres
+
+
+def grille_slats(g: Nodes):
+    """(grille, slat) masks at a car's trim: ``grille`` 1 on the black trim ahead of the front bumper's edge
+    and above it (the grille, not the sills), ``slat`` 1 on a slat's face and 0 in the dark gap between slats
+    (horizontal slats every :data:`GRILLE_PITCH_M`). Both 0 where ``ug_seam_on`` is 0."""
+    co = g.node("ShaderNodeSeparateXYZ")
+    g.set(co.inputs[0], g.coords("Object"))
+    x, z = co.outputs["X"], co.outputs["Z"]
+    x_bf, z_bf, _, _ = _four(g, "ug_seam_ends")
+    grille = _all(g, _above(g, x, x_bf), _above(g, z, g.math("SUBTRACT", z_bf, 0.08)),
+                  g.attr("ug_seam_on", "OBJECT", "Fac"))
+    phase = g.math("FRACT", g.math("DIVIDE", z, GRILLE_PITCH_M))
+    slat = g.math("SUBTRACT", 1.0, g.smooth(phase, 0.55, 0.7))
+    return grille, slat

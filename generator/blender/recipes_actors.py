@@ -12,7 +12,7 @@ signature as :mod:`generator.blender.recipes`.
 
 from __future__ import annotations
 
-from generator.blender.car_seam_shader import seam_gaps
+from generator.blender.car_seam_shader import grille_slats, seam_gaps
 from generator.blender.nodes import Nodes
 from generator.blender.plate_shader import plate_surface
 from generator.labels import class_table
@@ -113,7 +113,12 @@ def car_headliner(g: Nodes, rng):
 
 
 def car_trim(g: Nodes, rng):
-    return g.principled(base_color=(0.018, 0.018, 0.02), roughness=0.55)
+    """Black plastic: sills, pillars, the grille (horizontal slats with dark gaps, on car bodies with seams)."""
+    grille, slat = grille_slats(g)
+    gap = g.mul(grille, g.math("SUBTRACT", 1.0, slat))
+    base = g.mix(gap, (0.018, 0.018, 0.02), (0.002, 0.002, 0.002))
+    rough = g.lerp(grille, 0.55, g.lerp(slat, 0.9, 0.35))
+    return g.principled(base_color=base, roughness=rough, normal=g.bump(g.mul(grille, slat), 0.5, 0.004))
 
 
 def wheel_rim(g: Nodes, rng):

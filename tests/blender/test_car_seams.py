@@ -72,3 +72,39 @@ def test_the_seam_between_the_doors_is_a_dark_line_and_nothing_else_changes(side
     away = np.r_[cx - 40:cx - 10, cx + 10:cx + 40]
     np.testing.assert_allclose(lum_s[:, away].mean(), lum_p[:, away].mean(), rtol=0.03)   # the door skin as before
     assert (seamed.labels.class_id == plain.labels.class_id).all()   # labels: the same pixels, seams or not
+
+
+@pytest.fixture(scope="module")
+def front_views(tmp_path_factory, test_spec):
+    """The sedan's grille square on from 0.9 m at its height: with seams (slats) and without; 320 x 180, 4 samples."""
+    from generator.blender.renderer import Renderer
+    from generator.geometry import pose, rect
+    from generator.spec.render import load_render_config
+    from generator.weather import Lighting
+    from generator.world import rig
+    from kits.scene_kit import make_scene
+
+    m = car(np.random.default_rng(2), variant="sedan")
+    plain = Mesh(m.vertices, m.faces, m.face_class, m.face_material,
+                 {k: v for k, v in m.anchors.items() if k not in SEAM_ANCHORS})
+    front = m.bounds()[1][0]
+    z = float(m.anchors["seam/bumpers"][0, 2]) + 0.01             # the bumper's edge crosses the grille
+    ground = ("ground", rect(-5, -20, 10, 60, 0.0, "road", "asphalt"), np.eye(4), 0)
+    # yaw 180 degrees: the car's nose faces the camera at the origin looking along +x
+    parts = [ground] + [(f"car{i}", mesh, pose(0.9 + front, y, 0.0, yaw=np.pi), i)
+                        for i, mesh, y in ((4, m, 0.0), (9, plain, 20.0))]
+    cfg = dataclasses.replace(load_render_config("test"), resolution=(320, 180), samples=4)
+    r = Renderer(make_scene(parts, kind=None), test_spec, cfg, tmp_path_factory.mktemp("scratch"))
+    r.set_conditions(Lighting("day", sun_elevation_deg=40.0, sun_azimuth_deg=160.0))
+    return [r.render(rig.camera_extrinsics((0.0, y, z), (0, 0, 0)), seed=0, light_info={}) for y in (0.0, 20.0)]
+
+
+@pytest.mark.blender
+def test_the_grille_has_slats_and_the_plain_trim_does_not(front_views):
+    seamed, plain = front_views
+    crop = (slice(80, 100), slice(150, 170))                      # the middle of the grille, 0.9 m ahead
+    assert (seamed.labels.class_id[crop] == class_table().id("car")).all()
+    rows_s, rows_p = seamed.rgb[crop].mean((1, 2)), plain.rgb[crop].mean((1, 2))
+    # slats catch the light between dark gaps: rows alternate; the plain black box is even
+    assert rows_s.min() < 0.6 * rows_p.min()                      # the gaps between slats: darker than plain trim
+    assert rows_s.std() > 2.5 * rows_p.std()                       # light and dark rows, not noise about one level
