@@ -89,3 +89,15 @@ def test_a_quick_build_is_not_kept(store, monkeypatch):
     monkeypatch.setattr(proto_store, "WORTH_S", 60.0)
     _tree(cache)
     assert not list(folder.glob("*.pickle"))
+
+
+def test_a_value_pickle_refuses_is_not_kept_and_still_returned(store):
+    cache, folder = store
+    mesh, _ = _tree(cache)
+    n = len(list(folder.glob("*.pickle")))
+    value = cache.derive(mesh, "closure", _unpicklable)
+    assert value() == 1 and len(list(folder.glob("*.pickle"))) == n and not list(folder.glob(".*.tmp"))
+
+
+def _unpicklable(m):
+    return lambda: 1

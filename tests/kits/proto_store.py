@@ -78,9 +78,14 @@ def _read(path: Path):
 
 
 def _write(path: Path, value) -> None:
+    """``value`` pickled into ``path``, appearing whole; a value pickle refuses is not kept (built again)."""
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    with open(tmp, "wb") as f:
-        pickle.dump(value, f, protocol=pickle.HIGHEST_PROTOCOL)
+    try:
+        with open(tmp, "wb") as f:
+            pickle.dump(value, f, protocol=pickle.HIGHEST_PROTOCOL)
+    except (pickle.PicklingError, TypeError, AttributeError):
+        tmp.unlink(missing_ok=True)
+        return
     os.replace(tmp, path)
 
 
