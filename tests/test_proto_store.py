@@ -101,3 +101,20 @@ def test_a_value_pickle_refuses_is_not_kept_and_still_returned(store):
 
 def _unpicklable(m):
     return lambda: 1
+
+
+def test_a_builder_is_named_alike_in_every_process():
+    """The workers are separate processes: a builder's identity must not hold an address (a nested code
+    object's repr does), or no worker would ever read what the other built."""
+    import subprocess
+    import sys
+
+    from generator.geometry.proxy import label_proxy
+    from kits.paths import ROOT
+
+    code = ("import sys; sys.path.insert(0, 'tests'); from kits.proto_store import _code_of; "
+            "from generator.geometry.proxy import label_proxy; from assets_procedural import catalog; "
+            "print(_code_of(label_proxy)); print(_code_of(catalog.BUILDERS['hedge']))")
+    child = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=True)
+    here = [proto_store._code_of(label_proxy), proto_store._code_of(catalog.BUILDERS["hedge"])]
+    assert child.stdout.split() == here

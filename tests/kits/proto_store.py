@@ -37,13 +37,26 @@ _STATE = {"folder": None, "off": 0}
 WORTH_S = 0.003
 
 
+def _feed_code(h, code) -> None:
+    """Hash a code object by its byte code and constants, nested code (comprehensions, lambdas) by the same
+    rule: never by ``repr``, which holds the nested code's address and differs in every process."""
+    h.update(code.co_code)
+    for c in code.co_consts:
+        if hasattr(c, "co_code"):
+            h.update(b"<code>")
+            _feed_code(h, c)
+        else:
+            h.update(f"{type(c).__name__}:{c!r};".encode())
+
+
 def _code_of(fn) -> str:
     """The identity of a builder: its qualified name, the hash of its byte code and of the values its closure
     holds (a test's stand-in differs; a function whose closure cannot be pickled is this object only)."""
     code = getattr(fn, "__code__", None)
     if code is None:
         return f"{type(fn).__name__}:{os.getpid()}:{id(fn)}"
-    h = hashlib.sha256(code.co_code + repr(code.co_consts).encode())
+    h = hashlib.sha256()
+    _feed_code(h, code)
     try:
         h.update(pickle.dumps([c.cell_contents for c in fn.__closure__ or ()], protocol=pickle.HIGHEST_PROTOCOL))
     except Exception:  # noqa: BLE001 -- anything pickle refuses: no sharing for this function
