@@ -58,8 +58,12 @@ def main(argv=None) -> int:
     ap.add_argument("--candidate", default="-n 2 --dist loadgroup", help="pytest options of the candidate run")
     ap.add_argument("--no-baseline", action="store_true", help="run the candidate only")
     ap.add_argument("--slowest", type=int, default=25, help="how many of the slowest tests to list")
-    ap.add_argument("select", nargs="*", help="pytest arguments selecting tests (after --)")
-    args = ap.parse_args(argv)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    # the selection is everything after "--" (argparse would take the first positional run for it, so
+    # ``OUT --no-baseline -- tests/x`` was refused): split it off before parsing
+    cut = argv.index("--") if "--" in argv else len(argv)
+    args = ap.parse_args(argv[:cut])
+    args.select = argv[cut + 1:]
     args.out.mkdir(parents=True, exist_ok=True)
 
     runs = []

@@ -21,6 +21,29 @@ def root() -> Path:
     return ROOT
 
 
+@pytest.fixture(scope="session", autouse=True)
+def _shared_prototypes(tmp_path_factory):
+    """Under pytest-xdist the workers share the asset prototypes they build (:mod:`kits.proto_store`):
+    a town's library is built once per run instead of once per worker that builds a town of it."""
+    import os
+
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        from kits.proto_store import install
+
+        install(tmp_path_factory.getbasetemp().parent / "prototypes")
+
+
+def pytest_sessionfinish(session):
+    """The controlling process of ``pytest -n 2`` drops the shared prototypes (GBs) once the workers are done."""
+    import os
+    import shutil
+
+    factory = getattr(session.config, "_tmp_path_factory", None)
+    if factory is not None and not hasattr(session.config, "workerinput") and not os.environ.get(
+            "PYTEST_XDIST_WORKER"):
+        shutil.rmtree(factory.getbasetemp() / "prototypes", ignore_errors=True)
+
+
 @pytest.fixture(scope="session")
 def test_spec():
     from generator.spec import load_spec
