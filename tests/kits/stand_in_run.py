@@ -108,11 +108,14 @@ def forked(out: Path, frames: int, every: int | None = None, kill_at: str | None
 
     The child is the program's run without a new interpreter: it starts with what this process has
     imported (~1.2 s of imports a kill saved) and, like the program, dies alone -- the caller's state
-    is its own copy."""
+    is its own copy. A process that has imported ``bpy`` is never forked (Blender's threads and locks do not
+    survive a fork): there the run is started as its own program, as ``python -m kits.stand_in_run``."""
     import sys
     import time
     import traceback
 
+    if "bpy" in sys.modules:
+        return _spawned(out, frames, every, kill_at, timeout_s)
     out.parent.mkdir(parents=True, exist_ok=True)
     said = out.parent / f"{out.name}.output"
     pid = os.fork()
@@ -140,6 +143,19 @@ def forked(out: Path, frames: int, every: int | None = None, kill_at: str | None
             raise TimeoutError(f"the stand-in run into {out} took over {timeout_s} s")
         time.sleep(0.01)
     return os.waitstatus_to_exitcode(ended[1]), said.read_text(errors="replace")
+
+
+def _spawned(out: Path, frames: int, every: int | None, kill_at: str | None, timeout_s: float) -> tuple[int, str]:
+    """:func:`forked`'s run started as a new program (``python -m kits.stand_in_run``); same return value."""
+    import subprocess
+    import sys
+
+    path = os.pathsep.join([str(ROOT), str(ROOT / "tests"), os.environ.get("PYTHONPATH", "")])
+    env = {**os.environ, "PYTHONPATH": path}
+    cmd = [sys.executable, "-m", "kits.stand_in_run", str(out), str(frames)]
+    cmd += [*(["--every", str(every)] if every else []), *(["--kill-at", kill_at] if kill_at else [])]
+    done = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=timeout_s)
+    return done.returncode, done.stdout + done.stderr
 
 
 def main() -> None:
