@@ -33,8 +33,8 @@ def seam_properties(anchors: dict) -> dict[str, tuple[float, ...]]:
     dict of str to tuple of floats
         ``ug_seam_on`` (1.0,); ``ug_seam_doors`` (x front, x middle, x rear, z sill); ``ug_seam_band`` (z belt,
         z handles, x front handle, x rear handle); ``ug_seam_ends`` (x and z of the front bumper's edge, x and
-        z of the rear's); ``ug_seam_lids`` (bonnet x, bonnet sides |y|, boot x, boot sides |y|). Empty when
-        the anchors hold no seams (not a car body).
+        z of the rear's); ``ug_seam_lids`` (bonnet x, bonnet sides |y|, boot x, boot sides |y|); ``ug_seam_lamp``
+        (x, |y|, z of the headlamp's centre, 1). Empty when the anchors hold no seams (not a car body).
     """
     if not all(k in anchors for k in _KEYS):
         return {}
@@ -47,6 +47,9 @@ def seam_properties(anchors: dict) -> dict[str, tuple[float, ...]]:
         "ug_seam_ends": (ends[0, 0], ends[0, 2], ends[1, 0], ends[1, 2]),
         "ug_seam_lids": (lids[0, 0], lids[0, 1], lids[1, 0], lids[1, 1]),
     }
+    if "headlight" in anchors:                  # the left lamp's centre: |y| and z, the inner parts drawn round it
+        head = anchors["headlight"][0]
+        props["ug_seam_lamp"] = (head[0], abs(head[1]), head[2], 1.0)
     return {k: tuple(float(x) for x in v) for k, v in props.items()}
 
 
@@ -132,3 +135,26 @@ def grille_slats(g: Nodes):
     phase = g.math("FRACT", g.math("DIVIDE", z, GRILLE_PITCH_M))
     slat = g.math("SUBTRACT", 1.0, g.smooth(phase, 0.55, 0.7))
     return grille, slat
+
+
+def headlamp_inside(g: Nodes):
+    """(chrome, black, eye) masks behind a car's headlamp lens, in [0, 1], all 0 where ``ug_seam_lamp`` is
+    missing: two projectors side by side round the lamp's centre (a dark glass lens of 20 mm radius in a thin
+    chrome rim), in a smoked housing (``black``)."""
+    co = g.node("ShaderNodeSeparateXYZ")
+    g.set(co.inputs[0], g.coords("Object"))
+    ay, z = g.math("ABSOLUTE", co.outputs["Y"]), co.outputs["Z"]
+    _, y_c, z_c, on = _four(g, "ug_seam_lamp")
+    dv = g.math("SUBTRACT", z, z_c)
+    eyes = []
+    for du in (-0.035, 0.035):                  # two projectors either side of the centre
+        dy = g.math("SUBTRACT", ay, g.add(y_c, du))
+        r = g.math("SQRT", g.add(g.mul(dy, dy), g.mul(dv, dv)))
+        eyes.append(r)
+    r = g.math("MINIMUM", *eyes)
+    eye = g.math("SUBTRACT", 1.0, g.smooth(r, 0.019, 0.022))         # the projector's dark glass lens
+    rim = g.math("SUBTRACT", g.math("SUBTRACT", 1.0, g.smooth(r, 0.024, 0.027)), eye)   # its thin chrome rim
+    low = g.math("LESS_THAN", dv, -0.022)                              # the housing's lower band
+    chrome = g.mul(rim, g.math("SUBTRACT", 1.0, low))
+    black = g.math("MAXIMUM", low, g.math("SUBTRACT", g.math("SUBTRACT", 1.0, rim), eye))   # smoked housing
+    return g.mul(chrome, on), g.mul(black, on), g.mul(eye, on)

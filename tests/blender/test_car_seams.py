@@ -96,15 +96,31 @@ def front_views(tmp_path_factory, test_spec):
     cfg = dataclasses.replace(load_render_config("test"), resolution=(320, 180), samples=4)
     r = Renderer(make_scene(parts, kind=None), test_spec, cfg, tmp_path_factory.mktemp("scratch"))
     r.set_conditions(Lighting("day", sun_elevation_deg=40.0, sun_azimuth_deg=160.0))
-    return [r.render(rig.camera_extrinsics((0.0, y, z), (0, 0, 0)), seed=0, light_info={}) for y in (0.0, 20.0)]
+    k = rig.intrinsics(test_spec.sensors.camera.hfov_deg, 320, 180)
+    frames = [r.render(rig.camera_extrinsics((0.0, y, z), (0, 0, 0)), seed=0, light_info={}) for y in (0.0, 20.0)]
+    return frames, k, m, 0.9, z
 
 
 @pytest.mark.blender
 def test_the_grille_has_slats_and_the_plain_trim_does_not(front_views):
-    seamed, plain = front_views
+    (seamed, plain), *_ = front_views
     crop = (slice(80, 100), slice(150, 170))                      # the middle of the grille, 0.9 m ahead
     assert (seamed.labels.class_id[crop] == class_table().id("car")).all()
     rows_s, rows_p = seamed.rgb[crop].mean((1, 2)), plain.rgb[crop].mean((1, 2))
     # slats catch the light between dark gaps: rows alternate; the plain black box is even
     assert rows_s.min() < 0.6 * rows_p.min()                      # the gaps between slats: darker than plain trim
     assert rows_s.std() > 2.5 * rows_p.std()                       # light and dark rows, not noise about one level
+
+
+@pytest.mark.blender
+def test_a_headlamp_shows_dark_projector_lenses_where_the_plain_lens_is_even(front_views):
+    (seamed, plain), k, m, gap, z_eye = front_views
+    x, y, z = m.anchors["headlight"][0]                         # the lamp on the car's +y side: image right
+    depth = gap + m.bounds()[1][0] - x
+    v = int(round(k[1, 2] - k[1, 1] * (z - z_eye) / depth))
+    lum_s, lum_p = seamed.rgb.mean(-1), plain.rgb.mean(-1)
+    for du in (-0.035, 0.035):                                   # the two projectors either side of the centre
+        u = int(round(k[0, 2] + k[0, 0] * (abs(y) + du) / depth))
+        eye = (slice(v - 1, v + 2), slice(u - 1, u + 2))
+        assert (seamed.labels.class_id[eye] == class_table().id("car")).all()
+        assert lum_s[eye].mean() < 0.6 * lum_p[eye].mean()     # dark glass, not the plain lens's grey
