@@ -26,12 +26,12 @@ def test_only_car_bodies_get_seam_properties():
     assert seam_properties({"headlight": m.anchors["headlight"]}) == {}
 
 
-@pytest.fixture(scope="module")
-def side_views(tmp_path_factory, test_spec):
-    """One sedan twice, side on from 0.8 m at the seam between its doors (handle height): with its seams, and the
-    same mesh without the seam anchors; 640 x 360, 4 samples, by day."""
+def _seamed_and_plain(tmp_path_factory, test_spec, place, eye_z: float, size: tuple[int, int], sun_az: float):
+    """A sedan (seed 2) with its seams at y = 0 and the same mesh without seam anchors at y = 20, each placed by
+    ``place(mesh, y)`` -> (4, 4) pose and seen by a camera at (0, y, ``eye_z``) looking along +x; ``size`` pixels,
+    4 samples, by day. Returns (frames, intrinsics, the seamed mesh)."""
     from generator.blender.renderer import Renderer
-    from generator.geometry import pose, rect
+    from generator.geometry import rect
     from generator.spec.render import load_render_config
     from generator.weather import Lighting
     from generator.world import rig
@@ -40,18 +40,27 @@ def side_views(tmp_path_factory, test_spec):
     m = car(np.random.default_rng(2), variant="sedan")
     plain = Mesh(m.vertices, m.faces, m.face_class, m.face_material,
                  {k: v for k, v in m.anchors.items() if k not in SEAM_ANCHORS})
-    x_mid, z = m.anchors["seam/doors"][1, 0], m.anchors["seam/handles"][0, 2] + 0.1
-    half = m.bounds()[1][1]
     ground = ("ground", rect(-5, -20, 10, 60, 0.0, "road", "asphalt"), np.eye(4), 0)
-    # yaw 90 degrees: the car's right side (+y) faces the camera at the origin looking along +x; its x runs along +y
-    parts = [ground] + [(f"car{i}", mesh, pose(0.8 + half, y - x_mid, 0.0, yaw=np.pi / 2), i)
-                        for i, mesh, y in ((4, m, 0.0), (9, plain, 20.0))]
-    cfg = dataclasses.replace(load_render_config("test"), resolution=(640, 360), samples=4)
+    parts = [ground] + [(f"car{i}", mesh, place(m, y), i) for i, mesh, y in ((4, m, 0.0), (9, plain, 20.0))]
+    cfg = dataclasses.replace(load_render_config("test"), resolution=size, samples=4)
     r = Renderer(make_scene(parts, kind=None), test_spec, cfg, tmp_path_factory.mktemp("scratch"))
-    r.set_conditions(Lighting("day", sun_elevation_deg=40.0, sun_azimuth_deg=200.0))
-    k = rig.intrinsics(test_spec.sensors.camera.hfov_deg, 640, 360)
-    frames = [r.render(rig.camera_extrinsics((0.0, y, z), (0, 0, 0)), seed=0, light_info={}) for y in (0.0, 20.0)]
+    r.set_conditions(Lighting("day", sun_elevation_deg=40.0, sun_azimuth_deg=sun_az))
+    k = rig.intrinsics(test_spec.sensors.camera.hfov_deg, *size)
+    frames = [r.render(rig.camera_extrinsics((0.0, y, eye_z), (0, 0, 0)), seed=0, light_info={}) for y in (0.0, 20.0)]
     return frames, k, m
+
+
+@pytest.fixture(scope="module")
+def side_views(tmp_path_factory, test_spec):
+    """The sedan side on from 0.8 m at the seam between its doors, 10 cm above its handles; 640 x 360."""
+    from generator.geometry import pose
+
+    def place(m, y):   # yaw 90 degrees: the right side (+y) faces the camera; the car's x runs along +y
+        return pose(0.8 + m.bounds()[1][1], y - m.anchors["seam/doors"][1, 0], 0.0, yaw=np.pi / 2)
+
+    m = car(np.random.default_rng(2), variant="sedan")
+    return _seamed_and_plain(tmp_path_factory, test_spec, place, m.anchors["seam/handles"][0, 2] + 0.1,
+                             (640, 360), 200.0)
 
 
 @pytest.mark.blender
@@ -76,28 +85,15 @@ def test_the_seam_between_the_doors_is_a_dark_line_and_nothing_else_changes(side
 
 @pytest.fixture(scope="module")
 def front_views(tmp_path_factory, test_spec):
-    """The sedan's grille square on from 0.9 m at its height: with seams (slats) and without; 320 x 180, 4 samples."""
-    from generator.blender.renderer import Renderer
-    from generator.geometry import pose, rect
-    from generator.spec.render import load_render_config
-    from generator.weather import Lighting
-    from generator.world import rig
-    from kits.scene_kit import make_scene
+    """The sedan's nose square on from 0.9 m, the camera 1 cm above its front bumper's edge; 320 x 180."""
+    from generator.geometry import pose
+
+    def place(m, y):   # yaw 180 degrees: the nose faces the camera at the origin looking along +x
+        return pose(0.9 + m.bounds()[1][0], y, 0.0, yaw=np.pi)
 
     m = car(np.random.default_rng(2), variant="sedan")
-    plain = Mesh(m.vertices, m.faces, m.face_class, m.face_material,
-                 {k: v for k, v in m.anchors.items() if k not in SEAM_ANCHORS})
-    front = m.bounds()[1][0]
     z = float(m.anchors["seam/bumpers"][0, 2]) + 0.01             # the bumper's edge crosses the grille
-    ground = ("ground", rect(-5, -20, 10, 60, 0.0, "road", "asphalt"), np.eye(4), 0)
-    # yaw 180 degrees: the car's nose faces the camera at the origin looking along +x
-    parts = [ground] + [(f"car{i}", mesh, pose(0.9 + front, y, 0.0, yaw=np.pi), i)
-                        for i, mesh, y in ((4, m, 0.0), (9, plain, 20.0))]
-    cfg = dataclasses.replace(load_render_config("test"), resolution=(320, 180), samples=4)
-    r = Renderer(make_scene(parts, kind=None), test_spec, cfg, tmp_path_factory.mktemp("scratch"))
-    r.set_conditions(Lighting("day", sun_elevation_deg=40.0, sun_azimuth_deg=160.0))
-    k = rig.intrinsics(test_spec.sensors.camera.hfov_deg, 320, 180)
-    frames = [r.render(rig.camera_extrinsics((0.0, y, z), (0, 0, 0)), seed=0, light_info={}) for y in (0.0, 20.0)]
+    frames, k, m = _seamed_and_plain(tmp_path_factory, test_spec, place, z, (320, 180), 160.0)
     return frames, k, m, 0.9, z
 
 
