@@ -138,9 +138,9 @@ def grille_slats(g: Nodes):
 
 
 def headlamp_inside(g: Nodes):
-    """(chrome, black, eye) masks behind a car's headlamp lens, in [0, 1], all 0 where ``ug_seam_lamp`` is
-    missing: two projectors side by side round the lamp's centre (a dark glass lens of 20 mm radius in a thin
-    chrome rim), in a smoked housing (``black``)."""
+    """(chrome, black, eye, on) masks behind a car's headlamp lens, in [0, 1], all 0 where ``ug_seam_lamp`` is
+    missing (``on``: 1 on a car's lamp): two projectors side by side round the lamp's centre (a dark glass
+    lens of 20 mm radius in a thin chrome rim), in a smoked housing (``black``)."""
     co = g.node("ShaderNodeSeparateXYZ")
     g.set(co.inputs[0], g.coords("Object"))
     ay, z = g.math("ABSOLUTE", co.outputs["Y"]), co.outputs["Z"]
@@ -157,4 +157,4 @@ def headlamp_inside(g: Nodes):
     low = g.math("LESS_THAN", dv, -0.022)                              # the housing's lower band
     chrome = g.mul(rim, g.math("SUBTRACT", 1.0, low))
     black = g.math("MAXIMUM", low, g.math("SUBTRACT", g.math("SUBTRACT", 1.0, rim), eye))   # smoked housing
-    return g.mul(chrome, on), g.mul(black, on), g.mul(eye, on)
+    return g.mul(chrome, on), g.mul(black, on), g.mul(eye, on), on

@@ -277,13 +277,13 @@ def chrome(g, rng):
 def headlight(g, rng):
     """A clear lens; on a car (``ug_seam_lamp``) chrome reflectors, two projector eyes and a black housing behind
     it (:func:`generator.blender.car_seam_shader.headlamp_inside`); lit at night on vehicles in use."""
-    chrome, black, eye = headlamp_inside(g)
+    chrome, black, eye, on = headlamp_inside(g)
     base = g.mix(chrome, (0.8, 0.8, 0.8), (0.92, 0.92, 0.94))
     base = g.mix(black, base, (0.05, 0.05, 0.055))
     base = g.mix(eye, base, (0.02, 0.022, 0.028))
     metallic = g.lerp(black, g.lerp(chrome, 0.6, 1.0), 0.5)
-    lens = g.principled(base_color=base, roughness=g.lerp(chrome, 0.1, 0.06), metallic=metallic, coat=1.0,
-                        coat_roughness=0.02)
+    lens = g.principled(base_color=base, roughness=g.lerp(chrome, 0.1, 0.06), metallic=metallic, coat=on,
+                        coat_roughness=0.02)   # the clear cover on a car's lamp; other vehicles keep the plain lens
     return _emit(g, lens, (1.0, 0.95, 0.85), 40.0, "vehicle_lights", g.attr("ug_lights_on", "OBJECT"))
 
 

@@ -232,8 +232,7 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
     remove_last(seq, options.frames)  # the last sweep has no scene flow
     sk.write_poses(seq / "poses.txt", kitti_calib.camera_poses(np.array(starts), tr))
     sk.write_times(seq / "times.txt", times)
-    meta = _metadata(scene, spec, sensor, options, intensity_fn, n_points, counts)
-    meta["software"]["ray_casts"] = _RAY_CASTS[direct]
+    meta = _metadata(scene, spec, sensor, options, intensity_fn, n_points, counts, direct)
     meta["sweep_period_s"] = SWEEP_PERIOD_S
     meta["traffic"] = {"actors": len(actors), "moving_threshold_mps": MOVING_THRESHOLD_MPS,
                        "duration_s": float(world.duration_s) if actors else 0.0,
@@ -304,7 +303,8 @@ def write_dataset_label_config(out: str | Path, split: str | None = None, sequen
 _RAY_CASTS = {True: "Embree called directly", False: "embreex.run", None: "not Embree"}
 
 
-def _metadata(scene, spec, sensor: Sensor, options: SequenceOptions, intensity_fn, n_points, counts) -> dict:
+def _metadata(scene, spec, sensor: Sensor, options: SequenceOptions, intensity_fn, n_points, counts,
+              direct: bool | None) -> dict:
     import embreex
 
     from generator.lidar import embree_native
@@ -343,5 +343,5 @@ def _metadata(scene, spec, sensor: Sensor, options: SequenceOptions, intensity_f
         "raw_id_counts": {str(k): v for k, v in sorted(counts.items())},
         "software": {"numpy": np.__version__, "embreex": getattr(embreex, "__version__", "unknown"),
                      "embree": embree_native.version() or "through embreex.run",
-                     "ray_casts": _RAY_CASTS[embree_native.available()]},
+                     "ray_casts": _RAY_CASTS[direct]},
     }
