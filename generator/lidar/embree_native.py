@@ -10,12 +10,16 @@ prints both backends side by side). The LiDAR spends most of a sweep in Embree, 
 Embree functions the caster needs against the very library ``embreex`` installs (no other
 download, no compiler): a device, a scene of one shared triangle buffer, ``rtcIntersect1``.
 
-Same hits
----------
-The scene is built with ``RTC_SCENE_FLAG_ROBUST`` and Embree's default (medium) build
-quality, as ``embreex``'s scene is: the hit triangle and the ``tfar`` of every ray are the
-same bits as ``embreex``'s (a test casts a town through both). Without the robust flag about
-4 % of the distances differ in the last bit.
+Watertight or fast
+------------------
+By default the scene is built without ``RTC_SCENE_FLAG_ROBUST``: on the default town a sweep's casts
+take 1/1.29 of the time (``bench/lidar_traffic.py`` and ``docs/lidar.md`` give the figures). The
+price: Embree's fast triangle test is not watertight, so about one ray in a million meets the
+neighbour across a shared edge or slips through it to the surface behind, and about 2.5 % of the
+distances differ from the watertight test's in their last bit. ``Scene(..., robust=True)`` builds
+the watertight scene ``embreex`` builds, with its default (medium) build quality: then the hit
+triangle and the ``tfar`` of every ray are the same bits as ``embreex``'s (a test casts a town
+through both).
 
 Threads
 -------
@@ -114,8 +118,13 @@ def _kernel():
     intersect1 = ctypes.CFUNCTYPE(None, size, size, size)(("rtcIntersect1", _library()))
 
     @njit(nogil=True, boundscheck=False)
-    def cast(scene, o, d, tfar, rec, rec_u, dist, prim):  # pragma: no cover - compiled
-        p = rec.ctypes.data
+    def cast(scene, o, d, tfar, dist, prim):  # pragma: no cover - compiled
+        # one 64-byte aligned RTCRayHit (32 four-byte fields) per call, allocated here: no Python object
+        raw = np.zeros(48, np.uint32)
+        off = ((64 - raw.ctypes.data % 64) % 64) // 4
+        rec_u = raw[off:off + 32]
+        rec = rec_u.view(np.float32)
+        p = rec_u.ctypes.data
         one = tfar.shape[0] == 1
         for k in range(o.shape[0]):
             # RTCRayHit: org, tnear, dir, time, tfar, mask, id, flags | Ng, u, v, primID, geomID, instID
@@ -140,16 +149,8 @@ def _kernel():
     return cast
 
 
-def _record() -> tuple[np.ndarray, np.ndarray]:
-    """A 64-byte aligned RTCRayHit (room for 32 four-byte fields) as float32 and uint32 views."""
-    raw = np.zeros(48, np.float32)
-    off = (-raw.ctypes.data % 64) // 4
-    rec = raw[off:off + 32]
-    return rec, rec.view(np.uint32)
-
-
 class Scene:
-    """One Embree scene over one triangle soup, robust flag, default build quality.
+    """One Embree scene over one triangle soup, default (medium) build quality.
 
     Parameters
     ----------
@@ -157,9 +158,12 @@ class Scene:
         Vertex positions in the caster's frame, metres. Shared with Embree (kept alive here).
     faces : (F, 3) int
         Vertex indices; the primitive id of a hit is the row.
+    robust : bool
+        Watertight triangle tests (``RTC_SCENE_FLAG_ROBUST``, as ``embreex``: the same bits as its hits),
+        or Embree's fast test (default; see the module docstring).
     """
 
-    def __init__(self, vertices: np.ndarray, faces: np.ndarray):
+    def __init__(self, vertices: np.ndarray, faces: np.ndarray, robust: bool = False):
         lib = _library()
         self._cast = _kernel()
         # Embree reads the last float3 with a 16-byte load: one float of padding past the end
@@ -170,7 +174,7 @@ class Scene:
         self._f = faces.view(np.uint32) if faces.dtype == np.int32 else faces.astype(np.uint32)
         dev = _device()
         self._lib, self._ptr = lib, lib.rtcNewScene(dev)
-        lib.rtcSetSceneFlags(self._ptr, _ROBUST)
+        lib.rtcSetSceneFlags(self._ptr, _ROBUST if robust else 0)
         geom = lib.rtcNewGeometry(dev, _TRIANGLE)
         lib.rtcSetSharedGeometryBuffer(geom, _VERTEX, 0, _FLOAT3, self._v.ctypes.data, 0, 12, len(vertices))
         lib.rtcSetSharedGeometryBuffer(geom, _INDEX, 0, _UINT3, self._f.ctypes.data, 0, 12, len(self._f))
@@ -211,6 +215,5 @@ class Scene:
         """
         dist = np.empty(len(origins), np.float32)
         prim = np.empty(len(origins), np.int32)
-        rec, rec_u = _record()
-        self._cast(self._ptr, origins, directions, tfar, rec, rec_u, dist, prim)
+        self._cast(self._ptr, origins, directions, tfar, dist, prim)
         return dist, prim
