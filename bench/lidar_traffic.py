@@ -26,7 +26,8 @@ Rows, on the rays of the same HDL-64E sweeps (2083 x 64 = 133,312 rays each, mot
   beam divergence) and dual returns with beam divergence; and both again with the divergence model as it
   was before ``edge_subrays: differing`` (every sub-ray of a split beam cast: "all sub-rays").
   The ideal scanner and the two divergence rows run once more through embreex's ``run``
-  ("embreex" rows: the backend before Embree was called directly; the same points).
+  ("embreex" rows: the backend before Embree was called directly, whose watertight triangle test gives the
+  same points up to float rounding).
 
 Timings: each sweep of each method is timed in each of ``--rounds`` interleaved rounds and the
 best time per sweep is kept (a burst of load from other processes spoils one sample, not a row);
