@@ -60,23 +60,24 @@ def reaching(ray, pair, cand, ptr, ids, dist, offset, near, use_rows, use_offset
 
 
 @njit(nogil=True, cache=True)
-def nearest_hits(order, ray, pair, cand, t, prim, proto_sorted, proto_face_offset, d_loc, plan_actor, plan_moving,
+def nearest_hits(ray, pair, cand, t, prim, proto, proto_face_offset, d_loc, plan_actor, plan_moving,
                  dist, face, d_w):  # pragma: no cover - compiled
     """Each ray's nearest actor hit replaces its static one (arrays updated in place).
 
+    Of equal hits on one ray the entry of the lower prototype wins, then the earlier entry: the pick of the
+    casts grouped by prototype (a stable sort) that this replaced, so the bytes are the same.
+
     Parameters
     ----------
-    order : (k,) int64
-        Entries by prototype (stable): the order in which they were cast.
     ray, pair, cand : (k,) int64
-        Per entry (unsorted): its ray, (candidate, column) pair and candidate.
+        Per entry: its ray, (candidate, column) pair and candidate.
     t, prim : (k,) float32, int32
-        Per cast entry (sorted): hit distance and the prototype's face (-1: none).
-    proto_sorted : (k,) int64
-        Prototype per cast entry (sorted).
+        Per entry: hit distance and the prototype's face (-1: none).
+    proto : (k,) int64
+        Prototype per entry.
     proto_face_offset : (n_protos,) int64
     d_loc : (k, 3) float32
-        Per entry (unsorted): the direction in its actor's frame.
+        Per entry: the direction in its actor's frame.
     plan_actor, plan_moving : (K,) int64, (P,) uint8
         :class:`~generator.lidar.actors.SweepPlan`'s ``actor`` and ``moving``.
     dist, face, d_w : (n,) float32, (n,) int32, (n, 3) float32
@@ -92,23 +93,23 @@ def nearest_hits(order, ray, pair, cand, t, prim, proto_sorted, proto_face_offse
     n = dist.shape[0]
     best = np.full(n, np.inf, np.float32)
     win = np.full(n, -1, np.int64)
-    for s in range(order.shape[0]):
-        if prim[s] < 0:
+    for j in range(ray.shape[0]):
+        if prim[j] < 0:
             continue
-        r = ray[order[s]]
-        if t[s] < best[r]:  # strictly nearer: of equal hits the first cast wins (the stable lexsort's pick)
-            best[r] = t[s]
-            win[r] = s
+        r = ray[j]
+        w = win[r]
+        if t[j] < best[r] or (t[j] == best[r] and proto[j] < proto[w]):
+            best[r] = t[j]
+            win[r] = j
     actor = np.full(n, -1, np.int32)
     moving = np.zeros(n, np.uint8)
     count = 0
     for r in range(n):
-        s = win[r]
-        if s < 0:
+        j = win[r]
+        if j < 0:
             continue
-        j = order[s]
-        dist[r] = t[s]
-        face[r] = prim[s] + proto_face_offset[proto_sorted[s]]
+        dist[r] = t[j]
+        face[r] = prim[j] + proto_face_offset[proto[j]]
         d_w[r, 0], d_w[r, 1], d_w[r, 2] = d_loc[j, 0], d_loc[j, 1], d_loc[j, 2]
         actor[r] = plan_actor[cand[j]]
         moving[r] = plan_moving[pair[j]]

@@ -15,9 +15,10 @@ rays go to the actors instead of the actors to the BVH:
    (:func:`generator.lidar.windows.column_windows`: azimuth, rings, nearest distance).
 2. :meth:`ActorCaster.cast`, per chunk of columns after the static cast: the beams in those
    windows whose static hit lies beyond the actor's nearest possible distance are moved into the
-   actor's local frame at their own column's time, grouped by prototype (one ``run`` per
-   prototype) with ``tfar`` = the static hit, so Embree only reports actor hits that occlude the
-   town; the nearest hit per ray wins.
+   actor's local frame at their own column's time and cast into their prototype's scene (one compiled
+   loop for all of them, :func:`generator.lidar.embree_native.intersect_many`; through ``embreex``,
+   one ``run`` per prototype) with ``tfar`` = the static hit, so Embree only reports actor hits that
+   occlude the town; the nearest hit per ray wins.
 
 Every column therefore sees each actor exactly where ``actor.track.pose(t0 + column_time)``
 puts it: a passing car is smeared as a spinning sensor smears it. The alternative -- a second
@@ -35,6 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from generator.lidar import embree_native
 from generator.lidar.actor_kernels import aim_entries, nearest_hits, reaching
 from generator.lidar.caster import EmbreeCaster
 from generator.lidar.kernels import to_actor_frames
@@ -129,6 +131,9 @@ class ActorCaster:
         keys = list(dict.fromkeys(k for a in actors for k in ((a.prototype,) + (a.gait.keys if a.gait else ()))))
         self.protos = [world.prototypes[k] for k in keys]
         self._casters = [EmbreeCaster(m.vertices, m.faces, center=np.zeros(3), native=native) for m in self.protos]
+        #: the prototypes' scenes when Embree is called directly (one compiled loop casts into all of them)
+        self._scenes = ([c.direct_scene for c in self._casters]
+                        if all(c.direct_scene is not None for c in self._casters) else None)
         sizes = np.array([m.n_faces for m in self.protos], np.int64)
         self.proto_face_offset = face_offset + np.cumsum(sizes) - sizes
         self.proto_of = np.array([keys.index(a.prototype) for a in actors], np.int64)
@@ -287,14 +292,16 @@ class ActorCaster:
         to_actor_frames(o_w, d_w, ray, pair, plan.position, plan.cos, plan.sin, o_loc, d_loc)
         proto = plan.proto.take(pair)
         bound = np.minimum(dist.take(ray), np.float32(self.sensor.max_range_m))
-        # one Embree run per prototype, on its entries in order (a stable sort groups them)
-        order = np.argsort(proto, kind="stable")
-        proto = proto.take(order)
-        o_s, d_s, bound = o_loc.take(order, axis=0), d_loc.take(order, axis=0), bound.take(order)
-        t, prim = np.empty(len(order), np.float32), np.empty(len(order), np.int32)
-        ends = np.flatnonzero(np.diff(proto)) + 1
-        for a, b in itertools.pairwise([0, *ends.tolist(), len(proto)]):
-            t[a:b], prim[a:b] = self._casters[proto[a]].intersect_local(o_s[a:b], d_s[a:b], bound[a:b])
-        count, actor, moving = nearest_hits(order, ray, pair, cand, t, prim, proto, self.proto_face_offset, d_loc,
+        if self._scenes is not None:  # every entry into its prototype's scene, in one compiled loop
+            t, prim = embree_native.intersect_many(self._scenes, proto, o_loc, d_loc, bound)
+        else:  # embreex: one run per prototype, on its entries in order (a stable sort groups them)
+            order = np.argsort(proto, kind="stable")
+            p_s, b_s = proto.take(order), bound.take(order)
+            o_s, d_s = o_loc.take(order, axis=0), d_loc.take(order, axis=0)
+            t, prim = np.empty(len(order), np.float32), np.empty(len(order), np.int32)
+            ends = np.flatnonzero(np.diff(p_s)) + 1
+            for a, b in itertools.pairwise([0, *ends.tolist(), len(p_s)]):
+                t[order[a:b]], prim[order[a:b]] = self._casters[p_s[a]].intersect_local(o_s[a:b], d_s[a:b], b_s[a:b])
+        count, actor, moving = nearest_hits(ray, pair, cand, t, prim, proto, self.proto_face_offset, d_loc,
                                             plan.actor, plan.moving, dist, face, d_w)
         return (actor, moving) if count else None

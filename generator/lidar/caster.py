@@ -50,6 +50,11 @@ class RayCaster(Protocol):
         """(F, 3, 3) float32 corners of every face, re-centred; see :meth:`EmbreeCaster.triangle_corners`."""
 
     @property
+    def direct_scene(self) -> embree_native.Scene | None:
+        """The Embree scene the direct calls cast into (None when ``embreex.run`` casts)."""
+        return self._scene if self.native else None
+
+    @property
     def face_normals(self) -> np.ndarray:
         """(F, 3) float32 unit face normals, world frame."""
 
@@ -116,6 +121,11 @@ class EmbreeCaster:
     def from_scene(cls, scene) -> EmbreeCaster:
         """A caster over ``scene.vertices`` / ``scene.faces`` (the real geometry, never the label proxies)."""
         return cls(scene.vertices, scene.faces)
+
+    @property
+    def direct_scene(self) -> embree_native.Scene | None:
+        """The Embree scene the direct calls cast into (None when ``embreex.run`` casts)."""
+        return self._scene if self.native else None
 
     @property
     def face_normals(self) -> np.ndarray:

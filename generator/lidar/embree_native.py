@@ -111,14 +111,15 @@ def version() -> str | None:
 
 @cache
 def _kernel():
-    """The compiled cast loop, bound to this process's ``rtcIntersect1``."""
+    """The compiled cast loop, bound to this process's ``rtcIntersect1``: ray ``k`` is cast into scene
+    ``scenes[which[k]]`` (``which`` of length 1: every ray into ``scenes[which[0]]``)."""
     from numba import njit
 
     size = ctypes.c_size_t
     intersect1 = ctypes.CFUNCTYPE(None, size, size, size)(("rtcIntersect1", _library()))
 
     @njit(nogil=True, boundscheck=False)
-    def cast(scene, o, d, tfar, dist, prim):  # pragma: no cover - compiled
+    def cast(scenes, which, o, d, tfar, dist, prim):  # pragma: no cover - compiled
         # one 64-byte aligned RTCRayHit (32 four-byte fields) per call, allocated here: no Python object
         raw = np.zeros(48, np.uint32)
         off = ((64 - raw.ctypes.data % 64) % 64) // 4
@@ -126,6 +127,7 @@ def _kernel():
         rec = rec_u.view(np.float32)
         p = rec_u.ctypes.data
         one = tfar.shape[0] == 1
+        same = which.shape[0] == 1
         for k in range(o.shape[0]):
             # RTCRayHit: org, tnear, dir, time, tfar, mask, id, flags | Ng, u, v, primID, geomID, instID
             rec[0] = o[k, 0]
@@ -142,11 +144,45 @@ def _kernel():
             rec_u[11] = 0
             rec_u[17] = 0xFFFFFFFF
             rec_u[18] = 0xFFFFFFFF
-            intersect1(scene, p, 0)
+            intersect1(scenes[which[0] if same else which[k]], p, 0)
             dist[k] = rec[8]
             prim[k] = np.int32(rec_u[17]) if rec_u[18] != 0xFFFFFFFF else np.int32(-1)
 
     return cast
+
+
+def intersect_many(scenes: list, which: np.ndarray, origins: np.ndarray, directions: np.ndarray,
+                   tfar: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """First hits of rays each cast into a scene of its own, in one compiled loop (GIL released).
+
+    The actors' rays go to their prototypes' scenes this way: one call per chunk instead of one per
+    prototype, with no sort to group them. Each ray's hit is the one :meth:`Scene.intersect` gives it.
+
+    Parameters
+    ----------
+    scenes : list of Scene
+    which : (n,) int64
+        Index into ``scenes`` of each ray's scene.
+    origins, directions : (n, 3) float32, C-contiguous
+        In each ray's scene frame; unit directions, metres.
+    tfar : (n,) float32
+        Farthest distance to report per ray, metres.
+
+    Returns
+    -------
+    distance : (n,) float32
+        ``tfar`` where nothing was hit.
+    prim : (n,) int32
+        Face row in the ray's scene, -1 where nothing was hit.
+    """
+    dist = np.empty(len(origins), np.float32)
+    prim = np.empty(len(origins), np.int32)
+    ptrs = np.array([sc._ptr for sc in scenes], np.uint64)
+    _kernel()(ptrs, np.ascontiguousarray(which, np.int64), origins, directions, tfar, dist, prim)
+    return dist, prim
+
+
+_FIRST = np.zeros(1, np.int64)  # every ray into the first (only) scene
 
 
 class Scene:
@@ -174,6 +210,7 @@ class Scene:
         self._f = faces.view(np.uint32) if faces.dtype == np.int32 else faces.astype(np.uint32)
         dev = _device()
         self._lib, self._ptr = lib, lib.rtcNewScene(dev)
+        self._one = np.array([self._ptr], np.uint64)  # what the cast loop takes: an array of scenes
         lib.rtcSetSceneFlags(self._ptr, _ROBUST if robust else 0)
         geom = lib.rtcNewGeometry(dev, _TRIANGLE)
         lib.rtcSetSharedGeometryBuffer(geom, _VERTEX, 0, _FLOAT3, self._v.ctypes.data, 0, 12, len(vertices))
@@ -215,5 +252,5 @@ class Scene:
         """
         dist = np.empty(len(origins), np.float32)
         prim = np.empty(len(origins), np.int32)
-        self._cast(self._ptr, origins, directions, tfar, dist, prim)
+        self._cast(self._one, _FIRST, origins, directions, tfar, dist, prim)
         return dist, prim
