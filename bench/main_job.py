@@ -41,7 +41,7 @@ ARGS = ["generate", "scenes/first_look.json", "--config", "first_look", "--frame
 README_WORKERS = 2
 #: Files that record the run itself (times, the run's options), not the data.
 NOT_DATA = {"manifest.json", "journal.txt"}
-PROGRESS = re.compile(r"generate: (\d+)/(\d+) item.*elapsed (\d+) s")
+PROGRESS = re.compile(r"generate: (\d+)/(\d+) item.*elapsed (?:(\d+):)?(\d+)")
 
 
 def run_job(tree: Path, out: Path, workers: int | None) -> dict:
@@ -61,7 +61,7 @@ def run_job(tree: Path, out: Path, workers: int | None) -> dict:
         raise SystemExit(f"{tree}: the job failed (exit {proc.returncode})")
     (out.parent / f"{out.name}.log").write_text(proc.stderr, encoding="utf-8")
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-    items = [int(m.group(3)) for m in PROGRESS.finditer(proc.stderr)]
+    items = [60 * int(m.group(3) or 0) + int(m.group(4)) for m in PROGRESS.finditer(proc.stderr)]
     runs = json.loads((out / "manifest.json").read_text())["runs"]
     return {"wall": wall, "cpu": cpu, "items": items, "run": runs[-1]}
 
