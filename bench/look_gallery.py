@@ -592,9 +592,9 @@ def time_one(args) -> int:
                     labels = r.render_labels()
                     seconds.append({"rgb_pass": rgb_s, **labels.seconds, "render_total": time.perf_counter() - t1})
             rows += [{k: round(v, 3) for k, v in secs.items()} for secs in seconds]
-    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    use = resource.getrusage(resource.RUSAGE_SELF)
     print(json.dumps({"build": round(build, 3), "triangles": int(len(town.faces)), "frames": rows,
-                      "max_rss_mb": round(rss)}))
+                      "max_rss_mb": round(use.ru_maxrss / 1024), "cpu_s": round(use.ru_utime + use.ru_stime, 1)}))
     return 0
 
 
@@ -615,7 +615,7 @@ def time_compare(args) -> int:
     print(f"{args.config} preset, {args.frames} {views} x ({', '.join(args.lighting)}) x {args.rounds} rounds, "
           f"{args.spec}")
     print(f"{'tree':12s} {'triangles':>10s} {'build s':>8s} {'rgb s/frame':>12s} {'labels s/frame':>15s} "
-          f"{'total s/frame':>14s} {'peak MB':>8s}")
+          f"{'total s/frame':>14s} {'peak MB':>8s} {'process CPU s':>14s}")
     total, parts = {}, {}
     for name, rs in runs.items():
         fr = [f for r in rs for f in r["frames"]]
@@ -623,7 +623,8 @@ def time_compare(args) -> int:
         tot = np.mean([f["render_total"] for f in fr])
         total[name], parts[name] = tot, (rgb, tot - rgb)
         print(f"{name:12s} {rs[0]['triangles']:10d} {np.mean([r['build'] for r in rs]):8.2f} {rgb:12.2f} "
-              f"{tot - rgb:15.2f} {tot:14.2f} {max(r['max_rss_mb'] for r in rs):8d}")
+              f"{tot - rgb:15.2f} {tot:14.2f} {max(r['max_rss_mb'] for r in rs):8d} "
+              f"{np.mean([r.get('cpu_s', np.nan) for r in rs]):14.1f}")
     (rgb_b, lab_b), (rgb_t, lab_t) = parts["baseline"], parts["this tree"]
     print(f"ratio this tree / baseline: total per frame {total['this tree'] / total['baseline']:.3f}, "
           f"RGB {rgb_t / rgb_b:.3f}, label pass {lab_t / lab_b:.3f}")

@@ -28,6 +28,18 @@ log = logging.getLogger(__name__)
 
 LABEL_MATERIAL = "urbangen_label"
 
+#: A diffuse ray that has bounced this many times (None: never) sees every opaque, unlit material as a
+#: plain diffuse of its mean colour (:func:`plain_color`) instead of its full recipe. Light reflected
+#: diffusely off a surface carries its mean colour, not its cracks, bricks or leaf veins, and the detailed
+#: shaders evaluated at every bounce were a large share of the paper preset's render time. Camera rays,
+#: reflections and refraction (glossy and transmission rays), lamps and glass keep their recipes; the
+#: label pass (no bounces) is unchanged, and no geometry is cut (shadows and LiDAR unchanged).
+DEEP_DIFFUSE_BOUNCES: int | None = 1
+#: Materials whose colour is the object's colour (``Object.color``: paint, signs, clothes), and those
+#: whose table colour the object's colour tints (rendered facades, balconies).
+OBJECT_COLOURED = frozenset({"car_paint", "car_body", "truck_paint", "sign_face", "clothing", "clothing_bottom"})
+OBJECT_TINTED = frozenset({"facade_plaster", "balcony_metal"})
+
 
 def build_materials(seed: int) -> list[bpy.types.Material]:
     """Create the material of every material id; index the result with a material id.
@@ -45,8 +57,10 @@ def build_materials(seed: int) -> list[bpy.types.Material]:
             raise RuntimeError(f"no Blender recipe for material {row.name!r} (generator/blender/recipes*.py)")
         mat = bpy.data.materials.new(row.name)
         g = Nodes(mat.node_tree)
-        g.output(g.mix_shader(g.attr(controls.LABEL, "VIEW_LAYER"), recipe(g, stream(seed, "materials", row.name)),
-                              label_surface(g)))
+        surface = recipe(g, stream(seed, "materials", row.name))
+        if DEEP_DIFFUSE_BOUNCES is not None and row.emissive is None and row.transmittance == 0.0:
+            surface = plain_when_deep(g, surface, plain_color(g, row), DEEP_DIFFUSE_BOUNCES)
+        g.output(g.mix_shader(g.attr(controls.LABEL, "VIEW_LAYER"), surface, label_surface(g)))
         # Emission strength follows scene switches (day/night, the label switch); Cycles would
         # estimate it for its light tree once and keep the estimate with persistent data, so a
         # render would depend on the renders before it (and every label emission would be a
@@ -54,6 +68,31 @@ def build_materials(seed: int) -> list[bpy.types.Material]:
         mat.cycles.emission_sampling = "NONE"
         out.append(mat)
     return out
+
+
+def plain_when_deep(g: Nodes, surface, color, bounces: int):
+    """``surface``, but a diffuse of ``color`` for diffuse rays that have bounced ``bounces`` times or more
+    (Cycles evaluates only the branch of the Mix Shader a ray takes)."""
+    path = g.node("ShaderNodeLightPath").outputs
+    deep = g.mul(path["Is Diffuse Ray"], g.math("GREATER_THAN", path["Ray Depth"], bounces - 0.5))
+    plain = g.node("ShaderNodeBsdfDiffuse")
+    g.set(plain.inputs["Color"], color)
+    return g.mix_shader(deep, surface, plain.outputs[0])
+
+
+def plain_color(g: Nodes, row):
+    """The mean colour of material ``row`` (linear): its table colour, or the object's colour
+    (:data:`OBJECT_COLOURED`), or the table colour tinted by it (:data:`OBJECT_TINTED`)."""
+    table = tuple(_linear(c / 255.0) for c in row.color)
+    if row.name in OBJECT_COLOURED:
+        return g.object_info("Color")
+    if row.name in OBJECT_TINTED:
+        return g.mix(1.0, table, g.object_info("Color"), "MULTIPLY")
+    return table
+
+
+def _linear(c: float) -> float:
+    return c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4
 
 
 def label_surface(g: Nodes):
