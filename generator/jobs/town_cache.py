@@ -2,7 +2,7 @@
 
 Every task of a town (its scan, its render jobs, its finishing) needs the town's scene
 (:func:`generator.layout.build_scene`) and drive (:func:`generator.jobs.drive.plan_drive`); built
-afresh they cost ~12 s of one core per task (first_look), while the pickled pair (~60 MB) is
+afresh they cost ~12 s of one core per task (a town of 3 x 3 blocks), while the pickled pair (~60 MB) is
 written in ~0.15 s and read in ~0.15 s. So the first process that builds a town (``generate``'s
 preflight for the first town, else the town's scan task) writes them to
 ``out/.scratch/towns/NN.pickle`` and the later tasks read them.
