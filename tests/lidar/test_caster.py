@@ -120,3 +120,20 @@ def test_the_corners_the_return_model_reads_are_the_vertices_embree_casts_agains
     corners = caster.triangle_corners()
     np.testing.assert_array_equal(corners, (v - caster.center).astype(np.float32)[f])
     assert np.shares_memory(caster._local, caster._scene._v)  # one copy of the vertices, not two
+
+
+@pytest.mark.skipif(not embree_native.available(), reason="needs Embree called directly")
+def test_rays_cast_into_scenes_of_their_own_hit_what_each_scene_gives_them(rays):
+    """The actors' one-loop cast: each ray meets only its own scene, exactly as that scene alone casts it."""
+    o, d = rays
+    a, b = EmbreeCaster(*_terrain(40), center=np.zeros(3)), EmbreeCaster(*_terrain(40, 0.7), center=np.zeros(3))
+    which = np.random.default_rng(2).integers(0, 2, len(o))
+    tfar = np.full(len(o), 40.0, np.float32)
+    dist, prim = embree_native.intersect_many([a.direct_scene, b.direct_scene], which, o, d, tfar)
+    for k, c in enumerate((a, b)):
+        m = which == k
+        want = c.intersect_local(o[m], d[m], 40.0, mark_misses=False)
+        assert (want[1] >= 0).sum() > m.sum() // 4
+        np.testing.assert_array_equal(prim[m], want[1])
+        np.testing.assert_array_equal(dist[m].view(np.uint32), want[0].view(np.uint32))
+    assert not np.array_equal(*(c.intersect_local(o, d, 40.0)[1] for c in (a, b)))  # the scenes differ
