@@ -11,6 +11,12 @@ import numpy as np
 from generator.safeload import load_package_yaml
 
 
+def srgb_to_linear(c: np.ndarray) -> np.ndarray:
+    """(..., 3) float linear RGB of (..., 3) sRGB values in [0, 255] (IEC 61966-2-1)."""
+    s = np.asarray(c, float) / 255.0
+    return np.where(s <= 0.04045, s / 12.92, ((s + 0.055) / 1.055) ** 2.4)
+
+
 @dataclass(frozen=True)
 class MaterialInfo:
     """One row of the material table."""

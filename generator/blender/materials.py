@@ -21,7 +21,7 @@ import logging
 from generator.blender import controls, recipes, recipes_actors, recipes_far, recipes_look, recipes_street
 from generator.blender.bpy_guard import bpy
 from generator.blender.nodes import Nodes
-from generator.materials import material_table
+from generator.materials import material_table, srgb_to_linear
 from generator.rng import stream
 
 log = logging.getLogger(__name__)
@@ -83,16 +83,12 @@ def plain_when_deep(g: Nodes, surface, color, bounces: int):
 def plain_color(g: Nodes, row):
     """The mean colour of material ``row`` (linear): its table colour, or the object's colour
     (:data:`OBJECT_COLOURED`), or the table colour tinted by it (:data:`OBJECT_TINTED`)."""
-    table = tuple(_linear(c / 255.0) for c in row.color)
+    table = tuple(float(c) for c in srgb_to_linear(row.color))
     if row.name in OBJECT_COLOURED:
         return g.object_info("Color")
     if row.name in OBJECT_TINTED:
         return g.mix(1.0, table, g.object_info("Color"), "MULTIPLY")
     return table
-
-
-def _linear(c: float) -> float:
-    return c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4
 
 
 def label_surface(g: Nodes):

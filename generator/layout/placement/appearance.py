@@ -19,15 +19,10 @@ from pathlib import Path
 
 import numpy as np
 
+from generator.materials import srgb_to_linear
 from generator.safeload import load_package_yaml
 
 DRAWS_PER_COLOUR = 4  #: values one colour takes from its generator: the pick and 3 channel jitters
-
-
-def srgb_to_linear(c: np.ndarray) -> np.ndarray:
-    """(..., 3) float linear RGB of (..., 3) sRGB values in [0, 255] (IEC 61966-2-1)."""
-    s = np.asarray(c, float) / 255.0
-    return np.where(s <= 0.04045, s / 12.92, ((s + 0.055) / 1.055) ** 2.4)
 
 
 @dataclass(frozen=True)

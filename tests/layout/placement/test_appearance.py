@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from generator.layout.placement.appearance import Palette, appearance, fleet_paint, outfit, srgb_to_linear
+from generator.layout.placement.appearance import Palette, appearance, fleet_paint, outfit
+from generator.materials import srgb_to_linear
 from generator.rng import stream
 
 N_DRAWS = 20000
