@@ -98,7 +98,7 @@ def nearest_hits(ray, pair, cand, t, prim, proto, proto_face_offset, d_loc, plan
             continue
         r = ray[j]
         w = win[r]
-        if t[j] < best[r] or (t[j] == best[r] and proto[j] < proto[w]):
+        if w < 0 or t[j] < best[r] or (t[j] == best[r] and proto[j] < proto[w]):
             best[r] = t[j]
             win[r] = j
     actor = np.full(n, -1, np.int32)
