@@ -6,9 +6,8 @@ moving actors, each column of a sweep seeing them where they are at its firing t
 ``out/sequences/NN/`` (see :mod:`generator.formats.semantickitti`) plus ``bev/NNNNNN.png``
 (bird's-eye view), optionally ``range/NNNNNN.npy`` (range image, rings x columns float32,
 0 = no return) and ``ply/NNNNNN.ply``; ``lidar_meta.json`` says how the data was made (sensor,
-conventions, remission placeholder, point counts); the
-dataset's ``semantic-kitti.yaml`` label config sits in ``out/``.
-Side files for fusion: ``point_times/`` and ``native_labels/`` per scan
+conventions, remission placeholder, point counts); the dataset's ``semantic-kitti.yaml`` label config sits in
+``out/``. Side files for fusion: ``point_times/`` and ``native_labels/`` per scan
 (:mod:`generator.formats.point_sidecars`), the scene flow of every scan but the last
 (``scene_flow/``, :mod:`generator.formats.scene_flow`, :mod:`generator.jobs.scan_flow`) and, in ``lidar_meta.json``,
 ``sweep_poses_world`` (the LiDAR world poses during each sweep, :meth:`generator.world.rig.Rig.sweep_record`).
@@ -192,13 +191,17 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
     flows = ScanFlowWriter(seq, rig, world, sensor, skew)  # scene_flow/ of each sweep, once the next is cast
     with Scanner(scene, sensor, threads=options.threads, world=world, returns=returns) as scanner, flows:
         direct = getattr(scanner.caster, "native", None)  # which backend this scanner's caster casts through
+
+        def submit(j: int):  # sweep j starts on the scanner's threads
+            physical = {} if returns is None else {"alpha_per_m": sweep_alpha(spec, processing, j),
+                                                   "noise_key": frame_key(spec.seed, j)}
+            return scanner.submit_sweep(rig, times[j], skew, **physical)
+
+        ahead = [submit(0)] if options.frames else []
         for j in progress_bar(range(options.frames), desc=f"lidar {name}", unit="scan", enabled=progress):
-            t_j = times[j]
-            if returns is None:
-                scan = scanner.sweep(rig, t_j, skew)
-            else:
-                scan = scanner.sweep(rig, t_j, skew, alpha_per_m=sweep_alpha(spec, processing, j),
-                                     noise_key=frame_key(spec.seed, j))
+            if j + 1 < options.frames:  # the next sweep queues behind this one: cast while this one is written
+                ahead.append(submit(j + 1))
+            scan = ahead.pop(0).result()
             pts = scan.points
             if returns is not None and returns.params.mode == "dual":
                 second = pts[pts["echo"] == 1]
@@ -214,7 +217,7 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
             sk.write_scan(seq / "velodyne" / f"{stem}.bin", scan.xyz, remission)
             sk.write_labels(seq / "labels" / f"{stem}.label", semantic, pts["instance"])
             write_point_sidecars(seq, stem, pts["time"], pts["class"], pts["ring"])  # de-skew times, classes, rings
-            flows.add(j, t_j, pts)
+            flows.add(j, times[j], pts)
             if options.bev:
                 write_bev(seq / "bev" / f"{stem}.png", scan.xyz, pts["class"], title=f"{spec.name} {name}/{stem}",
                           moving=pts["moving"])
@@ -224,8 +227,8 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
             if options.ply:
                 write_ply(seq / "ply" / f"{stem}.ply", scan.xyz, remission, semantic, pts["instance"],
                           class_table().colors[pts["class"]])
-            starts.append(rig.T_world_lidar(t_j)[0])
-            sweeps.append(rig.sweep_record(t_j, sensor.period_s))
+            starts.append(rig.T_world_lidar(times[j])[0])
+            sweeps.append(rig.sweep_record(times[j], sensor.period_s))
             n_points.append(int(len(pts)))
             counts = merge_counts(counts, count_raw_ids(semantic))
     _remove_stale(seq, options.frames)

@@ -18,7 +18,7 @@ Steps, per chunk ``[c0, c1)`` of a sweep (the scanner's threads run chunks in pa
    is modelled: then only its own opaque faces return it
    (:func:`~generator.lidar.return_rays.absorb_interior`);
 4. the waveform of every beam (:func:`generator.lidar.return_kernels.beam_returns`) gives its
-   returns, handed to the sweep (:meth:`generator.lidar.scan._Sweep.deliver`), which places them
+   returns, handed to the sweep (:meth:`generator.lidar.sweep_flight.SweepInFlight.deliver`), which places them
    once the chunks before have counted theirs: no chunk waits for another.
 
 Per-hit work runs in compiled passes with the GIL released; what stays in numpy is per chunk, not

@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import itertools
 import os
-import threading
 from concurrent.futures import ThreadPoolExecutor, wait
 from dataclasses import dataclass
 from typing import Self
@@ -41,8 +40,9 @@ from generator.lidar.physical_chunk import FaceLookup, central_constants, run_ph
 from generator.lidar.points import POINT_DTYPE, RecordTables
 from generator.lidar.returns import ReturnModel
 from generator.lidar.sensors import Sensor
+from generator.lidar.sweep_flight import SweepInFlight
 
-__all__ = ["POINT_DTYPE", "Scan", "Scanner"]
+__all__ = ["POINT_DTYPE", "PendingScan", "Scan", "Scanner"]
 
 
 @dataclass
@@ -170,7 +170,7 @@ class Scanner:
 
     def scan(self, T_world_sensor: np.ndarray, t0: float | None = None, alpha_per_m: float = 0.0,
              noise_key: int = 0) -> Scan:
-        """Cast one sweep.
+        """Cast one sweep (:meth:`submit` and wait for it).
 
         Parameters
         ----------
@@ -190,6 +190,17 @@ class Scanner:
         -------
         Scan
         """
+        return self.submit(T_world_sensor, t0, alpha_per_m, noise_key).result()
+
+    def submit(self, T_world_sensor: np.ndarray, t0: float | None = None, alpha_per_m: float = 0.0,
+               noise_key: int = 0) -> PendingScan:
+        """Start casting one sweep (arguments as :meth:`scan`); :meth:`PendingScan.result` gives its points.
+
+        The sweep's chunks queue behind those of sweeps submitted before, so a caller that submits
+        sweep ``k + 1`` before it reads sweep ``k`` keeps both threads busy across the sweep boundary
+        (and while it writes sweep ``k``). Each sweep's points are the same whatever is in flight beside it.
+        Returns once the actors' plan of the sweep is made (on the calling thread, while the workers cast).
+        """
         poses = np.asarray(T_world_sensor, np.float64)
         skew = poses.ndim == 3
         if skew and len(poses) != self.sensor.azimuth_steps:
@@ -203,14 +214,15 @@ class Scanner:
         rot_t = np.ascontiguousarray(np.broadcast_to(rot_t, (steps, 3, 3)))
         trans = np.ascontiguousarray(np.broadcast_to(trans, (steps, 3)))
         per_beam = 2 if self.returns is not None and self.returns.params.mode == "dual" else 1
-        sweep = _Sweep(np.empty(per_beam * self.sensor.rays_per_sweep, POINT_DTYPE), len(self._chunks), rot_t, trans,
-                       skew, float(alpha_per_m), int(noise_key))
+        sweep = SweepInFlight(np.empty(per_beam * self.sensor.rays_per_sweep, POINT_DTYPE), len(self._chunks), rot_t,
+                              trans, skew, float(alpha_per_m), int(noise_key))
 
         def plan():  # which actors each column may see; the workers need it only after their static cast
             if self.actors is None:
                 return None
             return self.actors.plan(poses, float(t0), self.sensor.column_time() if skew else None)
 
+        futures = []
         if self._pool is None:
             sweep.set_plan(plan)
             sweep.raise_plan_error()
@@ -219,12 +231,7 @@ class Scanner:
         else:
             futures = [self._pool.submit(self._run_chunk, sweep, i, cols) for i, cols in enumerate(self._chunks)]
             sweep.set_plan(plan)
-            wait(futures)
-            sweep.raise_plan_error()
-            for f in futures:
-                f.result()
-        return Scan(sweep.out[:sweep.ends[-1]], poses[0] if skew else poses, self.sensor.rays_per_sweep,
-                    self.sensor.n_lasers, self.sensor.azimuth_steps)
+        return PendingScan(self, sweep, futures, poses[0] if skew else poses)
 
     def sweep(self, rig, t0: float, motion_skew: bool = True, alpha_per_m: float = 0.0, noise_key: int = 0) -> Scan:
         """Cast the sweep starting at ``t0`` seconds from ``rig``'s LiDAR.
@@ -241,10 +248,15 @@ class Scanner:
         alpha_per_m, noise_key
             As :meth:`scan`.
         """
-        return self.scan(rig.sweep_poses(t0, self.sensor.column_time() if motion_skew else None), t0=t0,
-                         alpha_per_m=alpha_per_m, noise_key=noise_key)
+        return self.submit_sweep(rig, t0, motion_skew, alpha_per_m, noise_key).result()
 
-    def _run_chunk(self, sweep: _Sweep, i: int, cols: slice) -> None:
+    def submit_sweep(self, rig, t0: float, motion_skew: bool = True, alpha_per_m: float = 0.0,
+                     noise_key: int = 0) -> PendingScan:
+        """:meth:`sweep` without waiting for it (see :meth:`submit`)."""
+        return self.submit(rig.sweep_poses(t0, self.sensor.column_time() if motion_skew else None), t0=t0,
+                           alpha_per_m=alpha_per_m, noise_key=noise_key)
+
+    def _run_chunk(self, sweep: SweepInFlight, i: int, cols: slice) -> None:
         if self.returns is not None:
             run_physical_chunk(self, sweep, i, cols)
             return
@@ -274,75 +286,17 @@ class Scanner:
             out["moving"][m] = moving.take(hit)[m]
 
 
-class _Sweep:
-    """One sweep in flight: the output array, the actors' plan and the chained chunk offsets."""
+class PendingScan:
+    """A sweep :meth:`Scanner.submit` started; :meth:`result` waits for its points."""
 
-    def __init__(self, out: np.ndarray, n_chunks: int, rot_t, trans, skew: bool, alpha: float = 0.0, key: int = 0):
-        self.out, self.rot_t, self.trans, self.skew = out, rot_t, trans, skew
-        self.alpha, self.key = alpha, key
-        self.ends: list[int | None] = [None] * n_chunks
-        self._done = [threading.Event() for _ in range(n_chunks)]
-        self._lock = threading.Lock()
-        self._pending: dict[int, tuple[np.ndarray, int]] = {}
-        self._next = 0  # the first chunk whose offset is not known yet (deliver)
-        self._plan, self._plan_error = None, None
-        self._planned = threading.Event()
+    def __init__(self, scanner: Scanner, sweep: SweepInFlight, futures: list, T_world_sensor: np.ndarray):
+        self._scanner, self._sweep, self._futures, self._pose = scanner, sweep, futures, T_world_sensor
 
-    def set_plan(self, make_plan) -> None:
-        """Compute the actors' plan (``make_plan()``) and release the chunks waiting for it."""
-        try:
-            self._plan = make_plan()
-        except Exception as e:  # noqa: BLE001 - re-raised by raise_plan_error, after the chunks stopped
-            self._plan_error = e
-        finally:
-            self._planned.set()
-
-    def get_plan(self):
-        """The plan (None without actors); waits until it is known."""
-        self._planned.wait()
-        if self._plan_error is not None:
-            raise RuntimeError("planning the actors of this sweep failed") from self._plan_error
-        return self._plan
-
-    def raise_plan_error(self) -> None:
-        """Raise what planning raised, if anything."""
-        if self._plan_error is not None:
-            raise self._plan_error
-
-    def claim(self, i: int, n: int) -> int:
-        """Offset of chunk ``i``'s ``n`` points: the end of chunk ``i - 1`` (waits until it is known)."""
-        start = 0
-        if i > 0:
-            self._done[i - 1].wait()
-            start = self.ends[i - 1]
-            if start is None:
-                raise RuntimeError("an earlier chunk of this sweep failed")
-        self.ends[i] = start + n
-        self._done[i].set()
-        return start
-
-    def deliver(self, i: int, buf: np.ndarray, n: int) -> None:
-        """Hand in chunk ``i``'s ``n`` points (``buf[:n]``) without waiting for the chunks before it.
-
-        The points go to their place in :attr:`out` as soon as every earlier chunk's count is known,
-        copied by whichever chunk completes the chain; a chunk finished early does not hold its thread.
-        (Use either this or :meth:`claim` for all the chunks of a sweep.)
-        """
-        todo = []
-        with self._lock:
-            self._pending[i] = (buf, n)
-            j = self._next
-            while j in self._pending:
-                b, m = self._pending.pop(j)
-                start = self.ends[j - 1] if j else 0
-                self.ends[j] = start + m
-                todo.append((start, b, m))
-                j += 1
-            self._next = j
-        raw = np.dtype((np.void, self.out.dtype.itemsize))  # a plain memory copy: numpy copies a packed
-        for start, b, m in todo:                            # record array field by field, ~20x slower
-            self.out[start:start + m].view(raw)[...] = b[:m].view(raw)
-
-    def fail(self, i: int) -> None:
-        """Release the chunks waiting on chunk ``i`` (they raise)."""
-        self._done[i].set()
+    def result(self) -> Scan:
+        """The sweep's :class:`Scan` (raises what a chunk or the actors' plan raised)."""
+        wait(self._futures)
+        self._sweep.raise_plan_error()
+        for f in self._futures:
+            f.result()
+        s = self._scanner.sensor
+        return Scan(self._sweep.out[:self._sweep.ends[-1]], self._pose, s.rays_per_sweep, s.n_lasers, s.azimuth_steps)

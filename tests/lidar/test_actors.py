@@ -11,11 +11,12 @@ import pytest
 
 from generator.formats import semantickitti as sk
 from generator.geometry import box, icosphere, rect
+from generator.jobs.lidar_returns import return_model
 from generator.labels import class_table
 from generator.labels.sets import semantickitti_labels
 from generator.lidar.caster import EmbreeCaster
 from generator.lidar.scan import POINT_DTYPE, Scanner
-from generator.lidar.sensors import load_preset
+from generator.lidar.sensors import load_preset, with_returns
 from generator.lidar.tracks import TrackBank
 from generator.materials import material_table
 from generator.world import rig
@@ -311,6 +312,24 @@ def test_threads_and_repeated_sweeps_give_identical_bytes(hdl64e, ground):
     with Scanner(ground, hdl64e, threads=1, world=world) as one, Scanner(ground, hdl64e, threads=2, world=world) as two:
         a, b, c = one.scan(poses, t0=0.2).points, two.scan(poses, t0=0.2).points, two.scan(poses, t0=0.2).points
     assert np.any(a["instance"] == 9) and same_bytes(a, b) and same_bytes(a, c)
+
+
+@pytest.mark.parametrize("mode", ["ideal", "dual"])
+def test_sweeps_submitted_ahead_are_the_sweeps_cast_one_at_a_time(hdl64e, ground, mode):
+    """A job keeps the next sweeps in flight while it writes one: their chunks share the threads, not their points."""
+    sensor = with_returns(hdl64e, mode)
+    returns = return_model(sensor, 7)
+    tr = track((5.0, -8.0, 0.0), (0.0, 11.0), np.pi / 2)
+    world = world_of(ground, [("car", 9, tr)], {"car": box_car()})
+    starts = [0.0, 0.1, 0.2, 0.3]
+    poses = [column_poses(hdl64e, t, speed=9.0) for t in starts]
+    with Scanner(ground, sensor, threads=2, world=world, returns=returns) as sc:
+        alone = [sc.scan(p, t0=t, noise_key=k).points for k, (p, t) in enumerate(zip(poses, starts, strict=True))]
+        pending = [sc.submit(p, t0=t, noise_key=k) for k, (p, t) in enumerate(zip(poses, starts, strict=True))]
+        ahead = [s.result().points for s in pending]
+    assert all(np.any(a["instance"] == 9) for a in alone)
+    assert (returns is None) == (mode == "ideal") and all(not same_bytes(alone[0], a) for a in alone[1:])
+    assert all(same_bytes(a, b) for a, b in zip(alone, ahead, strict=True))
 
 
 def test_a_scanner_with_actors_needs_the_sweep_time(hdl64e, ground):
