@@ -227,8 +227,9 @@ def main(argv=None) -> int:
     # best of the rounds for every sweep on its own: a burst of load from other processes spoils one
     # sweep of one method, not a whole row
     best = {k: np.full((2, args.sweeps), np.inf) for k in methods}
-    streamed = [(True, args.threads), *((k, args.threads) for k in
-                                        ("physical: strongest + divergence", "physical: dual + divergence"))]
+    streamed = {("ours: Scanner.scan, actors moving", args.threads): scanners[(True, args.threads)],
+                **{(k, args.threads): physical[k] for k in ("physical: strongest + divergence",
+                                                            "physical: dual + divergence")}}
     seq_best = dict.fromkeys(streamed, np.inf)
 
     def stream(sc):  # as `urbangen lidar` casts a sequence (generator.jobs.lidar_sequence)
@@ -246,7 +247,7 @@ def main(argv=None) -> int:
                 best[k][:, i] = np.minimum(best[k][:, i], (wall, cpu))
             if k in streamed:  # the same sweeps in one stream, the next submitted before this one is read
                 w0 = time.perf_counter()
-                stream(scanners[k])
+                stream(streamed[k])
                 seq_best[k] = min(seq_best[k], time.perf_counter() - w0)
     best = {k: tuple(v.sum(1)) for k, v in best.items()}
     scans = [scanners[(True, args.threads)].scan(p, t0=float(x)) for p, x in zip(poses, times, strict=False)]
@@ -311,9 +312,10 @@ def main(argv=None) -> int:
         print(f"{k}, actors moving: {n / new[0] / sensor.rotation_hz:.2f}x real time (embreex run: "
               f"{n / old[0] / sensor.rotation_hz:.2f}x), {old[0] / new[0]:.2f}x faster")
     for k in streamed:
-        one = best[k if k[0] is not True else ("ours: Scanner.scan, actors moving", args.threads)][0]
-        print(f"{'ideal' if k[0] is True else k[0][10:]}, actors moving, one stream of {n} sweeps (each submitted "
-              f"before the one before is read): {n / seq_best[k] / sensor.rotation_hz:.2f}x real time "
+        one = best[k][0]
+        label = "ideal" if k[0].startswith("ours") else k[0][len("physical: "):]
+        print(f"{label}, actors moving, one stream of {n} sweeps (each submitted before the one before is read): "
+              f"{n / seq_best[k] / sensor.rotation_hz:.2f}x real time "
               f"(sweeps one at a time: {n / one / sensor.rotation_hz:.2f}x)")
     print(f"per sweep: {np.mean(seen):.0f} actors in range, {np.mean(cand):,.0f} rays in their column windows (before "
           f"the per-laser azimuth and static-distance culls), {on_actor.mean():,.0f} points on actors "
