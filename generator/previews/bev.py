@@ -12,6 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from numba import njit
 from PIL import Image, ImageDraw
 
 from generator.atomic import atomic_path
@@ -19,6 +20,34 @@ from generator.labels import class_table
 
 #: Colour of moving points: pure green, far from every class colour of the table.
 MOVING_RGB = (0, 255, 0)
+
+
+@njit(nogil=True, cache=True)
+def _top_points(row, col, z, size):  # pragma: no cover - compiled
+    """Per pixel of a ``size`` x ``size`` grid the index of its highest point (-1: none); of points at the same
+    height the later one. What drawing the points lowest first gives (later writes win), without sorting.
+
+    Parameters
+    ----------
+    row, col : (n,) int64
+        Pixel of each point (those outside the grid are skipped).
+    z : (n,) float64
+        Height, metres.
+    size : int
+
+    Returns
+    -------
+    (size * size,) int64
+    """
+    top = np.full(size * size, -1, np.int64)
+    for i in range(z.shape[0]):
+        r, c = row[i], col[i]
+        if r < 0 or r >= size or c < 0 or c >= size:
+            continue
+        p = r * size + c
+        if top[p] < 0 or z[i] >= z[top[p]]:
+            top[p] = i
+    return top
 
 
 def bev_image(xyz: np.ndarray, cls: np.ndarray, extent_m: float = 80.0, res_m: float = 0.1,
@@ -51,10 +80,10 @@ def bev_image(xyz: np.ndarray, cls: np.ndarray, extent_m: float = 80.0, res_m: f
     col = np.floor((extent_m / 2 - xyz[:, 1]) / res_m).astype(np.int64)
     keep = (row >= 0) & (row < size) & (col >= 0) & (col < size)
     moving = np.zeros(len(cls), bool) if moving is None else np.asarray(moving, bool)
-    order = np.argsort(xyz[keep, 2], kind="stable")  # low first; later writes win
-    r, c, k = row[keep][order], col[keep][order], cls[keep][order]
+    top = _top_points(row, col, np.ascontiguousarray(xyz[:, 2]), size)  # the highest point covers the rest
+    seen = np.flatnonzero(top >= 0)
     img = np.zeros((size, size, 3), np.uint8)
-    img[r, c] = table.colors[k]
+    img.reshape(-1, 3)[seen] = table.colors[cls[top[seen]]]
     mr, mc = row[keep & moving], col[keep & moving]  # painted over everything
     for dr in (-1, 0, 1):  # 3x3 dots: a mover stands out of the terrain and vegetation greens
         for dc in (-1, 0, 1):
@@ -94,4 +123,4 @@ def write_bev(path: str | Path, xyz: np.ndarray, cls: np.ndarray, **kwargs) -> N
     """Write :func:`bev_image` as a PNG atomically (keyword arguments as there)."""
     img = bev_image(xyz, cls, **kwargs)
     with atomic_path(path) as tmp:
-        img.save(tmp, format="PNG")
+        img.save(tmp, format="PNG", compress_level=1)  # ~1.5x faster than zlib's default level, ~5 % larger
