@@ -123,4 +123,4 @@ def write_bev(path: str | Path, xyz: np.ndarray, cls: np.ndarray, **kwargs) -> N
     """Write :func:`bev_image` as a PNG atomically (keyword arguments as there)."""
     img = bev_image(xyz, cls, **kwargs)
     with atomic_path(path) as tmp:
-        img.save(tmp, format="PNG", compress_level=1)  # ~1.5x faster than zlib's default level, ~5 % larger
+        img.save(tmp, format="PNG", compress_level=3)  # 1.25x faster than the default (6), files ~20 % larger
