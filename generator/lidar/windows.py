@@ -26,6 +26,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 EPS = 1e-3  #: metres / radians of slack on every bound (float32 rays vs float64 poses)
 
@@ -146,35 +147,62 @@ def column_windows(beams: BeamTable, position: np.ndarray, yaw: np.ndarray, box_
         frame); ``ring0``, ``ring1``: only rings ``[ring0, ring1)`` can hit; ``near`` (float32):
         no hit nearer than this, metres.
     """
-    c, s = np.cos(yaw), np.sin(yaw)
-    R = poses[:, :3, :3]
-    center = position + np.stack([c * box_center[:, 0] - s * box_center[:, 1],
-                                  s * box_center[:, 0] + c * box_center[:, 1], box_center[:, 2]], -1)
-    v = np.einsum("mji,mj->mi", R, center - poses[:, :3, 3])  # box centre, sensor frame
-    axes = (c[:, None] * R[:, 0] + s[:, None] * R[:, 1], c[:, None] * R[:, 1] - s[:, None] * R[:, 0], R[:, 2])
-    rho = np.maximum(np.hypot(v[:, 0], v[:, 1]), 1e-9)
-    ux, uy = v[:, 0] / rho, v[:, 1] / rho
-    # support of the box along the horizontal line of sight, across it and along the sensor's z
-    along = sum(box_half[:, i] * np.abs(a[:, 0] * ux + a[:, 1] * uy) for i, a in enumerate(axes))
-    across = sum(box_half[:, i] * np.abs(a[:, 1] * ux - a[:, 0] * uy) for i, a in enumerate(axes))
-    up = sum(box_half[:, i] * np.abs(a[:, 2]) for i, a in enumerate(axes))
-    # a beam's horizontal trace is the line at its azimuth shifted across by the horizontal offset;
-    # its start moves along it by the vertical offset's horizontal part
-    depth = rho - along - beams.radial - EPS
-    half = np.where(depth > 0, np.arctan2(across + beams.lateral + EPS, np.maximum(depth, 1e-9)), 4.0) + EPS
-    if beams.spread:  # a sub-ray leaves its beam by up to `spread`, in azimuth by up to spread / cos(elevation)
-        half = half + beams.spread / np.cos(min(float(np.abs(beams.neg_elevation).max()) + beams.spread, 1.5))
-    off = beams.offset + EPS
-    # horizontal distance of box points: at least the depth of the box's near face, at most its far corner's
-    r_lo, r_hi = rho - along - off, np.hypot(rho + along, across) + off
-    z_lo, z_hi = v[:, 2] - up - off, v[:, 2] + up + off
-    inside = r_lo <= 0
-    r_lo = np.maximum(r_lo, 1e-9)
-    el_hi = np.where(inside, np.pi / 2, np.arctan2(z_hi, np.where(z_hi >= 0, r_lo, r_hi))) + EPS + beams.spread
-    el_lo = np.where(inside, -np.pi / 2, np.arctan2(z_lo, np.where(z_lo <= 0, r_lo, r_hi))) - EPS - beams.spread
-    # distance from the sensor origin to the box, in the box's axes
-    q = np.stack([np.abs((a * v).sum(1)) for a in axes], -1)
-    near = np.linalg.norm(np.maximum(q - box_half, 0.0), axis=1) - off
-    return {"azimuth": np.arctan2(v[:, 1], v[:, 0]), "half": half,
-            "ring0": np.searchsorted(beams.neg_elevation, -el_hi, "left"),
-            "ring1": np.searchsorted(beams.neg_elevation, -el_lo, "right"), "near": near.astype(np.float32)}
+    m = len(yaw)
+    out = {"azimuth": np.empty(m), "half": np.empty(m), "ring0": np.empty(m, np.int64), "ring1": np.empty(m, np.int64),
+           "near": np.empty(m, np.float32)}
+    # a sub-ray leaves its beam by up to `spread`, in azimuth by up to spread / cos(elevation)
+    widen = (beams.spread / np.cos(min(float(np.abs(beams.neg_elevation).max()) + beams.spread, 1.5))
+             if beams.spread else 0.0)
+    _column_windows(np.ascontiguousarray(position, np.float64), np.ascontiguousarray(yaw, np.float64),
+                    np.ascontiguousarray(box_center, np.float64), np.ascontiguousarray(box_half, np.float64),
+                    np.ascontiguousarray(poses, np.float64), np.ascontiguousarray(beams.neg_elevation, np.float64),
+                    float(beams.lateral), float(beams.radial), float(beams.offset), float(beams.spread), widen,
+                    out["azimuth"], out["half"], out["ring0"], out["ring1"], out["near"])
+    return out
+
+
+@njit(nogil=True, cache=True)
+def _column_windows(position, yaw, box_center, box_half, poses, neg_el, lateral, radial, offset, spread, widen,
+                    azimuth, half, ring0, ring1, near):  # pragma: no cover - compiled
+    """:func:`column_windows`, one (actor, column) pair at a time (written into the last five arrays)."""
+    off = offset + EPS
+    a, v = np.empty((3, 3)), np.empty(3)
+    for k in range(yaw.shape[0]):
+        c, s = np.cos(yaw[k]), np.sin(yaw[k])
+        bx, by, bz = box_center[k, 0], box_center[k, 1], box_center[k, 2]
+        d0 = position[k, 0] + (c * bx - s * by) - poses[k, 0, 3]
+        d1 = position[k, 1] + (s * bx + c * by) - poses[k, 1, 3]
+        d2 = position[k, 2] + bz - poses[k, 2, 3]
+        for i in range(3):  # box centre, sensor frame
+            v[i] = poses[k, 0, i] * d0 + poses[k, 1, i] * d1 + poses[k, 2, i] * d2
+        for j in range(3):  # the actor's axes, sensor frame
+            a[0, j] = c * poses[k, 0, j] + s * poses[k, 1, j]
+            a[1, j] = c * poses[k, 1, j] - s * poses[k, 0, j]
+            a[2, j] = poses[k, 2, j]
+        rho = max(np.hypot(v[0], v[1]), 1e-9)
+        ux, uy = v[0] / rho, v[1] / rho
+        # support of the box along the horizontal line of sight, across it and along the sensor's z
+        along, across, up, q2 = 0.0, 0.0, 0.0, 0.0
+        for i in range(3):
+            h = box_half[k, i]
+            along += h * abs(a[i, 0] * ux + a[i, 1] * uy)
+            across += h * abs(a[i, 1] * ux - a[i, 0] * uy)
+            up += h * abs(a[i, 2])
+            # distance from the sensor origin to the box, in the box's axes
+            g = max(abs(a[i, 0] * v[0] + a[i, 1] * v[1] + a[i, 2] * v[2]) - h, 0.0)
+            q2 += g * g
+        # a beam's horizontal trace is the line at its azimuth shifted across by the horizontal offset;
+        # its start moves along it by the vertical offset's horizontal part
+        depth = rho - along - radial - EPS
+        half[k] = (np.arctan2(across + lateral + EPS, max(depth, 1e-9)) if depth > 0 else 4.0) + EPS + widen
+        # horizontal distance of box points: at least the depth of the box's near face, at most its far corner's
+        r_lo, r_hi = rho - along - off, np.hypot(rho + along, across) + off
+        z_lo, z_hi = v[2] - up - off, v[2] + up + off
+        inside = r_lo <= 0
+        r_lo = max(r_lo, 1e-9)
+        el_hi = (np.pi / 2 if inside else np.arctan2(z_hi, r_lo if z_hi >= 0 else r_hi)) + EPS + spread
+        el_lo = (-np.pi / 2 if inside else np.arctan2(z_lo, r_lo if z_lo <= 0 else r_hi)) - EPS - spread
+        ring0[k] = np.searchsorted(neg_el, -el_hi, side="left")
+        ring1[k] = np.searchsorted(neg_el, -el_lo, side="right")
+        near[k] = np.float32(np.sqrt(q2) - off)
+        azimuth[k] = np.arctan2(v[1], v[0])
