@@ -33,6 +33,19 @@ def _shared_prototypes(tmp_path_factory):
         install(tmp_path_factory.getbasetemp().parent / "prototypes")
 
 
+def pytest_terminal_summary(terminalreporter, config):
+    """Where the run's shared builds (:mod:`kits.shared_build`) spent their time and made workers wait."""
+    import os
+
+    factory = getattr(config, "_tmp_path_factory", None)
+    if factory is None or hasattr(config, "workerinput") or os.environ.get("PYTEST_XDIST_WORKER"):
+        return
+    from kits.shared_build import summary
+
+    for line in summary(factory.getbasetemp()):
+        terminalreporter.write_line(line)
+
+
 def pytest_sessionfinish(session):
     """The controlling process of ``pytest -n 2`` drops the shared prototypes (GBs) once the workers are done."""
     import os

@@ -19,7 +19,7 @@ from generator.imaging.exr import read_exr
 from generator.imaging.paths import image_dir
 from generator.labels import class_table
 from generator.postfx.filters import luminance
-from kits.rendered_frame import FRAME, all_variants, copy_images, render_args
+from kits.rendered_frame import FRAME, all_variants, copy_images, render_args, second_render
 
 pytestmark = pytest.mark.blender
 #: A night's mean radiance is at least this many EV below the day's of the same frame (a real street:
@@ -92,8 +92,10 @@ def test_clouds_are_in_a_clear_days_sky(rendered):
     assert 0.0 <= meta["lighting"]["cloud_cover"] <= 0.6
 
 
-def test_same_seed_same_image(rendered, tmp_path, root):
-    again = _render(tmp_path, root, "day:clear,night:clear")
+def test_same_seed_same_image(rendered, tmp_path_factory, root):
+    """A second run of day:clear and night:clear (shared with tests/commands/test_render.py, which compares
+    its masks) renders the same RGB as the all-variant run."""
+    again = image_dir(second_render(tmp_path_factory, root).path(), FRAME)
     for tod in ("day", "night"):
         a, _ = _load(rendered, tod, "clear")
         b, _ = _load(again, tod, "clear")

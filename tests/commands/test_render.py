@@ -11,13 +11,12 @@ import json
 import numpy as np
 import pytest
 
-from generator.cli import main
 from generator.imaging.exr import read_exr
 from generator.imaging.paths import image_dir
 from generator.labels import class_table
 from generator.previews.preview import tonemap
 from generator.weather import combinations
-from kits.rendered_frame import FRAME, all_variants, render_args
+from kits.rendered_frame import FRAME, all_variants, second_render
 
 pytestmark = pytest.mark.blender
 
@@ -97,9 +96,10 @@ def test_exr_opens_in_blender(rendered):
         bpy.data.images.remove(img)
 
 
-def test_second_render_gives_identical_masks(rendered, tmp_path, root):
-    code = main(render_args(root, tmp_path, "clear"))  # the default variants: day:clear
-    assert code == 0
-    a, _ = _load(rendered, "day", "clear")
-    b, _ = _load(image_dir(tmp_path, FRAME), "day", "clear")
-    assert np.array_equal(a.class_id, b.class_id) and np.array_equal(a.depth, b.depth)
+def test_second_render_gives_identical_masks(rendered, tmp_path_factory, root):
+    """A second run of two variants (shared with tests/blender/test_skies.py, which compares its RGB)."""
+    again = image_dir(second_render(tmp_path_factory, root).path(), FRAME)
+    for tod in ("day", "night"):
+        a, _ = _load(rendered, tod, "clear")
+        b, _ = _load(again, tod, "clear")
+        assert np.array_equal(a.class_id, b.class_id) and np.array_equal(a.depth, b.depth)

@@ -13,10 +13,12 @@ from __future__ import annotations
 import fcntl
 import os
 import shutil
+import time
 from collections.abc import Callable
 from pathlib import Path
 
 DONE = ".shared-build-done"
+LOG = "shared-builds.log"   #: one line per build made or waited for (:func:`summary` reads it)
 
 
 class SharedBuild:
@@ -40,11 +42,34 @@ class SharedBuild:
 
     def path(self) -> Path:
         """The build's folder, made now (or waited for) if no worker has made it yet."""
+        t0 = time.perf_counter()
         with open(self.base / f"{self.folder.name}.lock", "w") as lock:
             fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
+            waited, built = time.perf_counter() - t0, 0.0
             if not (self.base / f"{self.folder.name}{DONE}").exists():
                 if self.folder.exists():  # a build that failed on another worker: start again
                     shutil.rmtree(self.folder)
                 self.build(self.folder)
                 (self.base / f"{self.folder.name}{DONE}").touch()
+                built = time.perf_counter() - t0 - waited
+        if waited > 0.5 or built:
+            with open(self.base / LOG, "a") as log:  # one short line: O_APPEND keeps the workers' lines whole
+                log.write(f"{self.folder.name} {os.environ.get('PYTEST_XDIST_WORKER', '-')} "
+                          f"waited {waited:.1f} built {built:.1f}\n")
         return self.folder
+
+
+def summary(base: Path) -> list[str]:
+    """Lines for the end of the run: per build, the seconds it took and the seconds workers waited for it
+    (a worker waiting holds its CPU idle unless the build uses both), from ``base/shared-builds.log``."""
+    try:
+        rows = [line.split() for line in (Path(base) / LOG).read_text().splitlines()]
+    except OSError:
+        return []
+    built = {r[0]: float(r[5]) for r in rows if float(r[5]) > 0}
+    waited: dict[str, float] = {}
+    for r in rows:
+        waited[r[0]] = waited.get(r[0], 0.0) + float(r[3])
+    lines = [f"{name}: built in {built.get(name, 0.0):.0f} s, waited for {waited[name]:.0f} s"
+             for name in sorted(waited, key=lambda n: -waited[n])]
+    return [f"shared builds: {sum(built.values()):.0f} s building, {sum(waited.values()):.0f} s waiting", *lines]
