@@ -125,6 +125,7 @@ class Renderer:
                 light.sun_elevation_deg, light.sun_azimuth_deg, light.cloud_cover, light.cloud_seed, light.overcast))
         if lit:
             info.update(night.lights_record(), lit_windows_fraction=light.lit_windows)
+        sky_map(self.bscene.world, self.cfg.sky_map_resolution)
         controls.apply(self.bscene, values)
         groups = [g[len("light_"):] for g, v in values.items() if g.startswith("light_") and v > 0]
         info.update(time_of_day=light.time_of_day, light_groups_on=sorted(groups), wetness=wetness,
@@ -198,3 +199,15 @@ class Renderer:
     def evaluated_geometry(self) -> tuple[int, np.ndarray]:
         """Triangle count and world bounds of Blender's evaluated real geometry."""
         return geometry.evaluated_triangles(bpy.context.evaluated_depsgraph_get(), self.handles.real)
+
+
+def sky_map(world, resolution: int) -> None:
+    """Give ``world`` an importance map ``resolution`` pixels wide (0: Cycles' automatic one).
+
+    Set only when it differs: a world kept from the image before (:func:`generator.blender.sky.kept_world`)
+    keeps its map, which Cycles would rebuild if a setting were written again.
+    """
+    w = world.cycles
+    method, res = ("MANUAL", resolution) if resolution else ("AUTOMATIC", w.sample_map_resolution)
+    if w.sampling_method != method or w.sample_map_resolution != res:
+        w.sampling_method, w.sample_map_resolution = method, res

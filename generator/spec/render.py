@@ -50,6 +50,7 @@ class RenderConfig:
     camera_model: bool = False
     motion_blur: MotionBlur = MotionBlur()
     label_supersample: int = 1
+    sky_map_resolution: int = 0
     source: str = ""
     config_hash: str = ""
 
@@ -71,6 +72,8 @@ class RenderConfig:
             d.pop("motion_blur")
         if self.label_supersample == 1:  # 1 = as every config before the option: same hash, same records
             d.pop("label_supersample")
+        if not self.sky_map_resolution:  # automatic = as every config before the option: same hash, same records
+            d.pop("sky_map_resolution")
         d["resolution"] = list(d["resolution"])
         return d
 
@@ -101,6 +104,7 @@ def load_render_config(name_or_path: str | Path) -> RenderConfig:
     full = with_defaults(doc, schema)
     full["resolution"] = tuple(int(v) for v in full["resolution"])
     full["label_supersample"] = int(full["label_supersample"])  # JSON Schema counts 3.0 as an integer
+    full["sky_map_resolution"] = int(full["sky_map_resolution"])
     cfg = build(RenderConfig, full)
     cfg = dataclasses.replace(cfg, resolution=tuple(full["resolution"]), source=source)
     return dataclasses.replace(cfg, config_hash=canonical_hash(cfg.to_dict()))
