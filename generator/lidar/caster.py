@@ -51,8 +51,8 @@ class RayCaster(Protocol):
 
     @property
     def direct_scene(self) -> embree_native.Scene | None:
-        """The Embree scene the direct calls cast into (None when ``embreex.run`` casts)."""
-        return self._scene if self.native else None
+        """The Embree scene the direct calls cast into (None when ``embreex.run`` casts); see
+        :attr:`EmbreeCaster.direct_scene`."""
 
     @property
     def face_normals(self) -> np.ndarray:
