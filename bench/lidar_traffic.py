@@ -233,11 +233,8 @@ def main(argv=None) -> int:
     seq_best = dict.fromkeys(streamed, np.inf)
 
     def stream(sc):  # as `urbangen lidar` casts a sequence (generator.jobs.lidar_sequence)
-        ahead = [sc.submit(poses[0], t0=float(times[0]), noise_key=0)]
-        for i in range(args.sweeps):
-            if i + 1 < args.sweeps:
-                ahead.append(sc.submit(poses[i + 1], t0=float(times[i + 1]), noise_key=i + 1))
-            ahead.pop(0).result()
+        for _ in sc.stream(args.sweeps, lambda i: sc.submit(poses[i], t0=float(times[i]), noise_key=i)):
+            pass
     for _ in range(args.rounds):
         for k, fn in methods.items():
             for i in range(args.sweeps):

@@ -197,11 +197,9 @@ def write_sequence(scene, spec, out: str | Path, options: SequenceOptions, senso
                                                    "noise_key": frame_key(spec.seed, j)}
             return scanner.submit_sweep(rig, times[j], skew, **physical)
 
-        ahead = [submit(0)] if options.frames else []
+        scans = scanner.stream(options.frames, submit)  # the next sweep is cast while this one is written
         for j in progress_bar(range(options.frames), desc=f"lidar {name}", unit="scan", enabled=progress):
-            if j + 1 < options.frames:  # the next sweep queues behind this one: cast while this one is written
-                ahead.append(submit(j + 1))
-            scan = ahead.pop(0).result()
+            scan = next(scans)
             pts = scan.points
             if returns is not None and returns.params.mode == "dual":
                 second = pts[pts["echo"] == 1]

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import itertools
 import os
+from collections.abc import Callable, Iterator
 from concurrent.futures import ThreadPoolExecutor, wait
 from dataclasses import dataclass
 from typing import Self
@@ -255,6 +256,25 @@ class Scanner:
         """:meth:`sweep` without waiting for it (see :meth:`submit`)."""
         return self.submit(rig.sweep_poses(t0, self.sensor.column_time() if motion_skew else None), t0=t0,
                            alpha_per_m=alpha_per_m, noise_key=noise_key)
+
+    def stream(self, n: int, start: Callable[[int], PendingScan]) -> Iterator[Scan]:
+        """The scans of ``start(0) .. start(n - 1)`` in order, sweep ``j + 1`` started before sweep ``j`` is
+        handed out: its chunks queue behind ``j``'s, so no thread waits at a sweep boundary or while the
+        caller writes sweep ``j``.
+
+        Parameters
+        ----------
+        n : int
+            Sweeps.
+        start : callable
+            ``start(j)`` submits sweep ``j`` (:meth:`submit` or :meth:`submit_sweep`) and returns its
+            :class:`PendingScan`.
+        """
+        ahead = [start(0)] if n > 0 else []
+        for j in range(n):
+            if j + 1 < n:
+                ahead.append(start(j + 1))
+            yield ahead.pop(0).result()
 
     def _run_chunk(self, sweep: SweepInFlight, i: int, cols: slice) -> None:
         if self.returns is not None:

@@ -327,9 +327,11 @@ def test_sweeps_submitted_ahead_are_the_sweeps_cast_one_at_a_time(hdl64e, ground
         alone = [sc.scan(p, t0=t, noise_key=k).points for k, (p, t) in enumerate(zip(poses, starts, strict=True))]
         pending = [sc.submit(p, t0=t, noise_key=k) for k, (p, t) in enumerate(zip(poses, starts, strict=True))]
         ahead = [s.result().points for s in pending]
+        streamed = [x.points for x in sc.stream(len(starts), lambda k: sc.submit(poses[k], t0=starts[k], noise_key=k))]
     assert all(np.any(a["instance"] == 9) for a in alone)
     assert (returns is None) == (mode == "ideal") and all(not same_bytes(alone[0], a) for a in alone[1:])
     assert all(same_bytes(a, b) for a, b in zip(alone, ahead, strict=True))
+    assert all(same_bytes(a, b) for a, b in zip(alone, streamed, strict=True))
 
 
 def test_a_scanner_with_actors_needs_the_sweep_time(hdl64e, ground):
