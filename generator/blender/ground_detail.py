@@ -14,8 +14,8 @@ LiDAR see exactly the triangles they saw before. Sizes are real (1 unit = 1 m):
   no gutter;
 * sidewalk: 0.6 m square slabs in the segment frame (joints along and square to the kerb), each a
   tone of its own and slightly tilted, dirt in the joints, chewing-gum spots, water stains;
-* fallen leaves: 7-12 cm pointed leaves at random angles in 25 cm cells, a share of the cells set by a
-  density socket;
+* fallen leaves: 7-12 cm pointed leaves at random angles, two candidates per 25 cm cell, a share of
+  them set by a density socket;
 * grass: clumps, clover, dry straw-coloured patches and worn soil, blade-scale speckle.
 
 Patterns that lie on the ground read only x and y (2D noise and Voronoi: a 3D Voronoi searches 27
@@ -112,20 +112,9 @@ def gutter(g: Nodes, co):
     return gut, grate, slots
 
 
-def leaves(g: Nodes, wp, density):
-    """(leaf mask 0..1, leaf colour): fallen leaves in ``density`` (socket or constant) of the cells.
-
-    A leaf is a pointed lens 7-12 cm long (half-width ``LEAF_ASPECT`` of its half-length) with a darker
-    midrib, lying at a random angle about a point jittered in its grid cell; browns, ochres, a few dark decayed
-    and yellow-green ones.
-    """
-    warp = g.mapping(g.noise(wp, scale=7.0, detail=1, out="Color", plane=True), scale=(0.08, 0.05, 0))
-    p = g.node("ShaderNodeVectorMath", operation="ADD")
-    g.set(p.inputs[0], wp)
-    g.set(p.inputs[1], warp)
-    # one candidate leaf per cell of a square grid, its centre jittered within the cell's middle half, so
-    # that no leaf reaches past its cell (half-length <= a quarter cell)
-    grid = g.mapping(p.outputs[0], scale=(LEAF_CELLS_PER_M, LEAF_CELLS_PER_M, 0))
+def _leaf_layer(g: Nodes, p, density, shift: float, salt: float):
+    """One grid of candidate leaves (:func:`leaves`), shifted by ``shift`` cells; (mask, colour key, across)."""
+    grid = g.mapping(p, scale=(LEAF_CELLS_PER_M, LEAF_CELLS_PER_M, 0), location=(shift, shift, salt))
     cell = g.node("ShaderNodeVectorMath", operation="FLOOR")
     g.set(cell.inputs[0], grid)
     frac = g.node("ShaderNodeVectorMath", operation="FRACTION")
@@ -134,22 +123,41 @@ def leaves(g: Nodes, wp, density):
     g.set(wn.inputs["Vector"], cell.outputs[0])
     r, gg, b = rgb(g, wn.outputs["Color"])
     fx, fy, _ = xyz(g, frac.outputs[0])
+    # the leaf's centre jittered within the cell's middle half: no leaf reaches past its cell
     dx = g.mul(g.math("SUBTRACT", fx, g.add(0.25, g.mul(g.math("FRACT", g.mul(r, 7.0)), 0.5))), 1 / LEAF_CELLS_PER_M)
     dy = g.mul(g.math("SUBTRACT", fy, g.add(0.25, g.mul(g.math("FRACT", g.mul(gg, 11.0)), 0.5))), 1 / LEAF_CELLS_PER_M)
     turn = g.mul(g.math("FRACT", g.mul(b, 17.0)), 6.2832)            # an angle per leaf
     c, s = g.math("COSINE", turn), g.math("SINE", turn)
     u = g.add(g.mul(dx, c), g.mul(dy, s))                             # along the leaf
     v = g.math("ABSOLUTE", g.math("SUBTRACT", g.mul(dy, c), g.mul(dx, s)))  # across it
-    half = g.add(0.035, g.mul(gg, 0.025))                             # half-length, metres
+    half = g.add(0.035, g.mul(gg, 0.025))                             # half-length, metres (<= a quarter cell)
     t = g.math("DIVIDE", u, half)
     edge = g.mul(g.mul(half, LEAF_ASPECT), inv(g, g.mul(t, t)))       # the lens's half-width at u
-    shape = g.smooth(g.math("SUBTRACT", edge, v), 0.0, 0.0015)
-    mask = g.mul(shape, g.math("LESS_THAN", r, density))
-    col = g.ramp(b, [(0.0, (0.17, 0.095, 0.03)), (0.3, (0.24, 0.13, 0.025)), (0.55, (0.19, 0.06, 0.02)),
-                     (0.8, (0.07, 0.045, 0.025)), (1.0, (0.17, 0.15, 0.045))])
+    mask = g.mul(g.smooth(g.math("SUBTRACT", edge, v), 0.0, 0.0015), g.math("LESS_THAN", r, density))
+    return mask, b, v
+
+
+def leaves(g: Nodes, wp, density):
+    """(leaf mask 0..1, leaf colour): fallen leaves, ``density`` (socket or constant) of the candidates.
+
+    A leaf is a pointed lens 7-12 cm long (half-width ``LEAF_ASPECT`` of its half-length) with a darker
+    midrib, lying at a random angle about a point jittered in its grid cell; two grids half a cell apart
+    (two candidates per cell area, a leaf may overlap another); ochres, reds, browns, a few dark decayed
+    and yellow-green ones.
+    """
+    warp = g.mapping(g.noise(wp, scale=7.0, detail=1, out="Color", plane=True), scale=(0.08, 0.05, 0))
+    p = g.node("ShaderNodeVectorMath", operation="ADD")
+    g.set(p.inputs[0], wp)
+    g.set(p.inputs[1], warp)
+    m1, b1, v1 = _leaf_layer(g, p.outputs[0], density, 0.0, 0.0)
+    m2, b2, v2 = _leaf_layer(g, p.outputs[0], density, 0.5, 37.0)
+    top = g.math("GREATER_THAN", m2, m1)                              # the second grid's leaf lies on top
+    b, v = g.lerp(top, b1, b2), g.lerp(top, v1, v2)
+    col = g.ramp(b, [(0.0, (0.22, 0.12, 0.03)), (0.3, (0.30, 0.16, 0.025)), (0.55, (0.25, 0.075, 0.018)),
+                     (0.8, (0.10, 0.055, 0.025)), (1.0, (0.18, 0.16, 0.04))])
     rib = inv(g, g.smooth(v, 0.0006, 0.0012))                          # the midrib, a little darker
     col = g.mix(g.mul(rib, 0.5), col, g.mix(0.5, col, (0.3, 0.3, 0.3), "MULTIPLY"))
-    return mask, col
+    return g.math("MAXIMUM", m1, m2), col
 
 
 def slabs(g: Nodes, co, tone: float):
