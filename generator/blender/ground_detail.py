@@ -112,17 +112,24 @@ def gutter(g: Nodes, co):
     return gut, grate, slots
 
 
-def _leaf_layer(g: Nodes, p, density, shift: float, salt: float):
-    """One grid of candidate leaves (:func:`leaves`), shifted by ``shift`` cells; (mask, colour key, across)."""
-    grid = g.mapping(p, scale=(LEAF_CELLS_PER_M, LEAF_CELLS_PER_M, 0), location=(shift, shift, salt))
+def grid_cells(g: Nodes, v, scale, location=(0.0, 0.0, 0.0)):
+    """Cells of a grid on ``v * scale + location`` (a Mapping): (white noise value and colour of the
+    cell, x and y of the point inside its cell in [0, 1))."""
+    grid = g.mapping(v, scale=scale, location=location)
     cell = g.node("ShaderNodeVectorMath", operation="FLOOR")
     g.set(cell.inputs[0], grid)
     frac = g.node("ShaderNodeVectorMath", operation="FRACTION")
     g.set(frac.inputs[0], grid)
     wn = g.node("ShaderNodeTexWhiteNoise", noise_dimensions="3D")
     g.set(wn.inputs["Vector"], cell.outputs[0])
-    r, gg, b = rgb(g, wn.outputs["Color"])
     fx, fy, _ = xyz(g, frac.outputs[0])
+    return wn.outputs["Value"], wn.outputs["Color"], fx, fy
+
+
+def _leaf_layer(g: Nodes, p, density, shift: float, salt: float):
+    """One grid of candidate leaves (:func:`leaves`), shifted by ``shift`` cells; (mask, colour key, across)."""
+    _, colour, fx, fy = grid_cells(g, p, (LEAF_CELLS_PER_M, LEAF_CELLS_PER_M, 0), (shift, shift, salt))
+    r, gg, b = rgb(g, colour)
     # the leaf's centre jittered within the cell's middle half: no leaf reaches past its cell
     dx = g.mul(g.math("SUBTRACT", fx, g.add(0.25, g.mul(g.math("FRACT", g.mul(r, 7.0)), 0.5))), 1 / LEAF_CELLS_PER_M)
     dy = g.mul(g.math("SUBTRACT", fy, g.add(0.25, g.mul(g.math("FRACT", g.mul(gg, 11.0)), 0.5))), 1 / LEAF_CELLS_PER_M)
