@@ -10,11 +10,14 @@ build meshes are in :mod:`generator.geometry.primitives`; rigid transforms in
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
-import trimesh
 
 from generator.geometry.transforms import apply, pose
+
+if TYPE_CHECKING:                   # trimesh (with scipy) costs ~0.7 s to import: only where used
+    import trimesh
 
 
 @dataclass
@@ -75,6 +78,8 @@ class Mesh:
 
     def to_trimesh(self) -> trimesh.Trimesh:
         """A :class:`trimesh.Trimesh` of the geometry (labels not carried)."""
+        import trimesh
+
         return trimesh.Trimesh(self.vertices, self.faces, process=False)
 
 

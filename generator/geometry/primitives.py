@@ -11,7 +11,6 @@ from __future__ import annotations
 import functools
 
 import numpy as np
-import trimesh
 
 from generator.geometry.hull import hull_arrays
 from generator.geometry.mesh import Mesh
@@ -104,6 +103,8 @@ def icosphere(radius: float, cls: str | int, material: str | int, subdivisions: 
 def _unit_icosphere(subdivisions: int, radius: float) -> tuple[np.ndarray, np.ndarray]:
     """trimesh's icosphere arrays (read-only), made once per (subdivisions, radius): trees and hedges
     ask for a thousand identical ones per town."""
+    import trimesh  # imported on first use (~0.7 s with scipy)
+
     tm = trimesh.creation.icosphere(subdivisions=subdivisions, radius=radius)
     vertices, faces = np.array(tm.vertices, np.float64), np.array(tm.faces, np.int64)
     vertices.setflags(write=False)
