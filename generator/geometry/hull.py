@@ -22,6 +22,8 @@ import logging
 
 import numpy as np
 
+from generator.geometry.transforms import cross
+
 log = logging.getLogger(__name__)
 
 #: hull vertices closer than this (metres, ``1e3 * trimesh.constants.tol.merge``) in every coordinate
@@ -99,7 +101,7 @@ def _fast(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | Non
     if not _closed_and_consistent(faces, len(vertices)):
         return None                               # fix_winding would traverse and flip
     tri = vertices[faces]
-    volume = np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])).sum() / 6.0
+    volume = np.einsum("ij,ij->i", tri[:, 0], cross(tri[:, 1], tri[:, 2])).sum() / 6.0
     if not volume > 0:
         return None                               # fix_inversion would invert
     angles = tm_triangles.angles(tri)

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from generator.geometry.transforms import apply, pose
+from generator.geometry.transforms import apply, cross, pose
 
 if TYPE_CHECKING:                   # trimesh (with scipy) costs ~0.7 s to import: only where used
     import trimesh
@@ -127,5 +127,5 @@ def on_ground(mesh: Mesh) -> Mesh:
 def face_normals(mesh: Mesh) -> np.ndarray:
     """(m, 3) float64 unit normals of the faces (right-hand rule on the vertex order)."""
     tri = mesh.vertices[mesh.faces]
-    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    n = cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     return n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)

@@ -14,6 +14,7 @@ import numpy as np
 
 from generator.geometry.hull import hull_arrays
 from generator.geometry.mesh import Mesh
+from generator.geometry.transforms import cross
 from generator.labels import class_table
 from generator.materials import material_table
 
@@ -189,9 +190,9 @@ def _frame(axis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Two unit vectors (u, v) with (u, v, axis) a right-handed orthonormal frame."""
     axis = np.asarray(axis, float) / np.linalg.norm(axis)
     helper = np.array([0.0, 0.0, 1.0]) if abs(axis[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
-    u = np.cross(helper, axis)
+    u = cross(helper, axis)
     u /= np.linalg.norm(u)
-    return u, np.cross(axis, u)
+    return u, cross(axis, u)
 
 
 def tube(p0: tuple[float, float, float], p1: tuple[float, float, float], radius: float, cls: str | int,
@@ -248,7 +249,7 @@ def loft(rings: np.ndarray, cls: str | int, material: str | int, caps: bool = Tr
     faces = np.concatenate(faces)
     centres = rings.mean(1)
     tri = v[faces]
-    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    normal = cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     ring_of_face = faces[:, 0] // k
     out = tri.mean(1) - 0.5 * (centres[ring_of_face] + centres[np.minimum(ring_of_face + 1, s - 1)])
     if np.sum(np.einsum("ij,ij->i", normal, out)) < 0:
@@ -261,7 +262,7 @@ def loft(rings: np.ndarray, cls: str | int, material: str | int, caps: bool = Tr
         cap1 = np.stack([np.full(k, c1), (s - 1) * k + i, (s - 1) * k + j], 1)
         for cap, inward in ((cap0, centres[min(1, s - 1)] - centres[0]), (cap1, centres[max(s - 2, 0)] - centres[-1])):
             t = v[cap]
-            n = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]).sum(0)
+            n = cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]).sum(0)
             if np.dot(n, inward) > 0:
                 cap[:] = cap[:, ::-1]
         faces = np.concatenate([faces, cap0, cap1])
@@ -280,7 +281,7 @@ def polygon(points: np.ndarray, cls: str | int, material: str | int,
     k = len(p)
     faces = np.stack([np.zeros(k - 2, np.int64), np.arange(1, k - 1), np.arange(2, k)], 1)
     if normal is not None:
-        n = np.cross(p[faces[:, 1]] - p[faces[:, 0]], p[faces[:, 2]] - p[faces[:, 0]]).sum(0)
+        n = cross(p[faces[:, 1]] - p[faces[:, 0]], p[faces[:, 2]] - p[faces[:, 0]]).sum(0)
         if np.dot(n, normal) < 0:
             faces = faces[:, ::-1]
     c, m = resolve_ids(cls, material)
@@ -316,7 +317,7 @@ def quads(corners: np.ndarray, cls: str | int, materials, normals: np.ndarray | 
     tri_a = base + np.array([0, 1, 2])
     tri_b = base + np.array([0, 2, 3])
     if normals is not None:
-        nq = np.cross(corners[:, 2] - corners[:, 0], corners[:, 3] - corners[:, 1])
+        nq = cross(corners[:, 2] - corners[:, 0], corners[:, 3] - corners[:, 1])
         flip = np.einsum("ij,ij->i", nq, np.asarray(normals, float).reshape(-1, 3)) < 0
         tri_a[flip] = tri_a[flip][:, ::-1]
         tri_b[flip] = tri_b[flip][:, ::-1]
