@@ -31,7 +31,9 @@ def outside(points: np.ndarray, owner: np.ndarray, centres: np.ndarray, radii: n
     clumps still counts as outside.
     """
     keep = np.ones(len(points), bool)
-    order = np.argsort(points[:, 0], kind="stable")
+    # which points fall in a clump's x extent is a matter of value, not of order among equal x: any sort
+    # gives the same sets (numpy's default one is ~4x faster than the stable one here)
+    order = np.argsort(points[:, 0])
     xs = points[order, 0]
     for j in range(len(centres)):      # only the points within the clump's x extent can be inside it
         lo, hi = np.searchsorted(xs, [centres[j, 0] - radii[j, 0], centres[j, 0] + radii[j, 0]], side="left")
