@@ -76,21 +76,38 @@ def cylinder(radius: float, height: float, cls: str | int, material: str | int, 
              z0: float = 0.0, radius_top: float | None = None, caps: bool = True) -> Mesh:
     """A vertical (optionally tapered) cylinder from ``z0`` to ``z0 + height`` around the z axis."""
     rt = radius if radius_top is None else radius_top
+    ring, faces = _cylinder_parts(int(sections), bool(caps))
+    k = len(ring)
+    v = np.empty((2 * k + (2 if caps else 0), 3))
+    v[:k, :2] = ring * radius
+    v[:k, 2] = z0
+    v[k:2 * k, :2] = ring * rt
+    v[k:2 * k, 2] = z0 + height
+    if caps:
+        v[2 * k:] = [[0, 0, z0], [0, 0, z0 + height]]
+    c, m = resolve_ids(cls, material)
+    return Mesh(v, faces.copy(), c, m)
+
+
+@functools.lru_cache(maxsize=64)
+def _cylinder_parts(sections: int, caps: bool) -> tuple[np.ndarray, np.ndarray]:
+    """The unit ring (cos, sin) and the faces of :func:`cylinder` (read-only): a town makes ~3000
+    cylinders of a handful of section counts."""
     a = np.linspace(0, 2 * np.pi, sections, endpoint=False)
     ring = np.stack([np.cos(a), np.sin(a)], 1)
-    v = np.concatenate([np.c_[ring * radius, np.full(sections, z0)], np.c_[ring * rt, np.full(sections, z0 + height)]])
     i = np.arange(sections)
     j = (i + 1) % sections
     faces = [np.stack([i, j, j + sections], 1), np.stack([i, j + sections, i + sections], 1)]
     if caps:
-        v = np.concatenate([v, [[0, 0, z0], [0, 0, z0 + height]]])
         cb, ct = 2 * sections, 2 * sections + 1
         faces += [
             np.stack([np.full(sections, cb), j, i], 1),
             np.stack([np.full(sections, ct), i + sections, j + sections], 1),
         ]
-    c, m = resolve_ids(cls, material)
-    return Mesh(v, np.concatenate(faces), c, m)
+    faces = np.concatenate(faces)
+    ring.setflags(write=False)
+    faces.setflags(write=False)
+    return ring, faces
 
 
 def icosphere(radius: float, cls: str | int, material: str | int, subdivisions: int = 1,
