@@ -50,7 +50,10 @@ class Mesh:
         m = len(self.faces)
         self.face_class = _per_face(self.face_class, np.uint8, m)
         self.face_material = _per_face(self.face_material, np.uint16, m)
-        self.anchors = {k: np.asarray(v, np.float64).reshape(-1, 3) for k, v in self.anchors.items()}
+        if self.anchors:
+            self.anchors = {k: np.asarray(v, np.float64).reshape(-1, 3) for k, v in self.anchors.items()}
+        else:
+            self.anchors = {}
 
     @property
     def n_faces(self) -> int:
@@ -87,7 +90,7 @@ def _per_face(values, dtype, m: int) -> np.ndarray:
     """A fresh (m,) ``dtype`` array of ``values`` (one value per face, or one for all)."""
     a = np.asarray(values, dtype)
     if a.shape == (m,):
-        return a.copy()
+        return a.copy() if a is values else a      # a converted array is fresh already
     if a.ndim == 0:
         return np.full(m, a, dtype)
     return np.broadcast_to(a, (m,)).copy()
