@@ -114,11 +114,11 @@ def chain_rings(joints: np.ndarray, table: np.ndarray, lateral: np.ndarray) -> n
     d1, d2 = unit(p1 - p0), unit(p2 - p1)
     s = table[:, 0]
     centre = np.where((s <= 1.0)[:, None], p0 + s[:, None] * (p1 - p0), p1 + (s[:, None] - 1.0) * (p2 - p1))
-    w = np.clip((s - 0.85) / 0.3, 0.0, 1.0)[:, None]
+    w = np.minimum(np.maximum((s - 0.85) / 0.3, 0.0), 1.0)[:, None]      # np.clip's values, without its wrapper
     t = unit((1.0 - w) * d1 + w * d2)
     lat = np.asarray(lateral, float)
     u = lat - (t @ lat)[:, None] * t
-    weak = np.linalg.norm(u, axis=1) < 0.3
+    weak = np.sqrt(np.add.reduce(u * u, axis=1)) < 0.3          # np.linalg.norm(u, axis=1)
     if weak.any():                       # a bone along the lateral axis: fall back to the forward one
         fwd = np.array([1.0, 0.0, 0.0])
         u[weak] = fwd - (t[weak] @ fwd)[:, None] * t[weak]
@@ -161,6 +161,12 @@ def hem(table: np.ndarray, s: float, flare: float) -> tuple[np.ndarray, int]:
     return np.array(rows), at
 
 
+#: hand sections (palm to finger tips), unit body height
+_HAND = np.array([(-0.05, 0.010, 0.016, 0.0), (0.35, 0.013, 0.025, 0.0), (0.95, 0.011, 0.026, 0.0),
+                  (1.5, 0.009, 0.021, 0.0), (2.0, 0.006, 0.015, 0.0)])
+_HAND.setflags(write=False)
+
+
 def hand(wrist: np.ndarray, elbow: np.ndarray, side: float, cls: str, material: str, curl: float = 0.35,
          scale: float = 1.0) -> Mesh:
     """A hand continuing the forearm: a flat palm (wide front to back, thin across) tapering into
@@ -169,8 +175,7 @@ def hand(wrist: np.ndarray, elbow: np.ndarray, side: float, cls: str, material: 
     lateral = np.array([0.0, side, 0.0])         # out of the body (the curl's sign); the frame uses +y
     knuckle = wrist + 0.058 * scale * d
     tip = knuckle + 0.05 * scale * unit(d * np.cos(curl) - lateral * np.sin(curl))    # toward the palm (the body)
-    table = np.array([(-0.05, 0.010, 0.016, 0.0), (0.35, 0.013, 0.025, 0.0), (0.95, 0.011, 0.026, 0.0),
-                      (1.5, 0.009, 0.021, 0.0), (2.0, 0.006, 0.015, 0.0)]) * [1.0, scale, scale, scale]
+    table = _HAND * [1.0, scale, scale, scale]
     return limb(np.stack([wrist, knuckle, tip]), table, np.array([0.0, 1.0, 0.0]), cls, material)
 
 
