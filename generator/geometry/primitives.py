@@ -12,6 +12,7 @@ import functools
 
 import numpy as np
 
+from generator.geometry.faces import cylinder_parts, fan_faces, loft_faces
 from generator.geometry.hull import hull_arrays
 from generator.geometry.mesh import Mesh
 from generator.geometry.transforms import cross
@@ -76,7 +77,7 @@ def cylinder(radius: float, height: float, cls: str | int, material: str | int, 
              z0: float = 0.0, radius_top: float | None = None, caps: bool = True) -> Mesh:
     """A vertical (optionally tapered) cylinder from ``z0`` to ``z0 + height`` around the z axis."""
     rt = radius if radius_top is None else radius_top
-    ring, faces = _cylinder_parts(int(sections), bool(caps))
+    ring, faces = cylinder_parts(int(sections), bool(caps))
     k = len(ring)
     v = np.empty((2 * k + (2 if caps else 0), 3))
     v[:k, :2] = ring * radius
@@ -87,27 +88,6 @@ def cylinder(radius: float, height: float, cls: str | int, material: str | int, 
         v[2 * k:] = [[0, 0, z0], [0, 0, z0 + height]]
     c, m = resolve_ids(cls, material)
     return Mesh(v, faces.copy(), c, m)
-
-
-@functools.lru_cache(maxsize=64)
-def _cylinder_parts(sections: int, caps: bool) -> tuple[np.ndarray, np.ndarray]:
-    """The unit ring (cos, sin) and the faces of :func:`cylinder` (read-only): a town makes ~3000
-    cylinders of a handful of section counts."""
-    a = np.linspace(0, 2 * np.pi, sections, endpoint=False)
-    ring = np.stack([np.cos(a), np.sin(a)], 1)
-    i = np.arange(sections)
-    j = (i + 1) % sections
-    faces = [np.stack([i, j, j + sections], 1), np.stack([i, j + sections, i + sections], 1)]
-    if caps:
-        cb, ct = 2 * sections, 2 * sections + 1
-        faces += [
-            np.stack([np.full(sections, cb), j, i], 1),
-            np.stack([np.full(sections, ct), i + sections, j + sections], 1),
-        ]
-    faces = np.concatenate(faces)
-    ring.setflags(write=False)
-    faces.setflags(write=False)
-    return ring, faces
 
 
 def icosphere(radius: float, cls: str | int, material: str | int, subdivisions: int = 1,
@@ -258,12 +238,7 @@ def loft(rings: np.ndarray, cls: str | int, material: str | int, caps: bool = Tr
     v = rings.reshape(-1, 3)
     i = np.arange(k)
     j = (i + 1) % k
-    faces = []
-    for r in range(s - 1):
-        a, b = r * k + i, (r + 1) * k + i
-        an, bn = r * k + j, (r + 1) * k + j
-        faces += [np.stack([a, an, bn], 1), np.stack([a, bn, b], 1)]
-    faces = np.concatenate(faces)
+    faces = loft_faces(s, k).copy()
     centres = rings.mean(1)
     tri = v[faces]
     normal = cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
@@ -295,14 +270,13 @@ def polygon(points: np.ndarray, cls: str | int, material: str | int,
     (counter-clockwise seen from the front) decides.
     """
     p = np.asarray(points, float)
-    k = len(p)
-    faces = np.stack([np.zeros(k - 2, np.int64), np.arange(1, k - 1), np.arange(2, k)], 1)
+    faces = fan_faces(len(p))
     if normal is not None:
         n = cross(p[faces[:, 1]] - p[faces[:, 0]], p[faces[:, 2]] - p[faces[:, 0]]).sum(0)
         if np.dot(n, normal) < 0:
             faces = faces[:, ::-1]
     c, m = resolve_ids(cls, material)
-    return Mesh(p, faces, c, m)
+    return Mesh(p, faces.copy(), c, m)
 
 
 def disc(center: tuple[float, float, float], normal: tuple[float, float, float], radius: float,
