@@ -20,10 +20,17 @@ from generator.labels import class_table
 from generator.materials import material_table
 
 
-@functools.lru_cache(maxsize=4096)
 def resolve_ids(cls: str | int, material: str | int) -> tuple[int, int]:
     """(class id, material id) from names or ids (``classes.yaml``, ``materials.yaml``; both tables
     are read once per process, so the answer is remembered: a town asks ~50 000 times)."""
+    try:
+        return _resolve_ids(cls, material)
+    except TypeError:                            # an unhashable id (a 0-d array): not remembered
+        return _resolve_ids.__wrapped__(cls, material)
+
+
+@functools.lru_cache(maxsize=4096)
+def _resolve_ids(cls: str | int, material: str | int) -> tuple[int, int]:
     c = class_table().id(cls) if isinstance(cls, str) else int(cls)
     m = material_table().id(material) if isinstance(material, str) else int(material)
     return c, m

@@ -27,6 +27,9 @@ def unit(v) -> np.ndarray:
 def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """``np.cross(a, b)`` for float64 (..., 3) vectors, the same products and differences in the same
     order (``a1 b2 - a2 b1``, ...), without np.cross's axis handling (~20 us a call)."""
+    a, b = np.asarray(a), np.asarray(b)
+    if a.shape[-1:] != (3,) or b.shape[-1:] != (3,):
+        return np.cross(a, b)                   # 2-vectors and errors: numpy's own
     a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
     b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
     out = np.empty(np.broadcast_shapes(a.shape, b.shape), np.result_type(a, b))

@@ -41,3 +41,10 @@ def test_unit_is_the_norm_division_bit_for_bit():
     want = v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-12)
     assert np.array_equal(unit(v), want)
     assert np.array_equal(unit(v[0]), want[0])
+
+
+def test_cross_falls_back_to_numpy_off_3_vectors():
+    from generator.geometry import cross
+
+    assert np.array_equal(cross(np.array([[1.0, 2.0]]), np.array([[3.0, 5.0]])), np.cross([[1.0, 2.0]], [[3.0, 5.0]]))
+    assert np.array_equal(cross([1, 2, 3], [4, 5, 7]), np.cross([1, 2, 3], [4, 5, 7]))
