@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from generator.geometry import Mesh, merge, quads
+from generator.geometry import Mesh, cross, merge, quads
 
 LENS_M = 0.02    #: metres a lens stands out of the shell (>= 2 cm: no z-fighting), closed by a rim
 
@@ -76,7 +76,7 @@ def lamp(info: dict, front: bool, y_in: float, z_lo: float, z_hi: float, wrap: f
     above = np.stack([lens_hi[:-1], lens_hi[1:], shell_hi[1:], shell_hi[:-1]], 1)
     ends = np.stack([np.stack([shell_lo[i], lens_lo[i], lens_hi[i], shell_hi[i]]) for i in (0, -1)])
     corners = np.concatenate([face, below, above, ends])
-    normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 3] - corners[:, 0])
+    normal = cross(corners[:, 1] - corners[:, 0], corners[:, 3] - corners[:, 0])
     normal[len(face):len(face) + len(below)] = [0.0, 0.0, -1.0]
     normal[len(face) + len(below):-2] = [0.0, 0.0, 1.0]
     normal[-2:] = [[0.0, -1.0, 0.0], [-sgn, 0.0, 0.0]]

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from generator.geometry import Mesh, icosphere, unit
+from generator.geometry import Mesh, cross, icosphere, unit
 from generator.geometry.primitives import resolve_ids
 
 
@@ -72,10 +72,10 @@ def sprays(rng: np.random.Generator, centre: np.ndarray, outward: np.ndarray, le
     n, k = len(centre), leaf.per_spray
     d = unit(np.asarray(outward, np.float64).reshape(-1, 3) + 0.35 * rng.normal(size=(n, 3)))
     up = unit(np.array([0.0, 0.0, 1.0]) + 0.6 * d + 0.5 * rng.normal(size=(n, 3)))
-    side = np.cross(up, d)
+    side = cross(up, d)
     side = np.where(np.linalg.norm(side, axis=1, keepdims=True) < 1e-6, [1.0, 0.0, 0.0], side)
     side = unit(side)
-    up = np.cross(d, side)
+    up = cross(d, side)
     fan = np.radians(leaf.fan)
     theta = np.linspace(-fan / 2, fan / 2, k)[None] + rng.uniform(-0.35, 0.35, (n, k))   # (n, k)
     length = rng.uniform(*leaf.length, (n, k)) * scale
@@ -84,8 +84,8 @@ def sprays(rng: np.random.Generator, centre: np.ndarray, outward: np.ndarray, le
     y = c * side[:, None] - s * d[:, None]                  # across the blade, near the spray plane
     y = unit(y + 0.45 * rng.normal(size=(n, k, 3)))        # each blade rolled its own way: no flat star
     y = unit(y - (y * x).sum(-1, keepdims=True) * x)
-    y = np.where((np.cross(x, y) * up[:, None]).sum(-1, keepdims=True) < 0, -y, y)   # upper side toward ``up``
-    z = np.cross(x, y)
+    y = np.where((cross(x, y) * up[:, None]).sum(-1, keepdims=True) < 0, -y, y)   # upper side toward ``up``
+    z = cross(x, y)
     lw = (leaf.width * length)[..., None]
     lb = (leaf.base * length)[..., None]
     tip = x * length[..., None] - z * (leaf.droop * length)[..., None]

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from generator.geometry import Mesh, face_normals, unit
+from generator.geometry import Mesh, cross, face_normals, unit
 from generator.geometry.primitives import resolve_ids
 
 #: Leaves per square metre of hedge face; leaf length range (m); half-width / length;
@@ -31,7 +31,9 @@ def outside(points: np.ndarray, owner: np.ndarray, centres: np.ndarray, radii: n
     clumps still counts as outside.
     """
     keep = np.ones(len(points), bool)
-    order = np.argsort(points[:, 0], kind="stable")
+    # which points fall in a clump's x extent is a matter of value, not of order among equal x: any sort
+    # gives the same sets (numpy's default one is ~4x faster than the stable one here)
+    order = np.argsort(points[:, 0])
     xs = points[order, 0]
     for j in range(len(centres)):      # only the points within the clump's x extent can be inside it
         lo, hi = np.searchsorted(xs, [centres[j, 0] - radii[j, 0], centres[j, 0] + radii[j, 0]], side="left")
@@ -66,7 +68,7 @@ def leaf_cover(rng: np.random.Generator, body: Mesh, owner: np.ndarray, centres:
     density = DENSITY if density is None else density
     tri = body.vertices[body.faces]
     n = face_normals(body)
-    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    area = 0.5 * np.linalg.norm(cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
     area = np.where(n[:, 2] > -0.5, area, 0.0)                       # not the underside
     count = int(rng.poisson(density * area.sum()))
     face = rng.choice(len(area), count, p=area / area.sum()) if count else np.zeros(0, int)
@@ -80,8 +82,8 @@ def leaf_cover(rng: np.random.Generator, body: Mesh, owner: np.ndarray, centres:
     keep = outside(p, owner[face], centres, radii, power) & (p[:, 2] > floor)
     p, up = p[keep], up[keep]
     m = len(p)
-    axis = unit(np.cross(up, rng.normal(size=(m, 3))))               # the blade's direction in its plane
-    across = np.cross(up, axis)
+    axis = unit(cross(up, rng.normal(size=(m, 3))))               # the blade's direction in its plane
+    across = cross(up, axis)
     length = rng.uniform(*LENGTH, (m, 1))
     base = p - 0.45 * length * axis                                   # the leaf's middle on the sample point
     w = WIDTH * length * rng.uniform(0.8, 1.2, (m, 1))

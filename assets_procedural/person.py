@@ -35,6 +35,8 @@ per cycle). :mod:`generator.traffic.build` turns these into the phase meshes a w
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from assets_procedural import person_gait as gait
@@ -140,7 +142,25 @@ def torso_sections(girth: float, breadth: float, sex: str | None, garment: str,
     return rings, mats
 
 
-def _legs_table(garment: str) -> tuple[np.ndarray, list[str]]:
+@functools.lru_cache(maxsize=16)
+def _legs_table(garment: str) -> tuple[np.ndarray, tuple[str, ...]]:
+    """:func:`_legs_table_of`, made once per garment (read-only; a walker asks once per gait phase)."""
+    t, m = _legs_table_of(garment)
+    t = t.copy()
+    t.setflags(write=False)
+    return t, tuple(m)
+
+
+@functools.lru_cache(maxsize=16)
+def _arms_table(short_sleeves: bool, coat: bool) -> tuple[np.ndarray, tuple[str, ...]]:
+    """:func:`_arms_table_of`, made once per sleeve (read-only)."""
+    t, m = _arms_table_of(short_sleeves, coat)
+    t = t.copy()
+    t.setflags(write=False)
+    return t, tuple(m)
+
+
+def _legs_table_of(garment: str) -> tuple[np.ndarray, list[str]]:
     """Leg sections and band materials: trousers to the ankle, shorts above the knee, bare under a skirt."""
     bare = shape.LEG
     if garment == "skirt":
@@ -154,7 +174,7 @@ def _legs_table(garment: str) -> tuple[np.ndarray, list[str]]:
     return t, ["clothing_bottom"] * (at + 1) + ["skin"] * (len(t) - at - 2)
 
 
-def _arms_table(short_sleeves: bool, coat: bool) -> tuple[np.ndarray, list[str]]:
+def _arms_table_of(short_sleeves: bool, coat: bool) -> tuple[np.ndarray, list[str]]:
     """Arm sections and band materials: a short sleeve's hem above the biceps, a long one's cuff."""
     bare = shape.ARM
     s, ease = (0.45, 0.006) if short_sleeves else (1.86, 0.009 if coat else 0.005)

@@ -21,10 +21,13 @@ import numpy as np
 
 from assets_procedural import person_gait as gait
 from generator.geometry import Mesh, resolve_ids, unit
+from generator.geometry.transforms import cross
 
 #: sides of a limb section
 SIDES = 8
 _ANG = np.linspace(0.0, 2.0 * np.pi, SIDES, endpoint=False)
+#: cosines and sines of the section angles (a walker makes ~300 limbs: computed once, the same values)
+_COS, _SIN = np.cos(_ANG), np.sin(_ANG)
 
 #: leg sections, bare skin: upper thigh, mid thigh, above the knee, knee, calf bulge (behind), ankle
 LEG = np.array([(-0.12, 0.038, 0.044, 0.0), (0.0, 0.048, 0.058, -0.004), (0.3, 0.045, 0.052, 0.003),
@@ -79,17 +82,25 @@ def skin(rings: np.ndarray, cls: str, materials, start=None, end=None) -> Mesh:
     """
     rings = np.asarray(rings, float)
     s, k, _ = rings.shape
-    names = [materials] * (s - 1) if isinstance(materials, str) else list(materials)
-    band = np.array([resolve_ids(cls, m)[1] for m in names])
-    mats = [np.repeat(band, 2 * k)]
-    if start is not None:
-        mats.append(np.full(k, band[0]))
-    if end is not None:
-        mats.append(np.full(k, band[-1]))
+    names = (materials,) * (s - 1) if isinstance(materials, str) else tuple(materials)
     apex = [np.asarray(p, float)[None] for p in (start, end) if p is not None]
     verts = np.concatenate([rings.reshape(-1, 3), *apex])
     return Mesh(verts, skin_faces(s, k, start is not None, end is not None), resolve_ids(cls, "skin")[0],
-                np.concatenate(mats))
+                _skin_materials(cls, names, k, start is not None, end is not None))
+
+
+@functools.lru_cache(maxsize=256)
+def _skin_materials(cls: str, names: tuple, k: int, start: bool, end: bool) -> np.ndarray:
+    """Material id per face of :func:`skin` (read-only): the bands', the end fans taking their bands'."""
+    band = np.array([resolve_ids(cls, m)[1] for m in names])
+    mats = [np.repeat(band, 2 * k)]
+    if start:
+        mats.append(np.full(k, band[0]))
+    if end:
+        mats.append(np.full(k, band[-1]))
+    out = np.concatenate(mats)
+    out.setflags(write=False)
+    return out
 
 
 def chain_rings(joints: np.ndarray, table: np.ndarray, lateral: np.ndarray) -> np.ndarray:
@@ -103,27 +114,32 @@ def chain_rings(joints: np.ndarray, table: np.ndarray, lateral: np.ndarray) -> n
     d1, d2 = unit(p1 - p0), unit(p2 - p1)
     s = table[:, 0]
     centre = np.where((s <= 1.0)[:, None], p0 + s[:, None] * (p1 - p0), p1 + (s[:, None] - 1.0) * (p2 - p1))
-    w = np.clip((s - 0.85) / 0.3, 0.0, 1.0)[:, None]
+    w = np.minimum(np.maximum((s - 0.85) / 0.3, 0.0), 1.0)[:, None]      # np.clip's values, without its wrapper
     t = unit((1.0 - w) * d1 + w * d2)
     lat = np.asarray(lateral, float)
     u = lat - (t @ lat)[:, None] * t
-    weak = np.linalg.norm(u, axis=1) < 0.3
+    weak = np.sqrt(np.add.reduce(u * u, axis=1)) < 0.3          # np.linalg.norm(u, axis=1)
     if weak.any():                       # a bone along the lateral axis: fall back to the forward one
         fwd = np.array([1.0, 0.0, 0.0])
         u[weak] = fwd - (t[weak] @ fwd)[:, None] * t[weak]
     u = unit(u)
-    v = np.cross(t, u)
+    v = cross(t, u)
     c = centre + table[:, 3:4] * v
-    return (c[:, None] + table[:, 1, None, None] * np.cos(_ANG)[None, :, None] * u[:, None]
-            + table[:, 2, None, None] * np.sin(_ANG)[None, :, None] * v[:, None])
+    return (c[:, None] + table[:, 1, None, None] * _COS[None, :, None] * u[:, None]
+            + table[:, 2, None, None] * _SIN[None, :, None] * v[:, None])
+
+
+def _mean0(a: np.ndarray) -> np.ndarray:
+    """``a.mean(0)``: the same sum and division, without ndarray.mean's bookkeeping."""
+    return np.add.reduce(a, 0) / a.shape[0]
 
 
 def limb(joints: np.ndarray, table: np.ndarray, lateral, cls: str, materials) -> Mesh:
     """A closed limb skin (see :func:`chain_rings`), its ends rounded by the fans' apexes."""
     rings = chain_rings(joints, table, lateral)
-    c0, c1 = rings[0].mean(0), rings[-1].mean(0)
-    d0, d1 = c0 - rings[1].mean(0), c1 - rings[-2].mean(0)
-    r0, r1 = table[0, 1:3].mean(), table[-1, 1:3].mean()
+    c0, c1 = _mean0(rings[0]), _mean0(rings[-1])
+    d0, d1 = c0 - _mean0(rings[1]), c1 - _mean0(rings[-2])
+    r0, r1 = _mean0(table[0, 1:3]), _mean0(table[-1, 1:3])
     return skin(rings, cls, materials, c0 + 0.6 * r0 * unit(d0), c1 + 0.6 * r1 * unit(d1))
 
 
@@ -145,6 +161,12 @@ def hem(table: np.ndarray, s: float, flare: float) -> tuple[np.ndarray, int]:
     return np.array(rows), at
 
 
+#: hand sections (palm to finger tips), unit body height
+_HAND = np.array([(-0.05, 0.010, 0.016, 0.0), (0.35, 0.013, 0.025, 0.0), (0.95, 0.011, 0.026, 0.0),
+                  (1.5, 0.009, 0.021, 0.0), (2.0, 0.006, 0.015, 0.0)])
+_HAND.setflags(write=False)
+
+
 def hand(wrist: np.ndarray, elbow: np.ndarray, side: float, cls: str, material: str, curl: float = 0.35,
          scale: float = 1.0) -> Mesh:
     """A hand continuing the forearm: a flat palm (wide front to back, thin across) tapering into
@@ -153,8 +175,7 @@ def hand(wrist: np.ndarray, elbow: np.ndarray, side: float, cls: str, material: 
     lateral = np.array([0.0, side, 0.0])         # out of the body (the curl's sign); the frame uses +y
     knuckle = wrist + 0.058 * scale * d
     tip = knuckle + 0.05 * scale * unit(d * np.cos(curl) - lateral * np.sin(curl))    # toward the palm (the body)
-    table = np.array([(-0.05, 0.010, 0.016, 0.0), (0.35, 0.013, 0.025, 0.0), (0.95, 0.011, 0.026, 0.0),
-                      (1.5, 0.009, 0.021, 0.0), (2.0, 0.006, 0.015, 0.0)]) * [1.0, scale, scale, scale]
+    table = _HAND * [1.0, scale, scale, scale]
     return limb(np.stack([wrist, knuckle, tip]), table, np.array([0.0, 1.0, 0.0]), cls, material)
 
 
@@ -167,6 +188,16 @@ def shoe(ankle: np.ndarray, pitch: float, cls: str, material: str, scale: float 
     """A shoe under ``ankle``: heel counter, collar, instep, a wide ball and a rounded toe, the sole flat
     on z = -ANKLE_Z from HEEL_X to TOE_X (what :mod:`assets_procedural.person_gait` keeps on the ground);
     pitched by ``pitch`` (+ = toe down) about the ankle; ``scale`` the body height."""
+    verts, faces, cls_id, mats = _shoe_at_ankle(cls, material)
+    c, s = np.cos(pitch), np.sin(pitch)
+    rot = np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
+    return Mesh((verts @ rot.T) * scale + ankle, faces, cls_id, mats)
+
+
+@functools.lru_cache(maxsize=16)
+def _shoe_at_ankle(cls: str, material: str) -> tuple[np.ndarray, np.ndarray, int, np.ndarray]:
+    """The unposed shoe of :func:`shoe` (vertices relative to the ankle, faces, class id, materials;
+    read-only): every shoe is this one rotated, scaled and moved, so it is lofted once."""
     sole = -gait.ANKLE_Z
     a = np.linspace(0.0, 2.0 * np.pi, SIDES, endpoint=False)
     cy, sz = np.cos(a), np.sin(a)
@@ -177,9 +208,8 @@ def shoe(ankle: np.ndarray, pitch: float, cls: str, material: str, scale: float 
         mid, half = (top + sole) / 2, (top - sole) / 2
         rings.append(np.stack([np.full(SIDES, x), hw * ey, np.maximum(mid + half * ez, sole)], 1))
     rings = np.array(rings)                       # along +x: u = y, v = z
-    c, s = np.cos(pitch), np.sin(pitch)
-    rot = np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
     heel, toe = rings[0].mean(0) - [0.006, 0.0, 0.0], rings[-1].mean(0) + [0.006, 0.0, 0.0]
     m = skin(rings, cls, material, heel, toe)
-    m.vertices = (m.vertices @ rot.T) * scale + ankle
-    return m
+    for x in (m.vertices, m.face_material):
+        x.setflags(write=False)
+    return m.vertices, m.faces, int(m.face_class[0]), m.face_material

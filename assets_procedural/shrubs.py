@@ -114,8 +114,8 @@ def _cut_back(leaves: Mesh, lo: np.ndarray, hi: np.ndarray) -> Mesh:
     base = (t[:, 0] + t[:, 2]) / 2
     inside = ((base > lo) & (base < hi)).all(1)
     rel = t - base[:, None]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        room = np.where(rel > 0, (hi - base)[:, None] / rel, np.where(rel < 0, (lo - base)[:, None] / rel, np.inf))
+    with np.errstate(divide="ignore", invalid="ignore"):      # one division: (hi - base) / rel or (lo - base) / rel
+        room = np.where(rel != 0, np.where(rel > 0, hi - base[:, None], lo - base[:, None]) / rel, np.inf)
     f = np.clip(0.98 * room.min((1, 2)), 0.0, 1.0)[:, None, None]     # 2 % short: no tips coplanar on a plane
     inside &= f[:, 0, 0] > 0.3                                          # a stub cut to a sliver is dropped
     t = (base[:, None] + f * rel)[inside]

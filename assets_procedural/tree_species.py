@@ -16,6 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from generator.geometry import cross
+
 
 @dataclass(frozen=True)
 class Species:
@@ -67,8 +69,8 @@ def _unit(v: np.ndarray) -> np.ndarray:
 def _turn(d: np.ndarray, angle: float, azimuth: float) -> np.ndarray:
     """``d`` (3,) turned by ``angle`` radians away from itself, toward the side ``azimuth``."""
     helper = np.array([0.0, 0.0, 1.0]) if abs(d[2]) < 0.95 else np.array([1.0, 0.0, 0.0])
-    u = _unit(np.cross(d, helper))
-    v = np.cross(d, u)
+    u = _unit(cross(d, helper))
+    v = cross(d, u)
     side = np.cos(azimuth) * u + np.sin(azimuth) * v
     return _unit(np.cos(angle) * d + np.sin(angle) * side)
 

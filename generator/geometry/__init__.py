@@ -25,8 +25,8 @@ from generator.geometry.primitives import (
                                            triangulate,
                                            tube,
 )
-from generator.geometry.transforms import apply, invert, mount, pose, unit
+from generator.geometry.transforms import apply, cross, invert, mount, pose, unit
 
-__all__ = ["Mesh", "apply", "box", "convex_hull", "cylinder", "disc", "empty", "face_normals", "icosphere", "invert",
-           "loft", "merge", "mount", "on_ground", "polygon", "pose", "prism", "quad", "quads", "rect", "resolve_ids",
-           "slab", "triangulate", "tube", "unit"]
+__all__ = ["Mesh", "apply", "box", "convex_hull", "cross", "cylinder", "disc", "empty", "face_normals", "icosphere",
+           "invert", "loft", "merge", "mount", "on_ground", "polygon", "pose", "prism", "quad", "quads", "rect",
+           "resolve_ids", "slab", "triangulate", "tube", "unit"]

@@ -21,22 +21,19 @@ from __future__ import annotations
 import logging
 
 import numpy as np
-import trimesh
-from scipy.spatial import ConvexHull, QhullError, cKDTree
-from trimesh import geometry as tm_geometry
-from trimesh import triangles as tm_triangles
-from trimesh import util as tm_util
-from trimesh.constants import tol
-from trimesh.convex import QHULL_DEFAULT
+
+from generator.geometry.transforms import cross
 
 log = logging.getLogger(__name__)
 
-#: hull vertices closer than this in every coordinate (metres) go the trimesh way: its vertex
-#: merge (rounding to ``tol.merge``) might join them
-MERGE_GUARD = 1e3 * tol.merge
+#: hull vertices closer than this (metres, ``1e3 * trimesh.constants.tol.merge``) in every coordinate
+#: go the trimesh way: its vertex merge (rounding to ``tol.merge``) might join them
+MERGE_GUARD = 1e3 * 1e-8
 
 
 def _by_trimesh(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    import trimesh
+
     hull = trimesh.convex.convex_hull(points)
     return np.asarray(hull.vertices, np.float64), np.asarray(hull.faces, np.int64), \
         np.asarray(hull.vertex_normals, np.float64)
@@ -55,6 +52,15 @@ def _closed_and_consistent(faces: np.ndarray, n_vertices: int) -> bool:
 
 def _fast(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
     """trimesh's hull arithmetic without the Trimesh object, or None where it would differ."""
+    # imported here, not with the module: trimesh and scipy.spatial take ~0.7 s to import, and most
+    # processes that import the geometry never make a hull
+    from scipy.spatial import ConvexHull, QhullError, cKDTree
+    from trimesh import geometry as tm_geometry
+    from trimesh import triangles as tm_triangles
+    from trimesh import util as tm_util
+    from trimesh.constants import tol
+    from trimesh.convex import QHULL_DEFAULT
+
     try:
         hull = ConvexHull(points, qhull_options=str(QHULL_DEFAULT))
     except QhullError:
@@ -95,7 +101,7 @@ def _fast(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray] | Non
     if not _closed_and_consistent(faces, len(vertices)):
         return None                               # fix_winding would traverse and flip
     tri = vertices[faces]
-    volume = np.einsum("ij,ij->i", tri[:, 0], np.cross(tri[:, 1], tri[:, 2])).sum() / 6.0
+    volume = np.einsum("ij,ij->i", tri[:, 0], cross(tri[:, 1], tri[:, 2])).sum() / 6.0
     if not volume > 0:
         return None                               # fix_inversion would invert
     angles = tm_triangles.angles(tri)

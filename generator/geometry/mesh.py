@@ -10,11 +10,14 @@ build meshes are in :mod:`generator.geometry.primitives`; rigid transforms in
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
-import trimesh
 
-from generator.geometry.transforms import apply, pose
+from generator.geometry.transforms import apply, cross, pose
+
+if TYPE_CHECKING:                   # trimesh (with scipy) costs ~0.7 s to import: only where used
+    import trimesh
 
 
 @dataclass
@@ -47,7 +50,10 @@ class Mesh:
         m = len(self.faces)
         self.face_class = _per_face(self.face_class, np.uint8, m)
         self.face_material = _per_face(self.face_material, np.uint16, m)
-        self.anchors = {k: np.asarray(v, np.float64).reshape(-1, 3) for k, v in self.anchors.items()}
+        if self.anchors:
+            self.anchors = {k: np.asarray(v, np.float64).reshape(-1, 3) for k, v in self.anchors.items()}
+        else:
+            self.anchors = {}
 
     @property
     def n_faces(self) -> int:
@@ -75,6 +81,8 @@ class Mesh:
 
     def to_trimesh(self) -> trimesh.Trimesh:
         """A :class:`trimesh.Trimesh` of the geometry (labels not carried)."""
+        import trimesh
+
         return trimesh.Trimesh(self.vertices, self.faces, process=False)
 
 
@@ -82,7 +90,7 @@ def _per_face(values, dtype, m: int) -> np.ndarray:
     """A fresh (m,) ``dtype`` array of ``values`` (one value per face, or one for all)."""
     a = np.asarray(values, dtype)
     if a.shape == (m,):
-        return a.copy()
+        return a.copy() if a is values else a      # a converted array is fresh already
     if a.ndim == 0:
         return np.full(m, a, dtype)
     return np.broadcast_to(a, (m,)).copy()
@@ -122,5 +130,5 @@ def on_ground(mesh: Mesh) -> Mesh:
 def face_normals(mesh: Mesh) -> np.ndarray:
     """(m, 3) float64 unit normals of the faces (right-hand rule on the vertex order)."""
     tri = mesh.vertices[mesh.faces]
-    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    n = cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     return n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)

@@ -11,16 +11,26 @@ from __future__ import annotations
 import functools
 
 import numpy as np
-import trimesh
 
+from generator.geometry.faces import cylinder_parts, fan_faces, loft_faces
 from generator.geometry.hull import hull_arrays
 from generator.geometry.mesh import Mesh
+from generator.geometry.transforms import cross
 from generator.labels import class_table
 from generator.materials import material_table
 
 
 def resolve_ids(cls: str | int, material: str | int) -> tuple[int, int]:
-    """(class id, material id) from names or ids (``classes.yaml``, ``materials.yaml``)."""
+    """(class id, material id) from names or ids (``classes.yaml``, ``materials.yaml``; both tables
+    are read once per process, so the answer is remembered: a town asks ~50 000 times)."""
+    try:
+        return _resolve_ids(cls, material)
+    except TypeError:                            # an unhashable id (a 0-d array): not remembered
+        return _resolve_ids.__wrapped__(cls, material)
+
+
+@functools.lru_cache(maxsize=4096)
+def _resolve_ids(cls: str | int, material: str | int) -> tuple[int, int]:
     c = class_table().id(cls) if isinstance(cls, str) else int(cls)
     m = material_table().id(material) if isinstance(material, str) else int(material)
     return c, m
@@ -74,21 +84,17 @@ def cylinder(radius: float, height: float, cls: str | int, material: str | int, 
              z0: float = 0.0, radius_top: float | None = None, caps: bool = True) -> Mesh:
     """A vertical (optionally tapered) cylinder from ``z0`` to ``z0 + height`` around the z axis."""
     rt = radius if radius_top is None else radius_top
-    a = np.linspace(0, 2 * np.pi, sections, endpoint=False)
-    ring = np.stack([np.cos(a), np.sin(a)], 1)
-    v = np.concatenate([np.c_[ring * radius, np.full(sections, z0)], np.c_[ring * rt, np.full(sections, z0 + height)]])
-    i = np.arange(sections)
-    j = (i + 1) % sections
-    faces = [np.stack([i, j, j + sections], 1), np.stack([i, j + sections, i + sections], 1)]
+    ring, faces = cylinder_parts(int(sections), bool(caps))
+    k = len(ring)
+    v = np.empty((2 * k + (2 if caps else 0), 3))
+    v[:k, :2] = ring * radius
+    v[:k, 2] = z0
+    v[k:2 * k, :2] = ring * rt
+    v[k:2 * k, 2] = z0 + height
     if caps:
-        v = np.concatenate([v, [[0, 0, z0], [0, 0, z0 + height]]])
-        cb, ct = 2 * sections, 2 * sections + 1
-        faces += [
-            np.stack([np.full(sections, cb), j, i], 1),
-            np.stack([np.full(sections, ct), i + sections, j + sections], 1),
-        ]
+        v[2 * k:] = [[0, 0, z0], [0, 0, z0 + height]]
     c, m = resolve_ids(cls, material)
-    return Mesh(v, np.concatenate(faces), c, m)
+    return Mesh(v, faces.copy(), c, m)
 
 
 def icosphere(radius: float, cls: str | int, material: str | int, subdivisions: int = 1,
@@ -104,6 +110,8 @@ def icosphere(radius: float, cls: str | int, material: str | int, subdivisions: 
 def _unit_icosphere(subdivisions: int, radius: float) -> tuple[np.ndarray, np.ndarray]:
     """trimesh's icosphere arrays (read-only), made once per (subdivisions, radius): trees and hedges
     ask for a thousand identical ones per town."""
+    import trimesh  # imported on first use (~0.7 s with scipy)
+
     tm = trimesh.creation.icosphere(subdivisions=subdivisions, radius=radius)
     vertices, faces = np.array(tm.vertices, np.float64), np.array(tm.faces, np.int64)
     vertices.setflags(write=False)
@@ -186,9 +194,9 @@ def _frame(axis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Two unit vectors (u, v) with (u, v, axis) a right-handed orthonormal frame."""
     axis = np.asarray(axis, float) / np.linalg.norm(axis)
     helper = np.array([0.0, 0.0, 1.0]) if abs(axis[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
-    u = np.cross(helper, axis)
+    u = cross(helper, axis)
     u /= np.linalg.norm(u)
-    return u, np.cross(axis, u)
+    return u, cross(axis, u)
 
 
 def tube(p0: tuple[float, float, float], p1: tuple[float, float, float], radius: float, cls: str | int,
@@ -237,15 +245,10 @@ def loft(rings: np.ndarray, cls: str | int, material: str | int, caps: bool = Tr
     v = rings.reshape(-1, 3)
     i = np.arange(k)
     j = (i + 1) % k
-    faces = []
-    for r in range(s - 1):
-        a, b = r * k + i, (r + 1) * k + i
-        an, bn = r * k + j, (r + 1) * k + j
-        faces += [np.stack([a, an, bn], 1), np.stack([a, bn, b], 1)]
-    faces = np.concatenate(faces)
+    faces = loft_faces(s, k).copy()
     centres = rings.mean(1)
     tri = v[faces]
-    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    normal = cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     ring_of_face = faces[:, 0] // k
     out = tri.mean(1) - 0.5 * (centres[ring_of_face] + centres[np.minimum(ring_of_face + 1, s - 1)])
     if np.sum(np.einsum("ij,ij->i", normal, out)) < 0:
@@ -258,7 +261,7 @@ def loft(rings: np.ndarray, cls: str | int, material: str | int, caps: bool = Tr
         cap1 = np.stack([np.full(k, c1), (s - 1) * k + i, (s - 1) * k + j], 1)
         for cap, inward in ((cap0, centres[min(1, s - 1)] - centres[0]), (cap1, centres[max(s - 2, 0)] - centres[-1])):
             t = v[cap]
-            n = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]).sum(0)
+            n = cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]).sum(0)
             if np.dot(n, inward) > 0:
                 cap[:] = cap[:, ::-1]
         faces = np.concatenate([faces, cap0, cap1])
@@ -274,14 +277,13 @@ def polygon(points: np.ndarray, cls: str | int, material: str | int,
     (counter-clockwise seen from the front) decides.
     """
     p = np.asarray(points, float)
-    k = len(p)
-    faces = np.stack([np.zeros(k - 2, np.int64), np.arange(1, k - 1), np.arange(2, k)], 1)
+    faces = fan_faces(len(p))
     if normal is not None:
-        n = np.cross(p[faces[:, 1]] - p[faces[:, 0]], p[faces[:, 2]] - p[faces[:, 0]]).sum(0)
+        n = cross(p[faces[:, 1]] - p[faces[:, 0]], p[faces[:, 2]] - p[faces[:, 0]]).sum(0)
         if np.dot(n, normal) < 0:
             faces = faces[:, ::-1]
     c, m = resolve_ids(cls, material)
-    return Mesh(p, faces, c, m)
+    return Mesh(p, faces.copy(), c, m)
 
 
 def disc(center: tuple[float, float, float], normal: tuple[float, float, float], radius: float,
@@ -313,7 +315,7 @@ def quads(corners: np.ndarray, cls: str | int, materials, normals: np.ndarray | 
     tri_a = base + np.array([0, 1, 2])
     tri_b = base + np.array([0, 2, 3])
     if normals is not None:
-        nq = np.cross(corners[:, 2] - corners[:, 0], corners[:, 3] - corners[:, 1])
+        nq = cross(corners[:, 2] - corners[:, 0], corners[:, 3] - corners[:, 1])
         flip = np.einsum("ij,ij->i", nq, np.asarray(normals, float).reshape(-1, 3)) < 0
         tri_a[flip] = tri_a[flip][:, ::-1]
         tri_b[flip] = tri_b[flip][:, ::-1]

@@ -19,7 +19,24 @@ def unit(v) -> np.ndarray:
     v = np.asarray(v)
     if v.dtype.kind != "f":
         v = v.astype(np.float64)
-    return v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-12)
+    # np.linalg.norm(v, axis=-1, keepdims=True) is sqrt(add.reduce(v * v, -1)) for real input: the
+    # same operations, without its ~5 us of argument handling (people call this ~350 times each)
+    return v / np.maximum(np.sqrt(np.add.reduce(v * v, axis=-1, keepdims=True)), 1e-12)
+
+
+def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``np.cross(a, b)`` for float64 (..., 3) vectors, the same products and differences in the same
+    order (``a1 b2 - a2 b1``, ...), without np.cross's axis handling (~20 us a call)."""
+    a, b = np.asarray(a), np.asarray(b)
+    if a.shape[-1:] != (3,) or b.shape[-1:] != (3,):
+        return np.cross(a, b)                   # 2-vectors and errors: numpy's own
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape), np.result_type(a, b))
+    out[..., 0] = a1 * b2 - a2 * b1
+    out[..., 1] = a2 * b0 - a0 * b2
+    out[..., 2] = a0 * b1 - a1 * b0
+    return out
 
 
 def apply(matrix: np.ndarray, points: np.ndarray) -> np.ndarray:

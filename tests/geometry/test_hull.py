@@ -84,3 +84,8 @@ def _outcome(fn, p):
         return tuple(a.tobytes() for a in fn(p))
     except Exception as e:  # noqa: BLE001 - the type is the outcome compared
         return type(e)
+
+
+def test_merge_guard_is_trimesh_tolerance():
+    """hull.py writes trimesh's merge tolerance out (so importing it does not import trimesh)."""
+    assert hull.MERGE_GUARD == 1e3 * trimesh.constants.tol.merge

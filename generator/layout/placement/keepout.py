@@ -9,7 +9,6 @@ Frames: whichever frame the samples are in (grid or world), metres.
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from generator.geometry.boxes import OrientedBox, point_box_distance, point_polygon_distance
 
@@ -20,6 +19,8 @@ class Keepout:
     def __init__(self, samples_xy: np.ndarray, limit: float):
         self.points = np.asarray(samples_xy, np.float64).reshape(-1, 2)
         self.limit = float(limit)
+        from scipy.spatial import cKDTree  # imported on first use (scipy.spatial: ~0.4 s)
+
         self.tree = cKDTree(self.points) if len(self.points) else None
 
     def distance(self, box: OrientedBox) -> float:

@@ -18,7 +18,6 @@ import numpy as np
 
 from generator.geometry import pose
 from generator.geometry.boxes import OrientedBox, box_of, world_boxes
-from generator.geometry.overlap_kernel import any_overlap
 from generator.layout.placement.keepout import Keepout
 from generator.layout.placement.prototypes import Library, Proto
 
@@ -56,7 +55,10 @@ class Occupancy:
         idx = sorted({i for key in self._keys(boxes) for i in self._cells.get(key, ())})
         if not idx:
             return False
-        # boxes_overlap(boxes, self.boxes[idx]).any(), compiled (the same float operations)
+        # boxes_overlap(boxes, self.boxes[idx]).any(), compiled (the same float operations); numba is
+        # imported on the first question, not with the layout (~0.2 s)
+        from generator.geometry.overlap_kernel import any_overlap
+
         yaw = np.ascontiguousarray(boxes, np.float64)[:, 4]
         return bool(any_overlap(np.ascontiguousarray(boxes, np.float64), np.cos(yaw), np.sin(yaw),
                                 self._buf[idx], self._cos[idx], self._sin[idx]))
