@@ -1,4 +1,4 @@
-"""Recipes for the materials of issue 14 item 4: tree species and facade details.
+"""Recipes of trees (bark and foliage of every species) and facade details (issue 14 item 4, issue 29 item 1).
 
 Same contract as :mod:`generator.blender.recipes` (one function per material name in
 ``generator/materials.yaml``, receiving a :class:`Nodes` builder and a seeded generator,
@@ -13,7 +13,36 @@ import numpy as np
 from generator.blender import facade_detail as fd
 from generator.blender.controls import CONTROL
 from generator.blender.nodes import Nodes
-from generator.blender.recipes import _emit, _foliage, _jit, _tint, _wall_coords
+from generator.blender.recipes import _emit, _jit, _tint, _wall_coords
+
+
+def bark(g, rng):
+    """Furrowed bark: vertical plates between dark cracks, grey-brown, a green film of algae in patches."""
+    co = g.coords("Object")
+    crack = g.smooth(g.voronoi(g.mapping(co, scale=(7.0, 7.0, 1.4)), scale=1.0, feature="DISTANCE_TO_EDGE"), 0.0, 0.09)
+    grain = g.noise(g.mapping(co, scale=(30, 30, 6)), scale=1.0, detail=2)
+    base = g.ramp(grain, [(0.25, _jit(rng, (0.07, 0.06, 0.05), 0.1)), (0.75, _jit(rng, (0.15, 0.135, 0.115), 0.1))])
+    base = g.mix(g.mul(g.smooth(g.noise(co, scale=1.2, detail=2), 0.55, 0.75), 0.6), base, (0.06, 0.08, 0.03))
+    base = g.mix(g.math("SUBTRACT", 1.0, crack), base, (0.015, 0.012, 0.01))
+    return g.principled(base_color=base, roughness=0.92, normal=g.bump(crack, 0.8, 0.02))
+
+
+def _foliage(g, rng, color):
+    """Leaves: each leaf (mesh island) its own shade and a little its own hue, sunny and shaded
+    sides of a crown, and clumps of ~0.4 m in sun or in each other's shade (what breaks up a smooth
+    distant crown into foliage); light through them from behind (a quarter translucent)."""
+    leaf = g.geometry("Random Per Island")
+    n = g.noise(g.coords("Object"), scale=0.8, detail=1)
+    clump = g.smooth(g.noise(g.geometry("Position"), scale=2.5, detail=2, roughness=0.6), 0.3, 0.72)
+    hue = g.add(g.add(0.46, g.mul(g.object_info("Random"), 0.06)), g.mul(leaf, 0.05))
+    base = g.ramp(n, [(0.3, _jit(rng, color, 0.1)), (0.75, _jit(rng, np.asarray(color) * 1.5, 0.1))])
+    base = g.hsv(base, hue=hue, value=g.mul(g.add(0.6, g.mul(leaf, 0.8)), g.add(0.6, g.mul(clump, 0.7))))
+    face = g.principled(base_color=base, roughness=0.55, specular=0.35)
+    return g.mix_shader(0.25, face, g.translucent(base))
+
+
+def leaves(g, rng):
+    return _foliage(g, rng, (0.045, 0.09, 0.02))
 
 
 def bark_birch(g: Nodes, rng: np.random.Generator):
