@@ -29,14 +29,12 @@ def bark(g, rng):
 
 def _foliage(g, rng, color):
     """Leaves: each leaf (mesh island) its own shade and a little its own hue, sunny and shaded
-    sides of a crown, and clumps of ~0.4 m in sun or in each other's shade (what breaks up a smooth
-    distant crown into foliage); light through them from behind (a quarter translucent)."""
+    sides of a crown; light through them from behind (a quarter translucent)."""
     leaf = g.geometry("Random Per Island")
     n = g.noise(g.coords("Object"), scale=0.8, detail=1)
-    clump = g.smooth(g.noise(g.geometry("Position"), scale=2.5, detail=2, roughness=0.6), 0.3, 0.72)
     hue = g.add(g.add(0.46, g.mul(g.object_info("Random"), 0.06)), g.mul(leaf, 0.05))
     base = g.ramp(n, [(0.3, _jit(rng, color, 0.1)), (0.75, _jit(rng, np.asarray(color) * 1.5, 0.1))])
-    base = g.hsv(base, hue=hue, value=g.mul(g.add(0.6, g.mul(leaf, 0.8)), g.add(0.6, g.mul(clump, 0.7))))
+    base = g.hsv(base, hue=hue, value=g.add(0.6, g.mul(leaf, 0.8)))
     face = g.principled(base_color=base, roughness=0.55, specular=0.35)
     return g.mix_shader(0.25, face, g.translucent(base))
 
