@@ -14,8 +14,7 @@ LiDAR see exactly the triangles they saw before. Sizes are real (1 unit = 1 m):
   no gutter;
 * sidewalk: 0.6 m square slabs in the segment frame (joints along and square to the kerb), each a
   tone of its own and slightly tilted, dirt in the joints, chewing-gum spots, water stains;
-* fallen leaves: 7-12 cm pointed leaves at random angles, two candidates per 25 cm cell, a share of
-  them set by a density socket;
+* fallen leaves: 4-7 cm leaves in 14 cm cells, a share of the cells set by a density socket;
 * grass: clumps, clover, dry straw-coloured patches and worn soil, blade-scale speckle.
 
 Patterns that lie on the ground read only x and y (2D noise and Voronoi: a 3D Voronoi searches 27
@@ -35,8 +34,7 @@ GUTTER_M = 0.6                 #: carriageway width by the kerb that is gutter
 DRAIN_CELL_M, DRAIN_SHARE = 24.0, 0.6  #: one gully grate per 24 m of kerb, in 60 % of the cells
 DRAIN_SIZE_M = (0.5, 0.36)     #: grate along the kerb x out from it
 SLAB_M = 0.6                   #: sidewalk slab edge
-LEAF_CELLS_PER_M = 4.0         #: fallen leaves: one candidate leaf per 25 cm cell
-LEAF_ASPECT = 0.48             #: a fallen leaf's half-width over its half-length
+LEAF_CELLS_PER_M = 5.0         #: fallen leaves: one candidate leaf per 20 cm cell
 
 
 def xyz(g: Nodes, v):
@@ -112,59 +110,22 @@ def gutter(g: Nodes, co):
     return gut, grate, slots
 
 
-def grid_cells(g: Nodes, v, scale, location=(0.0, 0.0, 0.0)):
-    """Cells of a grid on ``v * scale + location`` (a Mapping): (white noise value and colour of the
-    cell, x and y of the point inside its cell in [0, 1))."""
-    grid = g.mapping(v, scale=scale, location=location)
-    cell = g.node("ShaderNodeVectorMath", operation="FLOOR")
-    g.set(cell.inputs[0], grid)
-    frac = g.node("ShaderNodeVectorMath", operation="FRACTION")
-    g.set(frac.inputs[0], grid)
-    wn = g.node("ShaderNodeTexWhiteNoise", noise_dimensions="3D")
-    g.set(wn.inputs["Vector"], cell.outputs[0])
-    fx, fy, _ = xyz(g, frac.outputs[0])
-    return wn.outputs["Value"], wn.outputs["Color"], fx, fy
-
-
-def _leaf_layer(g: Nodes, p, density, shift: float, salt: float):
-    """One grid of candidate leaves (:func:`leaves`), shifted by ``shift`` cells; (mask, colour key, across)."""
-    _, colour, fx, fy = grid_cells(g, p, (LEAF_CELLS_PER_M, LEAF_CELLS_PER_M, 0), (shift, shift, salt))
-    r, gg, b = rgb(g, colour)
-    # the leaf's centre jittered within the cell's middle half: no leaf reaches past its cell
-    dx = g.mul(g.math("SUBTRACT", fx, g.add(0.25, g.mul(g.math("FRACT", g.mul(r, 7.0)), 0.5))), 1 / LEAF_CELLS_PER_M)
-    dy = g.mul(g.math("SUBTRACT", fy, g.add(0.25, g.mul(g.math("FRACT", g.mul(gg, 11.0)), 0.5))), 1 / LEAF_CELLS_PER_M)
-    turn = g.mul(g.math("FRACT", g.mul(b, 17.0)), 6.2832)            # an angle per leaf
-    c, s = g.math("COSINE", turn), g.math("SINE", turn)
-    u = g.add(g.mul(dx, c), g.mul(dy, s))                             # along the leaf
-    v = g.math("ABSOLUTE", g.math("SUBTRACT", g.mul(dy, c), g.mul(dx, s)))  # across it
-    half = g.add(0.035, g.mul(gg, 0.025))                             # half-length, metres (<= a quarter cell)
-    t = g.math("DIVIDE", u, half)
-    edge = g.mul(g.mul(half, LEAF_ASPECT), inv(g, g.mul(t, t)))       # the lens's half-width at u
-    mask = g.mul(g.smooth(g.math("SUBTRACT", edge, v), 0.0, 0.0015), g.math("LESS_THAN", r, density))
-    return mask, b, v
-
-
 def leaves(g: Nodes, wp, density):
-    """(leaf mask 0..1, leaf colour): fallen leaves, ``density`` (socket or constant) of the candidates.
-
-    A leaf is a pointed lens 7-12 cm long (half-width ``LEAF_ASPECT`` of its half-length) with a darker
-    midrib, lying at a random angle about a point jittered in its grid cell; two grids half a cell apart
-    (two candidates per cell area, a leaf may overlap another); ochres, reds, browns, a few dark decayed
-    and yellow-green ones.
-    """
+    """(leaf mask 0..1, leaf colour): fallen leaves in ``density`` (socket or constant) of the cells."""
     warp = g.mapping(g.noise(wp, scale=7.0, detail=1, out="Color", plane=True), scale=(0.08, 0.05, 0))
     p = g.node("ShaderNodeVectorMath", operation="ADD")
-    g.set(p.inputs[0], wp)
+    g.set(p.inputs[0], wp)  # the 2D Voronoi reads x and y only
     g.set(p.inputs[1], warp)
-    m1, b1, v1 = _leaf_layer(g, p.outputs[0], density, 0.0, 0.0)
-    m2, b2, v2 = _leaf_layer(g, p.outputs[0], density, 0.5, 37.0)
-    top = g.math("GREATER_THAN", m2, m1)                              # the second grid's leaf lies on top
-    b, v = g.lerp(top, b1, b2), g.lerp(top, v1, v2)
-    col = g.ramp(b, [(0.0, (0.22, 0.12, 0.03)), (0.3, (0.30, 0.16, 0.025)), (0.55, (0.25, 0.075, 0.018)),
-                     (0.8, (0.10, 0.055, 0.025)), (1.0, (0.18, 0.16, 0.04))])
-    rib = inv(g, g.smooth(v, 0.0006, 0.0012))                          # the midrib, a little darker
-    col = g.mix(g.mul(rib, 0.5), col, g.mix(0.5, col, (0.3, 0.3, 0.3), "MULTIPLY"))
-    return g.math("MAXIMUM", m1, m2), col
+    vor = g.node("ShaderNodeTexVoronoi", feature="F1", voronoi_dimensions="2D")
+    g.set(vor.inputs["Vector"], p.outputs[0])
+    vor.inputs["Scale"].default_value = LEAF_CELLS_PER_M
+    r, gg, b = rgb(g, vor.outputs["Color"])
+    size = g.add(0.2, g.mul(gg, 0.15))                                # radius in cell units (4-7 cm)
+    shape = inv(g, g.smooth(g.math("DIVIDE", vor.outputs["Distance"], size), 0.85, 1.0))
+    mask = g.mul(shape, g.math("LESS_THAN", r, density))
+    col = g.ramp(b, [(0.0, (0.30, 0.17, 0.02)), (0.35, (0.28, 0.08, 0.015)), (0.7, (0.11, 0.055, 0.02)),
+                     (1.0, (0.16, 0.14, 0.03))])
+    return mask, col
 
 
 def slabs(g: Nodes, co, tone: float):

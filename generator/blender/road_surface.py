@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from generator.blender.ground_detail import grid_cells, rgb
 from generator.blender.nodes import Nodes
 
 PATCH_CELL_M = (4.5, 3.2)     #: repair patch grid (a patch in a fraction of the cells)
@@ -28,21 +27,28 @@ def _vadd(g: Nodes, a, b):
 def road_wear(g: Nodes, co, base, tone: float, rng: np.random.Generator):
     """Repair patches, tar-sealed seams, oil stains, alligator cracks and manhole covers over an asphalt colour.
 
-    Everything is in the road's object coordinates (metres, z up): patches are rectangles of
-    their own size and place in the cells of a 4.5 m x 3.2 m grid, manholes 0.32 m-radius discs
-    anywhere in the middle of the cells of an 11 m x 7 m grid, each present in a random fraction
-    of the cells (white noise of the cell index).
+    Everything is in the road's object coordinates (metres, z up): patches are rectangles in
+    a 4.5 m x 3.2 m cell grid, manholes are 0.32 m-radius discs in a 13 m x 9 m grid, each
+    present in a random fraction of the cells (white noise of the cell index).
 
     Returns
     -------
     (colour socket, roughness socket, bump height socket)
     """
     def cells(size, offset):
-        return grid_cells(g, co, (1 / size[0], 1 / size[1], 0.0), offset)
+        v = g.mapping(co, scale=(1 / size[0], 1 / size[1], 0.0), location=offset)
+        fl = g.node("ShaderNodeVectorMath", operation="FLOOR")
+        g.set(fl.inputs[0], v)
+        fr = g.node("ShaderNodeVectorMath", operation="FRACTION")
+        g.set(fr.inputs[0], v)
+        wn = g.node("ShaderNodeTexWhiteNoise", noise_dimensions="3D")
+        g.set(wn.inputs["Vector"], fl.outputs[0])
+        sep = g.node("ShaderNodeSeparateXYZ")
+        g.set(sep.inputs[0], fr.outputs[0])
+        return wn.outputs["Value"], wn.outputs["Color"], sep.outputs["X"], sep.outputs["Y"]
 
-    def span(x, lo, hi, soft=0.004):  # 1 between the sockets lo and hi, soft edges
-        return g.mul(g.smooth(g.math("SUBTRACT", x, lo), -soft, soft),
-                     g.math("SUBTRACT", 1.0, g.smooth(g.math("SUBTRACT", x, hi), -soft, soft)))
+    def band(x, lo, hi, soft=0.004):
+        return g.mul(g.smooth(x, lo - soft, lo + soft), g.math("SUBTRACT", 1.0, g.smooth(x, hi - soft, hi + soft)))
 
     # repair patches: a rectangle in ~18% of the cells, fresher (darker) or older (greyer); the
     # edges wander a few centimetres and the new asphalt feathers out over ~8 cm (soft edges)
@@ -50,17 +56,9 @@ def road_wear(g: Nodes, co, base, tone: float, rng: np.random.Generator):
     wob = g.mul(g.math("SUBTRACT", g.noise(co, scale=2.0, detail=3, plane=True), 0.5), 0.03)
     fx, fy = g.add(fx, wob), g.add(fy, wob)
     present = g.math("LESS_THAN", r, PATCH_SHARE)
-    # each patch its own size and place in its cell (0.9-3.2 m along, 0.8-2.2 m across), so the
-    # patches of a street do not line up in the cell grid
-    c1, c2, c3 = rgb(g, col)
-    x0 = g.add(0.05, g.mul(c1, 0.3))
-    x1 = g.math("MINIMUM", g.add(x0, g.add(0.2, g.mul(c2, 0.5))), 0.95)
-    y0 = g.add(0.06, g.mul(c3, 0.3))
-    y1 = g.math("MINIMUM", g.add(y0, g.add(0.25, g.mul(g.math("FRACT", g.mul(c1, 7.0)), 0.45))), 0.95)
-    inside = g.mul(span(fx, x0, x1, 0.012), span(fy, y0, y1, 0.016))
-    seam = g.math("SUBTRACT", g.mul(span(fx, g.add(x0, -0.01), g.add(x1, 0.01)),
-                                    span(fy, g.add(y0, -0.01), g.add(y1, 0.01))),
-                  g.mul(span(fx, x0, x1), span(fy, y0, y1)))
+    inside = g.mul(band(fx, 0.12, 0.82, 0.012), band(fy, 0.15, 0.8, 0.016))
+    seam = g.math("SUBTRACT", g.mul(band(fx, 0.11, 0.83), band(fy, 0.14, 0.81)),
+                  g.mul(band(fx, 0.12, 0.82), band(fy, 0.15, 0.8)))
     patch = g.mul(present, inside)
     patch_col = g.mix(g.math("GREATER_THAN", r, PATCH_SHARE / 2), (tone * 0.7,) * 3,
                       (tone * 1.6, tone * 1.55, tone * 1.5))
@@ -70,26 +68,17 @@ def road_wear(g: Nodes, co, base, tone: float, rng: np.random.Generator):
     stains = g.mul(g.smooth(g.noise(co, scale=0.35, detail=3, plane=True), 0.56, 0.68),
                    g.smooth(g.noise(co, scale=2.5, detail=3, plane=True), 0.3, 0.6))
     out = g.mix(g.mul(stains, 0.75), out, (tone * 0.35,) * 3)
-    # alligator cracking in worn zones: cells of ~0.6 m on noise-warped coordinates, each crack of a
-    # width that wanders (4-20 mm) and broken into runs with gaps, so no even net shows; in the zones'
-    # cores the blocks crack again into ~0.2 m pieces with hairline cracks
+    # alligator cracking in worn zones: a fine cell network on noise-warped coordinates
     warp = _vadd(g, co, g.mapping(g.noise(co, scale=1.5, detail=2, out="Color", plane=True), scale=(0.6, 0.6, 0)))
-    width = g.add(0.006, g.mul(g.smooth(g.noise(co, scale=2.2, detail=2, plane=True), 0.3, 0.7), 0.026))
-    edge = g.math("DIVIDE", g.voronoi(warp, scale=1.6, feature="DISTANCE_TO_EDGE", plane=True), width)
-    runs = g.smooth(g.noise(co, scale=3.5, detail=2, plane=True), 0.36, 0.46)
-    net = g.mul(g.math("SUBTRACT", 1.0, g.smooth(edge, 0.0, 1.0)), runs)
-    fine = g.math("SUBTRACT", 1.0, g.smooth(g.voronoi(warp, scale=4.8, feature="DISTANCE_TO_EDGE", plane=True),
-                                             0.0, 0.02))
-    zone_noise = g.noise(co, scale=0.09, detail=2, plane=True)
-    zone = g.smooth(zone_noise, 0.6, 0.66)
-    core = g.mul(g.smooth(zone_noise, 0.66, 0.72), g.smooth(g.noise(co, scale=6.0, detail=1, plane=True), 0.42, 0.5))
-    cracks = g.mul(g.math("MAXIMUM", net, g.mul(g.mul(fine, core), 0.7)), zone)
+    net = g.math("SUBTRACT", 1.0, g.smooth(g.voronoi(warp, scale=1.6, feature="DISTANCE_TO_EDGE", plane=True),
+                                            0.0, 0.025))
+    zone = g.smooth(g.noise(co, scale=0.09, detail=2, plane=True), 0.6, 0.66)
+    cracks = g.mul(net, zone)
     out = g.mix(g.mul(cracks, 0.85), out, (0.008, 0.008, 0.008))
     # manhole covers: a cast-iron disc with a grid in a concrete collar, in MANHOLE_SHARE of the cells
-    m, mcol, mx, my = cells(MANHOLE_CELL_M, tuple(rng.uniform(0, 1, 3)))
-    k1, k2, _ = rgb(g, mcol)  # the cover anywhere in the cell's middle 60 %: no lattice shows
-    dx = g.mul(g.math("SUBTRACT", mx, g.add(0.2, g.mul(k1, 0.6))), MANHOLE_CELL_M[0])
-    dy = g.mul(g.math("SUBTRACT", my, g.add(0.2, g.mul(k2, 0.6))), MANHOLE_CELL_M[1])
+    m, _, mx, my = cells(MANHOLE_CELL_M, tuple(rng.uniform(0, 1, 3)))
+    dx = g.mul(g.math("SUBTRACT", mx, 0.5), MANHOLE_CELL_M[0])
+    dy = g.mul(g.math("SUBTRACT", my, 0.5), MANHOLE_CELL_M[1])
     dist = g.math("SQRT", g.add(g.mul(dx, dx), g.mul(dy, dy)))
     has = g.math("LESS_THAN", m, MANHOLE_SHARE)
     disc = g.mul(has, g.math("SUBTRACT", 1.0, g.smooth(dist, MANHOLE_R_M - 0.01, MANHOLE_R_M)))
@@ -99,9 +88,7 @@ def road_wear(g: Nodes, co, base, tone: float, rng: np.random.Generator):
     iron = g.mix(g.mul(grid, 0.7), (0.12, 0.11, 0.1), (0.04, 0.038, 0.036))     # worn cast iron, dark grooves
     out = g.mix(collar, out, (0.13, 0.128, 0.12))                                  # concrete collar
     out = g.mix(disc, out, iron)
-    # cracks are colour and roughness only: in the bump height Cycles would evaluate both crack
-    # networks three times (the paper preset rendered 1.13x slower with them there)
     rough = g.lerp(g.add(g.mul(stains, 0.35), g.mul(disc, 0.3)), 0.85, 0.5)
-    rough = g.lerp(cracks, rough, 1.0)
     height = g.add(g.mul(g.mul(disc, g.math("SUBTRACT", 1.0, grid)), -0.5), g.mul(g.mul(present, seam), 0.3))
+    height = g.add(height, g.mul(cracks, -0.6))
     return out, rough, height
