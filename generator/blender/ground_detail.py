@@ -128,16 +128,27 @@ def leaves(g: Nodes, wp, density):
     return mask, col
 
 
+def grid_cells(g: Nodes, v, scale, location=(0.0, 0.0, 0.0)):
+    """Cells of a grid on ``v * scale + location`` (a Mapping): (white noise value and colour of the
+    cell, x and y of the point inside its cell in [0, 1))."""
+    grid = g.mapping(v, scale=scale, location=location)
+    cell = g.node("ShaderNodeVectorMath", operation="FLOOR")
+    g.set(cell.inputs[0], grid)
+    frac = g.node("ShaderNodeVectorMath", operation="FRACTION")
+    g.set(frac.inputs[0], grid)
+    wn = g.node("ShaderNodeTexWhiteNoise", noise_dimensions="3D")
+    g.set(wn.inputs["Vector"], cell.outputs[0])
+    fx, fy, _ = xyz(g, frac.outputs[0])
+    return wn.outputs["Value"], wn.outputs["Color"], fx, fy
+
+
 def slabs(g: Nodes, co, tone: float):
     """Sidewalk slabs in object coordinates: (colour, joint mask, slab tilt height)."""
     xy = flat(g, co)
     joints = g.brick(xy, color1=(1, 1, 1), color2=(1, 1, 1), mortar=(0, 0, 0), scale=1.0, mortar_size=0.006,
                      brick_width=SLAB_M, row_height=SLAB_M, offset=0.0, out="Factor")
-    cell = g.node("ShaderNodeVectorMath", operation="FLOOR")
-    g.set(cell.inputs[0], g.mapping(xy, scale=(1 / SLAB_M, 1 / SLAB_M, 0)))
-    wn = g.node("ShaderNodeTexWhiteNoise", noise_dimensions="3D")
-    g.set(wn.inputs["Vector"], cell.outputs[0])
-    r, gg, b = rgb(g, wn.outputs["Color"])
+    _, colour, _, _ = grid_cells(g, xy, (1 / SLAB_M, 1 / SLAB_M, 0))
+    r, gg, b = rgb(g, colour)
     shade = g.add(0.82, g.mul(r, 0.3))
     base = g.mul(shade, tone)
     x, y, _ = xyz(g, co)

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from generator.blender.ground_detail import grid_cells
 from generator.blender.nodes import Nodes
 
 PATCH_CELL_M = (4.5, 3.2)     #: repair patch grid (a patch in a fraction of the cells)
@@ -36,16 +37,7 @@ def road_wear(g: Nodes, co, base, tone: float, rng: np.random.Generator):
     (colour socket, roughness socket, bump height socket)
     """
     def cells(size, offset):
-        v = g.mapping(co, scale=(1 / size[0], 1 / size[1], 0.0), location=offset)
-        fl = g.node("ShaderNodeVectorMath", operation="FLOOR")
-        g.set(fl.inputs[0], v)
-        fr = g.node("ShaderNodeVectorMath", operation="FRACTION")
-        g.set(fr.inputs[0], v)
-        wn = g.node("ShaderNodeTexWhiteNoise", noise_dimensions="3D")
-        g.set(wn.inputs["Vector"], fl.outputs[0])
-        sep = g.node("ShaderNodeSeparateXYZ")
-        g.set(sep.inputs[0], fr.outputs[0])
-        return wn.outputs["Value"], wn.outputs["Color"], sep.outputs["X"], sep.outputs["Y"]
+        return grid_cells(g, co, (1 / size[0], 1 / size[1], 0.0), offset)
 
     def band(x, lo, hi, soft=0.004):
         return g.mul(g.smooth(x, lo - soft, lo + soft), g.math("SUBTRACT", 1.0, g.smooth(x, hi - soft, hi + soft)))
