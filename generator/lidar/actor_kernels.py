@@ -150,8 +150,10 @@ def aim_entries(c0, c1, pair_off, ring0, ring1, azimuth, half, psi, rot, start, 
         for col in range(max(c0[k], start), min(c1[k], stop)):
             p = pair_off[k] + (col - c0[k])
             for ring in range(ring0[p], ring1[p]):
-                off = psi[col] + rot[ring] - azimuth[p]  # this laser's beam vs the actor's direction
-                if abs(np.mod(off + np.pi, two_pi) - np.pi) <= half[p]:
+                off = psi[col] + rot[ring] - azimuth[p] + np.pi  # this laser's beam vs the actor's direction
+                # np.mod(off, 2 pi) is off itself on [0, 2 pi): fmod, a libm call, only outside
+                wrapped = off if off >= 0.0 and off < two_pi else np.mod(off, two_pi)
+                if abs(wrapped - np.pi) <= half[p]:
                     beam[m], pair[m], cand[m] = (col - start) * n_l + ring, p, k
                     m += 1
     return beam[:m], pair[:m], cand[:m]
