@@ -109,6 +109,36 @@ def version() -> str | None:
     return f"{v // 10000}.{v // 100 % 100}.{v % 100}"
 
 
+#: how far outside a scene's bounding box a ray must pass to be taken as a miss without a cast, metres
+BOX_MARGIN_M = 1e-2
+
+
+def _box_test():
+    from numba import njit
+
+    @njit(nogil=True, inline="always")
+    def misses_box(boxes, s, o, d, k, tfar):  # pragma: no cover - compiled
+        """Ray ``k``'s segment ``[0, tfar]`` passes outside box ``s`` (lo xyz, hi xyz, already grown by
+        :data:`BOX_MARGIN_M`): no triangle of the scene can be hit, so Embree would report a miss."""
+        t0, t1 = 0.0, np.float64(tfar)
+        for a in range(3):
+            oa, da = np.float64(o[k, a]), np.float64(d[k, a])
+            lo, hi = boxes[s, a], boxes[s, 3 + a]
+            if da == 0.0:
+                if oa < lo or oa > hi:
+                    return True
+                continue
+            ta, tb = (lo - oa) / da, (hi - oa) / da
+            if ta > tb:
+                ta, tb = tb, ta
+            t0, t1 = max(t0, ta), min(t1, tb)
+            if t0 > t1:
+                return True
+        return False
+
+    return misses_box
+
+
 @cache
 def _kernel():
     """The compiled cast loop, bound to this process's ``rtcIntersect1``: ray ``k`` is cast into scene
@@ -116,10 +146,11 @@ def _kernel():
     from numba import njit
 
     size = ctypes.c_size_t
+    _misses_box = _box_test()
     intersect1 = ctypes.CFUNCTYPE(None, size, size, size)(("rtcIntersect1", _library()))
 
     @njit(nogil=True, boundscheck=False)
-    def cast(scenes, which, o, d, tfar, dist, prim):  # pragma: no cover - compiled
+    def cast(scenes, which, o, d, tfar, boxes, dist, prim):  # pragma: no cover - compiled
         # one 64-byte aligned RTCRayHit (32 four-byte fields) per call, allocated here: no Python object
         raw = np.zeros(48, np.uint32)
         off = ((64 - raw.ctypes.data % 64) % 64) // 4
@@ -128,7 +159,13 @@ def _kernel():
         p = rec_u.ctypes.data
         one = tfar.shape[0] == 1
         same = which.shape[0] == 1
+        boxed = boxes.shape[0] > 0
         for k in range(o.shape[0]):
+            s = which[0] if same else which[k]
+            if boxed and _misses_box(boxes, s, o, d, k, tfar[0] if one else tfar[k]):
+                dist[k] = tfar[0] if one else tfar[k]  # what Embree leaves in a missed ray's tfar
+                prim[k] = -1
+                continue
             # RTCRayHit: org, tnear, dir, time, tfar, mask, id, flags | Ng, u, v, primID, geomID, instID
             rec[0] = o[k, 0]
             rec[1] = o[k, 1]
@@ -144,7 +181,7 @@ def _kernel():
             rec_u[11] = 0
             rec_u[17] = 0xFFFFFFFF
             rec_u[18] = 0xFFFFFFFF
-            intersect1(scenes[which[0] if same else which[k]], p, 0)
+            intersect1(scenes[s], p, 0)
             dist[k] = rec[8]
             prim[k] = np.int32(rec_u[17]) if rec_u[18] != 0xFFFFFFFF else np.int32(-1)
 
@@ -178,11 +215,13 @@ def intersect_many(scenes: list, which: np.ndarray, origins: np.ndarray, directi
     dist = np.empty(len(origins), np.float32)
     prim = np.empty(len(origins), np.int32)
     ptrs = np.array([sc._ptr for sc in scenes], np.uint64)
-    _kernel()(ptrs, np.ascontiguousarray(which, np.int64), origins, directions, tfar, dist, prim)
+    boxes = np.array([sc.box for sc in scenes], np.float64)
+    _kernel()(ptrs, np.ascontiguousarray(which, np.int64), origins, directions, tfar, boxes, dist, prim)
     return dist, prim
 
 
 _FIRST = np.zeros(1, np.int64)  # every ray into the first (only) scene
+_NO_BOXES = np.zeros((0, 6), np.float64)  # every ray cast (no bounding-box test)
 
 
 class Scene:
@@ -211,6 +250,9 @@ class Scene:
         dev = _device()
         self._lib, self._ptr = lib, lib.rtcNewScene(dev)
         self._one = np.array([self._ptr], np.uint64)  # what the cast loop takes: an array of scenes
+        v = self._v[:-1].reshape(-1, 3).astype(np.float64)
+        #: bounding box of the vertices Embree holds, grown by BOX_MARGIN_M (lo xyz, hi xyz)
+        self.box = np.concatenate([v.min(0) - BOX_MARGIN_M, v.max(0) + BOX_MARGIN_M]) if len(v) else np.zeros(6)
         lib.rtcSetSceneFlags(self._ptr, _ROBUST if robust else 0)
         geom = lib.rtcNewGeometry(dev, _TRIANGLE)
         lib.rtcSetSharedGeometryBuffer(geom, _VERTEX, 0, _FLOAT3, self._v.ctypes.data, 0, 12, len(vertices))
@@ -252,5 +294,5 @@ class Scene:
         """
         dist = np.empty(len(origins), np.float32)
         prim = np.empty(len(origins), np.int32)
-        self._cast(self._one, _FIRST, origins, directions, tfar, dist, prim)
+        self._cast(self._one, _FIRST, origins, directions, tfar, _NO_BOXES, dist, prim)
         return dist, prim
