@@ -193,7 +193,10 @@ def intersect_many(scenes: list, which: np.ndarray, origins: np.ndarray, directi
     """First hits of rays each cast into a scene of its own, in one compiled loop (GIL released).
 
     The actors' rays go to their prototypes' scenes this way: one call per chunk instead of one per
-    prototype, with no sort to group them. Each ray's hit is the one :meth:`Scene.intersect` gives it.
+    prototype, with no sort to group them. Each ray's hit is the one :meth:`Scene.intersect` gives it: a ray
+    whose segment ``[0, tfar]`` passes outside its scene's bounding box (grown by :data:`BOX_MARGIN_M`) is
+    not cast, since Embree can only report a triangle inside that box and leaves a missed ray's ``tfar``
+    as it was (on the default town with 120 cars, ~9.4 k of the ~29.5 k actor rays of a physical sweep).
 
     Parameters
     ----------

@@ -137,3 +137,37 @@ def test_rays_cast_into_scenes_of_their_own_hit_what_each_scene_gives_them(rays)
         np.testing.assert_array_equal(prim[m], want[1])
         np.testing.assert_array_equal(dist[m].view(np.uint32), want[0].view(np.uint32))
     assert not np.array_equal(*(c.intersect_local(o, d, 40.0)[1] for c in (a, b)))  # the scenes differ
+
+
+def _cube(half: float) -> tuple[np.ndarray, np.ndarray]:
+    v = np.array([[x, y, z] for x in (-half, half) for y in (-half, half) for z in (-half, half)], np.float64)
+    quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    return v, np.array([t for a, b, c, e in quads for t in ((a, b, c), (a, c, e))], np.int64)
+
+
+@pytest.mark.skipif(not embree_native.available(), reason="needs Embree called directly")
+def test_rays_that_pass_outside_a_scenes_box_are_the_misses_embree_gives():
+    """intersect_many skips the rays whose segment passes outside their scene's box: the same misses, the same tfar;
+    rays grazing a cube's faces (which lie on its box) and rays that end before the box are among them."""
+    g = np.random.default_rng(5)
+    cube, plate = EmbreeCaster(*_cube(1.0), center=np.zeros(3)), EmbreeCaster(*_cube(0.4), center=np.zeros(3))
+    n = 4000
+    o = g.normal(size=(n, 3))
+    o = (10.0 * o / np.linalg.norm(o, axis=1, keepdims=True)).astype(np.float32)
+    aim = g.uniform(-1.0, 1.0, (n, 3)) * g.choice([0.9, 1.0, 1.0 + 1e-6, 1.2], (n, 1))  # faces, edges, just outside
+    d = aim - o
+    d = (d / np.linalg.norm(d, axis=1, keepdims=True)).astype(np.float32)
+    tfar = g.uniform(7.0, 14.0, n).astype(np.float32)
+    which = g.integers(0, 2, n)
+    dist, prim = embree_native.intersect_many([cube.direct_scene, plate.direct_scene], which, o, d, tfar)
+    for k, c in enumerate((cube, plate)):
+        m = which == k
+        want = c.direct_scene.intersect(o[m], d[m], tfar[m])
+        np.testing.assert_array_equal(prim[m], want[1])
+        np.testing.assert_array_equal(dist[m].view(np.uint32), want[0].view(np.uint32))
+    box = np.array([c.direct_scene.box for c in (cube, plate)])[which]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ta, tb = (box[:, :3] - o) / d, (box[:, 3:] - o) / d
+    outside = np.maximum(np.minimum(ta, tb).max(1), 0) > np.minimum(np.maximum(ta, tb).min(1), tfar)
+    assert 0.2 * n < outside.sum() < (prim < 0).sum()  # many skipped, and misses inside the box were cast
+    assert (prim >= 0).sum() > n // 4
