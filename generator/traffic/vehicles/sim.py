@@ -26,6 +26,7 @@ Accelerations are clamped to ``[-B_MAX, a_max]``; speeds never go negative.
 from __future__ import annotations
 
 import logging
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -96,6 +97,9 @@ class VehicleSim:
         self.holders: dict = {}   # node -> {vehicle index: connector edge}
         self.caps = speed_caps(graph)   # edge -> speed limit (shared streets), m/s
         self.occ: dict = {}             # this step's occupancy (edge -> [(s, vehicle)]), for turn_clearance
+        # asked for every vehicle at every step: the lane graph does not change during a run
+        self.length = [e.length for e in graph.edges]                  # metres
+        self.radius = [graph.turn_radius(e) for e in graph.edges]      # metres, None: no arc
 
     # -- plans ---------------------------------------------------------------------------------
     def _extend(self, veh: Vehicle) -> None:
@@ -121,9 +125,8 @@ class VehicleSim:
     # -- one step -------------------------------------------------------------------------------
     def step(self, t: float, dt: float) -> None:
         occ = self.occ = self._occupancy()
-        for veh in self.vehicles:
-            self._maybe_grant(veh, t, occ)
-        acc = [self._accel(veh, t, occ) for veh in self.vehicles]
+        stops = [self._maybe_grant(veh, t, occ) for veh in self.vehicles]
+        acc = [self._accel(veh, t, occ, stop) for veh, stop in zip(self.vehicles, stops, strict=True)]
         for veh, a in zip(self.vehicles, acc, strict=True):
             v1 = max(0.0, veh.v + a * dt)
             veh.s += 0.5 * (veh.v + v1) * dt
@@ -135,7 +138,7 @@ class VehicleSim:
         for veh in self.vehicles:
             occ.setdefault(veh.edge, []).append((veh.s, veh))
             if veh.prev is not None and veh.s < veh.length / 2:
-                occ.setdefault(veh.prev, []).append((self.g.edges[veh.prev].length + veh.s, veh))
+                occ.setdefault(veh.prev, []).append((self.length[veh.prev] + veh.s, veh))
         return occ
 
     def _leader_gap(self, veh: Vehicle, occ: dict) -> tuple[float, float]:
@@ -152,7 +155,7 @@ class VehicleSim:
                     best = (gap, other.v)
             if best is not None:
                 return best
-            offset += self.g.edges[e].length - (veh.s if n == 0 else 0.0)
+            offset += self.length[e] - (veh.s if n == 0 else 0.0)
             if offset > LOOKAHEAD_M:
                 break
         return np.inf, 0.0
@@ -167,15 +170,18 @@ class VehicleSim:
         # short of where a large vehicle turning through the node swings over the line (turn_clearance)
         return edge.length - self.g.stop_s_from_end - (veh.s + veh.length / 2) - held_setback(self, veh)
 
-    def _accel(self, veh: Vehicle, t: float, occ: dict) -> float:
+    def _accel(self, veh: Vehicle, t: float, occ: dict, stop: float | None = None) -> float:
+        """IDM acceleration of ``veh`` now, m/s^2; ``stop``: its :meth:`_stop_gap` from this step's
+        :meth:`_maybe_grant` (None: not asked there, or granted since)."""
         v0 = self._desired(veh)
         gap, v_lead = self._leader_gap(veh, occ)
-        stop = self._stop_gap(veh)
+        if stop is None or veh.grant == veh.plan[1]:
+            stop = self._stop_gap(veh)
         if stop + S0_M < gap:
             gap, v_lead = stop + S0_M, 0.0
         a = veh.a_max * (1.0 - (veh.v / max(v0, 0.1)) ** 4)
-        if np.isfinite(gap):
-            s_star = S0_M + max(0.0, veh.v * T_GAP_S + veh.v * (veh.v - v_lead) / (2 * np.sqrt(veh.a_max * B_COMF)))
+        if math.isfinite(gap):
+            s_star = S0_M + max(0.0, veh.v * T_GAP_S + veh.v * (veh.v - v_lead) / (2 * math.sqrt(veh.a_max * B_COMF)))
             a -= veh.a_max * (s_star / max(gap, 0.05)) ** 2
         return float(min(max(a, -B_MAX), veh.a_max))   # np.clip's value, without its per-call cost
 
@@ -184,31 +190,31 @@ class VehicleSim:
         v0 = veh.v_des
         ahead = -veh.s
         for e in veh.plan[:3]:
-            edge = self.g.edges[e]
-            r = self.g.turn_radius(edge)
+            r = self.radius[e]
             if r is not None:
-                v_turn = np.sqrt(A_LAT * r)
-                v0 = min(v0, np.sqrt(v_turn ** 2 + 2 * B_COMF * max(0.0, ahead - veh.length / 2)))
+                v_turn = math.sqrt(A_LAT * r)
+                v0 = min(v0, math.sqrt(v_turn ** 2 + 2 * B_COMF * max(0.0, ahead - veh.length / 2)))
             if e in self.caps:   # a shared street's limit, reached at comfortable braking with the front
-                v0 = min(v0, np.sqrt(self.caps[e] ** 2 + 2 * B_COMF * max(0.0, ahead - veh.length / 2)))
-            ahead += edge.length
+                v0 = min(v0, math.sqrt(self.caps[e] ** 2 + 2 * B_COMF * max(0.0, ahead - veh.length / 2)))
+            ahead += self.length[e]
         return v0
 
     # -- intersections ----------------------------------------------------------------------------
-    def _maybe_grant(self, veh: Vehicle, t: float, occ: dict) -> None:
+    def _maybe_grant(self, veh: Vehicle, t: float, occ: dict) -> float | None:
+        """Grant ``veh`` the connector ahead if it may go now; its :meth:`_stop_gap` before this, if asked."""
         edge = self.g.edges[veh.edge]
         if edge.kind != "lane" or len(veh.plan) < 2 or veh.grant == veh.plan[1]:
-            return
+            return None
         stop = self._stop_gap(veh)
         if stop > REQUEST_M or not self._first_in_line(veh, occ):
-            return
+            return stop
         conn = self.g.edges[veh.plan[1]]
         node = conn.node
         if veh.ego_route is not None and not self._ego_dwell(veh, t, stop, node):
-            return
+            return stop
         give_way = self.g.grid.is_roundabout(node)     # no signals: asks late, looks further ahead for people
         if (give_way and stop > GIVE_WAY_REQUEST_M) or not self.signals.vehicles_may_enter(node, t):
-            return
+            return stop
         key = conflict_key(self.g, conn)
         big = veh.length > BIG_M
         for vid, c in self.holders.get(node, {}).items():
@@ -217,10 +223,10 @@ class VehicleSim:
             if c == conn.index and not big and self.vehicles[vid].length <= BIG_M:
                 continue
             if big or self.vehicles[vid].length > BIG_M or okey in self.g.conflicts_at(node)[key]:
-                return
+                return stop
         if not self._room(veh, conn, occ) or ((give_way or is_large(veh))
                                               and not waiting_clear(self, veh, conn, occ, B_COMF)):
-            return
+            return stop
         # the signals keep vehicles from entering CLEAR_S before a walk phase: only people on (or
         # stepping onto) the crosswalks within that time can meet this vehicle -- on every crosswalk
         # its box passes over, not only those it enters and leaves by (a bus swings its overhangs
@@ -228,9 +234,10 @@ class VehicleSim:
         window = GIVE_WAY_CLEAR_S if give_way else CLEAR_S
         if self.crossing is not None and any(self.crossing(node, arm, t, t + window)
                                              for arm in swept_arms(self.g, conn, (veh.length, veh.width))):
-            return
+            return stop
         veh.grant = conn.index
         self.holders.setdefault(node, {})[veh.index] = conn.index
+        return stop
 
     def _first_in_line(self, veh: Vehicle, occ: dict) -> bool:
         """No vehicle between ``veh`` and the stop line except ones already granted through this node."""
