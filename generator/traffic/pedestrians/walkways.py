@@ -201,14 +201,20 @@ def _assemble(grid: Grid, geoms: list, succ: list[list[int]], offs, body: wc.Bod
     log.info("walk network: %d edges (%d cut round obstacles or dead ends)", alive.sum(), len(geoms) - alive.sum())
     paths, out_succ, nodes, road, stop = [], [], [], [], []
     rh, wi = grid.road_half, grid.walk_inner
-    for e in np.flatnonzero(alive):
+    edges, samples = np.flatnonzero(alive), []
+    for e in edges:
         xy = geoms[e]
         s = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(xy, axis=0), axis=1))]
         n = max(2, int(np.ceil(s[-1] / SAMPLE_M)) + 1)
         su = np.linspace(0.0, s[-1], n)
-        xy = np.stack([np.interp(su, s, xy[:, 0]), np.interp(su, s, xy[:, 1])], -1)
-        d = street_distance(grid, xy)
-        z = grid.ground_height(xy)
+        samples.append((su, np.stack([np.interp(su, s, xy[:, 0]), np.interp(su, s, xy[:, 1])], -1)))
+    # point by point: asked once for every edge's samples (each call walks every road rectangle)
+    dists, heights = [], []
+    if samples:
+        cut = np.cumsum([len(su) for su, _ in samples])[:-1]
+        every = np.concatenate([xy for _, xy in samples])
+        dists, heights = np.split(street_distance(grid, every), cut), np.split(grid.ground_height(every), cut)
+    for e, (su, xy), d, z in zip(edges, samples, dists, heights, strict=True):
         g = np.gradient(xy, axis=0)
         paths.append(Path(f"walk_{len(paths):04d}", np.column_stack([xy, z]), np.arctan2(g[:, 1], g[:, 0]), su))
         out_succ.append(tuple(int(ids[k]) for k in succ[e] if alive[k]))
