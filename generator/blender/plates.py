@@ -22,6 +22,8 @@ the LiDAR see exactly what they saw.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from generator.rng import stream
@@ -179,11 +181,12 @@ def _band() -> np.ndarray:
     return out
 
 
+@functools.cache
 def glyph_atlas() -> np.ndarray:
     """(CELL_PX[0], CELL_PX[1] * (len(CHARSET) + 1), 4) float32 RGBA, row 0 at the top: one cell per
     character of :data:`CHARSET` (near-black ink, alpha its coverage; FE-Schrift proportions: 75 mm
     high, 9 mm strokes, letters 34 mm and digits 30 mm wide in a :data:`CELL_MM` cell) and the EU band
-    (:data:`BAND_CODE`, opaque)."""
+    (:data:`BAND_CODE`, opaque). Read-only: made once per process."""
     h, w = CELL_PX
     bh = INNER_MM[1] - INNER_MM[0]
     cells = []
@@ -195,7 +198,9 @@ def glyph_atlas() -> np.ndarray:
         cell[..., 3] = cov
         cells.append(cell)
     cells.append(_band())
-    return np.concatenate(cells, 1)
+    atlas = np.concatenate(cells, 1)
+    atlas.flags.writeable = False     # made once per process (a constant), shared by every worker's image
+    return atlas
 
 
 def plate_uv(vertices: np.ndarray, faces: np.ndarray, plate: np.ndarray) -> np.ndarray:
