@@ -261,22 +261,19 @@ def _drive(spec, graph, scene, signals, lib, blocked, crossing, duration_s, dist
         sim._extend(v)
     ego.v_des = 0.0
     n_warm = round(WARMUP_S / DT_S)
-    lead_xy, lead_h = [], []  # the warm-up's last LEAD_IN samples: tracks start before t = 0
+    at = []   # (edge, s) of every vehicle at every recorded step: the poses are read after the run (_poses)
     for k in range(n_warm):
-        if k >= n_warm - LEAD_IN:
-            poses = [sim.pose(v) for v in vehicles]
-            lead_xy.append([p[0] for p in poses])
-            lead_h.append([p[1] for p in poses])
+        if k >= n_warm - LEAD_IN:   # the warm-up's last LEAD_IN samples: tracks start before t = 0
+            at.append([(v.edge, v.s) for v in vehicles])
         sim.step(-WARMUP_S + k * DT_S, DT_S)
     ego.v_des = spec.paths.speed_mps
-    rec_xy, rec_h, dist = [], [], [0.0]
+    ego_xy, dist = [], [0.0]
     t, k = 0.0, 0
     while True:
-        poses = [sim.pose(v) for v in vehicles]
-        rec_xy.append([p[0] for p in poses])
-        rec_h.append([p[1] for p in poses])
+        at.append([(v.edge, v.s) for v in vehicles])
+        ego_xy.append(sim.pose(ego)[0])
         if k > 0:
-            step = rec_xy[-1][0] - rec_xy[-2][0]
+            step = ego_xy[-1] - ego_xy[-2]
             dist.append(dist[-1] + float(np.linalg.norm(step if to_world is None else to_world @ step)))
         if t >= duration_s + 1.0 and dist[-1] >= distance_m + 1.0:
             break
@@ -286,7 +283,8 @@ def _drive(spec, graph, scene, signals, lib, blocked, crossing, duration_s, dist
         sim.step(t, DT_S)
         k += 1
         t = k * DT_S
-    xy, hd = np.asarray(lead_xy + rec_xy), np.unwrap(np.asarray(lead_h + rec_h), axis=0)
+    xy, hd = _poses(graph, at)
+    hd = np.unwrap(hd, axis=0)
     for j, m in enumerate(movers, start=1):
         c = (m.proto.lo + m.proto.hi) / 2
         cs, sn = np.cos(hd[:, j]), np.sin(hd[:, j])
@@ -295,6 +293,20 @@ def _drive(spec, graph, scene, signals, lib, blocked, crossing, duration_s, dist
     xy, hd = xy[LEAD_IN:], hd[LEAD_IN:]  # the ego's drive starts at t = 0 (it waits through the warm-up)
     ego_track = Track(0.0, DT_S, np.c_[xy[:, 0], np.zeros(len(xy))], hd[:, 0])
     return movers, ego_track, np.asarray(dist)
+
+
+def _poses(graph, at: list) -> tuple[np.ndarray, np.ndarray]:
+    """(steps, vehicles, 2) box-centre xy and (steps, vehicles) headings of the vehicles at the recorded
+    ``at[step][vehicle] = (edge, s)``: each edge's arc lengths in one :meth:`Path.at` (the arithmetic of
+    :meth:`VehicleSim.pose`, element by element)."""
+    edges = np.array([[e for e, _ in row] for row in at], np.int64)
+    s = np.array([[s for _, s in row] for row in at], np.float64)
+    xy, hd = np.empty(edges.shape + (2,)), np.empty(edges.shape)
+    for e in np.unique(edges):
+        where = edges == e
+        p, h = graph.edges[int(e)].path.at(s[where])
+        xy[where], hd[where] = p[:, :2], h
+    return xy, hd
 
 
 def _check_capacity(spec) -> None:
