@@ -37,7 +37,7 @@ from generator.traffic.movers import DT_S, Mover
 from generator.traffic.pedestrians.gait import walker_gait
 from generator.traffic.pedestrians.simulate import simulate_pedestrians
 from generator.traffic.vehicles.fleet import KINDS, drives, fleet_proto, how_many, n_variants, widest_half_width
-from generator.traffic.vehicles.sim import Vehicle, VehicleSim, arm_towards
+from generator.traffic.vehicles.sim import Vehicle, VehicleSim, arm_towards, recorded_poses
 from generator.world.actors import Actor, Track, TrackTrajectory, World, frozen_world
 from generator.world.trajectory import EgoTrajectory
 
@@ -261,7 +261,7 @@ def _drive(spec, graph, scene, signals, lib, blocked, crossing, duration_s, dist
         sim._extend(v)
     ego.v_des = 0.0
     n_warm = round(WARMUP_S / DT_S)
-    at = []   # (edge, s) of every vehicle at every recorded step: the poses are read after the run (_poses)
+    at = []   # (edge, s) of every vehicle at every recorded step: the poses are read after the run
     for k in range(n_warm):
         if k >= n_warm - LEAD_IN:   # the warm-up's last LEAD_IN samples: tracks start before t = 0
             at.append([(v.edge, v.s) for v in vehicles])
@@ -283,7 +283,7 @@ def _drive(spec, graph, scene, signals, lib, blocked, crossing, duration_s, dist
         sim.step(t, DT_S)
         k += 1
         t = k * DT_S
-    xy, hd = _poses(graph, at)
+    xy, hd = recorded_poses(graph, at)
     hd = np.unwrap(hd, axis=0)
     for j, m in enumerate(movers, start=1):
         c = (m.proto.lo + m.proto.hi) / 2
@@ -293,20 +293,6 @@ def _drive(spec, graph, scene, signals, lib, blocked, crossing, duration_s, dist
     xy, hd = xy[LEAD_IN:], hd[LEAD_IN:]  # the ego's drive starts at t = 0 (it waits through the warm-up)
     ego_track = Track(0.0, DT_S, np.c_[xy[:, 0], np.zeros(len(xy))], hd[:, 0])
     return movers, ego_track, np.asarray(dist)
-
-
-def _poses(graph, at: list) -> tuple[np.ndarray, np.ndarray]:
-    """(steps, vehicles, 2) box-centre xy and (steps, vehicles) headings of the vehicles at the recorded
-    ``at[step][vehicle] = (edge, s)``: each edge's arc lengths in one :meth:`Path.at` (the arithmetic of
-    :meth:`VehicleSim.pose`, element by element)."""
-    edges = np.array([[e for e, _ in row] for row in at], np.int64)
-    s = np.array([[s for _, s in row] for row in at], np.float64)
-    xy, hd = np.empty(edges.shape + (2,)), np.empty(edges.shape)
-    for e in np.unique(edges):
-        where = edges == e
-        p, h = graph.edges[int(e)].path.at(s[where])
-        xy[where], hd[where] = p[:, :2], h
-    return xy, hd
 
 
 def _check_capacity(spec) -> None:

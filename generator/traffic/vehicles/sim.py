@@ -289,6 +289,20 @@ class VehicleSim:
         return p[0, :2], float(h[0])
 
 
+def recorded_poses(graph: LaneGraph, at: list) -> tuple[np.ndarray, np.ndarray]:
+    """(steps, vehicles, 2) box-centre xy and (steps, vehicles) headings of the vehicles at the recorded
+    ``at[step][vehicle] = (edge, s)``: each edge's arc lengths in one :meth:`Path.at` (the arithmetic of
+    :meth:`VehicleSim.pose`, element by element)."""
+    edges = np.array([[e for e, _ in row] for row in at], np.int64)
+    s = np.array([[s for _, s in row] for row in at], np.float64)
+    xy, hd = np.empty(edges.shape + (2,)), np.empty(edges.shape)
+    for e in np.unique(edges):
+        where = edges == e
+        p, h = graph.edges[int(e)].path.at(s[where])
+        xy[where], hd[where] = p[:, :2], h
+    return xy, hd
+
+
 def conflict_key(graph: LaneGraph, conn) -> tuple:
     """The conflict-table key of connector ``conn``: ``(arm_in, arm_out, lane)``, or the key
     :mod:`generator.traffic.lanes.one_way` gave it (slots that differ in and out)."""

@@ -12,6 +12,7 @@ from generator.layout.network.draw import make_grid
 from generator.spec.load import parse_spec
 from generator.traffic.build import build_world
 from generator.traffic.lanes.graph import LaneGraph
+from generator.traffic.vehicles.sim import recorded_poses
 from generator.world.actors import MOVING_THRESHOLD_MPS, Track
 from generator.world.rig import SWEEP_PERIOD_S, Rig
 from kits.paths import ROOT
@@ -140,6 +141,23 @@ def test_zero_traffic_is_the_frozen_town(test_spec, test_scene):
     assert world.actors == []
     rig = Rig.from_world(test_spec, world)
     assert np.allclose(rig.T_world_ego(1.0), Rig.from_spec(test_spec, test_scene).T_world_ego(1.0))
+
+
+def test_poses_read_after_the_run_are_the_poses_of_each_step_bit_for_bit(town):
+    """The drive records (edge, s) and reads the poses afterwards, an edge at a time: the bytes of one
+    scalar lookup per vehicle and step (arc lengths before, on and past the ends and on samples too)."""
+    spec, _, _ = town
+    graph = LaneGraph(make_grid(spec))
+    rng = np.random.default_rng(3)
+    edges = rng.integers(len(graph.edges), size=(40, 7))
+    at = [[(int(e), float(v)) for e, v in zip(row, rng.uniform(-2.0, 1.2, 7) * [graph.edges[e].length for e in row],
+                                               strict=True)] for row in edges]
+    at[0] = [(int(e), float(graph.edges[e].path.s[1])) for e in edges[0]]
+    xy, hd = recorded_poses(graph, at)
+    for k, row in enumerate(at):
+        for j, (e, s) in enumerate(row):
+            p, h = graph.edges[e].path.at(s)
+            assert xy[k, j].tobytes() == p[0, :2].tobytes() and hd[k, j].tobytes() == h[0].tobytes()
 
 
 def test_every_connector_conflicts_with_itself_and_opposite_straights_do_not(town):
