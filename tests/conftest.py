@@ -33,28 +33,35 @@ def _shared_prototypes(tmp_path_factory):
         install(tmp_path_factory.getbasetemp().parent / "prototypes")
 
 
-def pytest_terminal_summary(terminalreporter, config):
-    """Where the run's shared builds (:mod:`kits.shared_build`) spent their time and made workers wait."""
+def _controller_temp(config) -> Path | None:
+    """The run's temporary folder, in the process that controls the run (the only one under plain ``pytest``,
+    the one that starts the workers under ``pytest -n 2``); None in a worker."""
     import os
 
     factory = getattr(config, "_tmp_path_factory", None)
     if factory is None or hasattr(config, "workerinput") or os.environ.get("PYTEST_XDIST_WORKER"):
+        return None
+    return factory.getbasetemp()
+
+
+def pytest_terminal_summary(terminalreporter, config):
+    """Where the run's shared builds (:mod:`kits.shared_build`) spent their time and made workers wait."""
+    temp = _controller_temp(config)
+    if temp is None:
         return
     from kits.shared_build import summary
 
-    for line in summary(factory.getbasetemp()):
+    for line in summary(temp):
         terminalreporter.write_line(line)
 
 
 def pytest_sessionfinish(session):
     """The controlling process of ``pytest -n 2`` drops the shared prototypes (GBs) once the workers are done."""
-    import os
     import shutil
 
-    factory = getattr(session.config, "_tmp_path_factory", None)
-    if factory is not None and not hasattr(session.config, "workerinput") and not os.environ.get(
-            "PYTEST_XDIST_WORKER"):
-        shutil.rmtree(factory.getbasetemp() / "prototypes", ignore_errors=True)
+    temp = _controller_temp(session.config)
+    if temp is not None:
+        shutil.rmtree(temp / "prototypes", ignore_errors=True)
 
 
 @pytest.fixture(scope="session")
