@@ -125,6 +125,9 @@ class VehicleSim:
     # -- one step -------------------------------------------------------------------------------
     def step(self, t: float, dt: float) -> None:
         occ = self.occ = self._occupancy()
+        # the stop gap a vehicle's grant check measured is its stop gap for the IDM below too: the grants
+        # given meanwhile change no other vehicle's (turn_clearance reads the node users once a step), and
+        # a vehicle granted now is asked again (its gap is then unbounded)
         stops = [self._maybe_grant(veh, t, occ) for veh in self.vehicles]
         acc = [self._accel(veh, t, occ, stop) for veh, stop in zip(self.vehicles, stops, strict=True)]
         for veh, a in zip(self.vehicles, acc, strict=True):
