@@ -173,9 +173,10 @@ class VehicleSim:
         # short of where a large vehicle turning through the node swings over the line (turn_clearance)
         return edge.length - self.g.stop_s_from_end - (veh.s + veh.length / 2) - held_setback(self, veh)
 
-    def _accel(self, veh: Vehicle, t: float, occ: dict, stop: float | None = None) -> float:
+    def _accel(self, veh: Vehicle, t: float, occ: dict, stop: float | None) -> float:
         """IDM acceleration of ``veh`` now, m/s^2; ``stop``: its :meth:`_stop_gap` from this step's
-        :meth:`_maybe_grant` (None: not asked there, or granted since)."""
+        :meth:`_maybe_grant`, None where that did not measure it (it is measured again, as it is for a vehicle
+        granted in this step)."""
         v0 = self._desired(veh)
         gap, v_lead = self._leader_gap(veh, occ)
         if stop is None or veh.grant == veh.plan[1]:
